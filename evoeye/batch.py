@@ -1,0 +1,152 @@
+"""Batches of runs: plan concrete scenarios, simulate each, write its MCAP log, summarise.
+
+A run's log path is a function of (logical scenario, batch, scenario id), and logs are written
+atomically, so a batch can be killed at any point and re-run: finished runs are skipped, an
+unfinished one (a `.tmp` file) is simulated again.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import time
+from collections.abc import Callable, Iterable, Sequence
+from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import numpy as np
+
+from evoeye.log import LogError, read_run, write_episode
+from evoeye.paths import DataRoot
+from evoeye.scenarios import get_scenario
+from evoeye.sim.episode import STATUS_OK, RunSpec
+from evoeye.sim.runner import run_episode, run_spec
+
+
+def plan_uniform(
+    scenario: str, n: int, seed: int, *, batch: str | None = None, source: str = "uniform",
+    round: int = 0,
+) -> list[RunSpec]:
+    """n concrete scenarios drawn uniformly, each with its own run seed; all fixed by `seed`."""
+    if n < 1:
+        raise ValueError(f"--n must be at least 1, got {n}")
+    if seed < 0:
+        raise ValueError(f"--seed must be non-negative, got {seed}")
+    space = get_scenario(scenario)
+    xs = space.sample(np.random.default_rng(seed), n)
+    run_seeds = np.random.SeedSequence(seed).generate_state(n)
+    batch = batch or f"{source}-seed{seed}"
+    return [
+        run_spec(scenario, x, int(s), batch=batch, source=source, round=round)
+        for x, s in zip(xs, run_seeds, strict=True)
+    ]
+
+
+@dataclass(frozen=True)
+class RunResult:
+    """What happened to one planned run."""
+
+    scenario_id: str
+    path: str
+    status: str  # "ok" / "failed" (the run itself) / "error" (could not simulate or write)
+    collided: bool = False
+    reason: str = ""
+    skipped: bool = False  # already on disk
+    sim_time_s: float = 0.0
+
+
+def simulate_and_log(spec: RunSpec, root: str | Path) -> RunResult:
+    """Simulate one run and write its log, unless its log already exists. Picklable."""
+    path = DataRoot.at(root).run_log(spec.scenario, spec.batch, spec.scenario_id)
+    if path.exists():
+        try:
+            meta = read_run(path, topics=()).metadata
+            return RunResult(
+                spec.scenario_id, str(path), meta["status"], bool(meta["collided"]),
+                meta.get("reason") or "", skipped=True, sim_time_s=float(meta["duration_s"]),
+            )
+        except LogError:
+            path.unlink()  # a final-named log that does not read back: simulate it again
+    episode = run_episode(spec)
+    write_episode(episode, path)
+    o = episode.outcome
+    return RunResult(spec.scenario_id, str(path), o.status, o.collided, o.reason,
+                     sim_time_s=o.duration_s)
+
+
+@dataclass
+class BatchSummary:
+    results: list[RunResult] = field(default_factory=list)
+    wall_s: float = 0.0
+
+    @property
+    def runs(self) -> int:
+        return len(self.results)
+
+    def count(self, predicate: Callable[[RunResult], bool]) -> int:
+        return sum(1 for r in self.results if predicate(r))
+
+    @property
+    def collisions(self) -> int:
+        return self.count(lambda r: r.status == STATUS_OK and r.collided)
+
+    @property
+    def failures(self) -> int:
+        return self.count(lambda r: r.status != STATUS_OK)
+
+    @property
+    def skipped(self) -> int:
+        return self.count(lambda r: r.skipped)
+
+    @property
+    def simulated_s(self) -> float:
+        return sum(r.sim_time_s for r in self.results if not r.skipped)
+
+
+def _context() -> mp.context.BaseContext:
+    # fork starts workers in milliseconds with highway-env already imported; spawn elsewhere.
+    return mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+
+
+def run_batch(
+    specs: Sequence[RunSpec], root: str | Path, *, workers: int = 1,
+    progress: Callable[[Iterable], Iterable] | None = None,
+) -> BatchSummary:
+    """Run every spec (in `workers` processes); one broken run never stops the others."""
+    if workers < 1:
+        raise ValueError(f"--workers must be at least 1, got {workers}")
+    t0 = time.perf_counter()
+    summary = BatchSummary()
+    wrap = progress or (lambda it: it)
+    if workers == 1:
+        for spec in wrap(specs):
+            summary.results.append(_guarded(spec, root))
+    else:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=_context()) as pool:
+            futures: dict[Future, RunSpec] = {
+                pool.submit(simulate_and_log, s, str(root)): s for s in specs
+            }
+            for fut in wrap(as_completed(futures)):
+                summary.results.append(_result(fut, futures[fut], root))
+    summary.results.sort(key=lambda r: r.scenario_id)
+    summary.wall_s = time.perf_counter() - t0
+    return summary
+
+
+def _guarded(spec: RunSpec, root: str | Path) -> RunResult:
+    try:
+        return simulate_and_log(spec, root)
+    except Exception as exc:  # noqa: BLE001 - reported per run, the batch goes on
+        return _error(spec, root, exc)
+
+
+def _result(fut: Future, spec: RunSpec, root: str | Path) -> RunResult:
+    try:
+        return fut.result()
+    except Exception as exc:  # noqa: BLE001 - includes a worker that died
+        return _error(spec, root, exc)
+
+
+def _error(spec: RunSpec, root: str | Path, exc: BaseException) -> RunResult:
+    path = DataRoot.at(root).run_log(spec.scenario, spec.batch, spec.scenario_id)
+    return RunResult(spec.scenario_id, str(path), "error", reason=f"{type(exc).__name__}: {exc}")

@@ -1,0 +1,136 @@
+"""The MCAP channels of a run log: each topic bound to its schema file and to what produces it.
+
+The schema files in `schemas/mcap/` are the single source of truth: a channel's MCAP schema name
+is the file's `title` and the fields of its messages are the file's `properties`, read from the
+file rather than retyped here (a contract test checks that they equal the dataclass fields).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable
+from dataclasses import dataclass
+from functools import cache
+from operator import attrgetter
+from pathlib import Path
+from typing import Any, NamedTuple
+
+from evoeye.ads.messages import (
+    ControlCommand,
+    Localization,
+    Obstacles,
+    PlannedTrajectory,
+    Predictions,
+)
+from evoeye.log import viz
+from evoeye.scene import SceneState
+from evoeye.sim.episode import Frame
+
+# The one place that locates the schemas (the project is installed editable).
+SCHEMA_DIR = Path(__file__).resolve().parents[2] / "schemas" / "mcap"
+
+MESSAGE_ENCODING = "json"
+SCHEMA_ENCODING = "jsonschema"
+RUN_RECORD = "evoeye.run"  # the MCAP metadata record holding the run's metadata
+ROAD_MAP_ATTACHMENT = "evoeye.road_map"  # the MCAP attachment holding the RoadMap as JSON
+RUN_SCHEMA_FILE = "run.v1.json"
+ROAD_MAP_SCHEMA_FILE = "road_map.v1.json"
+
+
+class Topics(NamedTuple):
+    """The topic names of a run log; iterating gives them all."""
+
+    localization: str = "/ads/localization"
+    obstacles: str = "/ads/perception/obstacles"
+    predictions: str = "/ads/prediction/trajectories"
+    plan: str = "/ads/planning/trajectory"
+    control: str = "/ads/control/command"
+    ground_truth: str = "/sim/ground_truth"
+    scene: str = "/viz/scene"
+    map: str = "/viz/map"
+
+
+TOPICS = Topics()
+
+
+@cache
+def load_schema(file_name: str) -> dict[str, Any]:
+    """The parsed JSON Schema `schemas/mcap/<file_name>` (loaded once)."""
+    return json.loads((SCHEMA_DIR / file_name).read_text(encoding="utf-8"))
+
+
+def schema_fields(file_name: str) -> tuple[str, ...]:
+    """The top-level property names of a schema, in file order."""
+    return tuple(load_schema(file_name)["properties"])
+
+
+def log_time_ns(t_s: float) -> int:
+    """Log and publish time of a message: simulation time in integer nanoseconds."""
+    return round(t_s * 1e9)
+
+
+Encoder = Callable[[Any, int], dict[str, Any]]  # (source, log time ns) -> message dict
+
+
+@dataclass(frozen=True)
+class Channel:
+    """A topic, its schema file, the type whose fields its messages carry and its encoder.
+
+    `encode` takes a Frame for the per-frame channels and the RoadMap for /viz/map.
+    """
+
+    topic: str
+    schema_file: str
+    encode: Encoder
+    message_type: type | None  # the dataclass mirrored field for field by the schema, if any
+
+    @property
+    def schema(self) -> dict[str, Any]:
+        return load_schema(self.schema_file)
+
+    @property
+    def schema_name(self) -> str:
+        return self.schema["title"]
+
+    @property
+    def fields(self) -> tuple[str, ...]:
+        return schema_fields(self.schema_file)
+
+
+def _fields_encoder(schema_file: str, pick: Callable[[Frame], Any]) -> Encoder:
+    """An encoder copying the schema's fields, by attribute, off the object `pick` selects."""
+    fields = schema_fields(schema_file)
+    get = attrgetter(*fields)
+
+    def encode(frame: Frame, t_ns: int) -> dict[str, Any]:
+        return dict(zip(fields, get(pick(frame)), strict=True))
+
+    return encode
+
+
+def _channel(topic: str, schema_file: str, message_type: type, pick: Callable) -> Channel:
+    return Channel(topic, schema_file, _fields_encoder(schema_file, pick), message_type)
+
+
+FRAME_CHANNELS: tuple[Channel, ...] = (
+    _channel(
+        TOPICS.localization, "localization.v1.json", Localization,
+        lambda f: f.messages.localization,
+    ),
+    _channel(TOPICS.obstacles, "obstacles.v1.json", Obstacles, lambda f: f.messages.obstacles),
+    _channel(
+        TOPICS.predictions, "predictions.v1.json", Predictions, lambda f: f.messages.predictions
+    ),
+    _channel(TOPICS.plan, "planned_trajectory.v1.json", PlannedTrajectory, lambda f: f.messages.plan),
+    _channel(TOPICS.control, "control_command.v1.json", ControlCommand, lambda f: f.messages.control),
+    # SceneState carries every ground-truth field (vx_mps, vy_mps are properties of it).
+    _channel(TOPICS.ground_truth, "ground_truth.v1.json", SceneState, lambda f: f.scene),
+    Channel(
+        TOPICS.scene,
+        "scene_update.v1.json",
+        lambda f, t_ns: viz.scene_update(f.scene, f.messages, t_ns),
+        None,
+    ),
+)
+MAP_CHANNEL = Channel(TOPICS.map, "scene_update.v1.json", viz.map_update, None)
+CHANNELS: dict[str, Channel] = {c.topic: c for c in (*FRAME_CHANNELS, MAP_CHANNEL)}

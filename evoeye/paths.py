@@ -1,0 +1,69 @@
+"""Where evoeye keeps its data: one data root, resolved once, with a named folder per stage.
+
+Layout under the root (default `./evoeye-data`, or `$EVOEYE_HOME`, or `--root`):
+
+    runs/<logical_scenario>/<batch>/<scenario_id>.mcap   one MCAP log per run (`.mcap.tmp` = unfinished)
+    warehouse/<table>/logical_scenario=…/batch=…/*.parquet   append-only Parquet tables
+    warehouse/evoeye.duckdb                               views over the Parquet, for the DuckDB CLI
+    quarantine/…                                          logs that could not be read, with a reason
+"""
+
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass
+from pathlib import Path
+
+ENV_VAR = "EVOEYE_HOME"
+DEFAULT_ROOT = Path("evoeye-data")
+LOG_SUFFIX = ".mcap"
+
+
+@dataclass(frozen=True)
+class DataRoot:
+    """The data root and the folders inside it; nothing is created until a writer asks."""
+
+    path: Path
+
+    @classmethod
+    def resolve(cls, root: str | os.PathLike[str] | None = None) -> DataRoot:
+        """An explicit root wins, then $EVOEYE_HOME, then ./evoeye-data; made absolute."""
+        chosen = root if root is not None else os.environ.get(ENV_VAR) or DEFAULT_ROOT
+        return cls(Path(chosen).expanduser().resolve())
+
+    @classmethod
+    def at(cls, root: str | os.PathLike[str] | None = None) -> DataRoot:
+        """Same as `resolve` (the name the batch runner uses)."""
+        return cls.resolve(root)
+
+    @property
+    def runs(self) -> Path:
+        return self.path / "runs"
+
+    @property
+    def warehouse(self) -> Path:
+        return self.path / "warehouse"
+
+    @property
+    def duckdb_file(self) -> Path:
+        return self.warehouse / "evoeye.duckdb"
+
+    @property
+    def writer_lock(self) -> Path:
+        """The file a warehouse writer holds an exclusive lock on."""
+        return self.warehouse / ".writer.lock"
+
+    @property
+    def quarantine(self) -> Path:
+        return self.path / "quarantine"
+
+    def table_dir(self, table: str) -> Path:
+        return self.warehouse / table
+
+    def run_log(self, logical_scenario: str, batch: str, scenario_id: str) -> Path:
+        """Where the MCAP log of one run lives."""
+        return self.runs / logical_scenario / batch / f"{scenario_id}{LOG_SUFFIX}"
+
+    def relative(self, path: Path) -> str:
+        """`path` relative to the root, POSIX-style (as stored in the warehouse)."""
+        return Path(path).resolve().relative_to(self.path).as_posix()

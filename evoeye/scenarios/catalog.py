@@ -1,0 +1,60 @@
+"""The two logical scenarios of the paper (§V "Logical Scenarios"), declared as data."""
+
+from __future__ import annotations
+
+from evoeye.scenarios.space import LogicalScenario, Parameter
+
+P = Parameter
+
+HIGHWAY_CUT_IN = LogicalScenario(
+    name="highway-cut-in",
+    description=(
+        "Three-lane highway; the ego starts in the middle lane with six NPCs: a lead vehicle that "
+        "may brake suddenly, a cut-in from each adjacent lane, a follower in each adjacent lane "
+        "and an overtaker coming from behind in the left lane."
+    ),
+    parameters=(
+        P("ego_speed_mps", 20.0, 30.0, "m/s", "ego initial and set cruise speed"),
+        P("lead_gap_m", 15.0, 70.0, "m", "initial bumper gap to the lead vehicle in the ego lane"),
+        P("lead_speed_mps", 15.0, 30.0, "m/s", "lead vehicle initial and desired speed"),
+        P("lead_brake_time_s", 2.0, 16.0, "s", "when the lead vehicle starts braking"),
+        P("lead_brake_decel_mps2", 0.0, 8.0, "m/s²", "how hard the lead vehicle brakes"),
+        P("lead_brake_duration_s", 0.5, 5.0, "s", "how long the lead vehicle keeps braking"),
+        P("left_cutin_gap_m", -20.0, 40.0, "m", "left cut-in NPC start, ahead (+) of the ego"),
+        P("left_cutin_speed_mps", 15.0, 32.0, "m/s", "left cut-in NPC speed"),
+        P("left_cutin_time_s", 1.0, 15.0, "s", "when the left NPC starts its lane change"),
+        P("left_cutin_duration_s", 0.8, 4.0, "s", "left lane-change duration (lower = sharper)"),
+        P("right_cutin_gap_m", -20.0, 40.0, "m", "right cut-in NPC start, ahead (+) of the ego"),
+        P("right_cutin_speed_mps", 15.0, 32.0, "m/s", "right cut-in NPC speed"),
+        P("right_cutin_time_s", 1.0, 15.0, "s", "when the right NPC starts its lane change"),
+        P("right_cutin_duration_s", 0.8, 4.0, "s", "right lane-change duration"),
+        P("left_follow_gap_m", -60.0, 80.0, "m", "left-lane traffic start relative to the ego"),
+        P("left_follow_speed_mps", 18.0, 33.0, "m/s", "left-lane traffic speed"),
+        P("right_follow_gap_m", -60.0, 80.0, "m", "right-lane traffic start relative to the ego"),
+        P("right_follow_speed_mps", 15.0, 30.0, "m/s", "right-lane traffic speed"),
+        P("overtaker_gap_m", -80.0, -15.0, "m", "overtaker start behind the ego (left lane)"),
+        P("overtaker_speed_mps", 25.0, 38.0, "m/s", "overtaker speed; it cuts back in once ahead"),
+    ),
+)
+
+INTERSECTION = LogicalScenario(
+    name="unprotected-intersection",
+    description=(
+        "Four-way intersection without signals; the ego drives straight from south to north. "
+        "Five NPCs: an opposing left turn (north→east), lateral crossings from the west and from "
+        "the east, a right-turn merge into the ego's exit lane (east→north) and a left-turn merge "
+        "(west→north). None of them yields."
+    ),
+    parameters=(
+        P("opp_left_speed_mps", 4.0, 12.0, "m/s", "opposing left-turner speed"),
+        P("opp_left_start_s", 0.0, 8.0, "s", "when the opposing left-turner enters"),
+        P("cross_west_speed_mps", 4.0, 12.0, "m/s", "crossing vehicle from the west, speed"),
+        P("cross_west_start_s", 0.0, 8.0, "s", "when the west crossing vehicle enters"),
+        P("cross_east_speed_mps", 4.0, 12.0, "m/s", "crossing vehicle from the east, speed"),
+        P("cross_east_start_s", 0.0, 8.0, "s", "when the east crossing vehicle enters"),
+        P("right_merge_speed_mps", 4.0, 12.0, "m/s", "east→north right-turn merger, speed"),
+        P("right_merge_start_s", 0.0, 8.0, "s", "when the right-turn merger enters"),
+        P("left_merge_speed_mps", 4.0, 12.0, "m/s", "west→north left-turn merger, speed"),
+        P("left_merge_start_s", 0.0, 8.0, "s", "when the left-turn merger enters"),
+    ),
+)

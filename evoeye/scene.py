@@ -1,0 +1,80 @@
+"""What the world looks like: the ground-truth scene at one instant and the static road map.
+
+These are the only world types the ADS may see (perception reads `SceneState`; every module may
+read the `RoadMap`, which stands for the HD map an ADS ships with). The simulator produces them;
+`evoeye.ads` consumes them, so neither package imports the other's internals.
+All positions are in the world frame, metres; headings in radians, counter-clockwise from +x.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+EGO_ID = 0  # the ego is actor 0 and always the first row of a SceneState
+
+
+@dataclass(slots=True)
+class SceneState:
+    """Ground truth of every present actor at time t_s (rows: actors, ego first)."""
+
+    t_s: float
+    actor_id: np.ndarray  # (N,) int64
+    x_m: np.ndarray  # (N,)
+    y_m: np.ndarray  # (N,)
+    heading_rad: np.ndarray  # (N,)
+    speed_mps: np.ndarray  # (N,) signed, along the heading
+    accel_mps2: np.ndarray  # (N,) longitudinal
+    length_m: np.ndarray  # (N,)
+    width_m: np.ndarray  # (N,)
+    crashed: np.ndarray  # (N,) bool
+    ego_collision: bool  # the ego is in a collision at t_s
+    collision_actor: int  # the actor the ego collided with first, -1 if none
+
+    @property
+    def n(self) -> int:
+        return int(self.actor_id.shape[0])
+
+    @property
+    def vx_mps(self) -> np.ndarray:
+        return self.speed_mps * np.cos(self.heading_rad)
+
+    @property
+    def vy_mps(self) -> np.ndarray:
+        return self.speed_mps * np.sin(self.heading_rad)
+
+
+@dataclass(frozen=True)
+class Lane:
+    """A lane centre line as a dense polyline (K, 2) with cumulative arc length (K,)."""
+
+    lane_id: str
+    points: np.ndarray  # (K, 2) metres
+    width_m: float
+    speed_limit_mps: float
+
+    @property
+    def s_m(self) -> np.ndarray:
+        seg = np.linalg.norm(np.diff(self.points, axis=0), axis=1)
+        return np.concatenate(([0.0], np.cumsum(seg)))
+
+    @property
+    def heading_rad(self) -> np.ndarray:
+        d = np.diff(self.points, axis=0)
+        h = np.arctan2(d[:, 1], d[:, 0])
+        return np.concatenate((h, h[-1:]))
+
+
+@dataclass(frozen=True)
+class RoadMap:
+    """The static map: every drivable lane, and the ego's route as one lane-like polyline."""
+
+    name: str
+    lanes: tuple[Lane, ...]
+    route: Lane  # the ego's intended path, concatenated over the lanes it traverses
+
+    @classmethod
+    def empty(cls, name: str) -> RoadMap:
+        """A map with no lanes, for a run that failed before its world was built."""
+        return cls(name=name, lanes=(), route=Lane("route", np.zeros((2, 2)), 0.0, 0.0))
