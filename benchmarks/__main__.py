@@ -1,0 +1,9 @@
+"""Run every benchmark in turn: `python -m benchmarks`."""
+
+import runpy
+import sys
+
+for module in ("benchmarks.bench_sim", "benchmarks.bench_warehouse"):
+    print(f"\n## {module}\n", flush=True)
+    sys.argv = [module]
+    runpy.run_module(module, run_name="__main__")
