@@ -68,6 +68,7 @@ def simulate_and_log(spec: RunSpec, root: str | Path) -> RunResult:
         except LogError:
             path.unlink()  # a final-named log that does not read back: simulate it again
     episode = run_episode(spec)
+    path.parent.mkdir(parents=True, exist_ok=True)
     write_episode(episode, path)
     o = episode.outcome
     return RunResult(spec.scenario_id, str(path), o.status, o.collided, o.reason,
