@@ -24,16 +24,18 @@ from evoeye.sim.runner import WORLD_BUILDERS, _seeds, run_episode
 DT_S = 0.05
 
 
-def bench_full(specs, out: Path) -> tuple[float, float, list[int]]:
-    """Sequential simulate + write: (simulated s, wall s, frames per run)."""
-    sim_s, frames = 0.0, []
+def bench_full(specs, out: Path) -> tuple[float, float, float, list[int]]:
+    """Sequential simulate + write: (simulated s, wall s, of which writing, frames per run)."""
+    sim_s, log_s, frames = 0.0, 0.0, []
     t0 = time.perf_counter()
     for spec in specs:
         ep = run_episode(spec)
+        t_log = time.perf_counter()
         write_episode(ep, out / f"{spec.scenario_id}.mcap")
+        log_s += time.perf_counter() - t_log
         sim_s += len(ep.frames) * DT_S
         frames.append(len(ep.frames))
-    return sim_s, time.perf_counter() - t0, frames
+    return sim_s, time.perf_counter() - t0, log_s, frames
 
 
 def bench_bare(specs, frames: list[int]) -> tuple[float, float]:
@@ -63,19 +65,22 @@ def main() -> None:
     args = ap.parse_args()
     print(f"Machine: {describe()}\n")
     print("| logical scenario | runs | sim s | full RTF (sim+ADS+log) | bare RTF (world) "
-          "| full / bare cost | 1 worker s | 2 workers s | speedup |")
-    print("|---|---|---|---|---|---|---|---|---|")
+          "| full / bare cost | full ms/frame | of which log | 1 worker s | 2 workers s "
+          "| speedup |")
+    print("|---|---|---|---|---|---|---|---|---|---|---|")
     for name in WORLD_BUILDERS:
         specs = plan_uniform(name, args.runs, seed=7)
         run_episode(specs[0])  # warm the per-process caches (road networks, imports)
         with tempfile.TemporaryDirectory() as d:
-            sim_s, wall_s, frames = bench_full(specs, Path(d))
+            sim_s, wall_s, log_s, frames = bench_full(specs, Path(d))
         bare_sim, bare_wall = bench_bare(specs, frames)
         full_rtf, bare_rtf = sim_s / wall_s, bare_sim / bare_wall
         w1 = bench_workers(name, args.runs, 1)
         w2 = bench_workers(name, args.runs, 2)
+        n_frames = sum(frames)
         print(f"| {name} | {len(specs)} | {sim_s:.0f} | {full_rtf:.1f}× | {bare_rtf:.1f}× "
-              f"| {bare_rtf / full_rtf:.2f} | {w1:.2f} | {w2:.2f} | {w1 / w2:.2f}× |")
+              f"| {bare_rtf / full_rtf:.2f} | {1e3 * wall_s / n_frames:.3f} "
+              f"| {1e3 * log_s / n_frames:.3f} | {w1:.2f} | {w2:.2f} | {w1 / w2:.2f}× |")
     print(f"\nper-frame budget at 20 Hz for 50×: {1000 * DT_S / 50:.2f} ms; "
           f"numpy {np.__version__}")
 

@@ -114,12 +114,15 @@ class FrameMessages:
     control: ControlCommand
 
     def all_finite(self) -> bool:
-        """False if any numeric field of any message is NaN or infinite."""
+        """False if any numeric field of any message is NaN or infinite (one vectorised check)."""
+        arrays, scalars = [], []
         for msg in (self.localization, self.obstacles, self.predictions, self.plan, self.control):
-            for value in msg.to_dict().values():
+            for name in msg.field_names():
+                value = getattr(msg, name)
                 if isinstance(value, np.ndarray):
-                    if value.dtype.kind == "f" and not np.isfinite(value).all():
-                        return False
-                elif isinstance(value, float) and not np.isfinite(value):
-                    return False
-        return True
+                    if value.dtype.kind == "f":
+                        arrays.append(value.ravel())
+                elif isinstance(value, float):
+                    scalars.append(value)
+        arrays.append(np.asarray(scalars))
+        return bool(np.isfinite(np.concatenate(arrays)).all())

@@ -97,40 +97,37 @@ class Channel:
         return schema_fields(self.schema_file)
 
 
-def _fields_encoder(schema_file: str, pick: Callable[[Frame], Any]) -> Encoder:
-    """An encoder copying the schema's fields, by attribute, off the object `pick` selects."""
+def _fields_encoder(schema_file: str, source: str) -> Encoder:
+    """An encoder copying the schema's fields off the frame attribute at dotted path `source`."""
     fields = schema_fields(schema_file)
-    get = attrgetter(*fields)
+    get = attrgetter(*(f"{source}.{name}" for name in fields))
 
     def encode(frame: Frame, t_ns: int) -> dict[str, Any]:
-        return dict(zip(fields, get(pick(frame)), strict=True))
+        return dict(zip(fields, get(frame), strict=True))
 
     return encode
 
 
-def _channel(topic: str, schema_file: str, message_type: type, pick: Callable) -> Channel:
-    return Channel(topic, schema_file, _fields_encoder(schema_file, pick), message_type)
+def _fields_channel(topic: str, schema_file: str, message_type: type, source: str) -> Channel:
+    return Channel(topic, schema_file, _fields_encoder(schema_file, source), message_type)
 
 
+def _scene_update(frame: Frame, t_ns: int) -> dict[str, Any]:
+    return viz.scene_update(frame.scene, frame.messages, t_ns)
+
+
+# fmt: off
 FRAME_CHANNELS: tuple[Channel, ...] = (
-    _channel(
-        TOPICS.localization, "localization.v1.json", Localization,
-        lambda f: f.messages.localization,
-    ),
-    _channel(TOPICS.obstacles, "obstacles.v1.json", Obstacles, lambda f: f.messages.obstacles),
-    _channel(
-        TOPICS.predictions, "predictions.v1.json", Predictions, lambda f: f.messages.predictions
-    ),
-    _channel(TOPICS.plan, "planned_trajectory.v1.json", PlannedTrajectory, lambda f: f.messages.plan),
-    _channel(TOPICS.control, "control_command.v1.json", ControlCommand, lambda f: f.messages.control),
-    # SceneState carries every ground-truth field (vx_mps, vy_mps are properties of it).
-    _channel(TOPICS.ground_truth, "ground_truth.v1.json", SceneState, lambda f: f.scene),
-    Channel(
-        TOPICS.scene,
-        "scene_update.v1.json",
-        lambda f, t_ns: viz.scene_update(f.scene, f.messages, t_ns),
-        None,
-    ),
+    _fields_channel(TOPICS.localization, "localization.v1.json", Localization,
+                    "messages.localization"),
+    _fields_channel(TOPICS.obstacles, "obstacles.v1.json", Obstacles, "messages.obstacles"),
+    _fields_channel(TOPICS.predictions, "predictions.v1.json", Predictions, "messages.predictions"),
+    _fields_channel(TOPICS.plan, "planned_trajectory.v1.json", PlannedTrajectory, "messages.plan"),
+    _fields_channel(TOPICS.control, "control_command.v1.json", ControlCommand, "messages.control"),
+    # SceneState carries every ground-truth field (vx_mps and vy_mps are properties of it).
+    _fields_channel(TOPICS.ground_truth, "ground_truth.v1.json", SceneState, "scene"),
+    Channel(TOPICS.scene, "scene_update.v1.json", _scene_update, None),
 )
+# fmt: on
 MAP_CHANNEL = Channel(TOPICS.map, "scene_update.v1.json", viz.map_update, None)
 CHANNELS: dict[str, Channel] = {c.topic: c for c in (*FRAME_CHANNELS, MAP_CHANNEL)}

@@ -51,34 +51,60 @@ def synthetic_frame(
         length_m=np.full(n, 5.0),
         width_m=np.full(n, 2.0),
         crashed=crashed,
-        ego_collision=bool(crashed[0]),
-        collision_actor=int(rng.integers(1, n)) if crashed[0] else -1,
+        ego_collision=bool(crashed[0]) and n > 1,
+        collision_actor=int(rng.integers(1, n)) if crashed[0] and n > 1 else -1,
     )
     ids = np.arange(1, n, dtype=np.int64)
     m = n_obstacles
     messages = FrameMessages(
         localization=Localization(
-            t_s, float(scene.x_m[0]), float(scene.y_m[0]), float(scene.heading_rad[0]),
-            float(scene.speed_mps[0]), float(scene.accel_mps2[0]),
+            t_s,
+            float(scene.x_m[0]),
+            float(scene.y_m[0]),
+            float(scene.heading_rad[0]),
+            float(scene.speed_mps[0]),
+            float(scene.accel_mps2[0]),
         ),
         obstacles=Obstacles(
-            t_s, ids, ["car"] * m, scene.x_m[1:] + rng.normal(0, 0.3, m),
-            scene.y_m[1:] + rng.normal(0, 0.3, m), scene.heading_rad[1:].copy(),
-            rng.uniform(0, 35, m), rng.normal(0, 1, m), np.full(m, 5.0), np.full(m, 2.0),
+            t_s,
+            ids,
+            ["car"] * m,
+            scene.x_m[1:] + rng.normal(0, 0.3, m),
+            scene.y_m[1:] + rng.normal(0, 0.3, m),
+            scene.heading_rad[1:].copy(),
+            rng.uniform(0, 35, m),
+            rng.normal(0, 1, m),
+            np.full(m, 5.0),
+            np.full(m, 2.0),
             rng.uniform(0.5, 1.0, m),
         ),
         predictions=Predictions(
-            t_s, 0.1, ids, ["lane" if i % 2 else "cv" for i in range(m)], np.full(m, 5.0),
-            np.full(m, 2.0), rng.uniform(0, 500, (m, k)), rng.uniform(-2, 10, (m, k)),
+            t_s,
+            0.1,
+            ids,
+            ["lane" if i % 2 else "cv" for i in range(m)],
+            np.full(m, 5.0),
+            np.full(m, 2.0),
+            rng.uniform(0, 500, (m, k)),
+            rng.uniform(-2, 10, (m, k)),
         ),
         plan=PlannedTrajectory(
-            t_s, PLANNING_DECISIONS[int(rng.integers(len(PLANNING_DECISIONS)))],
-            float(rng.uniform(0, 35)), int(rng.integers(-1, n)), np.linspace(0.0, 4.0, p),
-            rng.uniform(0, 500, p), rng.uniform(-2, 10, p), rng.uniform(-0.2, 0.2, p),
-            rng.uniform(0, 35, p), rng.normal(0, 2, p),
+            t_s,
+            PLANNING_DECISIONS[int(rng.integers(len(PLANNING_DECISIONS)))],
+            float(rng.uniform(0, 35)),
+            int(rng.integers(-1, n)),
+            np.linspace(0.0, 4.0, p),
+            rng.uniform(0, 500, p),
+            rng.uniform(-2, 10, p),
+            rng.uniform(-0.2, 0.2, p),
+            rng.uniform(0, 35, p),
+            rng.normal(0, 2, p),
         ),
         control=ControlCommand(
-            t_s, float(rng.uniform()), float(rng.uniform()), float(rng.normal(0, 0.05)),
+            t_s,
+            float(rng.uniform()),
+            float(rng.uniform()),
+            float(rng.normal(0, 0.05)),
             float(rng.normal(0, 2)),
         ),
     )
@@ -97,9 +123,7 @@ def synthetic_episode(
 ) -> Episode:
     """An Episode of n_frames random frames; `failed` marks it as a failed run with a reason."""
     rng = np.random.default_rng(seed)
-    frames = [
-        synthetic_frame(rng, i / rate_hz, n_obstacles, k, p) for i in range(n_frames)
-    ]
+    frames = [synthetic_frame(rng, i / rate_hz, n_obstacles, k, p) for i in range(n_frames)]
     collided = any(f.scene.ego_collision for f in frames)
     first = next((f.scene for f in frames if f.scene.ego_collision), None)
     outcome = Outcome(

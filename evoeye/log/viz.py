@@ -4,15 +4,22 @@ Per frame, `/viz/scene` replaces the whole scene: one entity per actor (a cube; 
 crashed actors in different colours), one with a line strip per predicted obstacle trajectory and
 one with the planned ego trajectory. The road is drawn once, on its own topic `/viz/map`: a viewer
 that seeks restores the latest message of each topic, so a map sent once on the per-frame topic
-would vanish after the first seek. Dicts are built lean (shared constant parts, one list
-comprehension per primitive kind) because this is the most expensive message of a frame.
+would vanish after the first seek.
+
+This is the most expensive message of a frame (a third of the logging budget), so it is built
+lean: constant parts are serialised once (orjson Fragments), and a trajectory is drawn through at
+most MAX_LINE_POINTS of its points, both ends kept (the full trajectories are on their own
+channels; the drawing only has to look right).
 """
 
 from __future__ import annotations
 
+from functools import cache
+from math import cos, sin
 from typing import Any
 
 import numpy as np
+import orjson
 
 from evoeye.ads.messages import FrameMessages
 from evoeye.scene import EGO_ID, Lane, RoadMap, SceneState
@@ -20,6 +27,7 @@ from evoeye.scene import EGO_ID, Lane, RoadMap, SceneState
 FRAME_ID = "map"
 ACTOR_HEIGHT_M = 1.5
 LINE_Z_M = 0.2  # lines float a little above the road so cubes do not hide them
+MAX_LINE_POINTS = 10  # trajectories are drawn through at most this many of their points
 
 LINE_STRIP = 0  # foxglove.LineType
 DELETE_ALL = 1  # foxglove.SceneEntityDeletionType
@@ -33,11 +41,22 @@ LANE_COLOR = {"r": 0.55, "g": 0.55, "b": 0.55, "a": 1.0}
 ROUTE_COLOR = {"r": 0.3, "g": 0.8, "b": 1.0, "a": 0.5}
 
 _NONE: tuple = ()  # an empty primitive list, shared (orjson writes a tuple as an array)
-_ZERO = {"sec": 0, "nsec": 0}
-_IDENTITY = {
-    "position": {"x": 0.0, "y": 0.0, "z": 0.0},
-    "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
-}
+
+
+def _json(value: Any) -> orjson.Fragment:
+    """A constant, serialised once: orjson copies a Fragment's bytes instead of re-encoding."""
+    return orjson.Fragment(orjson.dumps(value))
+
+
+_ZERO = _json({"sec": 0, "nsec": 0})
+_IDENTITY = _json(
+    {
+        "position": {"x": 0.0, "y": 0.0, "z": 0.0},
+        "orientation": {"x": 0.0, "y": 0.0, "z": 0.0, "w": 1.0},
+    }
+)
+_EGO, _NPC, _CRASHED = _json(EGO_COLOR), _json(NPC_COLOR), _json(CRASHED_COLOR)
+_PREDICTION, _PLAN = _json(PREDICTION_COLOR), _json(PLAN_COLOR)
 # Every field a foxglove.SceneEntity requires, with the empty defaults; entities override a few.
 _ENTITY: dict[str, Any] = {
     "timestamp": _ZERO,
@@ -63,16 +82,21 @@ def stamp(t_ns: int) -> dict[str, int]:
     return {"sec": sec, "nsec": nsec}
 
 
+def points(x_m: list[float], y_m: list[float], z_m: float = LINE_Z_M) -> list[dict[str, float]]:
+    """foxglove.Point3 dicts of a polyline (x_m and y_m of equal length)."""
+    return [{"x": x, "y": y, "z": z_m} for x, y in zip(x_m, y_m, strict=False)]  # hot: unchecked
+
+
 def line_strip(
-    x_m: list[float], y_m: list[float], color: dict, thickness_m: float
+    pts: list[dict[str, float]], color: dict | orjson.Fragment, thickness_m: float
 ) -> dict[str, Any]:
-    """A foxglove.LinePrimitive joining the points (x_m[i], y_m[i]) in order."""
+    """A foxglove.LinePrimitive joining the points in order."""
     return {
         "type": LINE_STRIP,
         "pose": _IDENTITY,
         "thickness": thickness_m,
         "scale_invariant": False,
-        "points": [{"x": x, "y": y, "z": LINE_Z_M} for x, y in zip(x_m, y_m, strict=True)],
+        "points": pts,
         "color": color,
         "colors": _NONE,
         "indices": _NONE,
@@ -81,19 +105,18 @@ def line_strip(
 
 def actor_entities(scene: SceneState, ts: dict[str, int]) -> list[dict[str, Any]]:
     """One entity per actor, each a single cube at the actor's pose."""
-    half = scene.heading_rad * 0.5
+    z = ACTOR_HEIGHT_M / 2
     rows = zip(
         scene.actor_id.tolist(),
         scene.x_m.tolist(),
         scene.y_m.tolist(),
-        np.sin(half).tolist(),  # quaternion about +z: (0, 0, sin(h/2), cos(h/2))
-        np.cos(half).tolist(),
+        scene.heading_rad.tolist(),
         scene.length_m.tolist(),
         scene.width_m.tolist(),
         scene.crashed.tolist(),
         strict=True,
     )
-    z = ACTOR_HEIGHT_M / 2
+    # A handful of actors: plain Python math is cheaper than numpy's per-call overhead here.
     return [
         {
             **_ENTITY,
@@ -103,25 +126,36 @@ def actor_entities(scene: SceneState, ts: dict[str, int]) -> list[dict[str, Any]
                 {
                     "pose": {
                         "position": {"x": x, "y": y, "z": z},
-                        "orientation": {"x": 0.0, "y": 0.0, "z": qz, "w": qw},
+                        # rotation by the heading about +z: (0, 0, sin(h/2), cos(h/2))
+                        "orientation": {"x": 0.0, "y": 0.0, "z": sin(0.5 * h), "w": cos(0.5 * h)},
                     },
                     "size": {"x": length, "y": width, "z": ACTOR_HEIGHT_M},
-                    "color": CRASHED_COLOR if crashed else EGO_COLOR if a == EGO_ID else NPC_COLOR,
+                    "color": _CRASHED if crashed else _EGO if a == EGO_ID else _NPC,
                 },
             ),
         }
-        for a, x, y, qz, qw, length, width, crashed in rows
+        for a, x, y, h, length, width, crashed in rows
     ]
+
+
+@cache
+def drawn(k: int) -> np.ndarray:
+    """Indices of the at most MAX_LINE_POINTS points drawn of a k-point line, both ends kept."""
+    return np.unique(np.linspace(0, k - 1, min(k, MAX_LINE_POINTS)).round().astype(np.intp))
 
 
 def trajectory_entities(messages: FrameMessages, ts: dict[str, int]) -> list[dict[str, Any]]:
     """The predicted obstacle trajectories and the planned ego trajectory, as line strips."""
     pred, plan = messages.predictions, messages.plan
+    px, py = np.asarray(pred.x_m, dtype=float), np.asarray(pred.y_m, dtype=float)
+    idx = drawn(px.shape[-1])  # take() is ~4x faster than fancy indexing on these small arrays
     predicted = [
-        line_strip(xs, ys, PREDICTION_COLOR, 0.15)
-        for xs, ys in zip(np.asarray(pred.x_m).tolist(), np.asarray(pred.y_m).tolist(), strict=True)
+        line_strip(points(xs, ys), _PREDICTION, 0.15)
+        for xs, ys in zip(px.take(idx, -1).tolist(), py.take(idx, -1).tolist(), strict=True)
     ]
-    planned = line_strip(np.asarray(plan.x_m).tolist(), np.asarray(plan.y_m).tolist(), PLAN_COLOR, 0.3)
+    qx, qy = np.asarray(plan.x_m, dtype=float), np.asarray(plan.y_m, dtype=float)
+    idx = drawn(qx.shape[-1])
+    planned = line_strip(points(qx.take(idx).tolist(), qy.take(idx).tolist()), _PLAN, 0.3)
     return [
         {**_ENTITY, "timestamp": ts, "id": "predictions", "lines": predicted},
         {**_ENTITY, "timestamp": ts, "id": "plan", "lines": (planned,)},
@@ -137,14 +171,30 @@ def scene_update(scene: SceneState, messages: FrameMessages, t_ns: int) -> dict[
     }
 
 
+def _corners(xy: np.ndarray, tol_rad: float = 1e-3) -> np.ndarray:
+    """The polyline without its collinear interior points: a straight lane keeps its 2 ends."""
+    if len(xy) <= 2:
+        return xy
+    d = np.diff(xy, axis=0)
+    turn = np.abs(np.angle(np.exp(1j * np.diff(np.arctan2(d[:, 1], d[:, 0]))))) > tol_rad
+    keep = np.concatenate(([0], np.flatnonzero(turn) + 1, [len(xy) - 1]))
+    return xy[keep]
+
+
 def _lane_strip(lane: Lane, color: dict, thickness_m: float) -> dict[str, Any]:
-    points = np.asarray(lane.points, dtype=float)
-    return line_strip(points[:, 0].tolist(), points[:, 1].tolist(), color, thickness_m)
+    xy = _corners(np.asarray(lane.points, dtype=float))
+    return line_strip(points(xy[:, 0].tolist(), xy[:, 1].tolist(), 0.0), color, thickness_m)
 
 
 def map_update(road_map: RoadMap, t_ns: int) -> dict[str, Any]:
     """The /viz/map message: lane centre lines and the ego route, kept forever (lifetime 0)."""
     lines = [_lane_strip(lane, LANE_COLOR, 0.1) for lane in road_map.lanes]
     lines.append(_lane_strip(road_map.route, ROUTE_COLOR, 0.6))
-    entity = {**_ENTITY, "timestamp": stamp(t_ns), "id": "map", "frame_locked": True, "lines": lines}
+    entity = {
+        **_ENTITY,
+        "timestamp": stamp(t_ns),
+        "id": "map",
+        "frame_locked": True,
+        "lines": lines,
+    }
     return {"deletions": _NONE, "entities": [entity]}

@@ -44,7 +44,7 @@ class SimConfig:
 
 def run_spec(
     scenario: str, params, seed: int, *, batch: str = "default", source: str = "initial",
-    round: int = 0,
+    round: int = 0,  # noqa: A002 - the paper's name for an acquisition round
 ) -> RunSpec:
     """A validated RunSpec whose id is derived from (scenario, params, seed)."""
     space = get_scenario(scenario)
@@ -59,6 +59,11 @@ def _seeds(seed: int) -> tuple[np.random.Generator, np.random.Generator]:
     """Independent streams for the world and for the ADS, both fixed by the run seed."""
     world_ss, ads_ss = np.random.SeedSequence(seed).spawn(2)
     return np.random.default_rng(world_ss), np.random.default_rng(ads_ss)
+
+
+def scene_finite(scene: SceneState) -> bool:
+    """False if any actor's position, heading or speed is NaN or infinite."""
+    return bool(np.isfinite(scene.x_m + scene.y_m + scene.heading_rad + scene.speed_mps).all())
 
 
 def _min_gap_m(scene: SceneState) -> float:
@@ -82,6 +87,8 @@ def run_episode(
     n_frames = int(round(config.duration_s * config.rate_hz))
     frames: list[Frame] = []
     collision_t: float | None = None
+    collision_k = -1
+    post_frames = int(round(config.post_collision_s * config.rate_hz))
     other: int | None = None
     min_gap = float("inf")
     road_map = None
@@ -93,13 +100,13 @@ def run_episode(
             scene = world.scene()
             scene.t_s = k * dt  # exact frame time, free of float accumulation
             msgs = ads.step(scene)
-            if not (world.finite() and msgs.all_finite()):
+            if not (scene_finite(scene) and msgs.all_finite()):
                 raise SimulationError(f"non-finite value at t={scene.t_s:.2f} s")
             frames.append(Frame(scene, msgs))
             min_gap = min(min_gap, _min_gap_m(scene))
             if scene.ego_collision and collision_t is None:
-                collision_t, other = scene.t_s, scene.collision_actor
-            if collision_t is not None and scene.t_s >= collision_t + config.post_collision_s:
+                collision_t, collision_k, other = scene.t_s, k, scene.collision_actor
+            if collision_t is not None and k >= collision_k + post_frames:
                 break
             world.step(msgs.control.accel_cmd_mps2, msgs.control.steering_rad, dt)
     except Exception as exc:  # noqa: BLE001 - a broken run is data, not a crash of the batch

@@ -110,9 +110,3 @@ class World:
                 if d < best_d:
                     best, best_d = a.actor_id, d
         return best
-
-    def finite(self) -> bool:
-        return all(
-            np.isfinite(a.vehicle.position).all() and np.isfinite(a.vehicle.speed)
-            for a in self.active
-        )
