@@ -19,6 +19,7 @@ EGO_START_X_M = 200.0
 MIN_SPACING_M = 9.0  # centre spacing enforced between NPCs spawned in one lane
 OVERTAKER_CUT_BACK_M = 12.0  # the overtaker returns to the ego lane this far ahead of the ego
 OVERTAKER_LANE_CHANGE_S = 2.0
+CUT_IN_EARLIEST_S = 1.0  # no cut-in before the ADS has had a second to track the scene
 
 
 def _place(wanted: list[tuple[int, float]]) -> list[float]:
@@ -34,6 +35,14 @@ def _place(wanted: list[tuple[int, float]]) -> list[float]:
         placed.append((lane, x))
         out.append(x)
     return out
+
+
+def _cut_in(p: dict[str, float], side: str, length_m: float) -> LaneChange:
+    """A cut-in: once the NPC's rear is 0…trigger gap ahead of the ego's front (after 1 s)."""
+    return LaneChange(
+        EGO_LANE, p[f"{side}_cutin_duration_s"], start_s=CUT_IN_EARLIEST_S,
+        ahead_min_m=length_m, ahead_max_m=length_m + p[f"{side}_cutin_trigger_gap_m"],
+    )
 
 
 @functools.cache
@@ -55,13 +64,13 @@ def build_highway(p: dict[str, float], rng: np.random.Generator) -> tuple[World,
          BrakeEvent(p["lead_brake_time_s"], p["lead_brake_decel_mps2"],
                     p["lead_brake_duration_s"]), None),
         (0, EGO_START_X_M + p["left_cutin_gap_m"], p["left_cutin_speed_mps"], None,
-         LaneChange(EGO_LANE, p["left_cutin_duration_s"], start_s=p["left_cutin_time_s"])),
+         _cut_in(p, "left", ego.LENGTH)),
         (2, EGO_START_X_M + p["right_cutin_gap_m"], p["right_cutin_speed_mps"], None,
-         LaneChange(EGO_LANE, p["right_cutin_duration_s"], start_s=p["right_cutin_time_s"])),
+         _cut_in(p, "right", ego.LENGTH)),
         (0, EGO_START_X_M + p["left_follow_gap_m"], p["left_follow_speed_mps"], None, None),
         (2, EGO_START_X_M + p["right_follow_gap_m"], p["right_follow_speed_mps"], None, None),
         (0, EGO_START_X_M + p["overtaker_gap_m"], p["overtaker_speed_mps"], None,
-         LaneChange(EGO_LANE, OVERTAKER_LANE_CHANGE_S, ahead_of_ego_m=OVERTAKER_CUT_BACK_M)),
+         LaneChange(EGO_LANE, OVERTAKER_LANE_CHANGE_S, ahead_min_m=OVERTAKER_CUT_BACK_M)),
     ]
     xs = _place([(s[0], s[1]) for s in specs])
     npcs = []

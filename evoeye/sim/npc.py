@@ -25,12 +25,14 @@ class BrakeEvent:
 
 @dataclass(frozen=True)
 class LaneChange:
-    """Change into lane `to_lane` at `start_s`, or once `ahead_of_ego_m` ahead of the ego."""
+    """Change into lane `to_lane` once after `start_s`, when the NPC's centre is between
+    `ahead_min_m` and `ahead_max_m` ahead of the ego's centre (the trigger window)."""
 
     to_lane: int
     duration_s: float  # time to complete the lateral move; lower is sharper
     start_s: float = 0.0
-    ahead_of_ego_m: float | None = None  # if set, also wait until this far ahead of the ego
+    ahead_min_m: float = -float("inf")
+    ahead_max_m: float = float("inf")
 
 
 class ScriptedVehicle(IDMVehicle):
@@ -61,6 +63,9 @@ class ScriptedVehicle(IDMVehicle):
             enable_lane_change=False,
             timer=0.0,
         )
+        # NPCs are scripted actors: contacts among them are not simulated (highway-env checks a
+        # pair only if one side checks), so a parameter means what it says; the ego checks all.
+        self.check_collisions = False
         self.brake = brake
         self.lane_change = lane_change
         self.ego = ego
@@ -79,13 +84,15 @@ class ScriptedVehicle(IDMVehicle):
     def step(self, dt: float) -> None:
         self.clock_s += dt
         super().step(dt)
+        _no_reverse(self)
 
     def _maybe_change_lane(self) -> None:
         lc = self.lane_change
         if lc is None or self._lane_change_done or self.clock_s < lc.start_s:
             return
-        if lc.ahead_of_ego_m is not None and self.ego is not None:
-            if self.position[0] - self.ego.position[0] < lc.ahead_of_ego_m:
+        if self.ego is not None:
+            ahead_m = self.position[0] - self.ego.position[0]
+            if not lc.ahead_min_m <= ahead_m <= lc.ahead_max_m:
                 return
         _from, _to, _ = self.lane_index
         self.target_lane_index = (_from, _to, lc.to_lane)
@@ -125,3 +132,13 @@ class EgoVehicle(Vehicle):
 
     def on_state_update(self) -> None:
         return
+
+    def step(self, dt: float) -> None:
+        super().step(dt)
+        _no_reverse(self)
+
+
+def _no_reverse(vehicle: Vehicle) -> None:
+    """Braking stops a vehicle; it never drives it backwards (highway-env's model would)."""
+    if vehicle.speed < 0.0:
+        vehicle.speed = 0.0

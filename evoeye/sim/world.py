@@ -14,7 +14,8 @@ from highway_env.road.road import Road
 from evoeye.scene import EGO_ID, RoadMap, SceneState
 from evoeye.sim.npc import EgoVehicle
 
-SPAWN_CLEARANCE_M = 8.0  # an NPC is not spawned closer than this to another vehicle
+SPAWN_CLEARANCE_M = 8.0  # an NPC is not spawned closer than this to a vehicle in its lane …
+SAME_LANE_M = 2.5  # … i.e. one less than this far to its side
 
 
 @dataclass
@@ -86,7 +87,7 @@ class World:
         for actor in list(self._pending):
             if actor.spawn_s > self.t_s + 1e-9:
                 break
-            if self._occupied(actor.vehicle.position):
+            if self._occupied(actor.vehicle):
                 continue
             self._pending.remove(actor)
             actor.prev_speed_mps = actor.vehicle.speed
@@ -94,11 +95,14 @@ class World:
             self.road.vehicles.append(actor.vehicle)
             self._accel = np.append(self._accel, 0.0)
 
-    def _occupied(self, position: np.ndarray) -> bool:
-        return any(
-            float(np.hypot(*(a.vehicle.position - position))) < SPAWN_CLEARANCE_M
-            for a in self.active
-        )
+    def _occupied(self, vehicle) -> bool:
+        """Another vehicle within SPAWN_CLEARANCE_M ahead or behind, in the same lane."""
+        c, s = np.cos(vehicle.heading), np.sin(vehicle.heading)
+        for a in self.active:
+            dx, dy = a.vehicle.position - vehicle.position
+            if abs(c * dx + s * dy) < SPAWN_CLEARANCE_M and abs(c * dy - s * dx) < SAME_LANE_M:
+                return True
+        return False
 
     def _partner(self) -> int:
         """The crashed NPC nearest the ego: who the ego collided with."""

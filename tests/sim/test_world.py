@@ -17,8 +17,9 @@ def highway_params(**overrides):
     """A calm highway: everyone far away and slow to act, except what a test overrides."""
     p = HIGHWAY.as_dict(HIGHWAY.low)
     p.update(ego_speed_mps=25.0, lead_gap_m=70.0, lead_speed_mps=25.0, lead_brake_time_s=16.0,
-             lead_brake_decel_mps2=0.0, left_cutin_time_s=15.0, right_cutin_time_s=15.0,
-             left_cutin_gap_m=40.0, right_cutin_gap_m=40.0, left_follow_gap_m=-60.0,
+             lead_brake_decel_mps2=0.0, left_cutin_trigger_gap_m=2.0, right_cutin_trigger_gap_m=2.0,
+             left_cutin_gap_m=40.0, right_cutin_gap_m=40.0, left_cutin_speed_mps=32.0,
+             right_cutin_speed_mps=32.0, left_follow_gap_m=-60.0,
              right_follow_gap_m=-60.0, overtaker_gap_m=-80.0, overtaker_speed_mps=25.0)
     p.update(overrides)
     return HIGHWAY.as_dict(HIGHWAY.from_dict(p))
@@ -52,21 +53,33 @@ def test_lead_vehicle_brakes_as_scripted():
 
 
 @pytest.mark.parametrize("side,lane_y", [("left", 0.0), ("right", 8.0)])
-def test_cut_in_moves_into_the_ego_lane_after_its_trigger(side, lane_y):
-    p = highway_params(**{f"{side}_cutin_time_s": 2.0, f"{side}_cutin_duration_s": 1.5,
-                          f"{side}_cutin_gap_m": 30.0, f"{side}_cutin_speed_mps": 25.0})
+def test_cut_in_triggers_when_the_gap_to_the_ego_closes(side, lane_y):
+    # the NPC starts 40 m ahead (centres), 5 m/s slower than the ego: its rear is 10 m ahead of
+    # the ego's front after (40 - 5 - 10) / 5 = 5 s, when a 10 m trigger gap fires
+    p = highway_params(**{f"{side}_cutin_trigger_gap_m": 10.0, f"{side}_cutin_duration_s": 1.5,
+                          f"{side}_cutin_gap_m": 40.0, f"{side}_cutin_speed_mps": 20.0},
+                       ego_speed_mps=25.0, lead_gap_m=70.0, lead_speed_mps=30.0)
     world, _ = build_highway(p, np.random.default_rng(0))
     actor = 2 if side == "left" else 3
-    scenes = run(world, 6.0)
+    scenes = run(world, 9.0)
     y = actor_track(scenes, actor, "y_m")
     t = np.array([s.t_s for s in scenes])
-    assert y[np.searchsorted(t, 1.9)] == pytest.approx(lane_y, abs=0.1)  # not before the trigger
-    assert y[np.searchsorted(t, 5.0)] == pytest.approx(EGO_LANE * LANE_W, abs=0.5)
+    assert y[np.searchsorted(t, 4.8)] == pytest.approx(lane_y, abs=0.1)  # not before the trigger
+    start = t[int(np.argmax(np.abs(y - lane_y) > 0.05))]
+    assert start == pytest.approx(5.0, abs=0.3)
+    assert y[np.searchsorted(t, 8.5)] == pytest.approx(EGO_LANE * LANE_W, abs=0.5)
+
+
+def test_a_cut_in_never_fires_outside_its_trigger_window():
+    p = highway_params(left_cutin_trigger_gap_m=5.0, left_cutin_gap_m=40.0,
+                       left_cutin_speed_mps=30.0, ego_speed_mps=20.0)  # it only pulls away
+    scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0)
+    assert np.abs(actor_track(scenes, 2, "y_m")).max() < 0.05
 
 
 def test_sharper_cut_in_reaches_the_lane_sooner():
     def time_to_enter(duration):
-        p = highway_params(left_cutin_time_s=2.0, left_cutin_duration_s=duration,
+        p = highway_params(left_cutin_trigger_gap_m=30.0, left_cutin_duration_s=duration,
                            left_cutin_gap_m=30.0, left_cutin_speed_mps=25.0)
         scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0)
         y = actor_track(scenes, 2, "y_m")
@@ -100,6 +113,33 @@ def test_ego_runs_into_a_stopped_lead_and_the_partner_is_recorded():
     assert not any(s.ego_collision for s in scenes[: scenes.index(hit[0])])
 
 
+def test_a_blocked_vehicle_stops_and_never_reverses():
+    p = highway_params(lead_gap_m=15.0, lead_speed_mps=20.0, lead_brake_time_s=2.0,
+                       lead_brake_decel_mps2=8.0, lead_brake_duration_s=5.0)
+    scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0, accel=-8.0)
+    speeds = np.concatenate([s.speed_mps for s in scenes])
+    assert speeds.min() == 0.0  # someone came to a standstill, and nobody went below it
+
+
+def test_npcs_pass_through_each_other_but_not_through_the_ego():
+    world, _ = build_highway(highway_params(), np.random.default_rng(0))
+    ego, a, b = (act.vehicle for act in world.active[:3])
+    a.position = ego.position + np.array([30.0, 0.0])
+    b.position = ego.position + np.array([31.0, 0.0])  # two NPCs on top of each other
+    world.step(0.0, 0.0, DT)
+    assert not world.scene().crashed.any()
+    b.position = ego.position + np.array([1.0, 0.0])  # an NPC on top of the ego
+    world.step(0.0, 0.0, DT)
+    scene = world.scene()
+    assert scene.ego_collision and scene.collision_actor == world.active[2].actor_id
+
+
+def test_an_npc_may_spawn_beside_the_ego_in_the_next_lane():
+    p = highway_params(right_cutin_gap_m=0.0)  # alongside the ego, one lane to the right
+    world, _ = build_highway(p, np.random.default_rng(0))
+    assert 3 in world.scene().actor_id
+
+
 def test_same_params_and_seed_give_the_same_world():
     x = HIGHWAY.sample(np.random.default_rng(9))
     a = run(build_highway(HIGHWAY.as_dict(x), np.random.default_rng(4))[0], 5.0, accel=0.5)
@@ -112,7 +152,7 @@ def test_same_params_and_seed_give_the_same_world():
 def test_intersection_npcs_appear_at_their_start_time_and_follow_their_route():
     p = CROSSING.as_dict(CROSSING.low)
     p.update(cross_east_start_s=3.0, cross_east_speed_mps=10.0, opp_left_start_s=0.0,
-             cross_west_start_s=8.0, right_merge_start_s=8.0, left_merge_start_s=8.0)
+             cross_west_start_s=5.0, right_merge_start_s=5.0, left_merge_start_s=5.0)
     world, _ = build_intersection(CROSSING.as_dict(CROSSING.from_dict(p)), np.random.default_rng(0))
     scenes = run(world, 12.0, accel=-3.0)  # the ego stays out of the way
     east = list(NPC_MOVES).index("cross_east") + 1
