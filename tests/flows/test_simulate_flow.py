@@ -1,0 +1,39 @@
+"""The simulate flow through Prefect: local processes by default, a Dask cluster on request."""
+
+from __future__ import annotations
+
+import pytest
+from distributed import LocalCluster
+from pydantic import ValidationError
+
+from evoeye.log import read_run
+from flows.simulate import SimulateParams, simulate_batch_flow
+
+
+def test_simulate_flow_writes_one_log_per_run_and_reruns_skip(prefect_server, tmp_path):
+    params = SimulateParams(scenario="unprotected-intersection", n=2, seed=4,
+                            root=str(tmp_path), workers=2)
+    results = simulate_batch_flow(params)
+    assert len(results) == 2 and all(r.status == "ok" for r in results)
+    for r in results:
+        assert read_run(r.path, topics=()).metadata["scenario_id"] == r.scenario_id
+    again = simulate_batch_flow(params)
+    assert all(r.skipped for r in again)
+    assert sorted(r.path for r in again) == sorted(r.path for r in results)
+
+
+def test_simulate_flow_on_a_two_worker_dask_cluster(prefect_server, tmp_path):
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                                  dashboard_address=None) as cluster:
+        params = SimulateParams(scenario="highway-cut-in", n=2, seed=9, root=str(tmp_path),
+                                dask_address=cluster.scheduler_address)
+        results = simulate_batch_flow(params)
+    assert len(results) == 2 and all(r.status == "ok" for r in results)
+    assert len(list(tmp_path.rglob("*.mcap"))) == 2
+
+
+def test_bad_parameters_are_refused_before_anything_runs():
+    with pytest.raises(ValidationError, match="roundabout"):
+        SimulateParams(scenario="roundabout")
+    with pytest.raises(ValidationError, match="n"):
+        SimulateParams(n=0)
