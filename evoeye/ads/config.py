@@ -1,0 +1,150 @@
+"""Every tuning knob of the ADS, grouped per module, with units in the names.
+
+The defaults describe a plausibly competent stack with realistic weaknesses: a sensor that misses
+far and occluded cars and sees little to its sides, 250 ms of perception latency, a cut-in
+recognised only once lateral motion shows, optimistic gap acceptance that commits early, and a
+late, moderate AEB. They were tuned so that uniform sampling gives collision rates in the bands
+the paper reports (README, "Collision rates"); tune with `dataclasses.replace` on the group.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field, replace
+
+
+@dataclass(frozen=True)
+class LocalizationConfig:
+    """Gaussian noise on the ego's own state."""
+
+    pos_sigma_m: float = 0.05
+    heading_sigma_rad: float = 0.003
+    speed_sigma_mps: float = 0.05
+    accel_sigma_mps2: float = 0.1
+
+
+@dataclass(frozen=True)
+class SensorConfig:
+    """Which actors are detected, how noisily, and how late."""
+
+    front_range_m: float = 100.0  # forward sensor (camera + radar)
+    front_half_fov_rad: float = math.radians(35.0)  # forward camera + radar; narrow, so side traffic …
+    surround_range_m: float = 12.0  # … is seen late: the 360° sensor is short-ranged
+    detect_prob_near: float = 0.98  # per-frame detection probability at zero range
+    detect_prob_far: float = 0.75  # … at the front sensor's maximum range (quadratic in between)
+    occluded_fraction_max: float = 0.7  # the probability falls linearly to 0 at this occlusion
+    pos_sigma_m: float = 0.10  # position noise at zero range …
+    pos_sigma_per_m: float = 0.006  # … plus this much per metre of range
+    vel_sigma_mps: float = 0.3
+    vel_sigma_per_m: float = 0.01
+    heading_sigma_rad: float = 0.02
+    heading_sigma_per_m: float = 0.001
+    latency_s: float = 0.25  # detections published now were made this long ago (0.1–0.3 s)
+
+
+@dataclass(frozen=True)
+class TrackerConfig:
+    """Constant-velocity Kalman tracker with gated global-nearest-neighbour association."""
+
+    gate_m: float = 4.0  # max distance between a predicted track and its detection
+    confirm_hits: int = 3  # a track is published once it has this many hits (M)
+    tentative_max_misses: int = 1  # an unconfirmed track dies after this many misses in a row
+    max_coast_frames: int = 10  # a confirmed track is coasted this many missed frames, then dropped
+    accel_noise_mps2: float = 3.0  # CV process noise (white acceleration σ)
+    confidence_hits_scale: float = 2.0  # confidence rises as hits / (hits + scale)
+    confidence_range_drop: float = 0.3  # confidence falls by this fraction at the front range
+    confidence_coast_decay: float = 0.85  # confidence × decay^missed_frames
+
+
+@dataclass(frozen=True)
+class PredictionConfig:
+    """Lane-following vs constant-velocity prediction."""
+
+    horizon_s: float = 3.0
+    dt_s: float = 0.1
+    lane_match_radius_m: float = 3.0  # an obstacle farther than this from every lane centre is "cv"
+    lane_offset_max_m: float = 1.0  # "lane" needs |lateral offset| below this …
+    cutin_lat_speed_mps: float = 1.2  # … and lateral speed below this: a cut-in shows late
+    lane_resample_m: float = 1.0  # lane polylines are resampled to this spacing at start-up
+    grid_cell_m: float = 1.0  # cell of the lookup grid used to project onto lanes
+
+
+@dataclass(frozen=True)
+class PlanningConfig:
+    """Route following, IDM car following, gap acceptance and emergency braking."""
+
+    horizon_s: float = 4.0
+    dt_s: float = 0.1
+    ego_length_m: float = 5.0
+    ego_width_m: float = 2.0
+    corridor_margin_m: float = 0.3  # lateral margin added to both half-widths for "in path"
+    max_obstacle_half_length_m: float = 3.0  # bounds the corridor search (route grid reach)
+    idm_accel_mps2: float = 2.0  # IDM a: max acceleration
+    idm_decel_mps2: float = 3.0  # IDM b: comfortable deceleration
+    idm_delta: float = 4.0
+    time_headway_s: float = 1.2  # IDM T
+    min_gap_m: float = 3.0  # IDM s0, bumper to bumper
+    follow_decel_max_mps2: float = 4.0  # following brakes harder only if the gap demands it …
+    follow_soft_headway_s: float = 0.6  # … or the gap is below min_gap + v · this
+    follow_range_m: float = 120.0  # leaders farther than this along the route are ignored
+    cutin_horizon_s: float = 2.0  # an aligned car predicted in the path within this is a leader
+    aligned_max_rad: float = 0.6  # heading difference to the route below which a car "follows"
+    gap_margin_s: float = -1.0  # optimistic: takes a crossing gap up to 1 s shorter than needed
+    go_accel_mps2: float = 3.0  # acceleration assumed when estimating the ego's arrival (optimistic)
+    stop_buffer_m: float = 1.5  # the ego stops this far before a conflict region
+    yield_decel_max_mps2: float = 1.5  # beyond this the ego is committed and proceeds
+    emergency_ttc_s: float = 0.7  # time to collision below which the ego brakes hard (late AEB)
+    emergency_decel_mps2: float = 6.0  # AEB deceleration
+    stitch_tolerance_mps: float = 1.0  # replan from the measured speed if the plan drifts more
+    route_resample_m: float = 1.0
+    grid_cell_m: float = 1.0
+
+
+@dataclass(frozen=True)
+class ControlConfig:
+    """Pure pursuit on the plan, PID on speed with the planned acceleration fed forward."""
+
+    vehicle_length_m: float = 5.0  # of the kinematic bicycle the command drives
+    lookahead_min_m: float = 4.0
+    lookahead_time_s: float = 0.6  # lookahead = max(min, time · speed)
+    max_steering_rad: float = 0.5
+    max_steering_rate_radps: float = 1.0
+    accel_min_mps2: float = -8.0  # brake saturation
+    accel_max_mps2: float = 3.0
+    speed_kp: float = 1.0  # 1/s
+    speed_ki: float = 0.2  # 1/s²
+    speed_integral_max_mps: float = 2.0  # anti-windup bound on the integrated speed error
+
+
+@dataclass(frozen=True)
+class ADSConfig:
+    """All knobs of the stack; `cruise_speed_mps` is the per-run set speed."""
+
+    cruise_speed_mps: float = 25.0
+    frame_dt_s: float = 0.05  # the ADS runs at 20 Hz
+    localization: LocalizationConfig = field(default_factory=LocalizationConfig)
+    sensor: SensorConfig = field(default_factory=SensorConfig)
+    tracker: TrackerConfig = field(default_factory=TrackerConfig)
+    prediction: PredictionConfig = field(default_factory=PredictionConfig)
+    planning: PlanningConfig = field(default_factory=PlanningConfig)
+    control: ControlConfig = field(default_factory=ControlConfig)
+
+    @classmethod
+    def cautious(cls) -> ADSConfig:
+        """A more careful stack: wide sensors, 100 ms latency, conservative gap acceptance.
+
+        Collides far less often than the defaults; unit tests pin it to test mechanisms
+        independently of the tuned defaults.
+        """
+        return cls(
+            sensor=SensorConfig(front_half_fov_rad=math.radians(60.0), surround_range_m=30.0,
+                                latency_s=0.10),
+            prediction=PredictionConfig(cutin_lat_speed_mps=0.6),
+            planning=PlanningConfig(time_headway_s=1.5, gap_margin_s=0.5, go_accel_mps2=2.0,
+                                    yield_decel_max_mps2=5.0, emergency_ttc_s=1.2,
+                                    emergency_decel_mps2=8.0),
+        )
+
+    def with_cruise_speed(self, cruise_speed_mps: float) -> ADSConfig:
+        """The same configuration with another set speed."""
+        return replace(self, cruise_speed_mps=float(cruise_speed_mps))

@@ -1,0 +1,60 @@
+"""Perception: detections from the sensor model, delayed by the processing latency, then tracked."""
+
+from __future__ import annotations
+
+from collections import deque
+from typing import Protocol
+
+import numpy as np
+
+from evoeye.ads.config import SensorConfig, TrackerConfig
+from evoeye.ads.messages import Localization, Obstacles
+from evoeye.ads.sensing import Detections, SensorModel
+from evoeye.ads.tracking import HEADING, LENGTH, VX, VY, WIDTH, CVTracker, X, Y
+from evoeye.scene import SceneState
+
+
+class Perception(Protocol):
+    """Turns the scene into tracked obstacles (the only module that reads the ground truth)."""
+
+    def perceive(self, scene: SceneState, ego: Localization) -> Obstacles: ...
+
+
+class TrackingPerception:
+    """Sensor model → latency ring buffer → CV Kalman tracker; publishes confirmed tracks.
+
+    What is published at t_s reflects the detections made `latency_s` earlier (rounded to whole
+    frames): the positions lag the truth by about speed · latency. `Obstacles.t_s` is the
+    publication time, so every message of a frame shares one time stamp. The sensors sit on the
+    car, so detection geometry uses the ego's true pose, not the localization estimate.
+    """
+
+    def __init__(
+        self, sensor: SensorConfig, tracker: TrackerConfig, dt_s: float, rng: np.random.Generator
+    ) -> None:
+        self.sensor = SensorModel(sensor, rng)
+        self.tracker = CVTracker(tracker, dt_s)
+        self.front_range_m = sensor.front_range_m
+        self.latency_frames = max(0, round(sensor.latency_s / dt_s))
+        self._pending: deque[Detections] = deque(maxlen=self.latency_frames + 1)
+
+    def perceive(self, scene: SceneState, ego: Localization) -> Obstacles:
+        self._pending.append(self.sensor.detect(scene))
+        if len(self._pending) == self._pending.maxlen:
+            self.tracker.step(self._pending[0].z)
+        trk = self.tracker
+        rows = trk.confirmed.nonzero()[0]
+        s = trk.state[:, rows]  # (13, n), a copy: every published row is contiguous
+        return Obstacles(
+            t_s=float(scene.t_s),
+            track_id=trk.track_id[rows],
+            obj_class=["car"] * len(rows),
+            x_m=s[X],
+            y_m=s[Y],
+            heading_rad=s[HEADING],
+            vx_mps=s[VX],
+            vy_mps=s[VY],
+            length_m=s[LENGTH],
+            width_m=s[WIDTH],
+            confidence=trk.confidence(s, self.front_range_m),
+        )

@@ -1,0 +1,248 @@
+"""Planning: a speed profile along the ego's route, from IDM following, gap acceptance and AEB.
+
+Everything is decided in the route's Frenet frame (s along the route, d to its left). Predicted
+obstacle points are projected onto the route; a point is *in the path* when it lies ahead of the
+ego and laterally within the ego's corridor (both half-widths plus a margin). Then:
+
+* an obstacle that enters the path aligned with the route within `cutin_horizon_s` is a leader
+  candidate; the nearest one is followed with IDM;
+* an obstacle that crosses the path is a conflict: the ego proceeds if, driving on, it clears the
+  conflict region `gap_margin_s` before the other arrives or arrives that long after it left;
+  otherwise it yields, stopping before the region (IDM towards a virtual stopped car), unless it
+  can no longer stop comfortably, in which case it is committed and proceeds;
+* automatic emergency braking (`emergency_decel_mps2`) when the time to collision with the
+  leader, or to the start of a crossing conflict the ego can no longer yield to, is below
+  `emergency_ttc_s`.
+
+Headings of the plan are continuous along the route (not wrapped to (−π, π]).
+"""
+
+from __future__ import annotations
+
+import math
+from typing import Protocol
+
+import numpy as np
+
+from evoeye.ads.config import PlanningConfig
+from evoeye.ads.geometry import PolylineIndex
+from evoeye.ads.messages import Localization, PlannedTrajectory, Predictions
+from evoeye.scene import RoadMap
+
+
+class Planner(Protocol):
+    """Plans the ego trajectory from the predicted obstacles."""
+
+    def plan(self, predictions: Predictions, ego: Localization) -> PlannedTrajectory: ...
+
+
+class RoutePlanner:
+    """Longitudinal planning along the fixed route (no lane changes)."""
+
+    def __init__(
+        self, road_map: RoadMap, config: PlanningConfig, cruise_speed_mps: float, frame_dt_s: float
+    ) -> None:
+        c = config
+        self.c = c
+        self.cruise_mps = max(float(cruise_speed_mps), 0.1)
+        self.frame_dt_s = frame_dt_s
+        reach = 0.5 * c.ego_width_m + c.max_obstacle_half_length_m + c.corridor_margin_m + 0.5
+        self.route = PolylineIndex.build(
+            [road_map.route.points], c.route_resample_m, reach, c.grid_cell_m, 1
+        )
+        n = int(round(c.horizon_s / c.dt_s)) + 1
+        self.t_rel = np.arange(n) * c.dt_s  # (P,)
+        self._half_len = 0.5 * c.ego_length_m
+        self._half_wid = 0.5 * c.ego_width_m
+        self._corridor_half = self._half_wid + c.corridor_margin_m
+        self._cos_aligned = math.cos(c.aligned_max_rad)
+        self._sqrt_ab = math.sqrt(c.idm_accel_mps2 * c.idm_decel_mps2)
+        self._plan_v: float | None = None  # speed and accel of the previous plan, for stitching
+        self._plan_a = 0.0
+        self._held_id = -1  # the track the previous plan yielded or braked for
+
+    def _idm(self, v: float, gap_m: float, dv_mps: float) -> float:
+        """IDM acceleration behind a leader gap_m ahead (bumper to bumper), closing at dv_mps."""
+        c = self.c
+        free = 1.0 - (v / self.cruise_mps) ** c.idm_delta
+        s_star = c.min_gap_m + max(0.0, v * c.time_headway_s + v * dv_mps / (2.0 * self._sqrt_ab))
+        return c.idm_accel_mps2 * (free - (s_star / max(gap_m, 0.1)) ** 2)
+
+    def _follow(self, v: float, gap_m: float, closing_mps: float) -> float:
+        """IDM behind a leader. IDM alone brakes very hard for a car that cuts in at a moderate
+        gap but is barely slower; so while the gap is at least min_gap + v·follow_soft_headway_s,
+        braking is bounded by `follow_decel_max_mps2`, unless stopping the closing speed within
+        the gap takes more."""
+        c = self.c
+        a = self._idm(v, gap_m, closing_mps)
+        if a >= -c.follow_decel_max_mps2 or gap_m < c.min_gap_m + v * c.follow_soft_headway_s:
+            return a
+        need = 0.0
+        if closing_mps > 0.0:
+            need = closing_mps * closing_mps / (2.0 * max(gap_m - c.min_gap_m, 0.1))
+        return max(a, -max(c.follow_decel_max_mps2, need))
+
+    def _arrival_s(self, v: float, dist_m: np.ndarray) -> np.ndarray:
+        """Time for the ego to cover dist_m from speed v, accelerating to cruise at go_accel."""
+        a = self.c.go_accel_mps2
+        vc = max(self.cruise_mps, v)
+        t_acc = (vc - v) / a
+        d_acc = 0.5 * (v + vc) * t_acc
+        d = np.maximum(dist_m, 0.0)
+        t_ramp = (np.sqrt(v * v + 2.0 * a * np.minimum(d, d_acc)) - v) / a
+        return t_ramp + np.maximum(d - d_acc, 0.0) / vc
+
+    def plan(self, predictions: Predictions, ego: Localization) -> PlannedTrajectory:
+        c = self.c
+        r = self.route
+        fp = r.project_point(ego.x_m, ego.y_m)
+        if fp is None:  # far off the route: rare, so a full search is fine
+            v0 = r.nearest_vertex(ego.x_m, ego.y_m)
+            s_e = float(r.g[v0]) + (ego.x_m - float(r.x[v0])) * float(r.tx[v0]) + (
+                ego.y_m - float(r.y[v0])
+            ) * float(r.ty[v0])
+        else:
+            s_e = fp[0]
+
+        v = ego.speed_mps
+        if self._plan_v is not None:  # stitch onto the previous plan while the ego follows it
+            v_stitch = self._plan_v + self._plan_a * self.frame_dt_s
+            if abs(v_stitch - v) <= c.stitch_tolerance_mps:
+                v = v_stitch
+        v = max(v, 0.0)
+        a = self._idm(v, math.inf, 0.0)  # free road
+        decision, leader, target = "cruise", -1, self.cruise_mps
+        if predictions.x_m.shape[0] and predictions.x_m.shape[1] > 1:
+            a, decision, leader, target = self._react(predictions, s_e, v, a)
+
+        # constant acceleration until t_end, when the speed reaches max(v, cruise) speeding up, or
+        # slowing down the cruise speed on a free road (0 otherwise); then constant
+        t = self.t_rel
+        if a > 1e-9:
+            t_end = (max(v, self.cruise_mps) - v) / a
+        elif a < -1e-9:
+            floor = min(v, self.cruise_mps) if decision in ("cruise", "proceed") else 0.0
+            t_end = (floor - v) / a
+        else:
+            t_end = math.inf
+        t_acc = np.minimum(t, t_end)  # (P,) time spent accelerating by t
+        speed = v + a * t_acc
+        accel = np.where(t < t_end, a, 0.0)
+        v_end = v + a * min(t_end, float(t[-1]))
+        s = (v + 0.5 * a * t_acc) * t_acc + v_end * (t - t_acc) + s_e  # route arc length
+        x, y = r.xy_at(s)
+        self._plan_v, self._plan_a = v, float(accel[0])
+        self._held_id = leader if decision in ("yield", "emergency_brake") else -1
+        return PlannedTrajectory(
+            t_s=ego.t_s, decision=decision, target_speed_mps=float(target),
+            leader_track_id=int(leader), t_rel_s=t, x_m=x, y_m=y, heading_rad=r.heading_at(s),
+            speed_mps=speed, accel_mps2=accel,
+        )
+
+    def _react(
+        self, p: Predictions, s_e: float, v: float, a_free: float
+    ) -> tuple[float, str, int, float]:
+        """(accel, decision, leader track id, target speed) given the predicted obstacles."""
+        c = self.c
+        r = self.route
+        n, k = p.x_m.shape
+        dt = p.dt_s
+        # every predicted point in the route frame: so, do (n, K) arc length and lateral offset
+        # (off the grid, the sentinel vertex puts so ≈ −1e9 and |do| ≈ 1e9: never in the path)
+        so, do, _, _ = r.project(p.x_m, p.y_m, r.candidates(p.x_m, p.y_m))
+        # the direction of motion relative to the route at every point (to the next point; a
+        # standing obstacle counts as aligned) → the half extents across and along the route.
+        # Points 0 … K-2 are examined.
+        ds = so[:, 1:] - so[:, :-1]  # (n, K-1)
+        ds += 1e-4
+        dd = do[:, 1:] - do[:, :-1]
+        inv = 1.0 / np.hypot(ds, dd)
+        cos_dh = ds * inv
+        sin_abs = np.abs(dd) * inv
+        cos_abs = np.abs(cos_dh)
+        hl, hw = (0.5 * p.length_m)[:, None], (0.5 * p.width_m)[:, None]
+        so, do = so[:, :-1], do[:, :-1]
+        in_path = (np.abs(do) - (hl * sin_abs + hw * cos_abs) < self._corridor_half) & (so > s_e)
+        k_in = in_path.argmax(axis=1)  # (n,) first point in the path
+        at_in = k_in + np.arange(0, n * (k - 1), k - 1)
+        enters = in_path.take(at_in)
+        if not np.count_nonzero(enters):
+            return a_free, "cruise", -1, self.cruise_mps
+        aligned = cos_dh.take(at_in) >= self._cos_aligned
+
+        # leader: the nearest aligned obstacle, ahead now, entering the path soon; AEB on its TTC
+        decision, leader, target, a_nom = "cruise", -1, self.cruise_mps, a_free
+        rear = so[:, 0] - (hl[:, 0] * cos_abs[:, 0] + hw[:, 0] * sin_abs[:, 0])
+        cand = enters & aligned & (rear > s_e) & (k_in < int(c.cutin_horizon_s / dt + 1e-9))
+        if np.count_nonzero(cand):
+            j = int(np.where(cand, rear, np.inf).argmin())
+            gap_m = float(rear[j]) - s_e - self._half_len
+            if gap_m <= c.follow_range_m:
+                v_lead = float(so[j, 1] - so[j, 0]) / dt
+                closing = v - v_lead
+                if closing > 0.0 and gap_m <= c.emergency_ttc_s * closing:
+                    return -c.emergency_decel_mps2, "emergency_brake", int(p.track_id[j]), 0.0
+                a_nom = min(a_free, self._follow(v, gap_m, closing))
+                decision, leader = "follow", int(p.track_id[j])
+                target = min(self.cruise_mps, max(v_lead, 0.0))
+
+        # gap acceptance for obstacles crossing the path
+        cross = enters & ~aligned
+        if np.count_nonzero(cross):
+            lon_ext = hl * cos_abs + hw * sin_abs  # (n, K-1) half extent along the route
+            return self._gap_acceptance(
+                p, so, in_path, lon_ext, cross, k_in, s_e, v, a_nom, decision, leader, target
+            )
+        return max(a_nom, -c.emergency_decel_mps2), decision, leader, target
+
+    def _gap_acceptance(
+        self, p: Predictions, so: np.ndarray, in_path: np.ndarray, lon_ext: np.ndarray,
+        cross: np.ndarray, k_in: np.ndarray, s_e: float, v: float, a_nom: float, decision: str,
+        leader: int, target: float,
+    ) -> tuple[float, str, int, float]:
+        """Proceed, yield or brake hard for the obstacles crossing the path (rows `cross`)."""
+        c = self.c
+        i = cross.nonzero()[0]
+        dt = p.dt_s
+        ip = in_path[i]  # (m, K-1)
+        km = ip.shape[1]  # points examined
+        k0 = k_in[i]
+        k1 = km - 1 - ip[:, ::-1].argmax(axis=1)  # last point in the path
+        # the conflict region along the route: a crossing path is straight enough that its ends
+        # in the corridor bound it
+        rows = i * km
+        so0, so1 = so.take(rows + k0), so.take(rows + k1)
+        ext0, ext1 = lon_ext.take(rows + k0), lon_ext.take(rows + k1)
+        s_lo = np.minimum(so0 - ext0, so1 - ext1)
+        s_hi = np.maximum(so0 + ext0, so1 + ext1)
+        t_in = (k0 + 0.5) * dt  # point k is at (k + 1)·dt: half a step before the first one in
+        t_out = np.where(k1 == km - 1, np.inf, (k1 + 1.5) * dt)  # still in at the end: never out
+        d_in = s_lo - s_e - self._half_len  # ego front to the conflict region
+        te = self._arrival_s(v, np.concatenate((d_in, s_hi - s_e + self._half_len)))
+        te_in, te_out = te[: len(i)], te[len(i):]
+        # the ego clears first, or arrives after the other has left; for the obstacle it was
+        # already yielding to, only once that one is about to leave (no proceed/brake flapping
+        # as braking itself delays the ego's arrival)
+        after = te_in >= t_out + c.gap_margin_s
+        if self._held_id >= 0:
+            after = np.where(p.track_id[i] == self._held_id, t_out <= c.gap_margin_s, after)
+        safe = (te_out + c.gap_margin_s <= t_in) | after
+        stoppable = (d_in > 0.0) & (v * v <= 2.0 * c.yield_decel_max_mps2 * d_in)
+        # AEB: a conflict the ego can no longer yield to, overlapping within emergency_ttc_s
+        urgent = ~safe & ~stoppable & (d_in > -c.ego_length_m) & (
+            np.maximum(te_in, t_in) <= c.emergency_ttc_s
+        )
+        if np.count_nonzero(urgent):
+            j = int(np.where(urgent, d_in, np.inf).argmin())
+            return -c.emergency_decel_mps2, "emergency_brake", int(p.track_id[i[j]]), 0.0
+        conflict = ~safe & stoppable
+        if np.count_nonzero(conflict):
+            j = int(np.where(conflict, d_in, np.inf).argmin())
+            d_stop = max(float(d_in[j]) - c.stop_buffer_m, 0.0)
+            a_yield = self._idm(v, d_stop + c.min_gap_m, v)  # virtual car at the stop point
+            if a_yield < a_nom:
+                a_nom, decision, target = a_yield, "yield", 0.0
+                leader = int(p.track_id[i[j]])
+        elif decision == "cruise":
+            decision = "proceed"
+        return max(a_nom, -c.emergency_decel_mps2), decision, leader, target
