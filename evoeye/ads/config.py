@@ -28,7 +28,7 @@ class SensorConfig:
     """Which actors are detected, how noisily, and how late."""
 
     front_range_m: float = 100.0  # forward sensor (camera + radar)
-    front_half_fov_rad: float = math.radians(35.0)  # forward camera + radar; narrow, so side traffic …
+    front_half_fov_rad: float = math.radians(35.0)  # forward camera + radar: narrow, so side …
     surround_range_m: float = 12.0  # … is seen late: the 360° sensor is short-ranged
     detect_prob_near: float = 0.98  # per-frame detection probability at zero range
     detect_prob_far: float = 0.75  # … at the front sensor's maximum range (quadratic in between)
@@ -88,11 +88,11 @@ class PlanningConfig:
     follow_soft_headway_s: float = 0.6  # … or the gap is below min_gap + v · this
     follow_range_m: float = 120.0  # leaders farther than this along the route are ignored
     cutin_horizon_s: float = 2.0  # an aligned car predicted in the path within this is a leader
-    aligned_max_rad: float = 0.6  # heading difference to the route below which a car "follows"
+    aligned_max_rad: float = 0.6  # heading gap to the route below which a car "follows"
     gap_margin_s: float = -1.0  # optimistic: takes a crossing gap up to 1 s shorter than needed
     go_accel_mps2: float = 3.0  # acceleration assumed when estimating the ego's arrival (optimistic)
     stop_buffer_m: float = 1.5  # the ego stops this far before a conflict region
-    yield_decel_max_mps2: float = 1.5  # beyond this the ego is committed and proceeds
+    yield_decel_max_mps2: float = 1.5  # beyond this the ego is committed and goes on
     emergency_ttc_s: float = 0.7  # time to collision below which the ego brakes hard (late AEB)
     emergency_decel_mps2: float = 6.0  # AEB deceleration
     stitch_tolerance_mps: float = 1.0  # replan from the measured speed if the plan drifts more
