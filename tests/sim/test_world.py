@@ -79,8 +79,8 @@ def test_a_cut_in_never_fires_outside_its_trigger_window():
 
 def test_sharper_cut_in_reaches_the_lane_sooner():
     def time_to_enter(duration):
-        p = highway_params(left_cutin_trigger_gap_m=30.0, left_cutin_duration_s=duration,
-                           left_cutin_gap_m=30.0, left_cutin_speed_mps=25.0)
+        p = highway_params(left_cutin_trigger_gap_m=20.0, left_cutin_duration_s=duration,
+                           left_cutin_gap_m=20.0, left_cutin_speed_mps=25.0)
         scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0)
         y = actor_track(scenes, 2, "y_m")
         return scenes[int(np.argmax(y > EGO_LANE * LANE_W - 1.0))].t_s
@@ -152,7 +152,7 @@ def test_same_params_and_seed_give_the_same_world():
 def test_intersection_npcs_appear_at_their_start_time_and_follow_their_route():
     p = CROSSING.as_dict(CROSSING.low)
     p.update(cross_east_start_s=3.0, cross_east_speed_mps=10.0, opp_left_start_s=0.0,
-             cross_west_start_s=5.0, right_merge_start_s=5.0, left_merge_start_s=5.0)
+             cross_west_start_s=4.0, right_merge_start_s=4.0, left_merge_start_s=4.0)
     world, _ = build_intersection(CROSSING.as_dict(CROSSING.from_dict(p)), np.random.default_rng(0))
     scenes = run(world, 12.0, accel=-3.0)  # the ego stays out of the way
     east = list(NPC_MOVES).index("cross_east") + 1
