@@ -48,15 +48,15 @@ INTERSECTION = LogicalScenario(
         "(west→north). None of them yields."
     ),
     parameters=(
-        P("opp_left_speed_mps", 6.0, 12.0, "m/s", "opposing left-turner speed"),
+        P("opp_left_speed_mps", 7.0, 13.0, "m/s", "opposing left-turner speed"),
         P("opp_left_start_s", 0.0, 4.0, "s", "when the opposing left-turner enters"),
-        P("cross_west_speed_mps", 6.0, 12.0, "m/s", "crossing vehicle from the west, speed"),
+        P("cross_west_speed_mps", 7.0, 13.0, "m/s", "crossing vehicle from the west, speed"),
         P("cross_west_start_s", 0.0, 4.0, "s", "when the west crossing vehicle enters"),
-        P("cross_east_speed_mps", 6.0, 12.0, "m/s", "crossing vehicle from the east, speed"),
+        P("cross_east_speed_mps", 7.0, 13.0, "m/s", "crossing vehicle from the east, speed"),
         P("cross_east_start_s", 0.0, 4.0, "s", "when the east crossing vehicle enters"),
-        P("right_merge_speed_mps", 6.0, 12.0, "m/s", "east→north right-turn merger, speed"),
+        P("right_merge_speed_mps", 7.0, 13.0, "m/s", "east→north right-turn merger, speed"),
         P("right_merge_start_s", 0.0, 4.0, "s", "when the right-turn merger enters"),
-        P("left_merge_speed_mps", 6.0, 12.0, "m/s", "west→north left-turn merger, speed"),
+        P("left_merge_speed_mps", 7.0, 13.0, "m/s", "west→north left-turn merger, speed"),
         P("left_merge_start_s", 0.0, 4.0, "s", "when the left-turn merger enters"),
     ),
 )

@@ -22,7 +22,7 @@ from evoeye.sim.world import Actor, World
 
 EGO_ROUTE = [("o0", "ir0", 0), ("ir0", "il2", 0), ("il2", "o2", 0), ("o2", "x2", 0)]
 EGO_START_S_M = 50.0  # on the 100 m south approach: 50 m before the intersection
-EGO_CRUISE_MPS = 9.0
+EGO_CRUISE_MPS = 10.0  # the intersection lanes' speed limit
 NPC_ENTRY_S_M = 65.0  # NPCs appear 35 m before the intersection on their approach
 EXIT_EXTENSION_M = 200.0
 
