@@ -1,6 +1,7 @@
 """Simulation throughput: real-time factor of simulate+log vs bare highway-env stepping.
 
-Real-time factor (RTF) = simulated seconds per wall-clock second, on one core. The bare
+Real-time factor (RTF) = simulated seconds per CPU second of this process, i.e. per core (CPU
+time, not wall time, so other load on the machine does not distort it). The bare
 reference steps the very same world (same vehicles, same scripts) for the same number of frames
 with a fixed ego command, and does nothing else: no ground-truth read, no ADS, no log.
 Targets (issue 2): full stack with logging ≥ 50× real time per core, ≤ 2× the bare cost.
@@ -9,6 +10,7 @@ Targets (issue 2): full stack with logging ≥ 50× real time per core, ≤ 2× 
 from __future__ import annotations
 
 import argparse
+import os
 import tempfile
 import time
 from pathlib import Path
@@ -27,15 +29,15 @@ DT_S = 0.05
 def bench_full(specs, out: Path) -> tuple[float, float, float, list[int]]:
     """Sequential simulate + write: (simulated s, wall s, of which writing, frames per run)."""
     sim_s, log_s, frames = 0.0, 0.0, []
-    t0 = time.perf_counter()
+    t0 = time.process_time()
     for spec in specs:
         ep = run_episode(spec)
-        t_log = time.perf_counter()
+        t_log = time.process_time()
         write_episode(ep, out / f"{spec.scenario_id}.mcap")
-        log_s += time.perf_counter() - t_log
+        log_s += time.process_time() - t_log
         sim_s += len(ep.frames) * DT_S
         frames.append(len(ep.frames))
-    return sim_s, time.perf_counter() - t0, log_s, frames
+    return sim_s, time.process_time() - t0, log_s, frames
 
 
 def bench_bare(specs, frames: list[int]) -> tuple[float, float]:
@@ -44,16 +46,17 @@ def bench_bare(specs, frames: list[int]) -> tuple[float, float]:
     for spec, n in zip(specs, frames, strict=True):
         params = get_scenario(spec.scenario).as_dict(spec.params)
         world, _ = WORLD_BUILDERS[spec.scenario](params, _seeds(spec.seed)[0])
-        t0 = time.perf_counter()
+        t0 = time.process_time()
         for _ in range(n):
             world.step(0.0, 0.0, DT_S)
-        wall_s += time.perf_counter() - t0
+        wall_s += time.process_time() - t0
         sim_s += n * DT_S
     return sim_s, wall_s
 
 
 def bench_workers(scenario: str, n: int, workers: int) -> float:
-    """Wall seconds for a batch of n runs (simulate + log) with `workers` processes."""
+    """Wall seconds for a batch of n runs (simulate + log) with `workers` processes (needs an
+    otherwise idle machine to mean anything)."""
     specs = plan_uniform(scenario, n, seed=123, batch=f"w{workers}")
     with tempfile.TemporaryDirectory() as root:
         return run_batch(specs, root, workers=workers).wall_s
@@ -63,7 +66,7 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--runs", type=int, default=20, help="runs per logical scenario")
     args = ap.parse_args()
-    print(f"Machine: {describe()}\n")
+    print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}\n")
     print("| logical scenario | runs | sim s | full RTF (sim+ADS+log) | bare RTF (world) "
           "| full / bare cost | full ms/frame | of which log | 1 worker s | 2 workers s "
           "| speedup |")
