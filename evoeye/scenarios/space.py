@@ -23,13 +23,15 @@ class ScenarioError(ValueError):
 
 @dataclass(frozen=True, slots=True)
 class Parameter:
-    """One scenario parameter: name, closed range [low, high], unit and a one-line meaning."""
+    """One scenario parameter: name, closed range [low, high], unit, a one-line meaning, and the
+    actor it belongs to (AV-Fuzzer's genes are grouped by actor)."""
 
     name: str
     low: float
     high: float
     unit: str
     meaning: str
+    actor: str = ""
 
     def __post_init__(self) -> None:
         if not (math.isfinite(self.low) and math.isfinite(self.high) and self.low < self.high):
@@ -74,6 +76,14 @@ class LogicalScenario:
 
     def index(self, name: str) -> int:
         return self._index[name]
+
+    @property
+    def actors(self) -> dict[str, tuple[int, ...]]:
+        """Parameter indices per actor, in declaration order (e.g. {"lead": (1, 2, …), …})."""
+        out: dict[str, list[int]] = {}
+        for i, p in enumerate(self.parameters):
+            out.setdefault(p.actor, []).append(i)
+        return {a: tuple(ix) for a, ix in out.items()}
 
     # -- validation --------------------------------------------------------------------------
     def validate(self, x: Sequence[float] | np.ndarray) -> np.ndarray:

@@ -92,3 +92,11 @@ def test_dict_round_trip_and_missing_keys():
     del d["ego_speed_mps"]
     with pytest.raises(ScenarioError, match="ego_speed_mps"):
         HIGHWAY.from_dict(d)
+
+
+def test_every_parameter_belongs_to_an_actor_and_npcs_match_the_paper():
+    assert set(HIGHWAY.actors) == {"ego", "lead", "left_cutin", "right_cutin", "left_follow",
+                                   "right_follow", "overtaker"}  # the ego and six NPCs
+    assert len(CROSSING.actors) == 5 and all(len(ix) == 2 for ix in CROSSING.actors.values())
+    flat = sorted(i for ix in HIGHWAY.actors.values() for i in ix)
+    assert flat == list(range(HIGHWAY.dim))
