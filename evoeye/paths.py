@@ -2,10 +2,11 @@
 
 Layout under the root (default `./evoeye-data`, or `$EVOEYE_HOME`, or `--root`):
 
-    runs/<logical_scenario>/<batch>/<scenario_id>.mcap   one MCAP log per run (`.mcap.tmp` = unfinished)
-    warehouse/<table>/logical_scenario=…/batch=…/*.parquet   append-only Parquet tables
-    warehouse/evoeye.duckdb                               views over the Parquet, for the DuckDB CLI
-    quarantine/…                                          logs that could not be read, with a reason
+    runs/<logical_scenario>/<batch>/<scenario_id>.mcap  one MCAP log per run (`*.tmp`: unfinished)
+    warehouse/<table>/logical_scenario=…/batch=…/*.parquet  append-only Parquet tables
+    warehouse/evoeye.duckdb                              views over the Parquet, for DuckDB's CLI
+    quarantine/…                                         logs that could not be read, and why
+    monitors/<version>/{model.pt,card.json}              trained monitor versions (cards)
 """
 
 from __future__ import annotations
@@ -27,9 +28,10 @@ class DataRoot:
 
     @classmethod
     def resolve(cls, root: str | os.PathLike[str] | None = None) -> DataRoot:
-        """An explicit root wins, then $EVOEYE_HOME, then ./evoeye-data; made absolute."""
+        """An explicit root wins, then $EVOEYE_HOME, then ./evoeye-data; made absolute (symlinks
+        are kept, so `runs/` may be a link to another disk)."""
         chosen = root if root is not None else os.environ.get(ENV_VAR) or DEFAULT_ROOT
-        return cls(Path(chosen).expanduser().resolve())
+        return cls(Path(os.path.abspath(Path(chosen).expanduser())))
 
     @classmethod
     def at(cls, root: str | os.PathLike[str] | None = None) -> DataRoot:
@@ -57,6 +59,10 @@ class DataRoot:
     def quarantine(self) -> Path:
         return self.path / "quarantine"
 
+    @property
+    def monitors(self) -> Path:
+        return self.path / "monitors"
+
     def table_dir(self, table: str) -> Path:
         return self.warehouse / table
 
@@ -66,4 +72,9 @@ class DataRoot:
 
     def relative(self, path: Path) -> str:
         """`path` relative to the root, POSIX-style (as stored in the warehouse)."""
-        return Path(path).resolve().relative_to(self.path).as_posix()
+        return Path(os.path.abspath(path)).relative_to(self.path).as_posix()
+
+
+def resolve_root(root: str | os.PathLike[str] | None = None) -> Path:
+    """The data root's path (see DataRoot.resolve)."""
+    return DataRoot.resolve(root).path

@@ -1,0 +1,93 @@
+"""DuckDB over the warehouse Parquet: the connection every reader uses, and the catalog file.
+
+Readers never open the DuckDB file for writing and take no lock: `Warehouse.connect()` gives an
+in-memory DuckDB whose views read the Parquet parts directly. The file
+`<root>/warehouse/evoeye.duckdb` holds the same views for the DuckDB CLI and other tools; only
+the ingester (under the writer lock) rewrites it.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+import duckdb
+import pyarrow as pa
+
+from evoeye.paths import DataRoot
+from evoeye.store.schema import DDL_SCHEMA, PARTITION_KEYS, TABLES, create_declared_tables
+from evoeye.store.sqlfiles import query, view_scripts
+
+PART_GLOB = "/".join(["*"] * len(PARTITION_KEYS) + ["*.parquet"])  # */*/*.parquet
+
+
+def _string_literal(text: str) -> str:
+    """A SQL string literal. Used for the Parquet folder paths only, which DuckDB cannot bind
+    as parameters inside a view definition."""
+    return "'" + text.replace("'", "''") + "'"
+
+
+def _parquet_view_sql(table: str, table_dir: Path) -> str:
+    """The base view `<table>_parquet` over every part of `table`, or the empty declared table."""
+    if not any(table_dir.glob(PART_GLOB)):
+        source = f"{DDL_SCHEMA}.{table}"
+    else:
+        hive_types = ", ".join(f"{_string_literal(k)}: 'VARCHAR'" for k in PARTITION_KEYS)
+        source = (
+            f"read_parquet({_string_literal(str(table_dir / PART_GLOB))}, "
+            f"hive_partitioning = true, hive_types = {{{hive_types}}}, union_by_name = true)"
+        )
+    keys = ", ".join(PARTITION_KEYS)  # hive keys come last, in DDL order
+    return (
+        f"CREATE OR REPLACE VIEW {table}_parquet AS "
+        f"SELECT * EXCLUDE ({keys}), {keys} FROM {source}"
+    )
+
+
+def install_views(con: duckdb.DuckDBPyConnection, root: DataRoot) -> None:
+    """Create the declared tables, the Parquet base views and every view script on `con`."""
+    create_declared_tables(con)
+    for table in TABLES:
+        con.execute(_parquet_view_sql(table, root.table_dir(table)))
+    for _, script in view_scripts():
+        con.execute(script)
+
+
+class Warehouse:
+    """Read access to the warehouse of one data root."""
+
+    def __init__(self, root: DataRoot | str | Path | None = None) -> None:
+        self.root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+
+    def connect(self) -> duckdb.DuckDBPyConnection:
+        """A fresh in-memory DuckDB with every warehouse view; the caller closes it."""
+        con = duckdb.connect()
+        try:
+            install_views(con, self.root)
+        except BaseException:
+            con.close()
+            raise
+        return con
+
+    def sql(self, text: str, params: dict[str, Any] | list[Any] | None = None) -> pa.Table:
+        """Run any SQL against the warehouse views, with bound parameters; the result as Arrow."""
+        con = self.connect()
+        try:
+            return con.sql(text, params=params).to_arrow_table()
+        finally:
+            con.close()
+
+    def query(self, name: str, **params: Any) -> pa.Table:
+        """Run `warehouse/queries/<name>.sql` with `$name` parameters bound."""
+        return self.sql(query(name), params or None)
+
+
+def write_catalog(root: DataRoot) -> None:
+    """Rewrite the views of `<root>/warehouse/evoeye.duckdb`. Call only under the writer lock."""
+    root.warehouse.mkdir(parents=True, exist_ok=True)
+    con = duckdb.connect(str(root.duckdb_file))
+    try:
+        install_views(con, root)
+        con.execute("CHECKPOINT")
+    finally:
+        con.close()

@@ -1,0 +1,323 @@
+"""Runtime signals of a frame → the fixed-size arrays a monitor consumes (pure numpy, no row loop).
+
+Everything is expressed in the ego frame of the ADS's own localization (x forward, y left,
+origin at the ego centre), so a monitor learns relative geometry, never absolute map positions.
+Per frame, with n = `max_obstacles`, K = `pred_points`, P = `plan_points`:
+
+    perception       (n, 9)    PERCEPTION_FEATURES of the n nearest obstacles, nearest first
+    perception_mask  (n,)      True where a slot holds an obstacle (slots fill from 0)
+    prediction       (n, K, 2) predicted centre (dx_m, dy_m) at K points, every `pred_stride`-th
+                               point of the ADS's prediction, ending at its horizon; obstacles
+                               ordered by the distance of their first predicted point
+    prediction_mask  (n,)
+    plan             (P, 7)    PLAN_FEATURES at every `plan_stride`-th planned point from now
+    plan_mask        (P,)      True where the plan had that point
+    plan_info        (6,)      PLAN_INFO_FEATURES: target speed, one-hot decision
+    control          (6,)      CONTROL_FEATURES: the command and the ego speed/accel it acts on
+
+Truncation and padding: obstacles beyond n are dropped, farthest first; empty obstacle slots
+are zeros with mask False; a prediction or plan shorter than asked repeats its last point (mask
+False on the plan's repeated points). Non-finite inputs become 0. The defaults turn the ADS's
+K = 30 predicted points (0.1 s apart) into 10 (0.3 s apart, up to 3 s) and its 41 planned points
+(0 … 4 s) into 11 (0.4 s apart): enough resolution for a 3 s horizon, 321 floats per frame.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+import numpy as np
+import pyarrow as pa
+import pyarrow.compute as pc
+
+from evoeye.ads.messages import PLANNING_DECISIONS
+
+PERCEPTION_FEATURES = (
+    "dx_m", "dy_m", "cos_dheading", "sin_dheading", "dvx_mps", "dvy_mps",
+    "length_m", "width_m", "confidence",
+)
+PREDICTION_FEATURES = ("dx_m", "dy_m")
+PLAN_FEATURES = ("t_rel_s", "dx_m", "dy_m", "cos_dheading", "sin_dheading", "speed_mps",
+                 "accel_mps2")
+PLAN_INFO_FEATURES = ("target_speed_mps", *(f"decision_{d}" for d in PLANNING_DECISIONS))
+CONTROL_FEATURES = ("throttle", "brake", "steering_rad", "accel_cmd_mps2", "ego_speed_mps",
+                    "ego_accel_mps2")
+
+
+@dataclass(frozen=True)
+class FeatureSpec:
+    """Fixed sizes of the per-frame arrays and which raw points they keep."""
+
+    max_obstacles: int = 8  # n
+    pred_points: int = 10  # K
+    pred_stride: int = 3  # keep raw prediction points stride-1, 2·stride-1, …
+    plan_points: int = 11  # P
+    plan_stride: int = 4  # keep raw plan points 0, stride, 2·stride, …
+
+    def __post_init__(self) -> None:
+        if min(self.max_obstacles, self.pred_points, self.pred_stride, self.plan_points,
+               self.plan_stride) < 1:
+            raise ValueError(f"every FeatureSpec size must be at least 1: {self}")
+
+    @property
+    def pred_raw_index(self) -> np.ndarray:
+        return (np.arange(self.pred_points) + 1) * self.pred_stride - 1
+
+    @property
+    def plan_raw_index(self) -> np.ndarray:
+        return np.arange(self.plan_points) * self.plan_stride
+
+
+FEATURES = FeatureSpec()  # the spec the warehouse's frame_features are built with
+
+
+@dataclass
+class FrameFeatures:
+    """Monitor inputs of N frames (shapes in the module docstring, with a leading N)."""
+
+    perception: np.ndarray  # (N, n, 9) float32
+    perception_mask: np.ndarray  # (N, n) bool
+    prediction: np.ndarray  # (N, n, K, 2) float32
+    prediction_mask: np.ndarray  # (N, n) bool
+    plan: np.ndarray  # (N, P, 7) float32
+    plan_mask: np.ndarray  # (N, P) bool
+    plan_info: np.ndarray  # (N, 6) float32
+    control: np.ndarray  # (N, 6) float32
+
+    def __len__(self) -> int:
+        return int(self.control.shape[0])
+
+    def arrays(self) -> dict[str, np.ndarray]:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @classmethod
+    def empty(cls, n_frames: int, spec: FeatureSpec) -> FrameFeatures:
+        n, k, p = spec.max_obstacles, spec.pred_points, spec.plan_points
+        return cls(
+            np.zeros((n_frames, n, len(PERCEPTION_FEATURES)), np.float32),
+            np.zeros((n_frames, n), bool),
+            np.zeros((n_frames, n, k, 2), np.float32),
+            np.zeros((n_frames, n), bool),
+            np.zeros((n_frames, p, len(PLAN_FEATURES)), np.float32),
+            np.zeros((n_frames, p), bool),
+            np.zeros((n_frames, len(PLAN_INFO_FEATURES)), np.float32),
+            np.zeros((n_frames, len(CONTROL_FEATURES)), np.float32),
+        )
+
+    def fill(self, start: int, part: FrameFeatures) -> None:
+        """Copy `part` into rows start … start + len(part)."""
+        for name, arr in part.arrays().items():
+            getattr(self, name)[start : start + len(part)] = arr
+
+
+# -- Arrow helpers -------------------------------------------------------------------------------
+def _scalar(table: pa.Table, name: str) -> np.ndarray:
+    return table.column(name).to_numpy(zero_copy_only=False).astype(np.float64)
+
+
+def _list(table: pa.Table, name: str) -> tuple[np.ndarray, pa.Array]:
+    """(offsets (N+1,) int64 from 0, child values) of a list column."""
+    arr = table.column(name).combine_chunks()
+    offsets = arr.offsets.to_numpy().astype(np.int64)
+    values = arr.values.slice(offsets[0], offsets[-1] - offsets[0])
+    return offsets - offsets[0], values
+
+
+def _values(table: pa.Table, name: str) -> tuple[np.ndarray, np.ndarray]:
+    offsets, values = _list(table, name)
+    return offsets, values.to_numpy(zero_copy_only=False).astype(np.float64)
+
+
+# -- geometry -----------------------------------------------------------------------------------
+@dataclass(frozen=True)
+class _EgoPose:
+    x_m: np.ndarray
+    y_m: np.ndarray
+    cos: np.ndarray
+    sin: np.ndarray
+    heading_rad: np.ndarray
+    vx_mps: np.ndarray
+    vy_mps: np.ndarray
+
+    @classmethod
+    def of(cls, table: pa.Table) -> _EgoPose:
+        h = _scalar(table, "loc_heading_rad")
+        v = _scalar(table, "loc_speed_mps")
+        c, s = np.cos(h), np.sin(h)
+        return cls(_scalar(table, "loc_x_m"), _scalar(table, "loc_y_m"), c, s, h, v * c, v * s)
+
+    def rotate(self, wx: np.ndarray, wy: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, ...]:
+        """World vectors (wx, wy) of frames `rows` → ego-frame (forward, left)."""
+        c, s = self.cos[rows], self.sin[rows]
+        return c * wx + s * wy, -s * wx + c * wy
+
+    def to_ego(self, x: np.ndarray, y: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, ...]:
+        """World points of frames `rows` → ego-frame points."""
+        return self.rotate(x - self.x_m[rows], y - self.y_m[rows], rows)
+
+
+def _nearest_slots(
+    offsets: np.ndarray, dist: np.ndarray, n_max: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """For items grouped by frame: (item, frame, slot) of the n_max nearest per frame."""
+    frame = np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
+    order = np.lexsort((dist, frame))  # by frame, then distance
+    slot = np.arange(len(order)) - offsets[frame[order]]
+    keep = slot < n_max
+    return order[keep], frame[order[keep]], slot[keep]
+
+
+def _points_index(
+    offsets: np.ndarray, raw_index: np.ndarray, n_values: int
+) -> tuple[np.ndarray, np.ndarray]:
+    """Indices (rows, len(raw_index)) into n_values values picking items `raw_index` of each
+    row, the row's last item standing in past its end; and the mask of items that exist.
+    Empty rows index a valid but meaningless item: callers mask them."""
+    counts = np.diff(offsets)[:, None]
+    idx = offsets[:-1, None] + np.minimum(raw_index[None, :], np.maximum(counts - 1, 0))
+    return np.minimum(idx, max(n_values - 1, 0)), raw_index[None, :] < counts
+
+
+def _finite32(a: np.ndarray) -> np.ndarray:
+    return np.nan_to_num(a, nan=0.0, posinf=0.0, neginf=0.0).astype(np.float32)
+
+
+# -- per module ---------------------------------------------------------------------------------
+def _perception(t: pa.Table, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
+    offsets, x = _values(t, "obs_x_m")
+    rows = np.repeat(np.arange(len(t)), np.diff(offsets))
+    dx, dy = ego.to_ego(x, _values(t, "obs_y_m")[1], rows)
+    dh = _values(t, "obs_heading_rad")[1] - ego.heading_rad[rows]
+    dvx, dvy = ego.rotate(
+        _values(t, "obs_vx_mps")[1] - ego.vx_mps[rows],
+        _values(t, "obs_vy_mps")[1] - ego.vy_mps[rows],
+        rows,
+    )
+    feats = np.stack(
+        [dx, dy, np.cos(dh), np.sin(dh), dvx, dvy, _values(t, "obs_length_m")[1],
+         _values(t, "obs_width_m")[1], _values(t, "obs_confidence")[1]],
+        axis=-1,
+    )
+    item, frame, slot = _nearest_slots(offsets, np.hypot(dx, dy), spec.max_obstacles)
+    out.perception[frame, slot] = _finite32(feats[item])
+    out.perception_mask[frame, slot] = True
+
+
+def _prediction(t: pa.Table, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
+    outer, inner_x = _list(t, "pred_x_m")
+    _, inner_y = _list(t, "pred_y_m")
+    inner = inner_x.offsets.to_numpy().astype(np.int64)  # absolute into inner_x.values
+    x = inner_x.values.to_numpy(zero_copy_only=False).astype(np.float64)
+    y = inner_y.values.to_numpy(zero_copy_only=False).astype(np.float64)
+    if len(inner) <= 1 or len(x) == 0:
+        return
+    idx, _ = _points_index(inner, spec.pred_raw_index, len(x))  # (M, K) into x / y
+    has_points = np.diff(inner) > 0
+    rows = np.repeat(np.arange(len(t)), np.diff(outer))
+    dx, dy = ego.to_ego(x[idx], y[idx], rows[:, None])
+    dist = np.where(has_points, np.hypot(dx[:, 0], dy[:, 0]), np.inf)
+    item, frame, slot = _nearest_slots(outer, dist, spec.max_obstacles)
+    item_ok = has_points[item]
+    out.prediction[frame, slot] = _finite32(np.stack([dx[item], dy[item]], axis=-1))
+    out.prediction_mask[frame, slot] = item_ok
+
+
+def _plan(t: pa.Table, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
+    offsets, x = _values(t, "plan_x_m")
+    if len(x) == 0:
+        return
+    idx, mask = _points_index(offsets, spec.plan_raw_index, len(x))  # (N, P)
+    rows = np.arange(len(t))[:, None]
+    dx, dy = ego.to_ego(x[idx], _values(t, "plan_y_m")[1][idx], rows)
+    dh = _values(t, "plan_heading_rad")[1][idx] - ego.heading_rad[rows]
+    feats = np.stack(
+        [_values(t, "plan_t_rel_s")[1][idx], dx, dy, np.cos(dh), np.sin(dh),
+         _values(t, "plan_speed_mps")[1][idx], _values(t, "plan_accel_mps2")[1][idx]],
+        axis=-1,
+    )
+    has_plan = np.diff(offsets) > 0
+    out.plan[has_plan] = _finite32(feats[has_plan])
+    out.plan_mask[:] = mask
+
+
+def _plan_info_and_control(t: pa.Table, out: FrameFeatures) -> None:
+    decision = pc.index_in(t.column("plan_decision"), value_set=pa.array(PLANNING_DECISIONS))
+    code = decision.to_numpy(zero_copy_only=False)  # float with NaN where unknown
+    known = np.isfinite(code)
+    one_hot = np.zeros((len(t), len(PLANNING_DECISIONS)))
+    one_hot[np.flatnonzero(known), code[known].astype(np.int64)] = 1.0
+    out.plan_info[:] = _finite32(
+        np.column_stack([_scalar(t, "plan_target_speed_mps"), one_hot])
+    )
+    out.control[:] = _finite32(np.column_stack([
+        _scalar(t, "ctrl_throttle"), _scalar(t, "ctrl_brake"), _scalar(t, "ctrl_steering_rad"),
+        _scalar(t, "ctrl_accel_cmd_mps2"), _scalar(t, "loc_speed_mps"),
+        _scalar(t, "loc_accel_mps2"),
+    ]))
+
+
+def frame_features(table: pa.Table, spec: FeatureSpec = FEATURES) -> FrameFeatures:
+    """The monitor inputs of every row of `table` (runtime_frames columns), in row order."""
+    out = FrameFeatures.empty(len(table), spec)
+    if len(table) == 0:
+        return out
+    ego = _EgoPose.of(table)
+    _perception(table, ego, spec, out)
+    _prediction(table, ego, spec, out)
+    _plan(table, ego, spec, out)
+    _plan_info_and_control(table, out)
+    return out
+
+
+# -- storage layout (table frame_features) -------------------------------------------------------
+# (stored column, FrameFeatures array, count column that encodes its mask or None)
+STORED = (
+    ("perception", "perception_mask", "n_perceived"),
+    ("prediction", "prediction_mask", "n_predicted"),
+    ("plan", "plan_mask", "n_plan_points"),
+    ("plan_info", None, None),
+    ("control", None, None),
+)
+
+
+def _flat_list(arr: np.ndarray) -> pa.ListArray:
+    """(N, …) → a list column of N rows of prod(…) float32 values each."""
+    width = int(np.prod(arr.shape[1:]))
+    offsets = pa.array(np.arange(arr.shape[0] + 1, dtype=np.int32) * width, pa.int32())
+    return pa.ListArray.from_arrays(offsets, pa.array(arr.reshape(-1), pa.float32()))
+
+
+def pack(features: FrameFeatures) -> dict[str, pa.Array]:
+    """FrameFeatures → the feature columns of frame_features (masks as slot counts)."""
+    columns: dict[str, pa.Array] = {}
+    for name, mask, count in STORED:
+        columns[name] = _flat_list(getattr(features, name))
+        if count is not None:
+            columns[count] = pa.array(getattr(features, mask).sum(axis=1), pa.int32())
+    return columns
+
+
+def _reshaped(col: pa.Array | pa.ChunkedArray, shape: tuple[int, ...], name: str) -> np.ndarray:
+    if isinstance(col, pa.ChunkedArray):
+        col = col.combine_chunks()
+    values = col.flatten().to_numpy(zero_copy_only=False)
+    if values.size != len(col) * int(np.prod(shape)):
+        raise ValueError(
+            f"frame_features.{name} has {values.size} values for {len(col)} rows, expected "
+            f"{shape} per row: the warehouse was built with another FeatureSpec"
+        )
+    return values.reshape((len(col), *shape))
+
+
+def unpack(batch: pa.RecordBatch | pa.Table, spec: FeatureSpec = FEATURES) -> FrameFeatures:
+    """The feature columns of frame_features → FrameFeatures (inverse of `pack`)."""
+    empty = FrameFeatures.empty(0, spec)
+    arrays: dict[str, np.ndarray] = {}
+    for name, mask, count in STORED:
+        shape = getattr(empty, name).shape[1:]
+        arrays[name] = _reshaped(batch.column(name), shape, name)
+        if count is not None:
+            width = getattr(empty, mask).shape[1]
+            n = batch.column(count).to_numpy(zero_copy_only=False)
+            arrays[mask] = np.arange(width)[None, :] < n[:, None]
+    return FrameFeatures(**arrays)

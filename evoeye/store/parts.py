@@ -1,0 +1,105 @@
+"""The Parquet parts of the warehouse tables: atomic writes, commit order, orphan clean-up.
+
+A part is one Parquet file per table per partition, named `<ingest_id>.parquet`, holding the
+rows of one or more runs. The `frames` and `frame_features` parts are written first; writing
+the `scenarios` part of the same name commits its runs. Each write goes to a temporary file
+that is fsynced and renamed, so a file under a final name is always complete; a part without
+its `scenarios` twin is an orphan of a killed ingest, invisible to the views (they join on
+ingest_id) and removed by the next writer.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pyarrow as pa
+import pyarrow.parquet as pq
+
+from evoeye.paths import DataRoot
+from evoeye.store.catalog import PART_GLOB
+from evoeye.store.schema import PARTITION_KEYS, TABLES, canonical_schema, file_schema
+
+PART_SUFFIX = ".parquet"
+TMP_SUFFIX = ".tmp"
+# Raw tables are cold storage: zstd. frame_features is read whole for every training set, so
+# it trades disk for read speed (see benchmarks/bench_warehouse.py).
+COMPRESSION = {"scenarios": "zstd", "frames": "zstd", "frame_features": "lz4"}
+
+
+def _fsync_dir(path: Path) -> None:
+    fd = os.open(path, os.O_RDONLY)
+    try:
+        os.fsync(fd)
+    finally:
+        os.close(fd)
+
+
+def _write_options(table: str, schema: pa.Schema) -> dict:
+    """Dictionaries for string columns only, statistics for scalar columns only: float
+    arrays neither repeat nor get filtered on, and both would slow writes and reads."""
+    scalar = [f.name for f in schema if not pa.types.is_list(f.type)]
+    strings = [f.name for f in schema if f.type in (pa.string(), pa.list_(pa.string()))]
+    return {
+        "compression": COMPRESSION[table],
+        "use_dictionary": strings,
+        "write_statistics": scalar,
+    }
+
+
+class PartStore:
+    """Writes and lists the Parquet parts of `scenarios` and `frames` under one data root."""
+
+    def __init__(self, root: DataRoot) -> None:
+        self.root = root
+
+    def partition_dir(self, table: str, partition: tuple[str, str]) -> Path:
+        folders = [f"{k}={v}" for k, v in zip(PARTITION_KEYS, partition, strict=True)]
+        return self.root.table_dir(table).joinpath(*folders)
+
+    def write(self, table: str, partition: tuple[str, str], part: str, data: pa.Table) -> Path:
+        """Write `data` as part `part` of `table`, atomically; the final path."""
+        expected = canonical_schema(file_schema(table))
+        if canonical_schema(data.schema) != expected:
+            raise ValueError(f"{table} part does not match the DDL:\n{data.schema}")
+        folder = self.partition_dir(table, partition)
+        folder.mkdir(parents=True, exist_ok=True)
+        final = folder / f"{part}{PART_SUFFIX}"
+        tmp = folder / f".{part}{PART_SUFFIX}.{os.getpid()}{TMP_SUFFIX}"
+        try:
+            with open(tmp, "wb") as f:
+                pq.write_table(data, f, **_write_options(table, data.schema))
+                f.flush()
+                os.fsync(f.fileno())
+            os.replace(tmp, final)
+        except BaseException:
+            tmp.unlink(missing_ok=True)
+            raise
+        _fsync_dir(folder)
+        return final
+
+    def commit(self, partition: tuple[str, str], part: str, scenarios: pa.Table) -> Path:
+        """Write the scenarios part: from here on the part's runs are visible."""
+        return self.write("scenarios", partition, part, scenarios)
+
+    def _parts(self, table: str) -> dict[Path, Path]:
+        """Part path relative to the table folder → absolute path."""
+        base = self.root.table_dir(table)
+        return {p.relative_to(base): p for p in base.glob(PART_GLOB)}
+
+    def orphans(self) -> list[Path]:
+        """Parts without a committed scenarios twin, and leftover temporary files."""
+        committed = set(self._parts("scenarios"))
+        found: list[Path] = []
+        for table in TABLES:
+            if table != "scenarios":
+                found += [p for rel, p in self._parts(table).items() if rel not in committed]
+            found += self.root.table_dir(table).glob(f"*/*/.*{TMP_SUFFIX}")
+        return sorted(found)
+
+    def remove_orphans(self) -> list[Path]:
+        """Delete what `orphans` lists; call only under the writer lock."""
+        removed = self.orphans()
+        for path in removed:
+            path.unlink(missing_ok=True)
+        return removed

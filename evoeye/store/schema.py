@@ -1,0 +1,77 @@
+"""The warehouse tables' contracts: the DDL in `schemas/warehouse/` and the Arrow schemas from it.
+
+The DDL is the one place a column is declared. Python never retypes it: the Arrow schema of a
+table is what DuckDB reports for the declared (empty) table, so the Parquet files, the views and
+the DDL cannot drift apart.
+"""
+
+from __future__ import annotations
+
+from functools import cache
+from pathlib import Path
+
+import duckdb
+import pyarrow as pa
+
+# The one place that locates the SQL folders (the project is installed editable).
+PROJECT_DIR = Path(__file__).resolve().parents[2]
+DDL_DIR = PROJECT_DIR / "schemas" / "warehouse"
+VIEWS_DIR = PROJECT_DIR / "warehouse" / "views"
+QUERIES_DIR = PROJECT_DIR / "warehouse" / "queries"
+
+TABLES = ("scenarios", "frames", "frame_features")
+# Hive partition keys, in folder order: they are columns of the views, not of the files.
+PARTITION_KEYS = ("logical_scenario", "batch")
+DDL_SCHEMA = "ddl"  # the DuckDB schema holding the declared, always empty, tables
+
+
+def ddl(table: str) -> str:
+    """The CREATE TABLE statement of `table`."""
+    if table not in TABLES:
+        raise KeyError(f"unknown warehouse table {table!r}; known: {TABLES}")
+    return (DDL_DIR / f"{table}.sql").read_text(encoding="utf-8")
+
+
+def create_declared_tables(con: duckdb.DuckDBPyConnection) -> None:
+    """Create every declared table, empty, in the `ddl` schema of `con`."""
+    con.execute(f"CREATE SCHEMA IF NOT EXISTS {DDL_SCHEMA}")
+    con.execute(f"SET schema = '{DDL_SCHEMA}'")
+    try:
+        for table in TABLES:
+            con.execute(f"DROP TABLE IF EXISTS {table}")
+            con.execute(ddl(table))
+    finally:
+        con.execute("SET schema = 'main'")
+
+
+def _canonical(t: pa.DataType) -> pa.DataType:
+    """`t` with list children renamed to Arrow's default, so DuckDB's and Parquet's names agree."""
+    if pa.types.is_list(t) or pa.types.is_large_list(t):
+        return pa.list_(_canonical(t.value_type))
+    if pa.types.is_large_string(t) or pa.types.is_string_view(t):
+        return pa.string()
+    return t
+
+
+@cache
+def table_schema(table: str) -> pa.Schema:
+    """The Arrow schema of `table` as declared, partition keys included, in DDL order."""
+    con = duckdb.connect()
+    try:
+        create_declared_tables(con)
+        declared = con.sql(f"SELECT * FROM {DDL_SCHEMA}.{table} LIMIT 0").to_arrow_table().schema
+    finally:
+        con.close()
+    return pa.schema([pa.field(f.name, _canonical(f.type)) for f in declared])
+
+
+@cache
+def file_schema(table: str) -> pa.Schema:
+    """The Arrow schema of one Parquet file of `table`: the declared one minus partition keys."""
+    full = table_schema(table)
+    return pa.schema([f for f in full if f.name not in PARTITION_KEYS])
+
+
+def canonical_schema(schema: pa.Schema) -> pa.Schema:
+    """`schema` with nullability, metadata and list child names dropped, for comparisons."""
+    return pa.schema([pa.field(f.name, _canonical(f.type)) for f in schema])

@@ -1,0 +1,72 @@
+"""Which runs: splits by scenario (seeded) and subsets of runs, both answered in SQL."""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass, field
+
+import duckdb
+import pyarrow as pa
+
+from evoeye.store.sqlfiles import query
+
+SPLITS = ("train", "val", "test")
+
+
+@dataclass(frozen=True)
+class SplitSpec:
+    """A scenario-level split (macro `scenario_splits`): seed and the train / val shares.
+
+    The defaults follow the paper's datasets: half the initial data trains, the other half is
+    held out and split val : test = 1 : 3. Runs of rounds >= 1 always train.
+    """
+
+    seed: int = 0
+    train_frac: float = 0.5
+    val_frac: float = 0.125
+
+    def __post_init__(self) -> None:
+        fracs_ok = min(self.train_frac, self.val_frac) >= 0.0
+        if not (fracs_ok and self.train_frac + self.val_frac <= 1.0):
+            raise ValueError(f"need 0 <= train_frac, val_frac and a sum <= 1: {self}")
+
+
+@dataclass(frozen=True)
+class RunFilter:
+    """A subset of runs; None means "any". Only runs with status 'ok' by default."""
+
+    logical_scenario: str | None = None
+    split: str | None = None  # train / val / test under `splits`
+    source: str | None = None
+    min_round: int | None = None
+    max_round: int | None = None
+    collided: bool | None = None  # True: violation runs only; False: collision-free only
+    status: str | None = "ok"
+    splits: SplitSpec = field(default_factory=SplitSpec)
+
+    def __post_init__(self) -> None:
+        if self.split is not None and self.split not in SPLITS:
+            raise ValueError(f"split must be one of {SPLITS}, got {self.split!r}")
+
+    def params(self) -> dict[str, object]:
+        """The `$name` parameters of warehouse/queries/select_runs.sql."""
+        p = {k: v for k, v in asdict(self).items() if k != "splits"}
+        return {**p, **asdict(self.splits)}
+
+
+Runs = RunFilter | Sequence[str] | str | None
+
+
+def select_runs(con: duckdb.DuckDBPyConnection, runs: Runs = None) -> pa.Table:
+    """The scenario ids (one column, `scenario_id`) of a subset of runs.
+
+    `runs` is a RunFilter, an explicit list of scenario ids, or any SQL query over the
+    warehouse views returning a `scenario_id` column; None means every run with status 'ok'.
+    """
+    if runs is None:
+        runs = RunFilter()
+    if isinstance(runs, RunFilter):
+        return con.sql(query("select_runs"), params=runs.params()).to_arrow_table()
+    if isinstance(runs, str):
+        return con.sql(runs).select("scenario_id").to_arrow_table()
+    return pa.table({"scenario_id": pa.array(list(runs), pa.string())})

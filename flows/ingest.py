@@ -1,0 +1,60 @@
+"""Flow: ingest every new run log under a data root into the warehouse (a thin wrapper).
+
+Ingest is idempotent, so the task may simply be retried; it is retried only when another
+writer holds the warehouse lock, since any other failure would fail the same way again.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict
+from typing import Any
+
+from prefect import flow, get_run_logger, task
+from prefect.client.schemas.objects import TaskRun
+from prefect.states import State
+from prefect.tasks import Task
+from pydantic import BaseModel, Field
+
+from evoeye.paths import resolve_root
+from evoeye.store import WarehouseLockedError, ingest
+from evoeye.store.ingest import DEFAULT_RUNS_PER_PART
+
+
+class IngestParams(BaseModel):
+    """Where to ingest and how many runs go into one Parquet part."""
+
+    root: str | None = None  # default: $EVOEYE_HOME or ./evoeye-data
+    runs_per_part: int = Field(DEFAULT_RUNS_PER_PART, ge=1, le=10_000)
+
+
+def _locked(task: Task, task_run: TaskRun, state: State) -> bool:
+    """Retry only while another process holds the writer lock."""
+    try:
+        state.result()
+    except WarehouseLockedError:
+        return True
+    except Exception:  # noqa: BLE001  (any other failure: do not retry)
+        return False
+    return False
+
+
+@task(retries=5, retry_delay_seconds=10, retry_condition_fn=_locked)
+def ingest_logs(root: str, runs_per_part: int) -> dict[str, Any]:
+    """One ingest pass; the IngestReport as a dict."""
+    return asdict(ingest(root, runs_per_part=runs_per_part))
+
+
+@flow(name="evoeye-ingest", log_prints=True)
+def ingest_flow(params: IngestParams | None = None) -> dict[str, Any]:
+    """Ingest the runs of `params.root`; the report names every quarantined log."""
+    params = params or IngestParams()
+    root = str(resolve_root(params.root))
+    report = ingest_logs(root, params.runs_per_part)
+    logger = get_run_logger()
+    logger.info("%d runs (%d frames) ingested, %d already in, into %s/warehouse",
+                len(report["ingested"]), report["frames"], report["skipped"], root)
+    for log, reason in report["quarantined"]:
+        logger.warning("quarantined %s: %s", log, reason)
+    if report["catalog_error"]:
+        logger.warning("views not refreshed: %s", report["catalog_error"])
+    return report

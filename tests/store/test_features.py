@@ -1,0 +1,131 @@
+"""Monitor inputs of a frame: ego frame, nearest first, truncation, padding, masks."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pyarrow as pa
+import pytest
+
+from evoeye.ads.messages import PLANNING_DECISIONS
+from evoeye.store import Warehouse, ingest
+from evoeye.store.features import (
+    FEATURES,
+    PERCEPTION_FEATURES,
+    PLAN_FEATURES,
+    FeatureSpec,
+    frame_features,
+    pack,
+    unpack,
+)
+from evoeye.store.records import runtime_table
+
+SPEC = FeatureSpec(max_obstacles=2, pred_points=2, pred_stride=3, plan_points=4, plan_stride=2)
+P = {name: i for i, name in enumerate(PERCEPTION_FEATURES)}
+Q = {name: i for i, name in enumerate(PLAN_FEATURES)}
+
+
+def _frames(decisions: list[str | None], obstacles_x: list[list[float]]) -> pa.Table:
+    """Frames with the ego at (10, 5) heading +y (pi/2) at 2 m/s; obstacles at x, y."""
+    n = len(decisions)
+    obs_y = [[25.0, 5.0, -40.0][: len(xs)] for xs in obstacles_x]
+    k_raw = 6
+    return pa.table({
+        "loc_x_m": [10.0] * n, "loc_y_m": [5.0] * n, "loc_heading_rad": [math.pi / 2] * n,
+        "loc_speed_mps": [2.0] * n, "loc_accel_mps2": [0.5] * n,
+        "obs_x_m": obstacles_x, "obs_y_m": obs_y,
+        "obs_heading_rad": [[math.pi / 2] * len(xs) for xs in obstacles_x],
+        "obs_vx_mps": [[0.0] * len(xs) for xs in obstacles_x],
+        "obs_vy_mps": [[12.0] * len(xs) for xs in obstacles_x],
+        "obs_length_m": [[4.0] * len(xs) for xs in obstacles_x],
+        "obs_width_m": [[2.0] * len(xs) for xs in obstacles_x],
+        "obs_confidence": [[0.9] * len(xs) for xs in obstacles_x],
+        # one predicted track per obstacle: straight ahead (+y) one metre per point
+        "pred_x_m": [[[x] * k_raw for x in xs] for xs in obstacles_x],
+        "pred_y_m": [[[y + j + 1 for j in range(k_raw)] for y in ys] for ys in obs_y],
+        "plan_decision": decisions,
+        "plan_target_speed_mps": [8.0] * n,
+        "plan_t_rel_s": [[0.0, 0.1, 0.2, 0.3, 0.4]] * n,
+        "plan_x_m": [[10.0] * 5] * n,
+        "plan_y_m": [[5.0, 6.0, 7.0, 8.0, float("nan")]] * n,
+        "plan_heading_rad": [[math.pi / 2] * 5] * n,
+        "plan_speed_mps": [[2.0, 2.1, 2.2, 2.3, 2.4]] * n,
+        "plan_accel_mps2": [[0.0] * 5] * n,
+        "ctrl_throttle": [0.3] * n, "ctrl_brake": [0.0] * n, "ctrl_steering_rad": [0.01] * n,
+        "ctrl_accel_cmd_mps2": [1.0] * n,
+    })
+
+
+def test_perception_is_ego_relative_nearest_first_and_truncated() -> None:
+    f = frame_features(_frames(["yield"], [[10.0, 7.0, 10.0]]), SPEC)
+    near, far = f.perception[0]
+    # (7, 5) is 3 m to the ego's left; (10, 25) is 20 m ahead; (10, -40) is dropped
+    assert near[P["dx_m"]] == pytest.approx(0.0, abs=1e-5)
+    assert near[P["dy_m"]] == pytest.approx(3.0)
+    assert far[P["dx_m"]] == pytest.approx(20.0) and far[P["dy_m"]] == pytest.approx(0.0, abs=1e-5)
+    assert far[P["cos_dheading"]] == pytest.approx(1.0)
+    # velocity (0, 12) minus the ego's (0, 2): 10 m/s forward in the ego frame
+    assert far[P["dvx_mps"]] == pytest.approx(10.0)
+    assert far[P["dvy_mps"]] == pytest.approx(0.0, abs=1e-5)
+    assert far[P["confidence"]] == pytest.approx(0.9)
+    assert f.perception_mask[0].tolist() == [True, True]
+
+
+def test_missing_obstacles_are_zero_and_masked() -> None:
+    f = frame_features(_frames(["cruise", "cruise"], [[10.0], []]), SPEC)
+    assert f.perception_mask.tolist() == [[True, False], [False, False]]
+    assert not f.perception[0, 1].any() and not f.perception[1].any()
+    assert f.prediction_mask.tolist() == [[True, False], [False, False]]
+
+
+def test_prediction_keeps_strided_points_in_the_ego_frame() -> None:
+    f = frame_features(_frames(["cruise"], [[10.0, 7.0]]), SPEC)
+    # raw points 2 and 5 (stride 3) of the track starting 20 m ahead: 23 m and 26 m ahead
+    np.testing.assert_allclose(f.prediction[0, 1, :, 0], [23.0, 26.0], rtol=1e-6)
+    np.testing.assert_allclose(f.prediction[0, 0, :, 1], [3.0, 3.0], rtol=1e-6)
+
+
+def test_plan_is_strided_padded_with_its_last_point_and_finite() -> None:
+    f = frame_features(_frames(["follow"], [[10.0]]), SPEC)
+    plan = f.plan[0]
+    # raw points 0, 2, 4 exist; slot 3 (raw 6) repeats raw 4 and is masked
+    np.testing.assert_allclose(plan[:, Q["t_rel_s"]], [0.0, 0.2, 0.4, 0.4], rtol=1e-6)
+    np.testing.assert_allclose(plan[:3, Q["dx_m"]], [0.0, 2.0, 0.0], atol=1e-5)  # NaN -> 0
+    assert f.plan_mask[0].tolist() == [True, True, True, False]
+    assert np.isfinite(plan).all()
+
+
+def test_plan_info_one_hot_and_control() -> None:
+    f = frame_features(_frames(["yield", "teleport"], [[10.0], [10.0]]), SPEC)
+    hot = f.plan_info[:, 1:]
+    assert hot[0].tolist() == [float(d == "yield") for d in PLANNING_DECISIONS]
+    assert not hot[1].any()  # an unknown decision has no hot entry
+    assert f.plan_info[0, 0] == pytest.approx(8.0)
+    np.testing.assert_allclose(f.control[0], [0.3, 0.0, 0.01, 1.0, 2.0, 0.5], rtol=1e-6)
+
+
+def test_pack_then_unpack_is_the_identity() -> None:
+    f = frame_features(_frames(["yield", "cruise"], [[10.0, 7.0, 10.0], [7.0]]), SPEC)
+    g = unpack(pa.table(pack(f)), SPEC)
+    for name, arr in f.arrays().items():
+        np.testing.assert_array_equal(getattr(g, name), arr, err_msg=name)
+
+
+def test_unpack_refuses_another_spec() -> None:
+    f = frame_features(_frames(["yield"], [[10.0]]), SPEC)
+    with pytest.raises(ValueError, match="another FeatureSpec"):
+        unpack(pa.table(pack(f)), FeatureSpec())
+
+
+def test_runtime_messages_give_the_inputs_stored_at_ingest(
+    root, episode_factory, log_writer
+) -> None:
+    """Training and runtime share one feature path: live messages → the stored inputs."""
+    episode = episode_factory("live", n_frames=15, seed=9)
+    log_writer(root, episode)
+    ingest(root)
+    stored = unpack(Warehouse(root).sql("SELECT * FROM frame_features ORDER BY frame"), FEATURES)
+    live = frame_features(runtime_table([f.messages for f in episode.frames]), FEATURES)
+    for name, arr in stored.arrays().items():
+        np.testing.assert_allclose(getattr(live, name), arr, rtol=1e-6, atol=1e-5, err_msg=name)
