@@ -63,6 +63,10 @@ class DataRoot:
     def monitors(self) -> Path:
         return self.path / "monitors"
 
+    @property
+    def reports(self) -> Path:
+        return self.path / "reports"
+
     def table_dir(self, table: str) -> Path:
         return self.warehouse / table
 

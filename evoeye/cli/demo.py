@@ -2,13 +2,13 @@
 
 from __future__ import annotations
 
-from pathlib import Path
 from typing import Annotated
 
 import typer
 
 from evoeye.cli.app import app
 from evoeye.cli.simulate import RootOpt, console, simulate_batch, summary_table
+from evoeye.cli.warehouse import ingest_command, stats_command
 from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
 
@@ -20,10 +20,13 @@ def demo(
     seed: Annotated[int, typer.Option(min=0)] = 0,
     workers: Annotated[int, typer.Option(min=1)] = 2,
 ) -> None:
-    """Simulate a batch of both logical scenarios and print where the logs are."""
-    data = DataRoot.at(root)
-    rows = []
-    for name in SCENARIOS:
-        rows.append((name, simulate_batch(name, n, seed, data.path, workers, batch="demo")))
-    console.print(summary_table("evoeye demo", rows))
-    console.print(f"MCAP logs (open in Foxglove or Lichtblick): {Path(data.runs).resolve()}")
+    """Simulate both logical scenarios, ingest the logs, print the dataset and where it all is."""
+    data = DataRoot.resolve(root)
+    rows = [(name, simulate_batch(name, n, seed, data.path, workers, batch="demo"))
+            for name in SCENARIOS]
+    console.print(summary_table("evoeye demo: simulate", rows))
+    ingest_command(root=data.path)
+    stats_command(root=data.path)
+    console.print(f"\nMCAP logs (open in Foxglove or Lichtblick): {data.runs}")
+    console.print(f"warehouse (Parquet + DuckDB): {data.warehouse}")
+    console.print(f'try: evoeye sql --root {data.path} "SELECT * FROM dataset_stats"')
