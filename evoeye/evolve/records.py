@@ -1,0 +1,94 @@
+"""The executed scenario records D that acquisition strategies read (one row per simulated run)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, replace
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Records:
+    """D in acquisition order: vectors, feedback and outcomes; append-only, rows never reordered.
+
+    Only `params` and `feedback` steer the density-aware strategies; the other columns are what
+    the loop needs anyway (AV-Fuzzer fitness, collisions, the simulated time charged).
+    """
+
+    params: np.ndarray  # (n, dim) concrete scenarios, parameter units
+    feedback: np.ndarray  # (n,) f_r(x) under the current monitor; NaN = not scored
+    fitness: np.ndarray | None = None  # (n,) criticality in [0, 1], minimised; NaN = unknown
+    collided: np.ndarray | None = None  # (n,) bool
+    duration_s: np.ndarray | None = None  # (n,) simulated seconds of each run
+    scenario_id: np.ndarray | None = None  # (n,) str, to align refreshed feedback with the runs
+
+    def __post_init__(self) -> None:
+        params = np.asarray(self.params, dtype=float)
+        if params.ndim != 2:
+            raise ValueError(f"params must be (n, dim), got shape {params.shape}")
+        n = len(params)
+        cols = {
+            "params": params,
+            "feedback": _column(self.feedback, n, np.nan, float, "feedback"),
+            "fitness": _column(self.fitness, n, np.nan, float, "fitness"),
+            "collided": _column(self.collided, n, False, bool, "collided"),
+            "duration_s": _column(self.duration_s, n, 0.0, float, "duration_s"),
+            "scenario_id": _column(self.scenario_id, n, "", object, "scenario_id"),
+        }
+        for name, value in cols.items():
+            object.__setattr__(self, name, value)
+
+    @classmethod
+    def empty(cls, dim: int) -> Records:
+        return cls(params=np.empty((0, dim)), feedback=np.empty(0))
+
+    @property
+    def n(self) -> int:
+        return len(self.params)
+
+    def __len__(self) -> int:
+        return self.n
+
+    def append(
+        self,
+        x: np.ndarray,
+        *,
+        feedback: float = np.nan,
+        fitness: float = np.nan,
+        collided: bool = False,
+        duration_s: float = 0.0,
+        scenario_id: str = "",
+    ) -> Records:
+        """A new table with one more run at the end (O(n) copy; n is a few thousand at most)."""
+        return Records(
+            params=np.vstack([self.params, np.asarray(x, dtype=float)[None, :]]),
+            feedback=np.append(self.feedback, feedback),
+            fitness=np.append(self.fitness, fitness),
+            collided=np.append(self.collided, collided),
+            duration_s=np.append(self.duration_s, duration_s),
+            scenario_id=np.append(self.scenario_id, np.array([scenario_id], dtype=object)),
+        )
+
+    def with_feedback(self, feedback: np.ndarray) -> Records:
+        """The same runs with every feedback refreshed (after a monitor update)."""
+        return replace(self, feedback=np.asarray(feedback, dtype=float))
+
+    def tail(self, start: int) -> Records:
+        """Rows from `start` on, e.g. the records one strategy acquired after D_init."""
+        return Records(
+            params=self.params[start:],
+            feedback=self.feedback[start:],
+            fitness=self.fitness[start:],
+            collided=self.collided[start:],
+            duration_s=self.duration_s[start:],
+            scenario_id=self.scenario_id[start:],
+        )
+
+
+def _column(value, n: int, default, dtype, name: str) -> np.ndarray:
+    if value is None:
+        return np.full(n, default, dtype=dtype)
+    arr = np.asarray(value, dtype=dtype)
+    if arr.shape != (n,):
+        raise ValueError(f"{name} must have shape ({n},), got {arr.shape}")
+    return arr
