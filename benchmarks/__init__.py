@@ -1,1 +1,1 @@
-"""Performance benchmarks: run `python -m benchmarks` (or `make bench`); results go to BENCHMARKS.md."""
+"""Performance benchmarks: `python -m benchmarks` (or `make bench`); figures go to BENCHMARKS.md."""

@@ -27,7 +27,8 @@ class SimulateParams(BaseModel):
 
     def model_post_init(self, __context) -> None:
         if self.scenario not in SCENARIOS:
-            raise ValueError(f"unknown logical scenario {self.scenario!r}; known: {sorted(SCENARIOS)}")
+            known = sorted(SCENARIOS)
+            raise ValueError(f"unknown logical scenario {self.scenario!r}; known: {known}")
 
 
 @task(retries=1, retry_delay_seconds=1, task_run_name="run-{spec.scenario_id}")

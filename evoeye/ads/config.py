@@ -90,7 +90,7 @@ class PlanningConfig:
     cutin_horizon_s: float = 2.0  # an aligned car predicted in the path within this is a leader
     aligned_max_rad: float = 0.6  # heading gap to the route below which a car "follows"
     gap_margin_s: float = -1.0  # optimistic: takes a crossing gap up to 1 s shorter than needed
-    go_accel_mps2: float = 3.0  # acceleration assumed when estimating the ego's arrival (optimistic)
+    go_accel_mps2: float = 3.0  # accel assumed for the ego's arrival estimate (optimistic)
     stop_buffer_m: float = 1.5  # the ego stops this far before a conflict region
     yield_decel_max_mps2: float = 1.5  # beyond this the ego is committed and goes on
     emergency_ttc_s: float = 0.7  # time to collision below which the ego brakes hard (late AEB)

@@ -22,7 +22,8 @@ class Thresholds:
         try:
             return self.by_fpr[fpr]
         except KeyError:
-            raise KeyError(f"no threshold calibrated for FPR {fpr}; have {sorted(self.by_fpr)}")
+            have = sorted(self.by_fpr)
+            raise KeyError(f"no threshold calibrated for FPR {fpr}; have {have}") from None
 
 
 @runtime_checkable

@@ -11,7 +11,8 @@ def get_scenario(name: str) -> LogicalScenario:
     try:
         return SCENARIOS[name]
     except KeyError:
-        raise ScenarioError(f"unknown logical scenario {name!r}; known: {sorted(SCENARIOS)}") from None
+        known = sorted(SCENARIOS)
+        raise ScenarioError(f"unknown logical scenario {name!r}; known: {known}") from None
 
 
 __all__ = [

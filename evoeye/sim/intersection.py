@@ -67,7 +67,8 @@ def build_intersection(p: dict[str, float], rng: np.random.Generator) -> tuple[W
     npcs = []
     for actor_id, (name, (src, dst)) in enumerate(NPC_MOVES.items(), start=1):
         speed = p[f"{name}_speed_mps"]
-        route = [(f"o{src}", f"ir{src}", 0), (f"ir{src}", f"il{dst}", 0), (f"il{dst}", f"o{dst}", 0)]
+        route = [(f"o{src}", f"ir{src}", 0), (f"ir{src}", f"il{dst}", 0),
+                 (f"il{dst}", f"o{dst}", 0)]
         lane = net.get_lane(route[0])
         v = ScriptedVehicle(
             road, lane.position(NPC_ENTRY_S_M, 0.0), lane.heading_at(NPC_ENTRY_S_M), speed,

@@ -121,6 +121,7 @@ def run_episode(
             min_distance_m=min_gap if np.isfinite(min_gap) else None,
         )
     return Episode(
-        spec=spec, road_map=road_map or RoadMap.empty(spec.scenario), outcome=outcome, software_version=__version__,
+        spec=spec, road_map=road_map or RoadMap.empty(spec.scenario), outcome=outcome,
+        software_version=__version__,
         rate_hz=config.rate_hz, frames=frames,
     )
