@@ -74,7 +74,8 @@ def build_highway(p: dict[str, float], rng: np.random.Generator) -> tuple[World,
     ]
     xs = _place([(s[0], s[1]) for s in specs])
     npcs = []
-    for actor_id, ((lane_i, _, speed, brake, change), x) in enumerate(zip(specs, xs, strict=True), start=1):
+    placed = zip(specs, xs, strict=True)
+    for actor_id, ((lane_i, _, speed, brake, change), x) in enumerate(placed, start=1):
         v = ScriptedVehicle(
             road, lane(lane_i).position(x, 0.0), 0.0, speed,
             target_speed=speed, target_lane_index=("0", "1", lane_i),
