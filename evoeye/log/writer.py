@@ -17,6 +17,7 @@ import orjson
 from mcap.writer import LIBRARY_IDENTIFIER
 
 from evoeye import __version__
+from evoeye.atomic import atomic_file
 from evoeye.log.channels import (
     FRAME_CHANNELS,
     MAP_CHANNEL,
@@ -109,14 +110,6 @@ def write_episode(episode: Episode, path: str | os.PathLike) -> Path:
     (status "failed", possibly with zero frames) are written too, so their reason is on disk.
     """
     path = Path(path)
-    tmp = path.with_name(f"{path.name}.{os.getpid()}.tmp")
-    try:
-        with open(tmp, "wb") as f:
-            write_stream(episode, f)
-            f.flush()
-            os.fsync(f.fileno())
-        os.replace(tmp, path)
-    except BaseException:
-        tmp.unlink(missing_ok=True)
-        raise
+    with atomic_file(path) as f:
+        write_stream(episode, f)
     return path

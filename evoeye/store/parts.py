@@ -16,6 +16,7 @@ from pathlib import Path
 import pyarrow as pa
 import pyarrow.parquet as pq
 
+from evoeye.atomic import atomic_file, fsync_dir
 from evoeye.paths import DataRoot
 from evoeye.store.catalog import PART_GLOB
 from evoeye.store.schema import PARTITION_KEYS, TABLES, canonical_schema, file_schema
@@ -25,14 +26,6 @@ TMP_SUFFIX = ".tmp"
 # Raw tables are cold storage: zstd. frame_features is read whole for every training set, so
 # it trades disk for read speed (see benchmarks/bench_warehouse.py).
 COMPRESSION = {"scenarios": "zstd", "frames": "zstd", "frame_features": "lz4"}
-
-
-def _fsync_dir(path: Path) -> None:
-    fd = os.open(path, os.O_RDONLY)
-    try:
-        os.fsync(fd)
-    finally:
-        os.close(fd)
 
 
 def _write_options(table: str, schema: pa.Schema) -> dict:
@@ -66,16 +59,9 @@ class PartStore:
         folder.mkdir(parents=True, exist_ok=True)
         final = folder / f"{part}{PART_SUFFIX}"
         tmp = folder / f".{part}{PART_SUFFIX}.{os.getpid()}{TMP_SUFFIX}"
-        try:
-            with open(tmp, "wb") as f:
-                pq.write_table(data, f, **_write_options(table, data.schema))
-                f.flush()
-                os.fsync(f.fileno())
-            os.replace(tmp, final)
-        except BaseException:
-            tmp.unlink(missing_ok=True)
-            raise
-        _fsync_dir(folder)
+        with atomic_file(final, tmp) as f:
+            pq.write_table(data, f, **_write_options(table, data.schema))
+        fsync_dir(folder)
         return final
 
     def commit(self, partition: tuple[str, str], part: str, scenarios: pa.Table) -> Path:
