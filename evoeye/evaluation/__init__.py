@@ -1,5 +1,30 @@
 """Evaluation: calibration, the paper's metrics, scenario-level detection, lead time, reports."""
 
 from evoeye.evaluation.calibration import alarms, calibrate
+from evoeye.evaluation.harness import EvaluationReport, MonitorResult, evaluate
+from evoeye.evaluation.metrics import PRF, FrameMetrics, frame_metrics, prf
+from evoeye.evaluation.monitors import BASELINES, baseline_monitors, load_monitors, train_fusion
+from evoeye.evaluation.report import markdown_report, write_report
+from evoeye.evaluation.scenario import LeadTimes, Runs, ScenarioMetrics, scenario_metrics
 
-__all__ = ["alarms", "calibrate"]
+__all__ = [
+    "BASELINES",
+    "PRF",
+    "EvaluationReport",
+    "FrameMetrics",
+    "LeadTimes",
+    "MonitorResult",
+    "Runs",
+    "ScenarioMetrics",
+    "alarms",
+    "baseline_monitors",
+    "calibrate",
+    "evaluate",
+    "frame_metrics",
+    "load_monitors",
+    "markdown_report",
+    "prf",
+    "scenario_metrics",
+    "train_fusion",
+    "write_report",
+]

@@ -37,7 +37,10 @@ def log_path(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFa
 
 
 def test_schema_files_exist_and_are_all_used() -> None:
-    used = {c.schema_file for c in CHANNELS.values()} | {RUN_SCHEMA_FILE, ROAD_MAP_SCHEMA_FILE}
+    from evoeye.monitor.replay import RISK_SCHEMA_FILE  # the replay's added channel
+
+    used = {c.schema_file for c in CHANNELS.values()} | {RUN_SCHEMA_FILE, ROAD_MAP_SCHEMA_FILE,
+                                                         RISK_SCHEMA_FILE}
     assert {p.name for p in SCHEMA_FILES} == used
 
 

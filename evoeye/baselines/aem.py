@@ -1,0 +1,204 @@
+"""AEM baseline (AutoEncode-Monitor): reconstruction error of the module inputs as the risk.
+
+Inspired by SelfOracle, but over the FusionMonitor's inputs: every window's perception,
+prediction, planning and control arrays with their masks (padded context slots zeroed),
+flattened to one vector, standardised with the training mean and std, and passed through an
+MLP autoencoder. It is trained on collision-free frames only: windows labelled 0 whose frame is
+before the run's collision (or in a run without one) — the caller passes that selection. The
+score is e / (e + ẽ), e the window's mean squared reconstruction error and ẽ the median error on
+the training windows: monotone in e, 0.5 at a typical normal window, → 1 for outliers.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import io
+import json
+from contextlib import contextmanager
+from dataclasses import asdict, dataclass
+from pathlib import Path
+
+import numpy as np
+import torch
+from torch import nn
+
+from evoeye.store.windows import Windows
+
+INPUT_ARRAYS = (  # (array, mask or None): the FusionMonitor's module inputs
+    ("perception", "perception_mask"),
+    ("prediction", "prediction_mask"),
+    ("plan", "plan_mask"),
+    ("plan_info", None),
+    ("control", None),
+)
+CHUNK = 8192  # windows gathered at a time (a window is ~L·350 floats)
+
+
+@dataclass(frozen=True)
+class AEMConfig:
+    """Autoencoder shape and training schedule."""
+
+    context_len: int = 5
+    hidden: tuple[int, ...] = (256, 64)
+    latent: int = 16
+    epochs: int = 25
+    batch_size: int = 256
+    lr: float = 1e-3
+    weight_decay: float = 1e-5
+    max_train_windows: int = 200_000
+    seed: int = 0
+
+
+def window_vectors(windows: Windows, index: np.ndarray | slice | None = None) -> np.ndarray:
+    """(b, D) float32: each window's module inputs and masks, flattened, padded slots zeroed."""
+    a = windows.arrays(index)
+    keep = a["context_mask"].astype(np.float32)  # (b, L)
+    parts = []
+    for name, mask in INPUT_ARRAYS:
+        x = a[name].astype(np.float32)
+        parts.append((x * keep.reshape(keep.shape + (1,) * (x.ndim - 2))).reshape(len(x), -1))
+        if mask is not None:
+            parts.append((a[mask] * keep[..., None]).reshape(len(x), -1).astype(np.float32))
+    return np.concatenate(parts, axis=1)
+
+
+class AutoEncoder(nn.Module):
+    """MLP D → hidden… → latent → …hidden → D."""
+
+    def __init__(self, dim: int, hidden: tuple[int, ...], latent: int) -> None:
+        super().__init__()
+        sizes = [dim, *hidden, latent]
+        enc: list[nn.Module] = []
+        dec: list[nn.Module] = []
+        for a, b in zip(sizes[:-1], sizes[1:], strict=True):
+            enc += [nn.Linear(a, b), nn.ReLU()]
+        for a, b in zip(sizes[::-1][:-1], sizes[::-1][1:], strict=True):
+            dec += [nn.Linear(a, b), nn.ReLU()]
+        self.encoder = nn.Sequential(*enc[:-1])  # linear bottleneck
+        self.decoder = nn.Sequential(*dec[:-1])  # linear output (standardised inputs)
+
+    def forward(self, x: torch.Tensor) -> torch.Tensor:  # (B, D) → (B, D)
+        return self.decoder(self.encoder(x))
+
+
+@dataclass
+class AEMMonitor:
+    """A trained autoencoder with its input standardisation and error scale."""
+
+    config: AEMConfig
+    model: AutoEncoder
+    mean: np.ndarray  # (D,)
+    std: np.ndarray  # (D,)
+    error_scale: float  # median reconstruction error on the training windows
+    name: str = "aem"
+
+    @property
+    def context_len(self) -> int:
+        return self.config.context_len
+
+    @property
+    def version(self) -> str:
+        h = hashlib.sha256(json.dumps(asdict(self.config), sort_keys=True).encode())
+        for t in self.model.state_dict().values():
+            h.update(t.detach().numpy().tobytes())
+        h.update(self.mean.tobytes() + self.std.tobytes())
+        return f"aem-{h.hexdigest()[:12]}"
+
+    def errors(self, windows: Windows) -> np.ndarray:
+        """(B,) mean squared reconstruction error of each standardised window."""
+        out = np.empty(len(windows), np.float64)
+        self.model.eval()
+        with torch.inference_mode():
+            for start in range(0, len(windows), CHUNK):
+                stop = min(start + CHUNK, len(windows))
+                x = torch.from_numpy((window_vectors(windows, slice(start, stop)) - self.mean)
+                                     / self.std)
+                out[start:stop] = ((self.model(x) - x) ** 2).mean(dim=1).double().numpy()
+        return out
+
+    def score(self, windows: Windows) -> np.ndarray:
+        e = self.errors(windows)
+        return e / (e + self.error_scale)
+
+    # -- persistence (torch.load(weights_only=True) reads it back) -------------------------------
+    def save(self, folder: Path, meta: dict | None = None) -> Path:
+        """Write `<folder>/<version>/model.pt` and `meta.json`; the version folder."""
+        out = Path(folder) / self.version
+        out.mkdir(parents=True, exist_ok=True)
+        buf = io.BytesIO()
+        torch.save({
+            "config": asdict(self.config),
+            "state_dict": self.model.state_dict(),
+            "mean": torch.from_numpy(self.mean),
+            "std": torch.from_numpy(self.std),
+            "error_scale": float(self.error_scale),
+        }, buf)
+        (out / "model.pt").write_bytes(buf.getvalue())
+        info = {"version": self.version, "name": self.name, "config": asdict(self.config)}
+        (out / "meta.json").write_text(json.dumps({**info, **(meta or {})}, indent=2) + "\n")
+        return out
+
+    @classmethod
+    def load(cls, version_dir: Path) -> AEMMonitor:
+        blob = torch.load(Path(version_dir) / "model.pt", weights_only=True)
+        cfg = dict(blob["config"])
+        cfg["hidden"] = tuple(cfg["hidden"])
+        config = AEMConfig(**cfg)
+        mean, std = blob["mean"].numpy(), blob["std"].numpy()
+        model = AutoEncoder(len(mean), config.hidden, config.latent)
+        model.load_state_dict(blob["state_dict"])
+        return cls(config, model, mean, std, float(blob["error_scale"]))
+
+
+@contextmanager
+def _threads(n: int):
+    """Run torch with n intra-op threads (small MLPs are slower with more on a busy CPU)."""
+    was = torch.get_num_threads()
+    torch.set_num_threads(n)
+    try:
+        yield
+    finally:
+        torch.set_num_threads(was)
+
+
+def train_aem(train: Windows, normal: np.ndarray, config: AEMConfig = AEMConfig(), *,
+              threads: int = 1) -> AEMMonitor:
+    """Fit the autoencoder on the windows `normal` (bool (B,)) of `train`; seeded by config
+    (the same seed, data and thread count give the same weights)."""
+    with _threads(threads):
+        return _train(train, normal, config)
+
+
+def _train(train: Windows, normal: np.ndarray, config: AEMConfig) -> AEMMonitor:
+    if train.context_len != config.context_len:
+        raise ValueError(f"windows have L={train.context_len}, config wants {config.context_len}")
+    idx = np.flatnonzero(np.asarray(normal, bool))
+    if len(idx) == 0:
+        raise ValueError("AEM needs at least one collision-free training window")
+    rng = np.random.default_rng(config.seed)
+    if len(idx) > config.max_train_windows:
+        idx = np.sort(rng.choice(idx, config.max_train_windows, replace=False))
+    x = np.concatenate([window_vectors(train, idx[s : s + CHUNK])
+                        for s in range(0, len(idx), CHUNK)])
+    mean = x.mean(axis=0)
+    std = x.std(axis=0)
+    std = np.where(std > 1e-3, std, 1.0).astype(np.float32)
+    xt = torch.from_numpy((x - mean) / std)
+
+    torch.manual_seed(config.seed)
+    model = AutoEncoder(x.shape[1], config.hidden, config.latent)
+    opt = torch.optim.Adam(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)
+    gen = torch.Generator().manual_seed(config.seed)
+    model.train()
+    for _ in range(config.epochs):
+        for batch in torch.randperm(len(xt), generator=gen).split(config.batch_size):
+            xb = xt[batch]
+            loss = ((model(xb) - xb) ** 2).mean()
+            opt.zero_grad()
+            loss.backward()
+            opt.step()
+    model.eval()
+    with torch.inference_mode():
+        err = torch.cat([((model(c) - c) ** 2).mean(dim=1) for c in xt.split(CHUNK)])
+    scale = max(float(err.median()), 1e-12)
+    return AEMMonitor(config, model, mean.astype(np.float32), std, scale)

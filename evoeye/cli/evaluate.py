@@ -1,0 +1,84 @@
+"""`evoeye evaluate`: the paper's RQ1 table for the baselines and trained monitors."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.console import Console
+
+from evoeye.cli.app import app
+from evoeye.evaluation.monitors import BASELINES
+from evoeye.evaluation.report import markdown_report
+from evoeye.evaluation.rq1 import rq1, rq1_report
+from evoeye.store import SplitSpec, WarehouseLockedError
+
+
+def _err() -> Console:
+    return Console(stderr=True)
+
+
+def parse_baselines(text: str) -> list[str]:
+    """'ttc,rss,aem' → names; '' or 'none' → none."""
+    names = [n.strip() for n in text.split(",") if n.strip() and n.strip() != "none"]
+    unknown = [n for n in names if n not in BASELINES]
+    if unknown:
+        raise typer.BadParameter(f"unknown baseline(s) {unknown}; known: {sorted(BASELINES)}")
+    return names
+
+
+@app.command("evaluate")
+def evaluate_command(
+    root: Annotated[Path | None, typer.Option(
+        "--root", help="Data root (default: $EVOEYE_HOME or ./evoeye-data).")] = None,
+    scenario: Annotated[list[str] | None, typer.Option(
+        "--scenario", help="Logical scenario (repeat for several; default: all in the "
+                           "warehouse).")] = None,
+    monitor: Annotated[list[str] | None, typer.Option(
+        "--monitor", help="Trained monitor version to evaluate (repeatable).")] = None,
+    baselines: Annotated[str, typer.Option(
+        help="Comma-separated baselines: ttc, rss, aem ('none' for none).")] = "ttc,rss,aem",
+    fusion: Annotated[bool, typer.Option(
+        "--train-fusion/--no-train-fusion",
+        help="Also train a FusionMonitor per scenario (seed 0, L = 5) and evaluate it.")] = False,
+    split_seed: Annotated[int, typer.Option(help="Split seed.")] = SplitSpec().seed,
+    train_frac: Annotated[float, typer.Option(help="Train share of round-0 runs.")] =
+        SplitSpec().train_frac,
+    val_frac: Annotated[float, typer.Option(help="Validation share of round-0 runs.")] =
+        SplitSpec().val_frac,
+    latency: Annotated[bool, typer.Option(
+        "--latency/--no-latency", help="Time inference on CPU (batch 1 and 1024).")] = True,
+    store: Annotated[bool, typer.Option(
+        "--store/--no-store", help="Write the scores to the warehouse (monitor_scores).")] = True,
+    name: Annotated[str | None, typer.Option(
+        help="Report folder name under <root>/reports (default rq1-<UTC time>).")] = None,
+    as_json: Annotated[bool, typer.Option(
+        "--json", help="Print the figures as JSON instead of the Markdown table.")] = False,
+) -> None:
+    """Score val and test splits, calibrate on val, and report the RQ1 figures on test."""
+    names = parse_baselines(baselines)
+    if not names and not monitor and not fusion:
+        raise typer.BadParameter("nothing to evaluate: give --monitor, --train-fusion or "
+                                 "--baselines")
+    err = _err()
+    try:
+        splits = SplitSpec(split_seed, train_frac, val_frac)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc)) from exc
+    try:
+        reports = rq1(root, scenario, baselines=names, monitor_versions=monitor or (),
+                      fusion=fusion, splits=splits, latency=latency, store_scores=store,
+                      progress=lambda msg: err.print(f"[dim]{msg}[/]"))
+    except (ValueError, KeyError, RuntimeError, WarehouseLockedError) as exc:
+        err.print(f"[red]error:[/] {exc}")
+        raise typer.Exit(1) from exc
+    files = rq1_report(root, reports, name)
+    dicts = [r.to_dict() for r in reports]
+    if as_json:
+        sys.stdout.write(json.dumps({"reports": dicts, "report_dir": str(files.folder)}) + "\n")
+        return
+    typer.echo(markdown_report(dicts))
+    typer.echo(f"report: {files.html}")

@@ -1,0 +1,148 @@
+"""`evoeye train`, `evoeye replay` and `evoeye export`: the FusionMonitor from the shell."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated, Any
+
+import typer
+from rich.console import Console
+from rich.table import Table
+
+from evoeye.cli.app import app
+from evoeye.monitor.inputs import ABLATIONS, MODULES, parse_modules
+from evoeye.monitor.protocol import TARGET_FPRS
+from evoeye.store import SplitSpec
+from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S
+
+RootOpt = Annotated[
+    Path | None,
+    typer.Option("--root", help="Data root (default: $EVOEYE_HOME or ./evoeye-data)."),
+]
+MonitorOpt = Annotated[str, typer.Option("--monitor", help="Monitor version, e.g. fusion-…")]
+
+
+def _fail(message: str, code: int = 1) -> typer.Exit:
+    Console(stderr=True).print(f"[red]error:[/] {message}")
+    return typer.Exit(code)
+
+
+def _pct(value: float | None) -> str:
+    return "—" if value is None else f"{100 * value:.1f}"
+
+
+def metrics_table(card: dict[str, Any]) -> Table:
+    """Validation metrics of a card: AUROC, AUPRC and precision / recall / F1 per target FPR."""
+    val = card["metrics"]["val"]
+    table = Table(title=f"{card['version']} on validation (%)")
+    for col in ("AUROC", "AUPRC", "target FPR", "threshold", "Prec.", "Rec.", "F1", "FPR"):
+        table.add_column(col, justify="right")
+    for i, fpr in enumerate(sorted((float(f) for f in card["thresholds"]), reverse=True)):
+        m = val[f"fpr_{fpr:g}"]
+        table.add_row(_pct(val["auroc"]) if i == 0 else "", _pct(val["auprc"]) if i == 0 else "",
+                      f"{fpr:g}", f"{m['threshold']:.4f}", _pct(m["precision"]),
+                      _pct(m["recall"]), _pct(m["f1"]), _pct(m["fpr"]))
+    return table
+
+
+@app.command("train")
+def train_command(
+    scenario: Annotated[str, typer.Option("--scenario", help="Logical scenario to train on.")],
+    root: RootOpt = None,
+    context_len: Annotated[int | None, typer.Option(
+        "--context-len", min=1, help=f"L, frames per context (default {DEFAULT_CONTEXT_LEN}, "
+        "or the parent's).")] = None,
+    horizon_s: Annotated[float, typer.Option("--horizon-s", min=0.0,
+                                             help="Label horizon H, s.")] = DEFAULT_HORIZON_S,
+    modules: Annotated[str | None, typer.Option(
+        "--modules", help=f"Inputs: one of {', '.join(ABLATIONS)} or a comma list of "
+        f"{', '.join(MODULES)} (default: all).")] = None,
+    seed: Annotated[int, typer.Option(help="Training seed.")] = 0,
+    split_seed: Annotated[int, typer.Option(help="Seed of the train/val/test split.")] =
+        SplitSpec().seed,
+    epochs: Annotated[int, typer.Option(min=1, help="At most this many epochs.")] = 40,
+    patience: Annotated[int, typer.Option(min=1, help="Early-stopping patience.")] = 8,
+    batch_size: Annotated[int, typer.Option(min=1)] = 256,
+    lr: Annotated[float, typer.Option(min=0.0, help="Adam learning rate.")] = 1e-3,
+    weight_decay: Annotated[float | None, typer.Option(
+        min=0.0, help="Adam weight decay (default: TrainParams').")] = None,
+    dropout: Annotated[float | None, typer.Option(
+        min=0.0, max=0.95, help="Dropout on frame features and the temporal MLP (default: "
+        "none, or the parent's).")] = None,
+    init_from: Annotated[str | None, typer.Option(
+        "--init-from", help="Fine-tune this version instead of training from scratch.")] = None,
+    quiet: Annotated[bool, typer.Option("--quiet", help="No per-epoch lines.")] = False,
+) -> None:
+    """Train a FusionMonitor on the scenario's train split, calibrate it on val, save a version."""
+    from evoeye.monitor.registry import CARD_FILE, MonitorLoadError, read_card, version_dir
+    from evoeye.monitor.train import train_monitor
+
+    console = Console()
+
+    def progress(row: dict[str, Any]) -> None:
+        if not quiet:
+            console.print(f"epoch {row['epoch']:3d}  train loss {row['train_loss']:.4f}  "
+                          f"val loss {row['val_loss']:.4f}  val AUROC {_pct(row['auroc'])}  "
+                          f"val AUPRC {_pct(row['auprc'])}")
+
+    extra = {} if weight_decay is None else {"weight_decay": weight_decay}
+    try:
+        version = train_monitor(
+            root, scenario, context_len=context_len, horizon_s=horizon_s,
+            modules=parse_modules(modules), dropout=dropout, seed=seed,
+            splits=SplitSpec(seed=split_seed), init_from=init_from, epochs=epochs,
+            patience=patience, batch_size=batch_size, lr=lr, progress=progress, **extra)
+    except (ValueError, MonitorLoadError) as exc:
+        raise _fail(str(exc)) from exc
+    card = read_card(root, version)
+    console.print(metrics_table(card))
+    t = card["training"]
+    console.print(f"best epoch {t['best_epoch']} of {t['epochs_run']}, {t['time_s']:.1f} s, "
+                  f"{card['n_parameters']:,} parameters, L = {card['context_len']}")
+    console.print(f"card: {version_dir(root, version) / CARD_FILE}")
+    console.print(f"version: [bold]{version}[/]")
+
+
+@app.command("replay")
+def replay_command(
+    log: Annotated[Path, typer.Argument(help="Run log (.mcap) to replay.", exists=True,
+                                        dir_okay=False)],
+    monitor: MonitorOpt,
+    root: RootOpt = None,
+    out: Annotated[Path | None, typer.Option(
+        "--out", help="Output log (default: <log>.risk.mcap beside it).")] = None,
+    fpr: Annotated[float, typer.Option(help=f"Alarm threshold's target FPR, one of "
+                                       f"{TARGET_FPRS}.")] = TARGET_FPRS[0],
+    consecutive: Annotated[int, typer.Option(
+        "--consecutive", min=1, help="Frames above the threshold before the alarm (K).")] = 1,
+) -> None:
+    """Copy a run log with the monitor's risk channel and alarm markers (Foxglove/Lichtblick)."""
+    from evoeye.log import LogError
+    from evoeye.monitor.registry import MonitorLoadError, load_monitor
+    from evoeye.monitor.replay import replay
+
+    try:
+        report = replay(log, load_monitor(root, monitor), out, fpr=fpr, consecutive=consecutive)
+    except (MonitorLoadError, LogError, ValueError, KeyError) as exc:
+        raise _fail(str(exc)) from exc
+    first = "none" if report.first_alarm_t_s is None else f"t = {report.first_alarm_t_s:.2f} s"
+    Console().print(f"{report.frames} frames, {report.alarm_frames} alarm frames (threshold "
+                    f"{report.threshold:.4f}), first alarm: {first}")
+    Console().print(f"wrote {report.out}")
+
+
+@app.command("export")
+def export_command(
+    monitor: MonitorOpt,
+    out: Annotated[Path, typer.Option("--out", help="ONNX file to write.")],
+    root: RootOpt = None,
+) -> None:
+    """Export a monitor version to ONNX (dynamic batch axis; output: risk in [0, 1])."""
+    from evoeye.monitor.export import export_onnx
+    from evoeye.monitor.registry import MonitorLoadError, load_monitor
+
+    try:
+        path = export_onnx(load_monitor(root, monitor), out)
+    except MonitorLoadError as exc:
+        raise _fail(str(exc)) from exc
+    Console().print(f"wrote {path} (inputs: see `evoeye.monitor.model.INPUTS`)")

@@ -1,0 +1,106 @@
+"""The windows a monitor is evaluated on: one split of one logical scenario, with run outcomes.
+
+Frames at or after a run's first collision are kept in the windows but are not *eligible*:
+Definition 1 labels them 0 because no collision lies ahead, not because they are safe, and a
+run of the paper's setup ends at the collision. Metrics and calibration use eligible frames.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from evoeye.paths import DataRoot
+from evoeye.store import RunFilter, SplitSpec, Warehouse, load_windows
+from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S, Windows
+
+OUTCOMES_SQL = """
+SELECT scenario_id, collided, collision_time_s
+FROM scenarios
+WHERE logical_scenario = $logical_scenario
+"""
+TIME_EPS_S = 1e-6  # frame times are floats on a 20 Hz grid
+
+
+@dataclass
+class SplitWindows:
+    """The windows of one split and, per window, its run's collision time (+inf if none)."""
+
+    logical_scenario: str
+    split: str
+    windows: Windows
+    collision_time_s: np.ndarray  # (B,) float64, tau_col of the window's run
+
+    def __len__(self) -> int:
+        return len(self.windows)
+
+    @property
+    def eligible(self) -> np.ndarray:
+        """(B,) bool: frames strictly before their run's collision (all frames of safe runs)."""
+        return self.windows.t_s < self.collision_time_s - TIME_EPS_S
+
+    @property
+    def n_scenarios(self) -> int:
+        return len(np.unique(self.windows.scenario_id))
+
+    @property
+    def n_violations(self) -> int:
+        _, first = np.unique(self.windows.scenario_id, return_index=True)
+        return int(np.isfinite(self.collision_time_s[first]).sum())
+
+    def stats(self) -> dict[str, int]:
+        """Scenarios, violations, eligible frames and unsafe frames of the split."""
+        ok = self.eligible
+        return {
+            "scenarios": self.n_scenarios,
+            "violations": self.n_violations,
+            "frames": int(ok.sum()),
+            "unsafe_frames": int(self.windows.label[ok].sum()),
+        }
+
+
+def narrow(windows: Windows, context_len: int) -> Windows:
+    """The same windows with only their newest `context_len` slots (an L-window's suffix is
+    the shorter window: windows.sql pads at the start of a run)."""
+    if context_len > windows.context_len:
+        raise ValueError(f"cannot widen windows of L={windows.context_len} to {context_len}")
+    if context_len == windows.context_len:
+        return windows
+    return Windows(
+        windows.features, windows.context[:, -context_len:],
+        windows.context_mask[:, -context_len:], windows.label, windows.scenario_id,
+        windows.frame, windows.t_s, windows.horizon_s, windows.spec,
+    )
+
+
+def collision_times(root: Warehouse | DataRoot | str | Path | None,
+                    logical_scenario: str) -> dict[str, float]:
+    """scenario_id → tau_col in s (+inf for runs without a collision)."""
+    wh = root if isinstance(root, Warehouse) else Warehouse(root)
+    rows = wh.sql(OUTCOMES_SQL, {"logical_scenario": logical_scenario}).to_pylist()
+    return {
+        r["scenario_id"]: float(r["collision_time_s"])
+        if r["collided"] and r["collision_time_s"] is not None else np.inf
+        for r in rows
+    }
+
+
+def load_split(
+    root: Warehouse | DataRoot | str | Path | None,
+    logical_scenario: str,
+    split: str,
+    splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
+    *,
+    context_len: int = DEFAULT_CONTEXT_LEN,
+    horizon_s: float = DEFAULT_HORIZON_S,
+) -> SplitWindows:
+    """Every window of one split of one logical scenario, with its run's collision time."""
+    wh = root if isinstance(root, Warehouse) else Warehouse(root)
+    runs = RunFilter(logical_scenario=logical_scenario, split=split, splits=splits)
+    windows = load_windows(wh, runs, context_len=context_len, horizon_s=horizon_s)
+    tau = collision_times(wh, logical_scenario)
+    ids, inverse = np.unique(windows.scenario_id.astype(str), return_inverse=True)
+    col = np.array([tau[i] for i in ids], dtype=np.float64)[inverse.reshape(-1)]
+    return SplitWindows(logical_scenario, split, windows, col)

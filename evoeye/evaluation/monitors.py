@@ -1,0 +1,165 @@
+"""Which monitors to evaluate: the baselines by name, FusionMonitors by version (a registry).
+
+TTC and RSS are rules and need no data. AEM is trained on the train split of the logical
+scenario and kept under `<root>/baselines/aem/<version>/`; a later call with the same training
+set, split and config loads it instead of training again. FusionMonitors come from
+`evoeye.monitor` (`load_monitor`, `train_monitor`), imported only when asked for.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+from collections.abc import Callable, Iterable
+from dataclasses import asdict
+from pathlib import Path
+from typing import TYPE_CHECKING
+
+import numpy as np
+
+from evoeye.baselines.rss import RSSMonitor
+from evoeye.baselines.ttc import TTCMonitor
+from evoeye.evaluation.dataset import load_split
+from evoeye.monitor.protocol import Monitor
+from evoeye.paths import DataRoot
+from evoeye.store import RunFilter, SplitSpec, Warehouse, select_runs
+from evoeye.store.windows import DEFAULT_HORIZON_S
+
+if TYPE_CHECKING:  # torch is imported when an AEM is asked for
+    from evoeye.baselines.aem import AEMConfig, AEMMonitor
+
+AEM_DIR = Path("baselines") / "aem"
+
+
+def _root(root: DataRoot | str | Path | None) -> DataRoot:
+    return root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+
+
+def _train_ids(root: DataRoot, scenario: str, splits: SplitSpec) -> list[str]:
+    con = Warehouse(root).connect()
+    try:
+        runs = select_runs(con, RunFilter(logical_scenario=scenario, split="train", splits=splits))
+    finally:
+        con.close()
+    return sorted(runs.column("scenario_id").to_pylist())
+
+
+def fit_aem(root: DataRoot | str | Path | None, scenario: str,
+            splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
+            config: AEMConfig | None = None, *,
+            horizon_s: float = DEFAULT_HORIZON_S) -> AEMMonitor:
+    """The AEM of this scenario's train split: loaded if trained before, else trained and saved.
+
+    Trained on the collision-free windows of the split: label 0 and before the run's collision."""
+    from evoeye.baselines.aem import AEMConfig, AEMMonitor, train_aem
+
+    config = config or AEMConfig()
+    root = _root(root)
+    ids = _train_ids(root, scenario, splits)
+    key = hashlib.sha256(json.dumps(
+        [scenario, asdict(splits), asdict(config), horizon_s, ids], sort_keys=True
+    ).encode()).hexdigest()
+    folder = root.path / AEM_DIR
+    for meta in sorted(folder.glob("*/meta.json")):
+        if json.loads(meta.read_text()).get("training_key") == key:
+            return AEMMonitor.load(meta.parent)
+    train = load_split(root, scenario, "train", splits, context_len=config.context_len,
+                       horizon_s=horizon_s)
+    normal = (train.windows.label == 0) & train.eligible
+    monitor = train_aem(train.windows, normal, config)
+    monitor.save(folder, {
+        "training_key": key, "logical_scenario": scenario, "splits": asdict(splits),
+        "horizon_s": horizon_s, "train_scenarios": len(ids), "train_windows": int(normal.sum()),
+    })
+    return monitor
+
+
+def load_aem(root: DataRoot | str | Path | None, version: str) -> AEMMonitor:
+    """A saved AEM by version."""
+    from evoeye.baselines.aem import AEMMonitor
+
+    folder = _root(root).path / AEM_DIR / version
+    if not (folder / "model.pt").is_file():
+        raise KeyError(f"no AEM version {version!r} under {folder.parent}")
+    return AEMMonitor.load(folder)
+
+
+BaselineBuilder = Callable[[DataRoot, str, SplitSpec], Monitor]
+BASELINES: dict[str, BaselineBuilder] = {
+    "ttc": lambda root, scenario, splits: TTCMonitor(),
+    "rss": lambda root, scenario, splits: RSSMonitor(),
+    "aem": lambda root, scenario, splits: fit_aem(root, scenario, splits),
+}
+
+
+def baseline_monitors(root: DataRoot | str | Path | None, scenario: str,
+                      splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
+                      names: Iterable[str] = tuple(BASELINES)) -> list[Monitor]:
+    """The named baselines, ready to score windows of `scenario`."""
+    names = list(names)
+    unknown = [n for n in names if n not in BASELINES]
+    if unknown:
+        raise KeyError(f"unknown baseline(s) {unknown}; known: {sorted(BASELINES)}")
+    return [BASELINES[n](_root(root), scenario, splits) for n in names]
+
+
+def fusion_api() -> tuple[Callable, Callable] | None:
+    """(train_monitor, load_monitor) from evoeye.monitor (or its train / registry modules), or
+    None before they exist."""
+    try:
+        from evoeye.monitor import load_monitor, train_monitor
+    except ImportError:
+        try:
+            from evoeye.monitor.registry import load_monitor
+            from evoeye.monitor.train import train_monitor
+        except ImportError:
+            return None
+    return train_monitor, load_monitor
+
+
+def load_monitors(root: DataRoot | str | Path | None, versions: Iterable[str]) -> list[Monitor]:
+    """Trained monitors by version: AEM versions from here, every other from evoeye.monitor."""
+    out: list[Monitor] = []
+    for v in versions:
+        if v.startswith("aem-"):
+            out.append(load_aem(root, v))
+            continue
+        api = fusion_api()
+        if api is None:
+            raise RuntimeError(f"cannot load monitor {v!r}: evoeye.monitor has no load_monitor")
+        out.append(api[1](_root(root).path, v))
+    return out
+
+
+def train_fusion(root: DataRoot | str | Path | None, scenario: str, *, context_len: int = 5,
+                 modules: tuple[str, ...] | None = None, seed: int = 0,
+                 splits: SplitSpec | None = None, **overrides) -> Monitor:
+    """Train (or let the registry reuse) a FusionMonitor for `scenario` and load it;
+    `overrides` go to train_monitor (epochs=…, lr=…)."""
+    api = fusion_api()
+    if api is None:
+        raise RuntimeError("evoeye.monitor has no train_monitor yet: FusionMonitor unavailable")
+    train_monitor, load_monitor = api
+    kwargs: dict = {"scenario": scenario, "context_len": context_len, "seed": seed,
+                    **overrides}
+    if modules is not None:
+        kwargs["modules"] = modules
+    if splits is not None:
+        kwargs["splits"] = splits
+    version = train_monitor(_root(root).path, **kwargs)
+    return load_monitor(_root(root).path, version)
+
+
+def monitor_context_len(monitor: Monitor, default: int = 5) -> int:
+    """The context length L a monitor reads (its `context_len`, else `default`)."""
+    return int(getattr(monitor, "context_len", default) or default)
+
+
+def check_scores(monitor: Monitor, scores: np.ndarray, n: int) -> np.ndarray:
+    """The monitor's scores as (n,) float64 in [0, 1], or a clear error."""
+    s = np.asarray(scores, dtype=np.float64).reshape(-1)
+    if s.shape != (n,):
+        raise ValueError(f"{monitor.name} returned {s.shape} scores for {n} windows")
+    if not np.isfinite(s).all() or s.min(initial=0.0) < 0.0 or s.max(initial=0.0) > 1.0:
+        raise ValueError(f"{monitor.name} returned scores outside [0, 1]")
+    return s

@@ -1,0 +1,129 @@
+"""Inline SVG charts for the HTML report: no plotting library, no external resources.
+
+Each function returns one `<svg>` element as text (HTML5 inline SVG needs no namespace URL).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from html import escape
+
+import numpy as np
+
+PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e377c2",
+           "#17becf", "#7f7f7f", "#bcbd22")
+WIDTH, HEIGHT = 420, 340
+MARGIN = {"left": 52, "right": 14, "top": 30, "bottom": 46}
+
+
+def _color(i: int) -> str:
+    return PALETTE[i % len(PALETTE)]
+
+
+class _Frame:
+    """Maps data coordinates into the plotting area of one chart."""
+
+    def __init__(self, xlim: tuple[float, float], ylim: tuple[float, float],
+                 width: int = WIDTH, height: int = HEIGHT) -> None:
+        self.xlim, self.ylim, self.width, self.height = xlim, ylim, width, height
+        self.x0, self.x1 = MARGIN["left"], width - MARGIN["right"]
+        self.y0, self.y1 = height - MARGIN["bottom"], MARGIN["top"]
+
+    def x(self, v: float) -> float:
+        lo, hi = self.xlim
+        return self.x0 + (v - lo) / ((hi - lo) or 1.0) * (self.x1 - self.x0)
+
+    def y(self, v: float) -> float:
+        lo, hi = self.ylim
+        return self.y0 - (v - lo) / ((hi - lo) or 1.0) * (self.y0 - self.y1)
+
+    def axes(self, title: str, xlabel: str, ylabel: str, xticks: Sequence[float],
+             yticks: Sequence[float]) -> list[str]:
+        out = [
+            f'<rect x="{self.x0}" y="{self.y1}" width="{self.x1 - self.x0}" '
+            f'height="{self.y0 - self.y1}" fill="#fff" stroke="#999"/>',
+            f'<text x="{self.width / 2}" y="18" text-anchor="middle" class="t">'
+            f"{escape(title)}</text>",
+            f'<text x="{(self.x0 + self.x1) / 2}" y="{self.height - 8}" '
+            f'text-anchor="middle">{escape(xlabel)}</text>',
+            f'<text x="14" y="{(self.y0 + self.y1) / 2}" text-anchor="middle" '
+            f'transform="rotate(-90 14 {(self.y0 + self.y1) / 2})">{escape(ylabel)}</text>',
+        ]
+        for v in xticks:
+            x = self.x(v)
+            out.append(f'<line x1="{x:.1f}" y1="{self.y0}" x2="{x:.1f}" y2="{self.y1}" '
+                       'stroke="#eee"/>')
+            out.append(f'<text x="{x:.1f}" y="{self.y0 + 15}" text-anchor="middle">'
+                       f"{v:g}</text>")
+        for v in yticks:
+            y = self.y(v)
+            out.append(f'<line x1="{self.x0}" y1="{y:.1f}" x2="{self.x1}" y2="{y:.1f}" '
+                       'stroke="#eee"/>')
+            out.append(f'<text x="{self.x0 - 5}" y="{y + 4:.1f}" text-anchor="end">{v:g}</text>')
+        return out
+
+    def svg(self, body: list[str], label: str) -> str:
+        return (f'<svg class="chart" width="{self.width}" height="{self.height}" '
+                f'viewBox="0 0 {self.width} {self.height}" role="img" '
+                f'aria-label="{escape(label)}">' + "".join(body) + "</svg>")
+
+
+def _legend(frame: _Frame, labels: Sequence[str], x: float, y: float) -> list[str]:
+    out = []
+    for i, label in enumerate(labels):
+        yy = y + 14 * i
+        out.append(f'<line x1="{x}" y1="{yy}" x2="{x + 16}" y2="{yy}" stroke="{_color(i)}" '
+                   'stroke-width="2.5"/>')
+        out.append(f'<text x="{x + 20}" y="{yy + 4}">{escape(label)}</text>')
+    return out
+
+
+def line_chart(series: Sequence[tuple[str, Sequence[float], Sequence[float]]], *, title: str,
+               xlabel: str, ylabel: str, diagonal: bool = False,
+               legend_at: str = "bottom-right") -> str:
+    """Curves (label, xs, ys) on [0, 1]²; one colour per series, in order."""
+    f = _Frame((0.0, 1.0), (0.0, 1.0))
+    ticks = [0.0, 0.2, 0.4, 0.6, 0.8, 1.0]
+    body = f.axes(title, xlabel, ylabel, ticks, ticks)
+    if diagonal:
+        body.append(f'<line x1="{f.x(0)}" y1="{f.y(0)}" x2="{f.x(1)}" y2="{f.y(1)}" '
+                    'stroke="#bbb" stroke-dasharray="4 3"/>')
+    for i, (label, xs, ys) in enumerate(series):
+        if len(xs) == 0:
+            continue
+        pts = " ".join(f"{f.x(a):.1f},{f.y(b):.1f}" for a, b in zip(xs, ys, strict=True))
+        body.append(f'<polyline points="{pts}" fill="none" stroke="{_color(i)}" '
+                    f'stroke-width="2" data-series="{escape(label)}"/>')
+    labels = [s[0] for s in series]
+    if legend_at == "bottom-right":
+        lx, ly = f.x1 - 130, f.y0 - 10 - 14 * (len(labels) - 1)
+    else:
+        lx, ly = f.x1 - 130, f.y1 + 14
+    body += _legend(f, labels, lx, ly)
+    return f.svg(body, title)
+
+
+def strip_chart(rows: Sequence[tuple[str, Sequence[float]]], *, title: str, xlabel: str) -> str:
+    """One row of dots per label (the values), with the median marked and written."""
+    values = [v for _, vs in rows for v in vs]
+    hi = max(1.0, float(np.ceil(max(values)))) if values else 1.0
+    height = max(160, 56 * len(rows) + MARGIN["top"] + MARGIN["bottom"])
+    f = _Frame((0.0, hi), (0.0, float(len(rows))), height=height)
+    step = max(0.5, float(np.ceil(hi / 8 * 2) / 2))
+    body = f.axes(title, xlabel, "", list(np.arange(0.0, hi + 1e-9, step)), [])
+    rng = np.random.default_rng(0)  # fixed jitter: the same report renders the same
+    for i, (label, vs) in enumerate(rows):
+        yc = f.y(len(rows) - i - 0.5)
+        body.append(f'<text x="{f.x0 + 4}" y="{yc - 14:.1f}" class="s">{escape(label)} '
+                    f"(n={len(vs)})</text>")
+        for v in vs:
+            jitter = rng.uniform(-8, 8)
+            body.append(f'<circle cx="{f.x(v):.1f}" cy="{yc + jitter:.1f}" r="3" '
+                        f'fill="{_color(i)}" fill-opacity="0.55"/>')
+        if len(vs):
+            med = float(np.median(vs))
+            body.append(f'<line x1="{f.x(med):.1f}" y1="{yc - 11:.1f}" x2="{f.x(med):.1f}" '
+                        f'y2="{yc + 11:.1f}" stroke="#000" stroke-width="2"/>')
+            body.append(f'<text x="{f.x(med) + 4:.1f}" y="{yc + 22:.1f}" class="s">'
+                        f"median {med:.2f} s</text>")
+    return f.svg(body, title)

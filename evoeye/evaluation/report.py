@@ -1,0 +1,203 @@
+"""The RQ1 report: Markdown tables and a self-contained HTML page, from evaluation dicts.
+
+Everything renders from `EvaluationReport.to_dict()` (what `--json` prints), so the Markdown,
+the HTML and the JSON cannot disagree. Rates are shown as percentages with one decimal, as in
+the paper's Table "Monitoring effectiveness"; lead times in seconds.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass
+from datetime import UTC, datetime
+from html import escape
+from pathlib import Path
+
+from evoeye.evaluation.plots import line_chart, strip_chart
+from evoeye.paths import DataRoot
+
+DASH = "–"
+
+
+def pct(x: float | None) -> str:
+    """A rate as a percentage with one decimal ('–' if undefined)."""
+    return DASH if x is None else f"{100 * x:.1f}"
+
+
+def secs(x: float | None) -> str:
+    return DASH if x is None else f"{x:.2f}"
+
+
+@dataclass
+class Table:
+    """Header and rows of text cells; section rows have a single cell."""
+
+    header: list[str]
+    rows: list[list[str]]
+
+    def markdown(self) -> str:
+        lines = ["| " + " | ".join(self.header) + " |",
+                 "|" + "|".join(["---"] + ["---:"] * (len(self.header) - 1)) + "|"]
+        for row in self.rows:
+            cells = row if len(row) > 1 else [f"**{row[0]}**"] + [""] * (len(self.header) - 1)
+            lines.append("| " + " | ".join(cells) + " |")
+        return "\n".join(lines)
+
+    def html(self) -> str:
+        head = "".join(f"<th>{escape(h)}</th>" for h in self.header)
+        body = []
+        for row in self.rows:
+            if len(row) == 1:
+                body.append(f'<tr class="sec"><td colspan="{len(self.header)}">'
+                            f"{escape(row[0])}</td></tr>")
+            else:
+                body.append("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in row) + "</tr>")
+        return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
+
+
+def rq1_table(report: dict) -> Table:
+    """The paper's RQ1 table for one logical scenario (plus warned violations and lead time)."""
+    fprs = [str(f) for f in report["fprs"]]
+    main = fprs[0]
+    header = ["Method"]
+    for f in fprs:
+        header += [f"P@{f}", f"R@{f}", f"F1@{f}"]
+    header += ["AUROC", "AUPRC", f"Warned@{main}", f"Lead@{main} (s)"]
+    rows: list[list[str]] = [["Frame-level"]]
+    for m in report["monitors"]:
+        fr = m["frame"]
+        cells = [m["name"]]
+        for f in fprs:
+            a = fr["at_fpr"][f]
+            cells += [pct(a["precision"]), pct(a["recall"]), pct(a["f1"])]
+        rows.append(cells + [pct(fr["auroc"]), pct(fr["auprc"]), DASH, DASH])
+    for k in report["ks"]:
+        rows.append([f"Scenario-level (K={k})"])
+        for m in report["monitors"]:
+            sc = m["scenario"][str(k)]
+            cells = [m["name"]]
+            for f in fprs:
+                a = sc["at_fpr"][f]
+                cells += [pct(a["precision"]), pct(a["recall"]), pct(a["f1"])]
+            lt = sc["lead_time"][main]
+            cells += [pct(sc["auroc"]), pct(sc["auprc"]),
+                      f"{lt['detected']}/{lt['violations']}", secs(lt["median_s"])]
+            rows.append(cells)
+    return Table(header, rows)
+
+
+def dataset_table(reports: list[dict]) -> Table:
+    rows = []
+    for r in reports:
+        for split, s in r["dataset"].items():
+            v = s["violations"] / s["scenarios"] if s["scenarios"] else None
+            u = s["unsafe_frames"] / s["frames"] if s["frames"] else None
+            rows.append([r["logical_scenario"], split, str(s["scenarios"]),
+                         f"{s['violations']} ({pct(v)}%)", str(s["frames"]),
+                         f"{s['unsafe_frames']} ({pct(u)}%)"])
+    return Table(["Logical scenario", "Split", "Scenarios", "Violations", "Frames", "Unsafe"],
+                 rows)
+
+
+def monitors_table(reports: list[dict]) -> Table:
+    """Versions, thresholds (with the FPR they realise on validation) and CPU cost."""
+    fprs = [str(f) for f in reports[0]["fprs"]] if reports else []
+    header = ["Logical scenario", "Method", "Version", "L"]
+    header += [f"thr@{f} (val FPR %)" for f in fprs]
+    header += ["Latency b=1 (ms)", "Throughput b=1024 (/s)"]
+    rows = []
+    for r in reports:
+        for m in r["monitors"]:
+            lat = m["latency"]
+            rows.append(
+                [r["logical_scenario"], m["name"], m["version"], str(m["context_len"])]
+                + [f"{m['thresholds'][f]:.4g} ({pct(m['val_fpr'][f])})" for f in fprs]
+                + ([f"{lat['latency_ms_median']:.3f}", f"{lat['throughput_per_s']:,.0f}"]
+                   if lat else [DASH, DASH])
+            )
+    return Table(header, rows)
+
+
+def markdown_report(reports: list[dict]) -> str:
+    """RQ1 for every logical scenario evaluated, with the dataset and the monitors used."""
+    parts = ["# RQ1: monitoring effectiveness", "",
+             "Rates in %, thresholds calibrated on validation for each target FPR and applied "
+             "unchanged to test. Warned: violation runs warned before the collision / all; "
+             "Lead: median warning lead time of those runs.", ""]
+    for r in reports:
+        parts += [f"## {r['logical_scenario']}", "", rq1_table(r).markdown(), ""]
+    parts += ["## Dataset", "", dataset_table(reports).markdown(), "",
+              "## Monitors", "", monitors_table(reports).markdown(), ""]
+    return "\n".join(parts)
+
+
+CSS = """
+body{font:14px/1.45 system-ui,sans-serif;margin:24px auto;max-width:1180px;color:#222}
+h1{font-size:22px}h2{font-size:18px;margin-top:30px;border-bottom:1px solid #ddd}
+table{border-collapse:collapse;margin:8px 0 16px;font-size:13px}
+th,td{border:1px solid #ddd;padding:3px 7px;text-align:right}
+th:first-child,td:first-child{text-align:left}
+tr.sec td{background:#f3f3f3;font-weight:600;text-align:left}
+.charts{display:flex;flex-wrap:wrap;gap:12px}
+svg.chart{font:11px sans-serif;background:#fafafa;border:1px solid #eee}
+svg .t{font-size:13px;font-weight:600} svg .s{font-size:11px}
+.note{color:#666;font-size:12px}
+"""
+
+
+def _scenario_html(r: dict) -> str:
+    ms = r["monitors"]
+    roc = [(m["name"], m["curves"]["roc_fpr"], m["curves"]["roc_tpr"]) for m in ms]
+    pr = [(m["name"], m["curves"]["pr_recall"], m["curves"]["pr_precision"]) for m in ms]
+    charts = [
+        line_chart(roc, title="ROC (test frames)", xlabel="false-positive rate",
+                   ylabel="true-positive rate", diagonal=True),
+        line_chart(pr, title="Precision-recall (test frames)", xlabel="recall",
+                   ylabel="precision", legend_at="top-right"),
+    ]
+    for k in r["ks"]:
+        for f in (str(x) for x in r["fprs"]):
+            rows = [(m["name"], m["scenario"][str(k)]["lead_time"][f]["values_s"]) for m in ms]
+            charts.append(strip_chart(rows, title=f"Warning lead time, K={k}, FPR {f}",
+                                      xlabel="lead time before the collision (s)"))
+    return (f"<h2>{escape(r['logical_scenario'])}</h2>" + rq1_table(r).html()
+            + '<div class="charts">' + "".join(charts) + "</div>")
+
+
+def html_report(reports: list[dict], title: str = "evoeye RQ1 report") -> str:
+    """One self-contained HTML page: inline CSS and SVG, no scripts, no external resources."""
+    stamp = f"{datetime.now(UTC):%Y-%m-%d %H:%M} UTC"
+    body = [f"<h1>{escape(title)}</h1>",
+            f'<p class="note">Generated {stamp}. Rates in %. Thresholds calibrated on '
+            "validation frames, applied unchanged to test; frames at or after a collision are "
+            "not scored. A run warns at its first K consecutive alarms before the collision.</p>"]
+    body += [_scenario_html(r) for r in reports]
+    body += ["<h2>Dataset</h2>", dataset_table(reports).html(),
+             "<h2>Monitors</h2>", monitors_table(reports).html()]
+    return ("<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">"
+            f"<title>{escape(title)}</title><style>{CSS}</style></head><body>"
+            + "".join(body) + "</body></html>\n")
+
+
+@dataclass(frozen=True)
+class ReportFiles:
+    folder: Path
+    markdown: Path
+    html: Path
+    json: Path
+
+
+def write_report(root: DataRoot | str | Path | None, reports: list[dict],
+                 name: str | None = None) -> ReportFiles:
+    """Write rq1.md, report.html and report.json under `<root>/reports/<name>/`."""
+    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+    name = name or f"rq1-{datetime.now(UTC):%Y%m%dT%H%M%SZ}"
+    if not name or "/" in name or name.startswith("."):
+        raise ValueError(f"report name must be a plain folder name, got {name!r}")
+    folder = root.path / "reports" / name
+    folder.mkdir(parents=True, exist_ok=True)
+    files = ReportFiles(folder, folder / "rq1.md", folder / "report.html", folder / "report.json")
+    files.markdown.write_text(markdown_report(reports), encoding="utf-8")
+    files.html.write_text(html_report(reports, f"evoeye RQ1 report — {name}"), encoding="utf-8")
+    files.json.write_text(json.dumps(reports, indent=1) + "\n", encoding="utf-8")
+    return files

@@ -1,0 +1,149 @@
+"""Scenario-level detection and warning lead time (paper §V-RQ1).
+
+A monitor *warns* in a run at the first frame that completes K consecutive alarms (frames
+t-K+1 … t of the run all alarm; K = 1 is a single alarm). Only frames before the run's first
+collision count (all frames of a run without one). A violation run with a warning is detected
+(TP), without one missed (FN); a safe run with a warning is a false positive (FP). The lead time
+of a detected violation is tau_col − tau_w, tau_w the time of the frame that completes the
+warning. For AUROC / AUPRC over runs, a run's score is the largest score the monitor holds for
+K consecutive eligible frames (max over t of the min over t-K+1 … t): the run warns at a
+threshold exactly when this score exceeds it.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+
+import numpy as np
+
+from evoeye.evaluation.calibration import alarms
+from evoeye.evaluation.metrics import PRF, auprc, auroc, prf
+from evoeye.monitor.protocol import Thresholds
+
+
+@dataclass(frozen=True)
+class Runs:
+    """Frames grouped by run: sorted by (scenario_id, frame) once, shared by every monitor."""
+
+    order: np.ndarray  # (N,) permutation of the input frames into run order
+    start: np.ndarray  # (R,) first sorted position of each run
+    run_of: np.ndarray  # (N,) run index of each sorted frame
+    scenario_id: np.ndarray  # (R,) str
+    collision_time_s: np.ndarray  # (R,) float64, +inf if no collision
+    t_s: np.ndarray  # (N,) sorted frame times
+    eligible: np.ndarray  # (N,) sorted: frame before its run's collision
+
+    @classmethod
+    def of(cls, scenario_id: np.ndarray, frame: np.ndarray, t_s: np.ndarray,
+           collision_time_s: np.ndarray, eligible: np.ndarray) -> Runs:
+        ids = np.asarray(scenario_id).astype(str)
+        order = np.lexsort((np.asarray(frame), ids))
+        sids = ids[order]
+        new_run = np.ones(len(sids), bool)
+        new_run[1:] = sids[1:] != sids[:-1]
+        start = np.flatnonzero(new_run)
+        return cls(order, start, np.cumsum(new_run) - 1, sids[start],
+                   np.asarray(collision_time_s, float)[order][start],
+                   np.asarray(t_s, float)[order], np.asarray(eligible, bool)[order])
+
+    @property
+    def violated(self) -> np.ndarray:
+        return np.isfinite(self.collision_time_s)
+
+    def __len__(self) -> int:
+        return len(self.start)
+
+
+def consecutive_counts(alarm: np.ndarray, start: np.ndarray) -> np.ndarray:
+    """(N,) length of the run of consecutive alarms ending at each frame, restarting per run.
+
+    `alarm` is in run order; `start` holds the first position of each run."""
+    alarm = np.asarray(alarm, bool)
+    idx = np.arange(len(alarm))
+    last_reset = np.where(alarm, -1, idx)  # a frame without alarm resets the count
+    last_reset[start] = np.maximum(last_reset[start], start - 1)  # so does a new run
+    return idx - np.maximum.accumulate(last_reset) if len(alarm) else idx
+
+
+def k_window_min(scores: np.ndarray, start: np.ndarray, k: int) -> np.ndarray:
+    """(N,) min of the scores of frames t-k+1 … t of the same run; -inf for the first k-1."""
+    scores = np.asarray(scores, float)
+    pos = np.arange(len(scores)) - np.repeat(start, np.diff(np.append(start, len(scores))))
+    out = scores.copy()
+    for j in range(1, k):
+        shifted = np.full_like(scores, np.inf)
+        shifted[j:] = scores[:-j]
+        out = np.minimum(out, shifted)
+    return np.where(pos >= k - 1, out, -np.inf)
+
+
+@dataclass(frozen=True)
+class LeadTimes:
+    """Warning lead times (s) of the detected violations."""
+
+    detected: int
+    violations: int
+    values_s: list[float]
+
+    @property
+    def median_s(self) -> float | None:
+        return float(np.median(self.values_s)) if self.values_s else None
+
+    def to_dict(self) -> dict:
+        return {"detected": self.detected, "violations": self.violations,
+                "median_s": self.median_s, "values_s": self.values_s}
+
+
+@dataclass(frozen=True)
+class ScenarioMetrics:
+    """Scenario-level results for one K: per target FPR the run counts and lead times."""
+
+    k: int
+    at_fpr: dict[float, PRF]
+    lead_time: dict[float, LeadTimes]
+    auroc: float | None
+    auprc: float | None
+    scenarios: int
+    violations: int
+
+    def to_dict(self) -> dict:
+        return {
+            "k": self.k,
+            "at_fpr": {str(f): v.to_dict() for f, v in self.at_fpr.items()},
+            "lead_time": {str(f): v.to_dict() for f, v in self.lead_time.items()},
+            "auroc": self.auroc, "auprc": self.auprc,
+            "scenarios": self.scenarios, "violations": self.violations,
+        }
+
+
+def warnings_at(runs: Runs, alarm_sorted: np.ndarray, k: int) -> np.ndarray:
+    """(R,) time of each run's first eligible K-consecutive alarm; NaN where it never warns."""
+    confirmed = (consecutive_counts(alarm_sorted, runs.start) >= k) & runs.eligible
+    first = np.full(len(runs), np.nan)
+    hit = np.flatnonzero(confirmed)
+    if len(hit):
+        r, first_pos = np.unique(runs.run_of[hit], return_index=True)
+        first[r] = runs.t_s[hit[first_pos]]
+    return first
+
+
+def scenario_metrics(scores: np.ndarray, runs: Runs, thresholds: Thresholds, k: int,
+                     fprs: Iterable[float] | None = None) -> ScenarioMetrics:
+    """Detection of violation runs with K consecutive alarms, per calibrated threshold."""
+    s = np.asarray(scores, float)[runs.order]
+    fprs = sorted(thresholds.by_fpr, reverse=True) if fprs is None else list(fprs)
+    violated = runs.violated
+    at_fpr, lead = {}, {}
+    for f in fprs:
+        warn_t = warnings_at(runs, alarms(s, thresholds.at(f)), k)
+        warned = ~np.isnan(warn_t)
+        at_fpr[f] = prf(warned, violated)
+        leads = runs.collision_time_s[warned & violated] - warn_t[warned & violated]
+        lead[f] = LeadTimes(int((warned & violated).sum()), int(violated.sum()),
+                            np.round(leads, 4).tolist())
+    windowed = np.where(runs.eligible, k_window_min(s, runs.start, k), -np.inf)
+    run_score = np.maximum.reduceat(windowed, runs.start) if len(s) else np.zeros(0)
+    run_score = np.where(np.isfinite(run_score), run_score, 0.0)
+    return ScenarioMetrics(k, at_fpr, lead, auroc(run_score, violated),
+                           auprc(run_score, violated), len(runs), int(violated.sum()))

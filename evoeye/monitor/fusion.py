@@ -1,0 +1,85 @@
+"""FusionMonitor: a trained FusionNet behind the Monitor protocol (windows in, risks out).
+
+Scoring runs a traced copy of the network (TorchScript, built on first use, sharing the
+network's parameters): at batch 1 the eager module spends most of its ~0.3 ms in Python
+dispatch over ~50 sub-module calls, the traced graph ~0.1 ms, with the same numbers. If tracing
+is unavailable the eager network is used.
+"""
+
+from __future__ import annotations
+
+import warnings
+from collections.abc import Callable
+from typing import Any
+
+import numpy as np
+import torch
+
+from evoeye.monitor.model import INPUTS, FusionNet, example_inputs
+from evoeye.monitor.protocol import Thresholds
+from evoeye.store.windows import WindowBatch, Windows
+
+SCORE_BATCH = 8192  # windows gathered and scored at a time (bounds memory, not results)
+
+
+def net_inputs(batch: WindowBatch | dict[str, torch.Tensor]) -> list[torch.Tensor]:
+    """The tensors FusionNet.forward takes, in order, from a WindowBatch or a dict of tensors."""
+    tensors = batch.tensors() if isinstance(batch, WindowBatch) else batch
+    return [tensors[name] for name in INPUTS]
+
+
+def traced(net: FusionNet) -> Callable[..., torch.Tensor]:
+    """The network traced for inference (any batch size), or the network itself on failure."""
+    try:
+        with warnings.catch_warnings(), torch.no_grad():
+            warnings.simplefilter("ignore")  # torch.jit announces its deprecation
+            return torch.jit.trace(net.eval(), example_inputs(net, 1), check_trace=False)
+    except Exception:  # noqa: BLE001 - a missing or failing tracer only costs speed
+        return net
+
+
+class FusionMonitor:
+    """A trained FusionMonitor version: `score(windows)` gives (B,) risks in [0, 1]."""
+
+    name = "fusion"
+
+    def __init__(self, net: FusionNet, version: str, thresholds: Thresholds,
+                 card: dict[str, Any] | None = None, *, trace: bool = True):
+        self.net = net.eval()
+        self.version = version
+        self.thresholds = thresholds
+        self.card = card or {}
+        self._trace = trace
+        self._forward: Callable[..., torch.Tensor] | None = None
+
+    @property
+    def context_len(self) -> int:
+        """L: score windows loaded with this context length."""
+        return self.net.config.context_len
+
+    @property
+    def horizon_s(self) -> float | None:
+        """H the monitor was trained for (None if unknown)."""
+        return self.card.get("horizon_s")
+
+    def score_batch(self, batch: WindowBatch | dict[str, torch.Tensor]) -> np.ndarray:
+        """(b,) float32 risks of one batch of (b, L, …) tensors; no grad, eval mode (set at
+        construction: a network being trained elsewhere must not be scored mid-step)."""
+        if self._forward is None:
+            self._forward = traced(self.net) if self._trace else self.net
+        with torch.inference_mode():
+            return torch.sigmoid(self._forward(*net_inputs(batch))).numpy()
+
+    def score(self, windows: Windows) -> np.ndarray:
+        """(B,) float32 risk scores, one per window, in chunks of SCORE_BATCH windows."""
+        if windows.context_len != self.context_len:
+            raise ValueError(f"monitor {self.version} takes contexts of L = {self.context_len} "
+                             f"frames; these windows have L = {windows.context_len}")
+        out = np.empty(len(windows), np.float32)
+        for start in range(0, len(windows), SCORE_BATCH):
+            index = slice(start, min(start + SCORE_BATCH, len(windows)))
+            out[index] = self.score_batch(windows.batch(index))
+        return out
+
+    def __repr__(self) -> str:
+        return f"FusionMonitor({self.version!r}, L={self.context_len})"

@@ -1,0 +1,190 @@
+"""Replay a run log through a monitor: a copy of the log with its risk and alarms added.
+
+The copy keeps every record of the original (schemas, channels, messages, the run metadata and
+the road-map attachment) and adds, per frame, at the frame's log time:
+
+    /monitor/risk   evoeye.MonitorRisk (schemas/mcap/monitor_risk.v1.json): t_s, score, alarm,
+                    threshold, monitor_version
+    /viz/monitor    foxglove.SceneUpdate: the score as text above the ego (red while the alarm is
+                    on) and, during an alarm, a red box around the ego
+
+so Foxglove or Lichtblick show the warning next to the scene. Frames are streamed through the
+RuntimeMonitor, so a replay shows what the monitor would have said live. Replaying a replayed
+log replaces its monitor channels. The copy is written atomically.
+"""
+
+from __future__ import annotations
+
+import io
+import os
+from dataclasses import dataclass
+from math import cos, sin
+from pathlib import Path
+from typing import Any
+
+from mcap.reader import SeekingReader
+
+from evoeye.ads.messages import (
+    ControlCommand,
+    FrameMessages,
+    Localization,
+    Obstacles,
+    PlannedTrajectory,
+    Predictions,
+)
+from evoeye.atomic import atomic_file
+from evoeye.log import TOPICS, read_run
+from evoeye.log.channels import MESSAGE_ENCODING, SCHEMA_ENCODING, load_schema, log_time_ns
+from evoeye.log.mcap_writer import McapWriter
+from evoeye.log.viz import CRASHED_COLOR, FRAME_ID, stamp
+from evoeye.log.writer import CHUNK_SIZE_BYTES, COMPRESSION, LIBRARY, ZSTD_LEVEL, dumps
+from evoeye.monitor.fusion import FusionMonitor
+from evoeye.monitor.runtime import RiskState, RuntimeMonitor
+
+RISK_TOPIC = "/monitor/risk"
+VIZ_TOPIC = "/viz/monitor"
+RISK_SCHEMA_FILE = "monitor_risk.v1.json"
+VIZ_SCHEMA_FILE = "scene_update.v1.json"
+MESSAGE_TYPES = (  # FrameMessages field, topic, message type
+    ("localization", TOPICS.localization, Localization),
+    ("obstacles", TOPICS.obstacles, Obstacles),
+    ("predictions", TOPICS.predictions, Predictions),
+    ("plan", TOPICS.plan, PlannedTrajectory),
+    ("control", TOPICS.control, ControlCommand),
+)
+TEXT_HEIGHT_M = 4.0
+ALARM_BOX_M = (7.0, 3.5, 2.0)  # drawn around the ego's pose: length, width, height
+SAFE_TEXT_COLOR = {"r": 1.0, "g": 1.0, "b": 1.0, "a": 1.0}
+ALARM_BOX_COLOR = {**CRASHED_COLOR, "a": 0.35}
+
+
+@dataclass(frozen=True)
+class ReplayReport:
+    """Where the copy went and what the monitor said."""
+
+    out: Path
+    frames: int
+    alarm_frames: int
+    first_alarm_t_s: float | None
+    threshold: float
+
+
+def log_frames(path: str | os.PathLike) -> list[FrameMessages]:
+    """The ADS module messages of every frame of a run log, as the warehouse reads them
+    (field values as decoded from JSON: lists where the dataclasses hold arrays)."""
+    run = read_run(path, topics=[topic for _, topic, _ in MESSAGE_TYPES])
+    per_topic = {name: [msg for _, msg in run.messages(topic)]
+                 for name, topic, _ in MESSAGE_TYPES}
+    counts = {len(msgs) for msgs in per_topic.values()}
+    if len(counts) != 1:
+        raise ValueError(f"{path}: the ADS topics have different message counts "
+                         f"{ {n: len(m) for n, m in per_topic.items()} }")
+    types = {name: cls for name, _, cls in MESSAGE_TYPES}
+    return [
+        FrameMessages(**{name: types[name](**msgs[i]) for name, msgs in per_topic.items()})
+        for i in range(counts.pop())
+    ]
+
+
+def risk_message(state: RiskState, version: str) -> dict[str, Any]:
+    """The /monitor/risk message of one frame."""
+    return {"t_s": state.t_s, "score": state.score, "alarm": state.alarm,
+            "threshold": state.threshold, "monitor_version": version}
+
+
+def _entity(t_ns: int, entity_id: str, **primitives: Any) -> dict[str, Any]:
+    entity: dict[str, Any] = {
+        "timestamp": stamp(t_ns), "frame_id": FRAME_ID, "id": entity_id,
+        "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": False, "metadata": [],
+    }
+    for kind in ("arrows", "cubes", "spheres", "cylinders", "lines", "triangles", "texts",
+                 "models"):
+        entity[kind] = primitives.get(kind, [])
+    return entity
+
+
+def marker_update(state: RiskState, ego: Localization, t_ns: int) -> dict[str, Any]:
+    """The /viz/monitor SceneUpdate of one frame: score text, and a red box while alarming."""
+    h = float(ego.heading_rad)
+    orientation = {"x": 0.0, "y": 0.0, "z": sin(0.5 * h), "w": cos(0.5 * h)}
+    at = {"x": float(ego.x_m), "y": float(ego.y_m)}
+    text = {
+        "pose": {"position": {**at, "z": TEXT_HEIGHT_M}, "orientation": orientation},
+        "billboard": True, "font_size": 18.0, "scale_invariant": True,
+        "color": CRASHED_COLOR if state.alarm else SAFE_TEXT_COLOR,
+        "text": f"{'ALARM ' if state.alarm else ''}risk {state.score:.2f}",
+    }
+    entities = [_entity(t_ns, "monitor/risk", texts=[text])]
+    if state.alarm:
+        length, width, height = ALARM_BOX_M
+        box = {"pose": {"position": {**at, "z": height / 2}, "orientation": orientation},
+               "size": {"x": length, "y": width, "z": height}, "color": ALARM_BOX_COLOR}
+        entities.append(_entity(t_ns, "monitor/alarm", cubes=[box]))
+    return {"deletions": [{"timestamp": stamp(t_ns), "type": 1, "id": ""}],
+            "entities": entities}
+
+
+def _write_copy(source: bytes, stream: io.BufferedWriter,
+                added: list[tuple[int, str, bytes]]) -> None:
+    """Copy every record of the MCAP `source`, merging in `added` = [(log ns, topic, data)]
+    (in time order) after the original messages of the same log time."""
+    reader = SeekingReader(io.BytesIO(source))
+    summary = reader.get_summary()
+    writer = McapWriter(stream, COMPRESSION, ZSTD_LEVEL, CHUNK_SIZE_BYTES)
+    writer.start(profile=reader.get_header().profile, library=LIBRARY)
+    schema_ids = {sid: writer.register_schema(s.name, s.encoding, s.data)
+                  for sid, s in sorted(summary.schemas.items())}
+    ours = {RISK_TOPIC, VIZ_TOPIC}
+    channel_ids = {cid: writer.register_channel(c.topic, c.message_encoding,
+                                                schema_ids[c.schema_id])
+                   for cid, c in sorted(summary.channels.items()) if c.topic not in ours}
+    by_name = {s.name: schema_ids[sid] for sid, s in summary.schemas.items()}
+    new_ids: dict[str, int] = {}
+    for topic, schema_file in ((RISK_TOPIC, RISK_SCHEMA_FILE), (VIZ_TOPIC, VIZ_SCHEMA_FILE)):
+        schema = load_schema(schema_file)
+        sid = by_name.get(schema["title"])
+        if sid is None:
+            sid = writer.register_schema(schema["title"], SCHEMA_ENCODING, dumps(schema))
+        new_ids[topic] = writer.register_channel(topic, MESSAGE_ENCODING, sid)
+    for record in reader.iter_metadata():
+        writer.add_metadata(record.name, record.metadata)
+    for a in reader.iter_attachments():
+        writer.add_attachment(a.create_time, a.log_time, a.name, a.media_type, a.data)
+    pending = iter(added)
+    nxt = next(pending, None)
+    seq = 0
+    for _, channel, message in reader.iter_messages(log_time_order=False):
+        while nxt is not None and nxt[0] < message.log_time:
+            writer.add_message(new_ids[nxt[1]], nxt[0], nxt[2], nxt[0], seq)
+            nxt = next(pending, None)
+        if channel.id in channel_ids:
+            writer.add_message(channel_ids[channel.id], message.log_time, message.data,
+                               message.publish_time, message.sequence)
+        seq = message.sequence
+    while nxt is not None:
+        writer.add_message(new_ids[nxt[1]], nxt[0], nxt[2], nxt[0], seq)
+        nxt = next(pending, None)
+    writer.finish()
+
+
+def replay(log: str | os.PathLike, monitor: FusionMonitor, out: str | os.PathLike | None = None,
+           *, fpr: float = 0.05, consecutive: int = 1) -> ReplayReport:
+    """Write a copy of `log` with the monitor's risk and alarm channels (default
+    `<log>.risk.mcap` beside it); what the monitor said."""
+    log = Path(log)
+    out = Path(out) if out is not None else log.with_name(f"{log.stem}.risk.mcap")
+    if out.resolve() == log.resolve():
+        raise ValueError(f"the replay must not overwrite its source log {log}")
+    frames = log_frames(log)
+    runtime = RuntimeMonitor(monitor, fpr=fpr, consecutive=consecutive)
+    states = runtime.run(frames)
+    added: list[tuple[int, str, bytes]] = []
+    for state, frame in zip(states, frames, strict=True):
+        t_ns = log_time_ns(state.t_s)
+        added.append((t_ns, RISK_TOPIC, dumps(risk_message(state, monitor.version))))
+        added.append((t_ns, VIZ_TOPIC, dumps(marker_update(state, frame.localization, t_ns))))
+    with atomic_file(out) as f:
+        _write_copy(log.read_bytes(), f, added)
+    alarm_t = [s.t_s for s in states if s.alarm]
+    return ReplayReport(out, len(states), len(alarm_t), alarm_t[0] if alarm_t else None,
+                        runtime.threshold)

@@ -1,0 +1,84 @@
+"""Flow: the RQ1 evaluation (a thin wrapper): one task per logical scenario, then the report.
+
+Writing monitor_scores takes the warehouse writer lock, so a task is retried only while another
+writer holds it; the report is published as a Markdown artifact.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from prefect import flow, get_run_logger, task
+from prefect.artifacts import create_markdown_artifact
+from prefect.client.schemas.objects import TaskRun
+from prefect.states import State
+from prefect.tasks import Task
+from pydantic import BaseModel, Field
+
+from evoeye.evaluation.monitors import BASELINES
+from evoeye.evaluation.report import markdown_report, write_report
+from evoeye.evaluation.rq1 import rq1, warehouse_scenarios
+from evoeye.paths import resolve_root
+from evoeye.store import SplitSpec, WarehouseLockedError
+
+
+class EvaluateParams(BaseModel):
+    """What to evaluate and where (validated before anything runs)."""
+
+    root: str | None = None  # default: $EVOEYE_HOME or ./evoeye-data
+    scenarios: list[str] = Field(default_factory=list)  # default: all in the warehouse
+    monitors: list[str] = Field(default_factory=list)  # trained monitor versions
+    baselines: list[str] = Field(default_factory=lambda: list(BASELINES))
+    train_fusion: bool = False
+    split_seed: int = Field(SplitSpec().seed, ge=0)
+    train_frac: float = Field(SplitSpec().train_frac, ge=0.0, le=1.0)
+    val_frac: float = Field(SplitSpec().val_frac, ge=0.0, le=1.0)
+    latency: bool = True
+    report_name: str | None = None
+
+    @property
+    def splits(self) -> SplitSpec:
+        return SplitSpec(self.split_seed, self.train_frac, self.val_frac)
+
+    def model_post_init(self, __context) -> None:
+        self.splits  # noqa: B018  (validates the fractions)
+        unknown = [b for b in self.baselines if b not in BASELINES]
+        if unknown:
+            raise ValueError(f"unknown baseline(s) {unknown}; known: {sorted(BASELINES)}")
+
+
+def _locked(task: Task, task_run: TaskRun, state: State) -> bool:
+    """Retry only while another process holds the writer lock."""
+    try:
+        state.result()
+    except WarehouseLockedError:
+        return True
+    except Exception:  # noqa: BLE001  (any other failure: do not retry)
+        return False
+    return False
+
+
+@task(retries=5, retry_delay_seconds=10, retry_condition_fn=_locked,
+      task_run_name="evaluate-{scenario}")
+def evaluate_scenario(root: str, scenario: str, params: EvaluateParams) -> dict[str, Any]:
+    """The RQ1 figures of one logical scenario (EvaluationReport as a dict)."""
+    (report,) = rq1(root, [scenario], baselines=params.baselines,
+                    monitor_versions=params.monitors, fusion=params.train_fusion,
+                    splits=params.splits, latency=params.latency)
+    return report.to_dict()
+
+
+@flow(name="evoeye-evaluate", log_prints=True)
+def evaluate_flow(params: EvaluateParams | None = None) -> dict[str, Any]:
+    """Evaluate every scenario, write the report, publish the RQ1 table as an artifact."""
+    params = params or EvaluateParams()
+    root = str(resolve_root(params.root))
+    scenarios = params.scenarios or warehouse_scenarios(root)
+    # one after the other: each task writes monitor_scores under the single writer lock
+    reports = [evaluate_scenario(root, s, params) for s in scenarios]
+    files = write_report(root, reports, params.report_name)
+    markdown = markdown_report(reports)
+    create_markdown_artifact(markdown=markdown, key="evoeye-rq1",
+                             description=f"RQ1 report, {files.html}")
+    get_run_logger().info("RQ1 report for %s: %s", ", ".join(scenarios), files.html)
+    return {"reports": reports, "report_dir": str(files.folder)}

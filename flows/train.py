@@ -1,0 +1,73 @@
+"""Flow: train (or fine-tune) a FusionMonitor version on warehouse windows (a thin wrapper).
+
+The task is not retried: training is deterministic, so a failure would repeat itself.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from prefect import flow, get_run_logger, task
+from pydantic import BaseModel, Field, field_validator
+
+from evoeye.monitor.inputs import parse_modules
+from evoeye.paths import resolve_root
+from evoeye.store import SplitSpec
+
+
+class TrainFlowParams(BaseModel):
+    """What to train on and how; by default the scenario's train / val splits."""
+
+    root: str | None = None  # default: $EVOEYE_HOME or ./evoeye-data
+    scenario: str | None = "highway-cut-in"
+    train_sql: str | None = None  # SQL returning scenario_id: overrides the train split
+    val_sql: str | None = None  # … and the validation split
+    context_len: int | None = Field(None, ge=1, le=64)  # None: 5, or the parent's
+    horizon_s: float = Field(3.0, gt=0.0)
+    modules: str | None = None  # an ABLATIONS name or a comma list of MODULES; None: all
+    seed: int = 0
+    split_seed: int = 0
+    epochs: int = Field(40, ge=1)
+    patience: int = Field(8, ge=1)
+    batch_size: int = Field(256, ge=1)
+    lr: float = Field(1e-3, gt=0.0)
+    init_from: str | None = None  # fine-tune this version
+
+    @field_validator("modules")
+    @classmethod
+    def _known_modules(cls, value: str | None) -> str | None:
+        parse_modules(value)  # raises ValueError naming the choices
+        return value
+
+
+@task(task_run_name="train-{params.scenario}")
+def train_version(params: TrainFlowParams, root: str) -> str:
+    """One training run; the saved version's id."""
+    from evoeye.monitor.train import train_monitor
+
+    return train_monitor(
+        root, params.scenario, context_len=params.context_len, horizon_s=params.horizon_s,
+        modules=parse_modules(params.modules), seed=params.seed,
+        splits=SplitSpec(seed=params.split_seed),
+        train_runs=params.train_sql, val_runs=params.val_sql, init_from=params.init_from,
+        epochs=params.epochs, patience=params.patience, batch_size=params.batch_size,
+        lr=params.lr,
+    )
+
+
+@flow(name="evoeye-train", log_prints=True)
+def train_flow(params: TrainFlowParams | None = None) -> dict[str, Any]:
+    """Train a monitor version; its id, card path and validation metrics."""
+    from evoeye.monitor.registry import CARD_FILE, read_card, version_dir
+
+    params = params or TrainFlowParams()
+    root = str(resolve_root(params.root))
+    version = train_version(params, root)
+    card = read_card(root, version)
+    val = card["metrics"]["val"]
+    get_run_logger().info(
+        "%s: val AUROC %s, AUPRC %s, F1@FPR0.05 %.3f (best epoch %d, %.1f s)", version,
+        val["auroc"], val["auprc"], val["fpr_0.05"]["f1"], card["training"]["best_epoch"],
+        card["training"]["time_s"])
+    return {"version": version, "card": str(version_dir(root, version) / CARD_FILE),
+            "parent": card["parent"], "metrics": val, "thresholds": card["thresholds"]}

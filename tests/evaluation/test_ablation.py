@@ -1,0 +1,33 @@
+"""The monitor ablation: its variants, and a small real run (one epoch per FusionMonitor)."""
+
+from __future__ import annotations
+
+import json
+
+from evoeye.evaluation.ablation import Variant, run_ablation, variants
+
+
+def test_paper_variants_l_rows_then_input_rows_at_l5() -> None:
+    got = [(v.label, v.context_len, v.inputs) for v in variants()]
+    assert got == [
+        ("L=1", 1, "all"), ("L=3", 3, "all"), ("L=5", 5, "all"), ("L=7", 7, "all"),
+        ("perception", 5, "perception"),
+        ("perception+prediction", 5, "perception+prediction"),
+        ("perception+prediction+planning", 5, "perception+prediction+planning"),
+    ]
+    assert variants((1,), ("perception", "all"))[-1] == Variant("all", 5, "all")
+
+
+def test_small_ablation_trains_evaluates_and_tabulates(eval_root, splits) -> None:
+    report = run_ablation(eval_root, ["highway-cut-in"], splits, context_lens=(1,),
+                          inputs=("perception",), store_scores=False, epochs=1)
+    assert [r.label for r in report.rows] == ["L=1", "perception"]
+    versions = {r.results["highway-cut-in"]["version"] for r in report.rows}
+    assert len(versions) == 2 and all(v.startswith("fusion-") for v in versions)
+    md = report.markdown()
+    for row in report.rows:
+        r = row.results["highway-cut-in"]
+        line = next(x for x in md.splitlines() if x.startswith(f"| {row.label} |"))
+        assert f"| {100 * r['auroc']:.1f} |" in line and f"| {100 * r['auprc']:.1f} |" in line
+    folder = report.write(eval_root, "ablation-test")
+    assert json.loads((folder / "ablation.json").read_text())["rows"][0]["context_len"] == 1

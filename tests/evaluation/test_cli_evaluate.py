@@ -1,0 +1,73 @@
+"""`evoeye evaluate`: the Markdown table and `--json` carry the same figures."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+from typer.testing import CliRunner
+
+import evoeye.cli.evaluate  # noqa: F401  (registers the command)
+from evoeye.cli import app
+from evoeye.evaluation.report import pct
+
+RUNNER = CliRunner()
+
+
+def _args(root, splits, *extra: str) -> list[str]:
+    return ["evaluate", "--root", str(root.path), "--scenario", "highway-cut-in",
+            "--baselines", "ttc,rss", "--no-latency", "--split-seed", str(splits.seed),
+            "--train-frac", str(splits.train_frac), "--val-frac", str(splits.val_frac), *extra]
+
+
+def _markdown_rows(text: str) -> dict[tuple[str, str], list[str]]:
+    """(section, method) → cells of the RQ1 table rows in `text`."""
+    rows, section = {}, None
+    for line in text.splitlines():
+        if not line.startswith("| ") or line.startswith("| Method"):
+            continue
+        cells = [c.strip() for c in line.strip("|").split("|")]
+        if cells[0].startswith("**"):
+            section = cells[0].strip("*")
+        elif section is not None and cells[0] in ("ttc", "rss"):
+            rows[(section, cells[0])] = cells[1:]
+    return rows
+
+
+def _expected(monitor: dict, section: str) -> list[str]:
+    block = monitor["frame"] if section == "Frame-level" else monitor["scenario"][section[-2]]
+    cells = []
+    for f in ("0.05", "0.01"):
+        a = block["at_fpr"][f]
+        cells += [pct(a["precision"]), pct(a["recall"]), pct(a["f1"])]
+    return cells + [pct(block["auroc"]), pct(block["auprc"])]
+
+
+def test_json_and_markdown_carry_the_same_numbers(eval_root, splits) -> None:
+    as_json = RUNNER.invoke(app, _args(eval_root, splits, "--json", "--name", "cli-json"))
+    assert as_json.exit_code == 0, as_json.output
+    data = json.loads(as_json.stdout)
+    (report,) = data["reports"]
+    assert report["logical_scenario"] == "highway-cut-in"
+    as_md = RUNNER.invoke(app, _args(eval_root, splits, "--name", "cli-md"))
+    assert as_md.exit_code == 0, as_md.output
+    assert "report: " in as_md.stdout and "cli-md/report.html" in as_md.stdout
+    rows = _markdown_rows(as_md.stdout)
+    sections = ["Frame-level", "Scenario-level (K=1)", "Scenario-level (K=3)"]
+    assert set(rows) == {(s, m) for s in sections for m in ("ttc", "rss")}
+    for monitor in report["monitors"]:
+        for section in sections:
+            assert rows[(section, monitor["name"])][:8] == _expected(monitor, section)
+        lead = monitor["scenario"]["1"]["lead_time"]["0.05"]
+        warned = rows[("Scenario-level (K=1)", monitor["name"])][8]
+        assert warned == f"{lead['detected']}/{lead['violations']}"
+
+
+@pytest.mark.parametrize(("extra", "message"), [
+    (["--baselines", "none"], "nothing to evaluate"),
+    (["--baselines", "ttc,foo"], "unknown baseline"),
+])
+def test_bad_arguments_are_refused(eval_root, splits, extra, message) -> None:
+    args = [a for a in _args(eval_root, splits) if a not in ("--baselines", "ttc,rss")]
+    result = RUNNER.invoke(app, args + extra)
+    assert result.exit_code != 0 and message in result.output

@@ -1,0 +1,119 @@
+"""evaluate(): calibration on val, figures on test, scores stored once, reports rendered."""
+
+from __future__ import annotations
+
+import json
+import re
+
+import numpy as np
+import pyarrow.parquet as pq
+import pytest
+
+from evoeye.baselines import RSSMonitor, TTCMonitor
+from evoeye.baselines.aem import AEMConfig
+from evoeye.evaluation import evaluate
+from evoeye.evaluation.dataset import load_split
+from evoeye.evaluation.monitors import AEM_DIR, baseline_monitors, fit_aem
+from evoeye.evaluation.report import html_report, markdown_report, write_report
+from evoeye.store.scores import read_scores, scores_dir, scores_schema
+
+SCENARIO = "highway-cut-in"  # the scenario of eval_root (conftest)
+
+
+@pytest.fixture(scope="module")
+def report(eval_root, splits):
+    return evaluate(eval_root, [TTCMonitor(), RSSMonitor()], SCENARIO, splits)
+
+
+def test_metrics_use_frames_before_the_collision_only(report, eval_root, splits,
+                                                      layout) -> None:
+    test = load_split(eval_root, SCENARIO, "test", splits)
+    stats = report.dataset["test"]
+    n_viol, after = stats["violations"], layout.n_frames - layout.collision_frame
+    assert stats["frames"] == stats["scenarios"] * layout.n_frames - n_viol * after
+    assert stats["unsafe_frames"] == n_viol * 3 * layout.rate_hz  # H = 3 s before the collision
+    assert report.monitors[0].frame.frames == stats["frames"] == int(test.eligible.sum())
+
+
+def test_thresholds_come_from_validation(report) -> None:
+    for m in report.monitors:
+        for fpr, realised in m.val_fpr.items():
+            assert realised <= fpr
+        assert m.thresholds[0.01] >= m.thresholds[0.05]
+        assert set(m.scenario) == {1, 3}
+
+
+def test_scores_are_stored_once_per_version_and_run(report, eval_root, splits) -> None:
+    again = evaluate(eval_root, [TTCMonitor(), RSSMonitor()], SCENARIO, splits)
+    assert [m.scores_written for m in again.monitors] == [0, 0]
+    n = len(load_split(eval_root, SCENARIO, "val", splits)) + len(
+        load_split(eval_root, SCENARIO, "test", splits))
+    for m in report.monitors:
+        rows = read_scores(eval_root, monitor_version=m.version)
+        assert rows.num_rows == n  # val + test, every frame once
+        keys = set(zip(rows.column("scenario_id").to_pylist(), rows.column("frame").to_pylist(),
+                       strict=True))
+        assert len(keys) == n
+    for part in scores_dir(eval_root).glob("*.parquet"):
+        assert pq.read_schema(part).remove_metadata().equals(scores_schema(), check_metadata=False)
+
+
+def test_stored_scores_are_the_monitors_scores(report, eval_root, splits) -> None:
+    test = load_split(eval_root, SCENARIO, "test", splits, context_len=1)
+    expected = TTCMonitor().score(test.windows)
+    rows = read_scores(eval_root, monitor_version=TTCMonitor().version).to_pydict()
+    stored = {(s, f): v for s, f, v in zip(rows["scenario_id"], rows["frame"], rows["score"],
+                                           strict=True)}
+    got = [stored[(s, int(f))] for s, f in zip(test.windows.scenario_id, test.windows.frame,
+                                               strict=True)]
+    assert np.allclose(got, expected, atol=1e-6)
+
+
+def test_report_dict_is_json(report) -> None:
+    d = json.loads(json.dumps(report.to_dict()))
+    assert [m["name"] for m in d["monitors"]] == ["ttc", "rss"]
+    assert d["monitors"][0]["frame"]["at_fpr"]["0.05"]["tp"] == report.monitors[0].frame.at_fpr[
+        0.05].tp
+
+
+def test_html_report_is_self_contained_with_every_monitors_curves(report, eval_root) -> None:
+    d = report.to_dict()
+    html = html_report([d])
+    assert not re.search(r"https?://|\bsrc=|<script|<link|url\(|@import", html)
+    for m in d["monitors"]:
+        assert html.count(f'data-series="{m["name"]}"') == 2  # ROC and PR
+    assert "ROC" in html and "Precision-recall" in html and "Warning lead time" in html
+    files = write_report(eval_root, [d], "t-html")
+    assert files.html.read_text().startswith("<!DOCTYPE html>")
+    assert files.markdown.read_text() == markdown_report([d])
+    assert json.loads(files.json.read_text())[0]["logical_scenario"] == SCENARIO
+
+
+def test_aem_is_trained_once_and_evaluated(eval_root, splits) -> None:
+    small = AEMConfig(hidden=(32,), latent=4, epochs=3)
+    first = fit_aem(eval_root, SCENARIO, splits, small)
+    again = fit_aem(eval_root, SCENARIO, splits, small)
+    assert again.version == first.version
+    assert (eval_root.path / AEM_DIR / first.version / "model.pt").is_file()
+    assert len(list((eval_root.path / AEM_DIR).iterdir())) == 1
+    rep = evaluate(eval_root, [first], SCENARIO, splits, store_scores=False)
+    assert rep.monitors[0].context_len == 5 and rep.monitors[0].scores_written == 0
+    assert rep.monitors[0].frame.auroc is not None
+
+
+def test_baselines_by_name(eval_root, splits) -> None:
+    ttc, rss = baseline_monitors(eval_root, SCENARIO, splits, ["ttc", "rss"])
+    assert (ttc.name, rss.name) == ("ttc", "rss")
+    with pytest.raises(KeyError, match="unknown baseline"):
+        baseline_monitors(eval_root, SCENARIO, splits, ["ttc", "nope"])
+
+
+def test_bad_monitor_scores_are_refused(eval_root, splits) -> None:
+    class Broken:
+        name, version, context_len = "broken", "broken-0", 1
+
+        def score(self, windows):
+            return np.full(len(windows), 2.0)
+
+    with pytest.raises(ValueError, match=r"outside \[0, 1\]"):
+        evaluate(eval_root, [Broken()], SCENARIO, splits, store_scores=False)

@@ -1,0 +1,74 @@
+"""Scenario-level detection with K consecutive alarms, and warning lead times, by hand."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from evoeye.evaluation.scenario import Runs, consecutive_counts, scenario_metrics
+from evoeye.monitor.protocol import Thresholds
+
+RATE_HZ = 20.0
+N_FRAMES = 15
+# run → (collision frame or None, frames that alarm)
+RUNS = {
+    "s1": (None, [0, 1, 2]),  # safe, three in a row: a false positive even at K = 3
+    "s2": (None, [4, 6, 13, 14]),  # safe, never three in a row; ends on two alarms
+    "v1": (10, [0, 3, 4, 12, 13, 14]),  # two in a row before the collision, three after
+    "v2": (10, [5, 6, 7]),  # three in a row, the third at frame 7 (0.35 s)
+}
+THRESHOLDS = Thresholds({0.05: 0.5, 0.01: 0.95})
+
+
+def frames(seed: int = 0):
+    ids, frame, t, tau, score = [], [], [], [], []
+    for sid, (col, on) in RUNS.items():
+        for i in range(N_FRAMES):
+            ids.append(sid)
+            frame.append(i)
+            t.append(i / RATE_HZ)
+            tau.append(np.inf if col is None else col / RATE_HZ)
+            score.append(0.9 if i in on else 0.1)
+    perm = np.random.default_rng(seed).permutation(len(ids))  # any input order
+    arrays = [np.array(a)[perm] for a in (ids, frame, t, tau, score)]
+    ids, frame, t, tau, score = arrays
+    return Runs.of(ids, frame, t, tau, t < tau - 1e-6), score
+
+
+def test_consecutive_counts_restart_at_every_run() -> None:
+    alarm = np.array([1, 1, 0, 1, 1, 1, 1, 0], bool)
+    assert consecutive_counts(alarm, np.array([0, 4])).tolist() == [1, 2, 0, 1, 1, 2, 3, 0]
+
+
+def test_k3_needs_three_alarms_before_the_collision() -> None:
+    runs, score = frames()
+    m = scenario_metrics(score, runs, THRESHOLDS, k=3)
+    at = m.at_fpr[0.05]
+    # v2 detected; v1 missed (two before, three only after the collision); s1 false positive;
+    # s2's last two alarms do not join v1's first one across the run boundary
+    assert (at.tp, at.fn, at.fp, at.tn) == (1, 1, 1, 1)
+    assert (at.precision, at.recall, at.f1) == pytest.approx((0.5, 0.5, 0.5))
+    lead = m.lead_time[0.05]
+    assert (lead.detected, lead.violations) == (1, 2)
+    assert lead.values_s == pytest.approx([0.5 - 7 / RATE_HZ])  # warned when the 3rd alarms
+    assert m.scenarios == 4 and m.violations == 2
+
+
+def test_k1_warns_at_the_first_alarm() -> None:
+    runs, score = frames(seed=1)
+    m = scenario_metrics(score, runs, THRESHOLDS, k=1)
+    at = m.at_fpr[0.05]
+    assert (at.tp, at.fn, at.fp, at.tn) == (2, 0, 2, 0)
+    assert m.lead_time[0.05].values_s == pytest.approx([0.5, 0.5 - 5 / RATE_HZ])  # v1, v2
+    assert m.lead_time[0.05].median_s == pytest.approx(0.375)
+    none = m.at_fpr[0.01]  # threshold 0.95: nothing alarms
+    assert (none.tp, none.fp, none.fn, none.tn) == (0, 0, 2, 2)
+    assert m.lead_time[0.01].median_s is None
+
+
+def test_run_scores_rank_runs_as_their_warnings_do() -> None:
+    runs, score = frames()
+    m = scenario_metrics(score, runs, THRESHOLDS, k=3)
+    # held-for-3 scores: s1 0.9, s2 0.1, v1 0.1 (before the collision), v2 0.9
+    # -> (v, s) pairs: v1<s1 0, v1=s2 .5, v2=s1 .5, v2>s2 1
+    assert m.auroc == pytest.approx(0.5)

@@ -1,0 +1,33 @@
+"""`evoeye train` from the shell: prints the version, the validation metrics and the card."""
+
+from __future__ import annotations
+
+from typer.testing import CliRunner
+
+import evoeye.cli.monitor  # noqa: F401  (registers the commands)
+from evoeye.cli.app import app
+from evoeye.monitor.registry import read_card
+
+
+def test_train_command_prints_version_metrics_and_card(tiny) -> None:
+    result = CliRunner().invoke(app, [
+        "train", "--root", str(tiny.root.path), "--scenario", tiny.scenario,
+        "--horizon-s", str(tiny.horizon_s), "--context-len", "3", "--epochs", "2",
+        "--modules", "perception+prediction", "--seed", "4",
+    ], env={"COLUMNS": "160"})
+    assert result.exit_code == 0, result.output
+    version = result.output.split("version: ")[-1].strip()
+    card = read_card(tiny.root, version)
+    assert card["context_len"] == 3 and card["modules"] == ["perception", "prediction"]
+    assert card["hyperparameters"]["seed"] == 4 and card["training"]["epochs_run"] == 2
+    assert "epoch   2" in result.output and "AUROC" in result.output
+    assert f"monitors/{version}/card.json" in result.output.replace("\n", "")
+
+
+def test_train_command_reports_bad_input_without_a_traceback(tiny) -> None:
+    result = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path), "--scenario",
+                                      "nowhere"])
+    assert result.exit_code == 1 and "training and validation windows" in result.output
+    result = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path), "--scenario",
+                                      tiny.scenario, "--init-from", "fusion-000000000000"])
+    assert result.exit_code == 1 and "no monitor version" in result.output

@@ -1,0 +1,29 @@
+"""ONNX export: ONNX Runtime gives PyTorch's scores on real windows, at any batch size."""
+
+from __future__ import annotations
+
+import numpy as np
+import onnx
+import onnxruntime as ort
+
+from evoeye.monitor.export import OUTPUT, export_onnx
+from evoeye.monitor.model import INPUTS
+from evoeye.monitor.registry import load_monitor
+from evoeye.store import load_windows
+
+
+def test_onnx_runtime_and_torch_give_the_same_scores(tiny, trained, tmp_path) -> None:
+    monitor = load_monitor(tiny.root, trained)
+    path = export_onnx(monitor, tmp_path / "sub" / "model.onnx")
+    onnx.checker.check_model(onnx.load(str(path)))
+    assert not list(path.parent.glob("*.tmp"))
+    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    assert [i.name for i in session.get_inputs()] == list(INPUTS)
+    windows = load_windows(tiny.root, context_len=5, horizon_s=tiny.horizon_s)
+    expected = monitor.score(windows)
+    for index in (np.arange(len(windows)), np.array([7]), np.arange(3, 120, 2)):
+        arrays = windows.arrays(index)
+        (risk,) = session.run([OUTPUT], {name: arrays[name] for name in INPUTS})
+        assert risk.shape == (len(index),)
+        np.testing.assert_allclose(risk, expected[index], rtol=0, atol=1e-5)
+    assert expected.std() > 0.05  # real, varied scores, not a constant
