@@ -32,6 +32,10 @@ QUERY_PARAMS = {
         "val_frac": 0.125,
     },
     "windows": {"context_len": 5, "horizon_s": 3.0},
+    "hard_set": {  # every run in test; a monitor scoring 0 everywhere misses every unsafe frame
+        "monitor_version": "m", "threshold": 0.5, "logical_scenario": "highway-cut-in",
+        "horizon_s": 3.0, "seed": 0, "train_frac": 0.0, "val_frac": 0.0,
+    },
 }
 
 
@@ -106,6 +110,8 @@ def test_every_query_runs(name: str, filled: DataRoot) -> None:
     con = Warehouse(filled).connect()
     try:
         con.register("selected_runs", con.sql("SELECT scenario_id FROM scenarios"))
+        con.register("monitor_scores", con.sql(
+            "SELECT scenario_id, frame, 'm' AS monitor_version, 0.0 AS score FROM frames"))
         rows = con.sql(query(name), params=QUERY_PARAMS[name] or None).fetchall()
         assert rows, name
     finally:

@@ -1,0 +1,96 @@
+"""`evoeye evolve` (one campaign, round by round) and `evoeye experiment` (the RQ2 table)."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from evoeye.cli.app import app
+from evoeye.evolve.campaign import UPDATE_MODES, Campaign, CampaignConfig
+from evoeye.paths import DataRoot
+from evoeye.store import SplitSpec
+
+Root = Annotated[Path | None, typer.Option(
+    "--root", help="Data root (default: $EVOEYE_HOME or ./evoeye-data).")]
+
+
+def _config(scenario: str, strategy: str, budget_s: float, seed: int, monitor: str | None,
+            n_round: int, update: str, epochs: int | None, split_seed: int) -> CampaignConfig:
+    if update not in UPDATE_MODES:
+        raise typer.BadParameter(f"--update must be one of {UPDATE_MODES}")
+    try:
+        return CampaignConfig(scenario=scenario, strategy=strategy, budget_s=budget_s, seed=seed,
+                              monitor=monitor, n_round=n_round, update=update, epochs=epochs,
+                              splits=SplitSpec(seed=split_seed))
+    except (ValueError, KeyError) as e:
+        raise typer.BadParameter(str(e)) from None
+
+
+@app.command("evolve")
+def evolve_command(
+    root: Root = None,
+    scenario: Annotated[str, typer.Option("--scenario")] = "highway-cut-in",
+    strategy: Annotated[str, typer.Option("--strategy")] = "evoeye",
+    budget_s: Annotated[float, typer.Option("--budget-s", help="Simulated seconds.")] = 600.0,
+    seed: Annotated[int, typer.Option("--seed")] = 0,
+    monitor: Annotated[str | None, typer.Option("--monitor", help="G_0 version.")] = None,
+    n_round: Annotated[int, typer.Option("--n-round")] = 20,
+    update: Annotated[str, typer.Option("--update", help="finetune | retrain")] = "finetune",
+    epochs: Annotated[int | None, typer.Option("--epochs")] = None,
+    max_rounds: Annotated[int | None, typer.Option("--max-rounds")] = None,
+    split_seed: Annotated[int, typer.Option("--split-seed")] = 0,
+) -> None:
+    """Run (or resume) an evolution campaign; per round, G_r's F1 / AUPRC on the test set."""
+    from evoeye.evolve.assess import Assessor
+
+    cfg = _config(scenario, strategy, budget_s, seed, monitor, n_round, update, epochs,
+                  split_seed)
+    data = DataRoot.resolve(root)
+    probe = Campaign(data, cfg)
+    assess = Assessor(data, cfg.scenario, probe.g0, splits=cfg.splits, horizon_s=cfg.horizon_s)
+    campaign = Campaign(data, cfg, assess=assess)
+    typer.echo(f"campaign {campaign.campaign_id}: logs in "
+               f"{data.runs / cfg.scenario / campaign.campaign_id}, state in "
+               f"{data.table_dir('campaign_rounds')} and {data.table_dir('feedback')}")
+
+    def show(row, state) -> None:
+        m = json.loads(row.metrics) if row.metrics else {}
+        t, h = m.get("test", {}), m.get("hard", {})
+        typer.echo(f"round {row.round}: {len(row.scenario_ids)} runs, {row.simulated_s:.0f}/"
+                   f"{cfg.budget_s:.0f} s, monitor {row.monitor_version} | test F1@0.05 "
+                   f"{t.get('f1@0.05', 0):.3f} AUPRC {t.get('auprc') or 0:.3f} | hard F1@0.05 "
+                   f"{h.get('f1@0.05', 0):.3f}")
+
+    state = campaign.start()
+    show(state.rounds[-1], state)
+    state = campaign.run(max_rounds=max_rounds, on_round=show)
+    typer.echo(f"{'budget spent' if campaign.done(state) else 'paused'} after round "
+               f"{state.round}: {state.acquired} runs, {state.spent_s:.0f} s; monitor "
+               f"{state.monitor}")
+
+
+@app.command("experiment")
+def experiment_command(
+    root: Root = None,
+    scenario: Annotated[list[str] | None, typer.Option("--scenario")] = None,
+    budget_s: Annotated[float, typer.Option("--budget-s")] = 600.0,
+    repetitions: Annotated[int, typer.Option("--repetitions", "-r")] = 3,
+    n_round: Annotated[int, typer.Option("--n-round")] = 20,
+    epochs: Annotated[int | None, typer.Option("--epochs")] = None,
+    ablation: Annotated[bool, typer.Option("--ablation/--no-ablation")] = True,
+    name: Annotated[str | None, typer.Option("--name", help="Report folder name.")] = None,
+) -> None:
+    """The RQ2 table (+ evolution ablation): G_0 vs uniform / avfuzzer / evoeye, R seeds."""
+    from evoeye.evolve.experiment import ABLATION, MAIN, run_experiment, write_experiment_report
+
+    scenarios = scenario or ["highway-cut-in", "unprotected-intersection"]
+    base = _config(scenarios[0], "evoeye", budget_s, 0, None, n_round, "finetune", epochs, 0)
+    results = run_experiment(root, scenarios, base,
+                             strategies=MAIN + (ABLATION if ablation else ()),
+                             seeds=range(repetitions), progress=typer.echo)
+    folder = write_experiment_report(root, results, name)
+    typer.echo((folder / "rq2.md").read_text(encoding="utf-8"))
+    typer.echo(f"report: {folder / 'rq2.html'}")

@@ -1,0 +1,372 @@
+"""An evolution campaign: Algorithm 1 as a resumable loop of acquisition rounds.
+
+Round r+1 starts from the monitor G_r and the records D_r (D_init, then every run acquired so
+far, each with its feedback under G_r). It proposes one scenario at a time, simulates it, scores
+the new run with G_r and adds it to D_r, until N_round runs or the budget is spent; then it
+ingests the round's logs, updates the monitor on D_r, refreshes the feedback of every record
+with G_{r+1} and stores the round. The campaign stops when no run fits in the budget left.
+
+Monitor update, `update="finetune"` (the default): G_{r+1} starts from G_r's weights and input
+normalisers and trains a few epochs on D_r — Algorithm 1, line 12 is Train(G_r, D_r), and a
+round adds only N_round runs to hundreds, so re-fitting from scratch every round would spend
+most of a campaign's wall time relearning what G_r knows. `update="retrain"` trains from scratch
+on D_r every round (slower; useful to check that fine-tuning does not drift).
+
+State and resume. Everything a campaign knows is in the data root: run logs under
+`runs/<scenario>/<campaign id>/`, the feedback table (f_r per run and monitor version) and the
+campaign_rounds table (per round: G_r and the runs acquired, in order). `start()` rebuilds D_r
+and the strategy (`replay`) from the last stored round; a round interrupted anywhere (mid-run,
+mid-round, mid-training) is re-done from its start — its proposals are deterministic (the
+strategy's, and run seed k for proposal k), logs already on disk are read instead of simulated,
+so no run is lost, duplicated or charged twice. A run is started only if the budget left is at
+least the longest run (`max_run_s`), so the budget is never overspent.
+
+Deviation from Algorithm 1: a last round cut short by the budget still updates the monitor (its
+runs were paid for; training costs no simulated time).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from collections.abc import Callable
+from dataclasses import asdict, dataclass, field
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+
+from evoeye.batch import simulate_and_log
+from evoeye.evolve.avfuzzer import criticality
+from evoeye.evolve.protocol import Strategy
+from evoeye.evolve.records import Records
+from evoeye.evolve.scoring import read_logged_run, warehouse_feedback, windows_feedback
+from evoeye.evolve.strategies import STRATEGIES, make_strategy
+from evoeye.log import read_run
+from evoeye.paths import DataRoot
+from evoeye.scenarios import DEFAULT_DELTA, get_scenario
+from evoeye.sim.runner import SimConfig, run_spec
+from evoeye.store import RunFilter, SplitSpec, Warehouse, ingest
+from evoeye.store.feedback import FeedbackRows, RoundRow, feedback_of, read_rounds, write_feedback
+from evoeye.store.feedback import write_round as store_round
+from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S
+
+UPDATE_MODES = ("finetune", "retrain")
+MAX_RUN_S = SimConfig().duration_s  # no run lasts longer than this (20 s)
+FINETUNE_EPOCHS, FINETUNE_PATIENCE = 10, 4
+
+INITIAL_RECORDS_SQL = """
+SELECT s.scenario_id, s.params, s.collided, s.min_distance_m, s.duration_s
+FROM scenarios AS s
+JOIN scenario_splits($seed, $train_frac, $val_frac) AS p USING (scenario_id)
+WHERE s.logical_scenario = $scenario AND s.round = 0 AND p.split = 'train' AND s.status = 'ok'
+ORDER BY s.scenario_id
+"""
+
+
+@dataclass(frozen=True)
+class CampaignConfig:
+    """What a campaign does. Every field but `budget_s` is part of the campaign id."""
+
+    scenario: str
+    strategy: str = "evoeye"
+    budget_s: float = 600.0  # simulated seconds the acquired runs may use in total
+    seed: int = 0
+    monitor: str | None = None  # G_0; None: the newest from-scratch monitor of the scenario
+    n_round: int = 20  # N_round: runs per round
+    update: str = "finetune"
+    epochs: int | None = None  # per update; None: 10 when fine-tuning, TrainParams' when not
+    patience: int | None = None
+    delta: float = DEFAULT_DELTA
+    horizon_s: float = DEFAULT_HORIZON_S
+    splits: SplitSpec = field(default_factory=SplitSpec)
+    max_run_s: float = MAX_RUN_S
+
+    def __post_init__(self) -> None:
+        get_scenario(self.scenario)
+        if self.strategy not in STRATEGIES:
+            raise ValueError(f"unknown strategy {self.strategy!r}; known: {sorted(STRATEGIES)}")
+        if self.update not in UPDATE_MODES:
+            raise ValueError(f"update must be one of {UPDATE_MODES}, got {self.update!r}")
+        if self.n_round < 1 or self.budget_s < 0 or self.seed < 0 or self.max_run_s <= 0:
+            raise ValueError(f"need n_round >= 1, budget_s >= 0, seed >= 0: {self}")
+
+    def train_overrides(self) -> dict[str, int]:
+        """TrainParams fields of one monitor update."""
+        out = {}
+        epochs = self.epochs or (FINETUNE_EPOCHS if self.update == "finetune" else None)
+        patience = self.patience or (FINETUNE_PATIENCE if self.update == "finetune" else None)
+        if epochs:
+            out["epochs"] = epochs
+        if patience:
+            out["patience"] = patience
+        return out
+
+
+@dataclass
+class CampaignState:
+    """D_r and G_r after `round` finished rounds, with the strategy that acquired D_r \\ D_init."""
+
+    campaign_id: str
+    round: int
+    monitor: str
+    records: Records
+    ok: np.ndarray  # (n,) bool: the run finished and can train the monitor
+    n_init: int
+    strategy: Strategy
+    rounds: list[RoundRow]
+
+    @property
+    def spent_s(self) -> float:
+        return float(self.records.tail(self.n_init).duration_s.sum())
+
+    @property
+    def acquired(self) -> int:
+        return self.records.n - self.n_init
+
+
+Trainer = Callable[..., str]  # train_monitor's signature
+Assessor = Callable[[str], dict]  # monitor version → metrics (stored with the round, as JSON)
+
+
+def _default_trainer(root, scenario, **kwargs) -> str:
+    from evoeye.monitor import train_monitor
+
+    return train_monitor(root, scenario, **kwargs)
+
+
+def _load_monitor(root: DataRoot, version: str):
+    """A version for batch scoring: untraced (tracing pays off only over many calls)."""
+    from evoeye.monitor import FusionMonitor, load_monitor
+
+    m = load_monitor(root, version)
+    return FusionMonitor(m.net, m.version, m.thresholds, m.card, trace=False)
+
+
+def run_seed(campaign_seed: int, k: int) -> int:
+    """The simulation seed of proposal k (0-based) of a campaign."""
+    return int(np.random.SeedSequence([campaign_seed, k]).generate_state(1)[0])
+
+
+def initial_monitor(root: DataRoot | str | Path | None, scenario: str) -> str:
+    """The newest full FusionMonitor (all modules, L = 5) trained from scratch on `scenario`."""
+    from evoeye.monitor import list_versions, read_card
+    from evoeye.monitor.model import MODULES
+
+    cards = [(read_card(root, v), v) for v in list_versions(root)]
+    mine = [(c.get("created_at", ""), v) for c, v in cards  # the full model, not an ablation
+            if c.get("logical_scenario") == scenario and not c.get("parent")
+            and tuple(c.get("modules", ())) == tuple(MODULES)
+            and c.get("context_len") == DEFAULT_CONTEXT_LEN]
+    if not mine:
+        raise LookupError(f"no monitor trained on {scenario!r} under {root}: train one first "
+                          "(`evoeye monitor train`) or name it")
+    return max(mine)[1]
+
+
+class Campaign:
+    """One campaign over a data root: `start()` (or resume), then `run_round` until `done`."""
+
+    def __init__(self, root: DataRoot | str | Path | None, config: CampaignConfig, *,
+                 train: Trainer | None = None, assess: Assessor | None = None) -> None:
+        self.root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+        self.config = config
+        self.space = get_scenario(config.scenario)
+        self._train = train or _default_trainer
+        self._assess = assess
+        self._monitors: dict[str, object] = {}
+
+    # -- identity and initial data -------------------------------------------------------------
+    @cached_property
+    def initial(self) -> dict[str, np.ndarray]:
+        """D_init: the train split of the scenario's round-0 runs, by scenario id."""
+        cfg = self.config
+        t = Warehouse(self.root).sql(INITIAL_RECORDS_SQL, {
+            "scenario": cfg.scenario, **asdict(cfg.splits)}).to_pydict()
+        if not t["scenario_id"]:
+            raise LookupError(f"no initial (round 0) training runs of {cfg.scenario!r} in "
+                              f"{self.root.warehouse}: simulate and ingest them first")
+        return {k: np.asarray(v, dtype=object if k == "scenario_id" else None)
+                for k, v in t.items()}
+
+    @cached_property
+    def g0(self) -> str:
+        return self.config.monitor or initial_monitor(self.root, self.config.scenario)
+
+    @cached_property
+    def campaign_id(self) -> str:
+        """`evo-<strategy>-s<seed>-<hash>` of everything but the budget: same inputs, same id."""
+        cfg = asdict(self.config)
+        cfg.pop("budget_s")
+        cfg["monitor"] = self.g0
+        cfg["initial"] = hashlib.sha256("\n".join(self.initial["scenario_id"]).encode()).hexdigest()
+        digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]
+        return f"evo-{self.config.strategy}-s{self.config.seed}-{digest}"
+
+    def log_path(self, scenario_id: str) -> Path:
+        return self.root.run_log(self.config.scenario, self.campaign_id, scenario_id)
+
+    def monitor(self, version: str):
+        if version not in self._monitors:
+            self._monitors[version] = _load_monitor(self.root, version)
+        return self._monitors[version]
+
+    # -- state -----------------------------------------------------------------------------------
+    def start(self) -> CampaignState:
+        """The state after the last stored round; round 0 (G_0, D_init scored) is stored first."""
+        rounds = read_rounds(self.root, self.campaign_id)
+        if not rounds:
+            self._store_feedback(self.g0, self.initial["scenario_id"])
+            row = RoundRow(self.campaign_id, self.config.scenario, self.config.strategy,
+                           self.config.seed, 0, self.g0, [], 0, 0.0,
+                           metrics=self._metrics(self.g0))
+            store_round(self.root, row)
+            rounds = read_rounds(self.root, self.campaign_id)
+        last = rounds[-1]
+        init = self.initial
+        records = Records(
+            params=np.stack([np.asarray(p, float) for p in init["params"]]),
+            feedback=np.full(len(init["scenario_id"]), np.nan),
+            fitness=criticality(init["collided"].astype(bool),
+                                np.array(init["min_distance_m"], dtype=float)),
+            collided=init["collided"].astype(bool), duration_s=init["duration_s"].astype(float),
+            scenario_id=init["scenario_id"],
+        )
+        ok = [True] * records.n
+        for sid in (s for r in rounds for s in r.scenario_ids):
+            meta = read_run(self.log_path(sid), topics=()).metadata
+            records = records.append(np.asarray(meta["params"], float), **_outcome(meta))
+            ok.append(meta["status"] == "ok")
+        n_init = len(init["scenario_id"])
+        stored = feedback_of(self.root, last.monitor_version)
+        records = records.with_feedback(np.array(
+            [stored.get(s, np.nan) for s in records.scenario_id], dtype=float))
+        options = {"delta": self.config.delta} if self.config.delta != DEFAULT_DELTA else {}
+        strategy = make_strategy(self.config.strategy, self.space, self.config.seed, **options)
+        mine = records.tail(n_init)
+        strategy.replay(mine.params, mine.fitness)
+        return CampaignState(self.campaign_id, last.round, last.monitor_version, records,
+                             np.array(ok, bool), n_init, strategy, rounds)
+
+    def remaining_s(self, state: CampaignState) -> float:
+        return self.config.budget_s - state.spent_s
+
+    def done(self, state: CampaignState) -> bool:
+        """No run fits in the budget left."""
+        return self.remaining_s(state) < self.config.max_run_s
+
+    # -- one round, in the steps a flow runs as tasks ----------------------------------------------
+    def acquire(self, state: CampaignState) -> list[str]:
+        """Lines 5–10, up to N_round times: propose, simulate, score with G_r, add. New ids."""
+        cfg, monitor = self.config, self.monitor(state.monitor)
+        new: list[str] = []
+        while len(new) < cfg.n_round and not self.done(state):
+            prop = state.strategy.propose(state.records)
+            spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
+                            batch=self.campaign_id, source=cfg.strategy, round=state.round + 1)
+            result = simulate_and_log(spec, self.root.path)
+            if result.status == "error":
+                raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
+                                   f"{result.reason}")
+            run = read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
+            fb = (windows_feedback(monitor, run.windows).feedback[0]
+                  if run.ok and run.windows is not None else np.nan)
+            outcome = _outcome(run.metadata)
+            state.strategy.tell(prop.x, outcome["fitness"])
+            state.records = state.records.append(
+                np.asarray(run.metadata["params"], float), feedback=float(fb), **outcome)
+            state.ok = np.append(state.ok, run.ok)
+            new.append(spec.scenario_id)
+        return new
+
+    def ingest(self):
+        """Put the round's logs into the warehouse (every log not yet there)."""
+        return ingest(self.root)
+
+    def update_monitor(self, state: CampaignState) -> tuple[str, float]:
+        """Line 12: G_{r+1} from D_r (train) and the fixed val split; (version, wall seconds)."""
+        cfg = self.config
+        ids = [str(s) for s, ok in zip(state.records.scenario_id, state.ok, strict=True) if ok]
+        val = RunFilter(logical_scenario=cfg.scenario, split="val", splits=cfg.splits)
+        t0 = time.perf_counter()
+        version = self._train(
+            self.root, cfg.scenario, train_runs=ids, val_runs=val, horizon_s=cfg.horizon_s,
+            seed=cfg.seed * 1000 + state.round + 1, splits=cfg.splits,
+            init_from=state.monitor if cfg.update == "finetune" else None,
+            context_len=None if cfg.update == "finetune" else self.monitor(self.g0).context_len,
+            **cfg.train_overrides(),
+        )
+        return version, time.perf_counter() - t0
+
+    def finish_round(self, state: CampaignState, new_ids: list[str], version: str,
+                     train_s: float) -> RoundRow:
+        """Line 13 and the commit: store f_r of the new runs and f_{r+1} of all, then the round."""
+        new = state.records.tail(state.records.n - len(new_ids))
+        self._write_feedback(state.monitor, new.scenario_id, new.feedback)
+        ok_ids = state.records.scenario_id[state.ok]
+        self._store_feedback(version, ok_ids)
+        row = RoundRow(self.campaign_id, self.config.scenario, self.config.strategy,
+                       self.config.seed, state.round + 1, version, list(new_ids),
+                       state.acquired, state.spent_s, train_s, self._metrics(version))
+        store_round(self.root, row)
+        stored = feedback_of(self.root, version)
+        state.records = state.records.with_feedback(np.array(
+            [stored.get(s, np.nan) for s in state.records.scenario_id], dtype=float))
+        state.round, state.monitor = row.round, version
+        state.rounds.append(row)
+        return row
+
+    def run_round(self, state: CampaignState) -> RoundRow | None:
+        """One whole round (acquire → ingest → update → refresh); None when the budget is spent."""
+        new_ids = self.acquire(state)
+        if not new_ids:
+            return None
+        self.ingest()
+        version, train_s = self.update_monitor(state)
+        return self.finish_round(state, new_ids, version, train_s)
+
+    def run(self, max_rounds: int | None = None,
+            on_round: Callable[[RoundRow, CampaignState], None] | None = None) -> CampaignState:
+        """Resume, then run rounds until the budget is spent (or `max_rounds` more are done)."""
+        state = self.start()
+        done_rounds = 0
+        while not self.done(state) and (max_rounds is None or done_rounds < max_rounds):
+            row = self.run_round(state)
+            if row is None:
+                break
+            done_rounds += 1
+            if on_round is not None:
+                on_round(row, state)
+        return state
+
+    # -- helpers ---------------------------------------------------------------------------------
+    def _store_feedback(self, version: str, scenario_ids) -> None:
+        """Score ingested runs with `version` and store f (runs already stored are skipped)."""
+        have = feedback_of(self.root, version)
+        todo = [str(s) for s in scenario_ids if s not in have]
+        if not todo:
+            return
+        fb = warehouse_feedback(self.root, self.monitor(version), todo, self.config.horizon_s)
+        self._write_feedback(version, fb.scenario_id, fb.feedback, fb.n_contexts)
+
+    def _write_feedback(self, version: str, ids, feedback, n_contexts=None) -> None:
+        ids, feedback = np.asarray(ids, dtype=object), np.asarray(feedback, float)
+        keep = np.isfinite(feedback)
+        n = np.zeros(len(ids), int) if n_contexts is None else np.asarray(n_contexts)
+        write_feedback(self.root, FeedbackRows(self.config.scenario, version, ids[keep],
+                                               feedback[keep], n[keep]))
+
+    def _metrics(self, version: str) -> str:
+        return json.dumps(self._assess(version)) if self._assess else ""
+
+
+def _outcome(meta: dict) -> dict:
+    """Records columns of one run from its log metadata (a failed run is not critical)."""
+    collided = bool(meta["collided"])
+    gap = meta.get("min_distance_m")
+    return {
+        "fitness": float(criticality(collided, np.nan if gap is None else float(gap))),
+        "collided": collided, "duration_s": float(meta["duration_s"]),
+        "scenario_id": str(meta["scenario_id"]),
+    }

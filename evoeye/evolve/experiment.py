@@ -1,0 +1,176 @@
+"""The RQ2 experiment: G_0 vs every strategy at the same budget, R seeds, Test Set and Hard Set.
+
+Each (scenario, strategy, seed) is one campaign (resumable, so a killed experiment re-run picks
+up where it stopped); every round's G_r is assessed and stored with the round, so the per-round
+curves come from the campaign_rounds table. The report (Markdown + self-contained HTML with SVG
+charts) goes to `<root>/reports/<name>/`.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Callable, Sequence
+from dataclasses import replace
+from datetime import UTC, datetime
+from html import escape
+from pathlib import Path
+
+import numpy as np
+
+from evoeye.evaluation.plots import line_chart
+from evoeye.evolve.assess import Assessor
+from evoeye.evolve.campaign import Campaign, CampaignConfig, initial_monitor
+from evoeye.paths import DataRoot
+from evoeye.store.feedback import read_rounds
+
+MAIN = ("uniform", "avfuzzer", "evoeye")
+ABLATION = ("no-feedback", "no-density")
+COLUMNS = ("f1@0.05", "f1@0.01", "auroc", "auprc")
+
+
+def run_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str],
+                   base: CampaignConfig, *, strategies: Sequence[str] = MAIN + ABLATION,
+                   seeds: Sequence[int] = (0, 1, 2),
+                   progress: Callable[[str], None] = print) -> dict:
+    """Run (or resume) every campaign; {scenario: {"initial": m, strategy: [per-seed runs]}}."""
+    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+    out: dict = {}
+    for scenario in scenarios:
+        cfg0 = replace(base, scenario=scenario, monitor=base.monitor
+                       if base.scenario == scenario and base.monitor else None)
+        g0 = cfg0.monitor or initial_monitor(root, scenario)
+        assess = Assessor(root, scenario, g0, splits=base.splits, horizon_s=base.horizon_s)
+        res: dict = {"initial": assess(g0), "g0": g0}
+        for strategy in strategies:
+            res[strategy] = []
+            for seed in seeds:
+                cfg = replace(cfg0, strategy=strategy, seed=seed, monitor=g0)
+                c = Campaign(root, cfg, assess=assess)
+                progress(f"{scenario} {strategy} seed {seed}: campaign {c.campaign_id}")
+                c.run(on_round=lambda row, st, s=strategy: progress(
+                    f"  {s} round {row.round}: {_brief(row.metrics)}"))
+                rows = read_rounds(root, c.campaign_id)
+                res[strategy].append({
+                    "campaign_id": c.campaign_id, "seed": seed,
+                    "rounds": [json.loads(r.metrics) if r.metrics else None for r in rows],
+                    "simulated_s": rows[-1].simulated_s, "records": rows[-1].n_records,
+                    "blind_spots": _blind_spots(c) if strategy == "evoeye" else None,
+                })
+        out[scenario] = res
+    return out
+
+
+def _brief(metrics: str) -> str:
+    if not metrics:
+        return ""
+    m = json.loads(metrics)
+    return (f"test F1@0.05 {m['test']['f1@0.05']:.3f} AUPRC {m['test']['auprc'] or 0:.3f} | "
+            f"hard F1@0.05 {m['hard']['f1@0.05']:.3f}")
+
+
+def _blind_spots(c: Campaign) -> dict:
+    """Feedback of the final records over their first two (normalised) parameters."""
+    st = c.start()
+    u = c.space.normalise(st.records.params)
+    return {"names": list(c.space.names[:2]), "u0": u[:, 0].tolist(), "u1": u[:, 1].tolist(),
+            "feedback": np.nan_to_num(st.records.feedback).tolist(),
+            "acquired": [i >= st.n_init for i in range(st.records.n)]}
+
+
+def _value(v: float | None) -> float:
+    """A metric as a float; None (undefined, e.g. AUPRC with one class) becomes NaN."""
+    return np.nan if v is None else float(v)
+
+
+def _final(run: dict, split: str, col: str) -> float:
+    return _value(run["rounds"][-1][split][col])
+
+
+def _mean_std(values: list[float]) -> str:
+    a = np.asarray(values, float)
+    return f"{100 * np.nanmean(a):.1f} ± {100 * np.nanstd(a):.1f}" if len(a) else "–"
+
+
+def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
+    """Rows: method, then mean ± std (in %) of each column on the Test Set and the Hard Set."""
+    rows = [["initial (G_0)"] + [_mean_std([_value(res["initial"][s][c])])
+                                 for s in ("test", "hard") for c in COLUMNS]]
+    for strategy in strategies:
+        runs = res.get(strategy, [])
+        rows.append([strategy] + [_mean_std([_final(r, s, c) for r in runs])
+                                  for s in ("test", "hard") for c in COLUMNS])
+    return rows
+
+
+def markdown(results: dict) -> str:
+    head = ["method"] + [f"{s} {c}" for s in ("Test", "Hard") for c in COLUMNS]
+    out = ["# evoeye RQ2: self-evolution under the same budget", ""]
+    for scenario, res in results.items():
+        for title, strategies in (("RQ2", MAIN), ("Evolution ablation", ("evoeye",) + ABLATION)):
+            out += [f"## {scenario} — {title} (mean ± std over seeds, %)", "",
+                    "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+            out += ["| " + " | ".join(r) + " |" for r in table_rows(res, strategies)]
+            out.append("")
+    return "\n".join(out)
+
+
+def _curves(res: dict, split: str, col: str) -> str:
+    series = []
+    n_max = max((len(r["rounds"]) for s in res if isinstance(res[s], list) for r in res[s]),
+                default=1)
+    for strategy, runs in res.items():
+        if not isinstance(runs, list) or not runs:
+            continue
+        n = min(len(r["rounds"]) for r in runs)
+        ys = [float(np.nanmean([_value(r["rounds"][i][split][col]) for r in runs]))
+              for i in range(n)]
+        series.append((strategy, [i / max(n_max - 1, 1) for i in range(n)], ys))
+    return line_chart(series, title=f"{split} {col} per round", xlabel="round (0 … last)",
+                      ylabel=col)
+
+
+def _scatter(b: dict) -> str:
+    pts = []
+    hi = max(b["feedback"]) or 1.0
+    for x, y, f, new in zip(b["u0"], b["u1"], b["feedback"], b["acquired"], strict=True):
+        red = int(255 * f / hi)
+        pts.append(f'<circle cx="{40 + 300 * x:.1f}" cy="{330 - 300 * y:.1f}" r="{4 if new else 3}"'
+                   f' fill="rgb({red},60,{255 - red})" stroke="{"#000" if new else "none"}"/>')
+    return (f'<svg xmlns="http://www.w3.org/2000/svg" width="360" height="370">'
+            f'<rect x="40" y="30" width="300" height="300" fill="none" stroke="#999"/>'
+            f'{"".join(pts)}<text x="120" y="360">{escape(b["names"][0])}</text>'
+            f'<text x="5" y="20">{escape(b["names"][1])} (red = high feedback, ringed = '
+            f'acquired)</text></svg>')
+
+
+def html(results: dict) -> str:
+    body = []
+    for scenario, res in results.items():
+        body.append(f"<h2>{escape(scenario)}</h2>")
+        for title, strategies in (("RQ2", MAIN), ("Evolution ablation", ("evoeye",) + ABLATION)):
+            head = ["method"] + [f"{s} {c}" for s in ("Test", "Hard") for c in COLUMNS]
+            rows = "".join("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in r) + "</tr>"
+                           for r in table_rows(res, strategies))
+            body.append(f"<h3>{title}</h3><table border=1 cellpadding=3><tr>"
+                        + "".join(f"<th>{escape(h)}</th>" for h in head) + f"</tr>{rows}</table>")
+        for split in ("test", "hard"):
+            for col in ("f1@0.05", "auprc"):
+                body.append(_curves(res, split, col))
+        spots = [r["blind_spots"] for r in res.get("evoeye", []) if r.get("blind_spots")]
+        if spots:
+            body.append("<h3>Blind-spot map (EvoEye, first seed)</h3>" + _scatter(spots[0]))
+    return ("<!doctype html><meta charset=utf-8><title>evoeye RQ2</title>"
+            "<body style='font-family:sans-serif'>" + "".join(body) + "</body>")
+
+
+def write_experiment_report(root: DataRoot | str | Path | None, results: dict,
+                            name: str | None = None) -> Path:
+    """rq2.md, rq2.html and rq2.json under `<root>/reports/<name>/`; the folder."""
+    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+    folder = root.reports / (name or f"rq2-{datetime.now(UTC):%Y%m%dT%H%M%SZ}")
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "rq2.md").write_text(markdown(results), encoding="utf-8")
+    (folder / "rq2.html").write_text(html(results), encoding="utf-8")
+    (folder / "rq2.json").write_text(json.dumps(results, indent=1, default=float),
+                                     encoding="utf-8")
+    return folder

@@ -1,0 +1,71 @@
+"""The evolution flow through Prefect: rounds are `round-<r>` flow runs; the nightly deployment."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+from pydantic import ValidationError
+
+from evoeye.batch import plan_uniform, run_batch
+from evoeye.paths import DataRoot
+from evoeye.store import SplitSpec, ingest
+from evoeye.store.feedback import read_rounds
+from flows.deploy import NIGHTLY_CRON, nightly_deployment
+from flows.evolve import EvolveParams, evolution_flow
+
+SCENARIO = "unprotected-intersection"
+SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
+
+
+@pytest.fixture(scope="module")
+def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    from evoeye.monitor import train_monitor
+
+    root = DataRoot.resolve(tmp_path_factory.mktemp("evolve-flow") / "data")
+    run_batch(plan_uniform(SCENARIO, 16, 3), root.path)
+    ingest(root)
+    return root.path, train_monitor(root, SCENARIO, seed=0, splits=SPLITS, epochs=1)
+
+
+def test_params_reject_unknown_strategy() -> None:
+    with pytest.raises(ValidationError, match="strategy"):
+        EvolveParams(strategy="grid")
+    with pytest.raises(ValidationError, match="budget_s"):
+        EvolveParams(budget_s=-1)
+
+
+def test_nightly_deployment_has_cron_and_parameter_schema() -> None:
+    d = nightly_deployment(EvolveParams(scenario=SCENARIO, strategy="uniform", budget_s=60))
+    assert d.name == "nightly-evolution"
+    assert d.schedules[0].schedule.cron == NIGHTLY_CRON == "0 2 * * *"
+    assert d.parameters["params"]["strategy"] == "uniform"
+    schema = d._parameter_openapi_schema.model_dump()
+    fields = schema["definitions"]["EvolveParams"]["properties"]
+    assert {"scenario", "strategy", "budget_s", "seed", "n_round", "max_rounds"} <= set(fields)
+    assert "avfuzzer" in fields["strategy"]["enum"]
+    assert d.concurrency_limit == 1
+
+
+def test_evolution_flow_runs_each_round_as_a_flow_run(prefect_server, seeded) -> None:
+    from prefect.client.orchestration import get_client
+    from prefect.client.schemas.filters import FlowRunFilter, FlowRunFilterName
+
+    root, g0 = seeded
+    params = EvolveParams(root=str(root), scenario=SCENARIO, strategy="evoeye", budget_s=1000,
+                          monitor=g0, n_round=3, epochs=1, max_rounds=2, train_frac=0.5,
+                          val_frac=0.25, assess=True)
+    out = evolution_flow(params)
+    assert out["round"] == 2 and len(out["rounds"]) == 2
+    rows = read_rounds(root, out["campaign_id"])
+    assert [r.round for r in rows] == [0, 1, 2]
+    assert [len(r.scenario_ids) for r in rows] == [0, 3, 3]
+    assert all('"hard"' in r.metrics for r in rows)  # every G_r assessed
+    with get_client(sync_client=True) as client:
+        runs = client.read_flow_runs(flow_run_filter=FlowRunFilter(
+            name=FlowRunFilterName(any_=["round-1", "round-2"])))
+    assert sorted(r.name for r in runs) == ["round-1", "round-2"]
+    assert all(r.state.is_completed() for r in runs)
+    # a second flow run with a higher max resumes the same campaign at round 3
+    out2 = evolution_flow(params.model_copy(update={"max_rounds": 1}))
+    assert out2["campaign_id"] == out["campaign_id"] and out2["round"] == 3
