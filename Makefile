@@ -4,7 +4,7 @@ VENV   := .venv
 BIN    := $(VENV)/bin
 STAMP  := $(VENV)/.installed
 ROOT   ?= evoeye-data
-N      ?= 20
+N      ?= 40
 WORKERS ?= 2
 
 .PHONY: demo test install bench lint clean
@@ -21,7 +21,7 @@ $(STAMP): pyproject.toml | $(BIN)/python
 install: $(STAMP)
 
 demo: $(STAMP)
-	$(BIN)/evoeye demo --root $(ROOT) --n $(N) --workers $(WORKERS)
+	$(BIN)/python -m flows.demo --root $(ROOT) --n $(N) --workers $(WORKERS)
 
 test: $(STAMP)
 	$(BIN)/python -m pytest -q -n 2 --dist loadgroup
