@@ -1,4 +1,4 @@
-"""The main job at a small scale, as one Prefect flow: `python -m flows.demo` (what `make demo` runs).
+"""The main job, small, as one Prefect flow: `python -m flows.demo` (what `make demo` runs).
 
 simulate both logical scenarios → ingest → train the FusionMonitor and evaluate it against the
 TTC / RSS / AEM baselines (RQ1 report) → one evolution round of BlindSpotEvolver. With no
