@@ -10,16 +10,14 @@ from typing import Any
 
 from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_markdown_artifact
-from prefect.client.schemas.objects import TaskRun
-from prefect.states import State
-from prefect.tasks import Task
 from pydantic import BaseModel, Field
 
 from evoeye.evaluation.monitors import BASELINES
 from evoeye.evaluation.report import markdown_report, write_report
 from evoeye.evaluation.rq1 import rq1, warehouse_scenarios
 from evoeye.paths import resolve_root
-from evoeye.store import SplitSpec, WarehouseLockedError
+from evoeye.store import SplitSpec
+from flows.runners import retry_while_locked
 
 
 class EvaluateParams(BaseModel):
@@ -47,18 +45,7 @@ class EvaluateParams(BaseModel):
             raise ValueError(f"unknown baseline(s) {unknown}; known: {sorted(BASELINES)}")
 
 
-def _locked(task: Task, task_run: TaskRun, state: State) -> bool:
-    """Retry only while another process holds the writer lock."""
-    try:
-        state.result()
-    except WarehouseLockedError:
-        return True
-    except Exception:  # noqa: BLE001  (any other failure: do not retry)
-        return False
-    return False
-
-
-@task(retries=5, retry_delay_seconds=10, retry_condition_fn=_locked,
+@task(retries=5, retry_delay_seconds=10, retry_condition_fn=retry_while_locked,
       task_run_name="evaluate-{scenario}")
 def evaluate_scenario(root: str, scenario: str, params: EvaluateParams) -> dict[str, Any]:
     """The RQ1 figures of one logical scenario (EvaluationReport as a dict)."""

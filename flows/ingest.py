@@ -10,14 +10,12 @@ from dataclasses import asdict
 from typing import Any
 
 from prefect import flow, get_run_logger, task
-from prefect.client.schemas.objects import TaskRun
-from prefect.states import State
-from prefect.tasks import Task
 from pydantic import BaseModel, Field
 
 from evoeye.paths import resolve_root
-from evoeye.store import WarehouseLockedError, ingest
+from evoeye.store import ingest
 from evoeye.store.ingest import DEFAULT_RUNS_PER_PART
+from flows.runners import retry_while_locked
 
 
 class IngestParams(BaseModel):
@@ -27,18 +25,7 @@ class IngestParams(BaseModel):
     runs_per_part: int = Field(DEFAULT_RUNS_PER_PART, ge=1, le=10_000)
 
 
-def _locked(task: Task, task_run: TaskRun, state: State) -> bool:
-    """Retry only while another process holds the writer lock."""
-    try:
-        state.result()
-    except WarehouseLockedError:
-        return True
-    except Exception:  # noqa: BLE001  (any other failure: do not retry)
-        return False
-    return False
-
-
-@task(retries=5, retry_delay_seconds=10, retry_condition_fn=_locked)
+@task(retries=5, retry_delay_seconds=10, retry_condition_fn=retry_while_locked)
 def ingest_logs(root: str, runs_per_part: int) -> dict[str, Any]:
     """One ingest pass; the IngestReport as a dict."""
     return asdict(ingest(root, runs_per_part=runs_per_part))

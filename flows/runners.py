@@ -1,8 +1,13 @@
-"""Pick the task runner a flow fans out on: local processes by default, or a Dask cluster."""
+"""How flows run their tasks: the task runner they fan out on, and when a task is retried."""
 
 from __future__ import annotations
 
+from prefect.client.schemas.objects import TaskRun
+from prefect.states import State
 from prefect.task_runners import ProcessPoolTaskRunner, TaskRunner
+from prefect.tasks import Task
+
+from evoeye.store import WarehouseLockedError
 
 
 def task_runner(workers: int = 2, dask_address: str | None = None) -> TaskRunner:
@@ -12,3 +17,14 @@ def task_runner(workers: int = 2, dask_address: str | None = None) -> TaskRunner
 
         return DaskTaskRunner(address=dask_address)
     return ProcessPoolTaskRunner(max_workers=workers)
+
+
+def retry_while_locked(task: Task, task_run: TaskRun, state: State) -> bool:
+    """Retry condition: only while another process holds the warehouse's writer lock."""
+    try:
+        state.result()
+    except WarehouseLockedError:
+        return True
+    except Exception:  # noqa: BLE001  (any other failure: do not retry)
+        return False
+    return False
