@@ -88,7 +88,11 @@ def _final(run: dict, split: str, col: str) -> float:
 
 def _mean_std(values: list[float]) -> str:
     a = np.asarray(values, float)
-    return f"{100 * np.nanmean(a):.1f} ± {100 * np.nanstd(a):.1f}" if len(a) else "–"
+    if not len(a):
+        return "–"
+    mean = f"{100 * np.nanmean(a):.1f}"
+    # one seed has no spread to report: "± 0.0" would read as zero variance
+    return f"{mean} ± {100 * np.nanstd(a):.1f}" if np.isfinite(a).sum() > 1 else mean
 
 
 def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:

@@ -27,7 +27,13 @@ def test_table_reports_mean_and_std_of_the_last_round() -> None:
     assert rows["uniform"][1] == "40.0 ± 10.0"  # test F1@0.05 of 0.3 and 0.5
     assert rows["evoeye"][1] == "60.0 ± 0.0"
     assert rows["evoeye"][5] == "30.0 ± 0.0"  # hard F1@0.05
-    assert rows["initial (G_0)"][5] == "0.0 ± 0.0"
+    assert rows["initial (G_0)"][5] == "0.0"  # one value: no spread to report
+
+
+def test_a_single_seed_shows_no_spread() -> None:
+    one = {**RESULTS["highway-cut-in"], "uniform": [_run([0.2, 0.3])]}
+    rows = {r[0]: r for r in table_rows(one, ("uniform",))}
+    assert rows["uniform"][1] == "30.0"
 
 
 def test_report_files_hold_tables_curves_and_map(tmp_path) -> None:
