@@ -13,7 +13,6 @@ import uuid
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
-from functools import cache
 from pathlib import Path
 
 import duckdb
@@ -22,25 +21,11 @@ import pyarrow as pa
 
 from evoeye.paths import DataRoot
 from evoeye.store.lock import WriterLock
-from evoeye.store.schema import DDL_DIR, canonical_schema
+from evoeye.store.schema import declared_schema
 from evoeye.store.scores import PART_SUFFIX, _write_part
 
 FEEDBACK_TABLE = "feedback"
 ROUNDS_TABLE = "campaign_rounds"
-
-
-@cache
-def declared_schema(table: str) -> pa.Schema:
-    """The Arrow schema of `table` as DuckDB reports its declared (empty) DDL table."""
-    if table not in (FEEDBACK_TABLE, ROUNDS_TABLE):
-        raise KeyError(f"not a campaign table: {table!r}")
-    con = duckdb.connect()
-    try:
-        con.execute((DDL_DIR / f"{table}.sql").read_text(encoding="utf-8"))
-        declared = con.sql(f"SELECT * FROM {table} LIMIT 0").to_arrow_table().schema
-    finally:
-        con.close()
-    return canonical_schema(declared)
 
 
 def _root(root: DataRoot | str | Path | None) -> DataRoot:

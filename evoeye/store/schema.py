@@ -54,15 +54,25 @@ def _canonical(t: pa.DataType) -> pa.DataType:
 
 
 @cache
-def table_schema(table: str) -> pa.Schema:
-    """The Arrow schema of `table` as declared, partition keys included, in DDL order."""
+def declared_schema(table: str) -> pa.Schema:
+    """The Arrow schema of any table declared in `schemas/warehouse/<table>.sql` (ingested or
+    derived, e.g. monitor_scores), in DDL order, canonical."""
+    path = DDL_DIR / f"{table}.sql"
+    if not path.is_file():
+        raise KeyError(f"no DDL for table {table!r} in {DDL_DIR}")
     con = duckdb.connect()
     try:
-        create_declared_tables(con)
-        declared = con.sql(f"SELECT * FROM {DDL_SCHEMA}.{table} LIMIT 0").to_arrow_table().schema
+        con.execute(path.read_text(encoding="utf-8"))
+        declared = con.sql(f"SELECT * FROM {table} LIMIT 0").to_arrow_table().schema
     finally:
         con.close()
-    return pa.schema([pa.field(f.name, _canonical(f.type)) for f in declared])
+    return canonical_schema(declared)
+
+
+def table_schema(table: str) -> pa.Schema:
+    """The Arrow schema of ingested table `table`, partition keys included, in DDL order."""
+    ddl(table)  # refuses a table that is not ingested
+    return declared_schema(table)
 
 
 @cache

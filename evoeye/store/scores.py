@@ -15,7 +15,6 @@ import uuid
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
-from functools import cache
 from pathlib import Path
 
 import duckdb
@@ -26,22 +25,15 @@ import pyarrow.parquet as pq
 from evoeye.atomic import atomic_file, fsync_dir
 from evoeye.paths import DataRoot
 from evoeye.store.lock import WriterLock
-from evoeye.store.schema import DDL_DIR, canonical_schema
+from evoeye.store.schema import canonical_schema, declared_schema
 
 SCORES_TABLE = "monitor_scores"
 PART_SUFFIX = ".parquet"
 
 
-@cache
 def scores_schema() -> pa.Schema:
-    """The Arrow schema of monitor_scores, as DuckDB reports the declared (empty) table."""
-    con = duckdb.connect()
-    try:
-        con.execute((DDL_DIR / f"{SCORES_TABLE}.sql").read_text(encoding="utf-8"))
-        declared = con.sql(f"SELECT * FROM {SCORES_TABLE} LIMIT 0").to_arrow_table().schema
-    finally:
-        con.close()
-    return canonical_schema(declared)
+    """The Arrow schema of monitor_scores, from its DDL."""
+    return declared_schema(SCORES_TABLE)
 
 
 def scores_dir(root: DataRoot) -> Path:
