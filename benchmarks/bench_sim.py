@@ -20,8 +20,7 @@ import numpy as np
 from benchmarks.machine import describe
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.log import write_episode
-from evoeye.scenarios import get_scenario
-from evoeye.sim.runner import WORLD_BUILDERS, _seeds, run_episode
+from evoeye.sim.runner import WORLD_BUILDERS, build_world, run_episode
 
 DT_S = 0.05
 
@@ -44,8 +43,7 @@ def bench_bare(specs, frames: list[int]) -> tuple[float, float]:
     """The same worlds stepped bare for the same number of frames."""
     sim_s, wall_s = 0.0, 0.0
     for spec, n in zip(specs, frames, strict=True):
-        params = get_scenario(spec.scenario).as_dict(spec.params)
-        world, _ = WORLD_BUILDERS[spec.scenario](params, _seeds(spec.seed)[0])
+        world, _ = build_world(spec)
         t0 = time.process_time()
         for _ in range(n):
             world.step(0.0, 0.0, DT_S)

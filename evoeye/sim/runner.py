@@ -61,6 +61,12 @@ def _seeds(seed: int) -> tuple[np.random.Generator, np.random.Generator]:
     return np.random.default_rng(world_ss), np.random.default_rng(ads_ss)
 
 
+def build_world(spec: RunSpec, world_rng: np.random.Generator | None = None) -> tuple[World, float]:
+    """The world of a run and the ego's cruise speed, exactly as `run_episode` sets it up."""
+    params = get_scenario(spec.scenario).as_dict(spec.params)
+    return WORLD_BUILDERS[spec.scenario](params, world_rng or _seeds(spec.seed)[0])
+
+
 def scene_finite(scene: SceneState) -> bool:
     """False if any actor's position, heading or speed is NaN or infinite."""
     return bool(np.isfinite(scene.x_m + scene.y_m + scene.heading_rad + scene.speed_mps).all())
@@ -80,8 +86,7 @@ def run_episode(
 ) -> Episode:
     """Simulate one run. Never raises for a problem inside the run: it returns a failed Episode."""
     config = config or SimConfig()
-    space = get_scenario(spec.scenario)
-    params = space.as_dict(spec.params)
+    get_scenario(spec.scenario).validate(spec.params)  # a bad vector is the caller's error: raise
     world_rng, ads_rng = _seeds(spec.seed)
     dt = 1.0 / config.rate_hz
     n_frames = int(round(config.duration_s * config.rate_hz))
@@ -93,7 +98,7 @@ def run_episode(
     min_gap = float("inf")
     road_map = None
     try:
-        world, cruise_mps = WORLD_BUILDERS[spec.scenario](params, world_rng)
+        world, cruise_mps = build_world(spec, world_rng)
         road_map = world.road_map
         ads = ADS(road_map, ads_rng, (ads_config or ADSConfig()).with_cruise_speed(cruise_mps))
         for k in range(n_frames):
