@@ -53,6 +53,20 @@ class EvolveParams(BaseModel):
             raise ValueError(f"unknown strategy {value!r}; known: {sorted(STRATEGIES)}")
         return value
 
+    @classmethod
+    def of(cls, config: CampaignConfig, root: str | None = None, **options: Any) -> EvolveParams:
+        """The parameters of the campaign `config` (fields EvolveParams does not carry must be
+        at their defaults, or the flow would run a different campaign)."""
+        default = CampaignConfig(config.scenario)
+        for name in ("delta", "horizon_s", "patience", "max_run_s"):
+            if getattr(config, name) != getattr(default, name):
+                raise ValueError(f"the evolution flow runs campaigns with the default {name}")
+        return cls(root=root, scenario=config.scenario, strategy=config.strategy,
+                   budget_s=config.budget_s, seed=config.seed, monitor=config.monitor,
+                   n_round=config.n_round, update=config.update, epochs=config.epochs,
+                   split_seed=config.splits.seed, train_frac=config.splits.train_frac,
+                   val_frac=config.splits.val_frac, **options)
+
     def config(self) -> CampaignConfig:
         return CampaignConfig(
             scenario=self.scenario, strategy=self.strategy, budget_s=self.budget_s,

@@ -76,7 +76,9 @@ def evolve_command(
 def experiment_command(
     root: Root = None,
     scenario: Annotated[list[str] | None, typer.Option("--scenario")] = None,
-    budget_s: Annotated[float, typer.Option("--budget-s")] = 600.0,
+    budget_s: Annotated[float | None, typer.Option(
+        "--budget-s", help="Simulated seconds per campaign (default: the simulated time of the "
+        "scenario's initial training data, as in the paper).")] = None,
     repetitions: Annotated[int, typer.Option("--repetitions", "-r")] = 3,
     n_round: Annotated[int, typer.Option("--n-round")] = 20,
     epochs: Annotated[int | None, typer.Option("--epochs")] = None,
@@ -87,10 +89,13 @@ def experiment_command(
     from evoeye.evolve.experiment import ABLATION, MAIN, run_experiment, write_experiment_report
 
     scenarios = scenario or ["highway-cut-in", "unprotected-intersection"]
-    base = _config(scenarios[0], "evoeye", budget_s, 0, None, n_round, "finetune", epochs, 0)
+    if budget_s is not None and budget_s < 0:
+        raise typer.BadParameter(f"--budget-s must be >= 0, got {budget_s}")
+    base = _config(scenarios[0], "evoeye", budget_s or 0.0, 0, None, n_round, "finetune", epochs,
+                   0)
     results = run_experiment(root, scenarios, base,
                              strategies=MAIN + (ABLATION if ablation else ()),
-                             seeds=range(repetitions), progress=typer.echo)
+                             seeds=range(repetitions), budget_s=budget_s, progress=typer.echo)
     folder = write_experiment_report(root, results, name)
     typer.echo((folder / "rq2.md").read_text(encoding="utf-8"))
     typer.echo(f"report: {folder / 'rq2.html'}")

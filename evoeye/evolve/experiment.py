@@ -28,36 +28,80 @@ ABLATION = ("no-feedback", "no-density")
 COLUMNS = ("f1@0.05", "f1@0.01", "auroc", "auprc")
 
 
+def initial_budget_s(root: DataRoot, scenario: str, base: CampaignConfig) -> float:
+    """Simulated seconds of D_init (the paper gives evolution the initial data's budget)."""
+    return float(Campaign(root, replace(base, scenario=scenario)).initial["duration_s"].sum())
+
+
+def plan_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str],
+                    base: CampaignConfig, *, strategies: Sequence[str] = MAIN + ABLATION,
+                    seeds: Sequence[int] = (0, 1, 2),
+                    budget_s: float | None = None) -> list[CampaignConfig]:
+    """Every campaign of the experiment, seed-major (a stopped experiment has whole repetitions).
+
+    G_0 is resolved per scenario (`base.monitor` applies to `base.scenario` only); `budget_s`
+    None gives each scenario the simulated time of its initial training data.
+    """
+    root = _root(root)
+    plan = []
+    for scenario in scenarios:
+        g0 = (base.monitor if base.scenario == scenario and base.monitor
+              else initial_monitor(root, scenario))
+        budget = initial_budget_s(root, scenario, base) if budget_s is None else budget_s
+        plan += [replace(base, scenario=scenario, strategy=strategy, seed=seed, monitor=g0,
+                         budget_s=budget) for seed in seeds for strategy in strategies]
+    return plan
+
+
+def assessors(root: DataRoot | str | Path | None,
+              plan: Sequence[CampaignConfig]) -> dict[str, Assessor]:
+    """One Test/Hard Set assessor per scenario of the plan, against that scenario's G_0."""
+    root = _root(root)
+    return {c.scenario: Assessor(root, c.scenario, c.monitor, splits=c.splits,
+                                 horizon_s=c.horizon_s) for c in plan}
+
+
+def collect_results(root: DataRoot | str | Path | None, plan: Sequence[CampaignConfig]) -> dict:
+    """{scenario: {"initial": G_0's metrics, "g0", strategy: [per-seed runs]}} from the stored
+    rounds of the plan's campaigns (round 0 holds G_0's assessment)."""
+    root = _root(root)
+    out: dict = {}
+    for cfg in plan:
+        c = Campaign(root, cfg)
+        rows = read_rounds(root, c.campaign_id)
+        if not rows:
+            continue  # not started yet
+        rounds = [json.loads(r.metrics) if r.metrics else None for r in rows]
+        res = out.setdefault(cfg.scenario, {"initial": rounds[0], "g0": cfg.monitor})
+        res.setdefault(cfg.strategy, []).append({
+            "campaign_id": c.campaign_id, "seed": cfg.seed, "rounds": rounds,
+            "budget_s": cfg.budget_s, "simulated_s": rows[-1].simulated_s,
+            "records": rows[-1].n_records,
+            "blind_spots": _blind_spots(c) if cfg.strategy == "evoeye" else None,
+        })
+    return out
+
+
 def run_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str],
                    base: CampaignConfig, *, strategies: Sequence[str] = MAIN + ABLATION,
-                   seeds: Sequence[int] = (0, 1, 2),
+                   seeds: Sequence[int] = (0, 1, 2), budget_s: float | None = None,
                    progress: Callable[[str], None] = print) -> dict:
-    """Run (or resume) every campaign; {scenario: {"initial": m, strategy: [per-seed runs]}}."""
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
-    out: dict = {}
-    for scenario in scenarios:
-        cfg0 = replace(base, scenario=scenario, monitor=base.monitor
-                       if base.scenario == scenario and base.monitor else None)
-        g0 = cfg0.monitor or initial_monitor(root, scenario)
-        assess = Assessor(root, scenario, g0, splits=base.splits, horizon_s=base.horizon_s)
-        res: dict = {"initial": assess(g0), "g0": g0}
-        for strategy in strategies:
-            res[strategy] = []
-            for seed in seeds:
-                cfg = replace(cfg0, strategy=strategy, seed=seed, monitor=g0)
-                c = Campaign(root, cfg, assess=assess)
-                progress(f"{scenario} {strategy} seed {seed}: campaign {c.campaign_id}")
-                c.run(on_round=lambda row, st, s=strategy: progress(
-                    f"  {s} round {row.round}: {_brief(row.metrics)}"))
-                rows = read_rounds(root, c.campaign_id)
-                res[strategy].append({
-                    "campaign_id": c.campaign_id, "seed": seed,
-                    "rounds": [json.loads(r.metrics) if r.metrics else None for r in rows],
-                    "simulated_s": rows[-1].simulated_s, "records": rows[-1].n_records,
-                    "blind_spots": _blind_spots(c) if strategy == "evoeye" else None,
-                })
-        out[scenario] = res
-    return out
+    """Run (or resume) every campaign of the plan, then `collect_results`."""
+    root = _root(root)
+    plan = plan_experiment(root, scenarios, base, strategies=strategies, seeds=seeds,
+                           budget_s=budget_s)
+    assess = assessors(root, plan)
+    for cfg in plan:
+        c = Campaign(root, cfg, assess=assess[cfg.scenario])
+        progress(f"{cfg.scenario} {cfg.strategy} seed {cfg.seed}: campaign {c.campaign_id}, "
+                 f"budget {cfg.budget_s:.0f} s")
+        c.run(on_round=lambda row, st, s=cfg.strategy: progress(
+            f"  {s} round {row.round}: {_brief(row.metrics)}"))
+    return collect_results(root, plan)
+
+
+def _root(root: DataRoot | str | Path | None) -> DataRoot:
+    return root if isinstance(root, DataRoot) else DataRoot.resolve(root)
 
 
 def _brief(metrics: str) -> str:
@@ -170,8 +214,7 @@ def html(results: dict) -> str:
 def write_experiment_report(root: DataRoot | str | Path | None, results: dict,
                             name: str | None = None) -> Path:
     """rq2.md, rq2.html and rq2.json under `<root>/reports/<name>/`; the folder."""
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
-    folder = root.reports / (name or f"rq2-{datetime.now(UTC):%Y%m%dT%H%M%SZ}")
+    folder = _root(root).reports / (name or f"rq2-{datetime.now(UTC):%Y%m%dT%H%M%SZ}")
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "rq2.md").write_text(markdown(results), encoding="utf-8")
     (folder / "rq2.html").write_text(html(results), encoding="utf-8")

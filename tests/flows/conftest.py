@@ -14,8 +14,14 @@ from pathlib import Path
 
 import pytest
 
+from evoeye.batch import plan_uniform, run_batch
+from evoeye.paths import DataRoot
+from evoeye.store import SplitSpec, ingest
+
 os.environ["PREFECT_HOME"] = tempfile.mkdtemp(prefix="evoeye-prefect-")
 
+SCENARIO = "unprotected-intersection"  # of the `seeded` data root
+SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
 FLOWS_DIR = Path(__file__).resolve().parent
 
 
@@ -32,3 +38,14 @@ def prefect_server() -> Iterator[None]:
 
     with prefect_test_harness(server_startup_timeout=120):
         yield
+
+
+@pytest.fixture(scope="session")
+def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+    """A data root with 16 ingested intersection runs and a G_0 (campaign tests add to it)."""
+    from evoeye.monitor import train_monitor
+
+    root = DataRoot.resolve(tmp_path_factory.mktemp("evolve-flow") / "data")
+    run_batch(plan_uniform(SCENARIO, 16, 3), root.path)
+    ingest(root)
+    return root.path, train_monitor(root, SCENARIO, seed=0, splits=SPLITS, epochs=1)

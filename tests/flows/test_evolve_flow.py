@@ -2,30 +2,14 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import pytest
 from pydantic import ValidationError
 
-from evoeye.batch import plan_uniform, run_batch
-from evoeye.paths import DataRoot
-from evoeye.store import SplitSpec, ingest
 from evoeye.store.feedback import read_rounds
 from flows.deploy import NIGHTLY_CRON, nightly_deployment
 from flows.evolve import EvolveParams, evolution_flow
 
-SCENARIO = "unprotected-intersection"
-SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
-
-
-@pytest.fixture(scope="module")
-def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
-    from evoeye.monitor import train_monitor
-
-    root = DataRoot.resolve(tmp_path_factory.mktemp("evolve-flow") / "data")
-    run_batch(plan_uniform(SCENARIO, 16, 3), root.path)
-    ingest(root)
-    return root.path, train_monitor(root, SCENARIO, seed=0, splits=SPLITS, epochs=1)
+SCENARIO = "unprotected-intersection"  # the scenario of the `seeded` fixture (conftest)
 
 
 def test_params_reject_unknown_strategy() -> None:

@@ -1,0 +1,78 @@
+"""Flow: the RQ2 experiment — every (scenario, seed, strategy) campaign as an evolution flow run.
+
+Each campaign is a sub-flow run named `<scenario>-<strategy>-s<seed>` whose rounds are in turn
+`round-<r>` flow runs, so the UI shows the experiment's progress round by round. Campaigns are
+resumable, so a crashed experiment flow run is simply started again. The RQ2 and ablation tables
+are written under `<root>/reports/<name>/` and published as a Markdown artifact.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from prefect import flow, get_run_logger
+from prefect.artifacts import create_markdown_artifact
+from pydantic import BaseModel, Field, ValidationInfo, field_validator
+
+from evoeye.evolve.campaign import CampaignConfig
+from evoeye.evolve.experiment import (
+    ABLATION,
+    MAIN,
+    collect_results,
+    markdown,
+    plan_experiment,
+    write_experiment_report,
+)
+from evoeye.evolve.strategies import STRATEGIES
+from evoeye.paths import resolve_root
+from evoeye.scenarios import SCENARIOS
+from evoeye.store import SplitSpec
+from flows.evolve import EvolveParams, evolution_flow
+
+
+class ExperimentParams(BaseModel):
+    """The experiment (defaults: the paper's — both scenarios, 3 seeds, budget = initial data)."""
+
+    root: str | None = None
+    scenarios: list[str] = Field(default_factory=lambda: list(SCENARIOS))
+    strategies: list[str] = Field(default_factory=lambda: list(MAIN + ABLATION))
+    repetitions: int = Field(3, ge=1)
+    budget_s: float | None = Field(None, ge=0.0)  # None: simulated time of the initial data
+    n_round: int = Field(20, ge=1)
+    epochs: int | None = Field(None, ge=1)
+    split_seed: int = Field(SplitSpec().seed, ge=0)
+    train_frac: float = Field(SplitSpec().train_frac, ge=0.0, le=1.0)
+    val_frac: float = Field(SplitSpec().val_frac, ge=0.0, le=1.0)
+    report_name: str | None = None
+
+    @field_validator("scenarios", "strategies")
+    @classmethod
+    def _all_known(cls, value: list[str], info: ValidationInfo) -> list[str]:
+        known = SCENARIOS if info.field_name == "scenarios" else STRATEGIES
+        unknown = [v for v in value if v not in known]
+        if unknown or not value:
+            raise ValueError(f"unknown {info.field_name} {unknown}; known: {sorted(known)}")
+        return value
+
+    def base(self) -> CampaignConfig:
+        return CampaignConfig(self.scenarios[0], budget_s=self.budget_s or 0.0,
+                              n_round=self.n_round, epochs=self.epochs,
+                              splits=SplitSpec(self.split_seed, self.train_frac, self.val_frac))
+
+
+@flow(name="evoeye-experiment", log_prints=True)
+def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
+    """Run (or resume) every campaign, then write and publish the RQ2 report."""
+    params = params or ExperimentParams()
+    root = str(resolve_root(params.root))
+    plan = plan_experiment(root, params.scenarios, params.base(), strategies=params.strategies,
+                           seeds=range(params.repetitions), budget_s=params.budget_s)
+    for cfg in plan:
+        name = f"{cfg.scenario}-{cfg.strategy}-s{cfg.seed}"
+        evolution_flow.with_options(flow_run_name=name)(EvolveParams.of(cfg, root, assess=True))
+    results = collect_results(root, plan)
+    folder = write_experiment_report(root, results, params.report_name)
+    create_markdown_artifact(markdown=markdown(results), key="evoeye-rq2",
+                             description=f"RQ2 report, {folder / 'rq2.html'}")
+    get_run_logger().info("RQ2 report: %s", folder / "rq2.html")
+    return {"report_dir": str(folder), "campaigns": len(plan), "results": results}

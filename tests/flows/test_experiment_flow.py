@@ -1,0 +1,77 @@
+"""The RQ2 experiment as a flow: every campaign a named evolution flow run, then the report."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+import pytest
+from pydantic import ValidationError
+
+from evoeye.evolve.campaign import Campaign, CampaignConfig
+from evoeye.evolve.experiment import plan_experiment
+from evoeye.store import SplitSpec
+from evoeye.store.feedback import read_rounds
+from flows.experiment import ExperimentParams, experiment_flow
+
+SCENARIO = "unprotected-intersection"  # the scenario of the `seeded` fixture (conftest)
+SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
+
+
+def test_params_reject_unknown_names() -> None:
+    with pytest.raises(ValidationError, match="grid"):
+        ExperimentParams(strategies=["uniform", "grid"])
+    with pytest.raises(ValidationError, match="mars"):
+        ExperimentParams(scenarios=["mars"])
+    with pytest.raises(ValidationError, match="repetitions"):
+        ExperimentParams(repetitions=0)
+
+
+def test_plan_is_seed_major_with_the_initial_data_budget(seeded) -> None:
+    root, g0 = seeded
+    base = CampaignConfig(SCENARIO, splits=SPLITS)
+    plan = plan_experiment(root, [SCENARIO], base, strategies=["uniform", "evoeye"], seeds=[0, 1])
+    assert [(c.seed, c.strategy) for c in plan] == [
+        (0, "uniform"), (0, "evoeye"), (1, "uniform"), (1, "evoeye")]
+    assert {c.monitor for c in plan} == {g0}
+    d_init = Campaign(root, base).initial["duration_s"]
+    assert len(d_init) > 0
+    assert [c.budget_s for c in plan] == pytest.approx([d_init.sum()] * 4)
+    fixed = plan_experiment(root, [SCENARIO], base, strategies=["uniform"], seeds=[0],
+                            budget_s=45.0)
+    assert fixed == [replace(plan[0], budget_s=45.0)]
+
+
+def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_server,
+                                                                   seeded) -> None:
+    from prefect.client.orchestration import get_client
+    from prefect.client.schemas.filters import FlowRunFilter, FlowRunFilterName
+
+    root, _ = seeded
+    params = ExperimentParams(root=str(root), scenarios=[SCENARIO],
+                              strategies=["uniform", "evoeye"], repetitions=1, budget_s=45.0,
+                              n_round=2, epochs=1, train_frac=0.5, val_frac=0.25,
+                              report_name="rq2-test")
+    out = experiment_flow(params)
+    res = out["results"][SCENARIO]
+    for strategy in ("uniform", "evoeye"):
+        (run,) = res[strategy]
+        rows = read_rounds(root, run["campaign_id"])
+        sizes = [len(r.scenario_ids) for r in rows]
+        assert sizes[0] == 0 and all(1 <= n <= 2 for n in sizes[1:]) and len(sizes) > 1
+        # run to the budget: spent, but never overspent (no run lasts more than 20 s)
+        assert 45.0 - 20.0 < rows[-1].simulated_s <= 45.0 and run["budget_s"] == 45.0
+        assert run["rounds"][0] == res["initial"]  # G_0's assessment, shared by all campaigns
+        assert set(run["rounds"][-1]) >= {"test", "hard"}
+    names = ["unprotected-intersection-uniform-s0", "unprotected-intersection-evoeye-s0"]
+    with get_client(sync_client=True) as client:
+        runs = client.read_flow_runs(flow_run_filter=FlowRunFilter(
+            name=FlowRunFilterName(any_=names)))
+    assert sorted(r.name for r in runs) == sorted(names)
+    assert all(r.state.is_completed() for r in runs)
+    report = json.loads((root / "reports" / "rq2-test" / "rq2.json").read_text())
+    assert report[SCENARIO]["evoeye"][0]["campaign_id"] == res["evoeye"][0]["campaign_id"]
+    assert "| evoeye |" in (root / "reports" / "rq2-test" / "rq2.md").read_text()
+    # re-running resumes: same campaigns, nothing simulated twice
+    again = experiment_flow(params)
+    assert again["results"][SCENARIO]["evoeye"][0]["rounds"] == res["evoeye"][0]["rounds"]
