@@ -19,13 +19,14 @@ import numpy as np
 
 from evoeye.evaluation.plots import line_chart
 from evoeye.evolve.assess import Assessor
-from evoeye.evolve.campaign import Campaign, CampaignConfig, initial_monitor
+from evoeye.evolve.campaign import Campaign, CampaignConfig, CampaignState, initial_monitor
 from evoeye.paths import DataRoot
 from evoeye.store.feedback import read_rounds
 
 MAIN = ("uniform", "avfuzzer", "evoeye")
 ABLATION = ("no-feedback", "no-density")
 COLUMNS = ("f1@0.05", "f1@0.01", "auroc", "auprc")
+ACQUISITION_HEAD = ("method", "runs", "collisions %", "within δ of an earlier record %")
 
 
 def initial_budget_s(root: DataRoot, scenario: str, base: CampaignConfig) -> float:
@@ -73,11 +74,12 @@ def collect_results(root: DataRoot | str | Path | None, plan: Sequence[CampaignC
             continue  # not started yet
         rounds = [json.loads(r.metrics) if r.metrics else None for r in rows]
         res = out.setdefault(cfg.scenario, {"initial": rounds[0], "g0": cfg.monitor})
+        state = c.start()
         res.setdefault(cfg.strategy, []).append({
             "campaign_id": c.campaign_id, "seed": cfg.seed, "rounds": rounds,
             "budget_s": cfg.budget_s, "simulated_s": rows[-1].simulated_s,
-            "records": rows[-1].n_records,
-            "blind_spots": _blind_spots(c) if cfg.strategy == "evoeye" else None,
+            "records": rows[-1].n_records, "acquisition": acquisition(c, state),
+            "blind_spots": _blind_spots(c, state) if cfg.strategy == "evoeye" else None,
         })
     return out
 
@@ -112,9 +114,20 @@ def _brief(metrics: str) -> str:
             f"hard F1@0.05 {m['hard']['f1@0.05']:.3f}")
 
 
-def _blind_spots(c: Campaign) -> dict:
+def acquisition(c: Campaign, st: CampaignState) -> dict:
+    """What a campaign acquired: runs, their collision share, and the share of runs within δ
+    (Chebyshev) of an earlier record — local mutations, in effect (a uniform sample lands that
+    close with probability ≈ n·(2δ)^dim)."""
+    u = c.space.normalise(st.records.params)
+    near = [np.abs(u[:i] - u[i]).max(axis=1).min() <= c.config.delta
+            for i in range(st.n_init, st.records.n)]
+    new = st.records.tail(st.n_init)
+    return {"runs": int(new.n), "collision_share": float(np.mean(new.collided)) if new.n else 0.0,
+            "near_share": float(np.mean(near)) if near else 0.0}
+
+
+def _blind_spots(c: Campaign, st: CampaignState) -> dict:
     """Feedback of the final records over their first two (normalised) parameters."""
-    st = c.start()
     u = c.space.normalise(st.records.params)
     return {"names": list(c.space.names[:2]), "u0": u[:, 0].tolist(), "u1": u[:, 1].tolist(),
             "feedback": np.nan_to_num(st.records.feedback).tolist(),
@@ -150,6 +163,20 @@ def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
     return rows
 
 
+def acquisition_rows(res: dict) -> list[list[str]]:
+    """Per strategy: acquired runs, collision share and near share (mean ± std over seeds)."""
+    rows = []
+    for strategy in MAIN + ABLATION:
+        acq = [r["acquisition"] for r in res.get(strategy, []) if r.get("acquisition")]
+        if acq:
+            runs = np.array([a["runs"] for a in acq], float)
+            runs_s = f"{runs.mean():.0f} ± {runs.std():.0f}" if len(runs) > 1 else f"{runs[0]:.0f}"
+            rows.append([strategy, runs_s,
+                         _mean_std([a["collision_share"] for a in acq]),
+                         _mean_std([a["near_share"] for a in acq])])
+    return rows
+
+
 def markdown(results: dict) -> str:
     head = ["method"] + [f"{s} {c}" for s in ("Test", "Hard") for c in COLUMNS]
     out = ["# evoeye RQ2: self-evolution under the same budget", ""]
@@ -159,6 +186,10 @@ def markdown(results: dict) -> str:
                     "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
             out += ["| " + " | ".join(r) + " |" for r in table_rows(res, strategies)]
             out.append("")
+        out += [f"## {scenario} — what each strategy acquired (mean ± std over seeds)", "",
+                "| " + " | ".join(ACQUISITION_HEAD) + " |", "|---|---|---|---|"]
+        out += ["| " + " | ".join(r) + " |" for r in acquisition_rows(res)]
+        out.append("")
     return "\n".join(out)
 
 
@@ -191,16 +222,21 @@ def _scatter(b: dict) -> str:
             f'acquired)</text></svg>')
 
 
+def _html_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    cells = "".join("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in r) + "</tr>" for r in rows)
+    return ("<table border=1 cellpadding=3><tr>" + "".join(f"<th>{escape(h)}</th>" for h in head)
+            + f"</tr>{cells}</table>")
+
+
 def html(results: dict) -> str:
     body = []
     for scenario, res in results.items():
         body.append(f"<h2>{escape(scenario)}</h2>")
         for title, strategies in (("RQ2", MAIN), ("Evolution ablation", ("evoeye",) + ABLATION)):
             head = ["method"] + [f"{s} {c}" for s in ("Test", "Hard") for c in COLUMNS]
-            rows = "".join("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in r) + "</tr>"
-                           for r in table_rows(res, strategies))
-            body.append(f"<h3>{title}</h3><table border=1 cellpadding=3><tr>"
-                        + "".join(f"<th>{escape(h)}</th>" for h in head) + f"</tr>{rows}</table>")
+            body.append(f"<h3>{title}</h3>" + _html_table(head, table_rows(res, strategies)))
+        body.append("<h3>What each strategy acquired</h3>" + _html_table(
+            ACQUISITION_HEAD, acquisition_rows(res)))
         for split in ("test", "hard"):
             for col in ("f1@0.05", "auprc"):
                 body.append(_curves(res, split, col))

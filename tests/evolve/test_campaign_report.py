@@ -2,22 +2,30 @@
 
 from __future__ import annotations
 
-from evoeye.evolve.experiment import html, markdown, table_rows, write_experiment_report
+from evoeye.evolve.experiment import (
+    acquisition_rows,
+    html,
+    markdown,
+    table_rows,
+    write_experiment_report,
+)
 
 
 def _m(f1: float) -> dict:
     return {"f1@0.05": f1, "f1@0.01": f1 / 2, "auroc": 0.9, "auprc": f1}
 
 
-def _run(f1s: list[float]) -> dict:
-    return {"rounds": [{"test": _m(f), "hard": _m(f / 2)} for f in f1s], "blind_spots": {
+def _run(f1s: list[float], collisions: float = 0.5) -> dict:
+    return {"rounds": [{"test": _m(f), "hard": _m(f / 2)} for f in f1s],
+            "acquisition": {"runs": 40, "collision_share": collisions, "near_share": 0.25},
+            "blind_spots": {
         "names": ["a", "b"], "u0": [0.1, 0.9], "u1": [0.5, 0.2], "feedback": [0.0, 0.4],
         "acquired": [False, True]}}
 
 
 RESULTS = {"highway-cut-in": {
     "initial": {"test": _m(0.2), "hard": _m(0.0)}, "g0": "fusion-x",
-    "uniform": [_run([0.2, 0.3]), _run([0.2, 0.5])],
+    "uniform": [_run([0.2, 0.3], 0.2), _run([0.2, 0.5], 0.4)],
     "evoeye": [_run([0.2, 0.6]), _run([0.2, 0.6])],
 }}
 
@@ -44,3 +52,34 @@ def test_report_files_hold_tables_curves_and_map(tmp_path) -> None:
     assert 'data-series="evoeye"' in page
     folder = write_experiment_report(tmp_path, RESULTS, "t")
     assert {p.name for p in folder.iterdir()} == {"rq2.md", "rq2.html", "rq2.json"}
+
+
+def test_acquisition_table_averages_over_seeds() -> None:
+    rows = {r[0]: r for r in acquisition_rows(RESULTS["highway-cut-in"])}
+    assert set(rows) == {"uniform", "evoeye"}  # strategies that did not run are left out
+    assert rows["uniform"] == ["uniform", "40 ± 0", "30.0 ± 10.0", "25.0 ± 0.0"]
+    assert "| uniform | 40 ± 0 | 30.0 ± 10.0 |" in markdown(RESULTS)
+
+
+def test_acquisition_counts_runs_within_delta_of_an_earlier_record() -> None:
+    from types import SimpleNamespace
+
+    import numpy as np
+
+    from evoeye.evolve.experiment import acquisition
+    from evoeye.evolve.records import Records
+    from evoeye.scenarios import get_scenario
+
+    space = get_scenario("unprotected-intersection")
+    u = np.array([[0.1] * space.dim, [0.9] * space.dim,  # D_init
+                  [0.25] * space.dim,  # 0.15 from the first record: near
+                  [0.5] * space.dim,  # 0.25 from the nearest earlier one (0.25): not near
+                  [0.65] * space.dim])  # 0.15 from the acquired [0.5]: near an earlier record
+    records = Records(params=space.denormalise(u), feedback=np.zeros(5),
+                      collided=np.array([0, 0, 1, 0, 0], bool))
+    campaign = SimpleNamespace(space=space, config=SimpleNamespace(delta=0.2))
+    state = SimpleNamespace(records=records, n_init=2)
+    got = acquisition(campaign, state)
+    assert got["runs"] == 3
+    assert got["collision_share"] == 1 / 3
+    assert got["near_share"] == 2 / 3

@@ -63,6 +63,7 @@ def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_serv
         assert 45.0 - 20.0 < rows[-1].simulated_s <= 45.0 and run["budget_s"] == 45.0
         assert run["rounds"][0] == res["initial"]  # G_0's assessment, shared by all campaigns
         assert set(run["rounds"][-1]) >= {"test", "hard"}
+        assert run["acquisition"]["runs"] == sum(sizes)
     names = ["unprotected-intersection-uniform-s0", "unprotected-intersection-evoeye-s0"]
     with get_client(sync_client=True) as client:
         runs = client.read_flow_runs(flow_run_filter=FlowRunFilter(
