@@ -10,6 +10,7 @@ import typer
 
 from evoeye.cli.app import app
 from evoeye.evolve.campaign import UPDATE_MODES, Campaign, CampaignConfig
+from evoeye.evolve.strategies import STRATEGIES
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 
@@ -83,18 +84,24 @@ def experiment_command(
     n_round: Annotated[int, typer.Option("--n-round")] = 20,
     epochs: Annotated[int | None, typer.Option("--epochs")] = None,
     ablation: Annotated[bool, typer.Option("--ablation/--no-ablation")] = True,
+    strategy: Annotated[list[str] | None, typer.Option(
+        "--strategy", help="Run only these strategies (repeatable); default: the RQ2 ones, "
+        "plus the ablations unless --no-ablation.")] = None,
     name: Annotated[str | None, typer.Option("--name", help="Report folder name.")] = None,
 ) -> None:
     """The RQ2 table (+ evolution ablation): G_0 vs uniform / avfuzzer / evoeye, R seeds."""
     from evoeye.evolve.experiment import ABLATION, MAIN, run_experiment, write_experiment_report
 
     scenarios = scenario or ["highway-cut-in", "unprotected-intersection"]
+    unknown = sorted(set(strategy or ()) - set(STRATEGIES))
+    if unknown:
+        raise typer.BadParameter(f"unknown strategy {unknown}; known: {sorted(STRATEGIES)}")
     if budget_s is not None and budget_s < 0:
         raise typer.BadParameter(f"--budget-s must be >= 0, got {budget_s}")
     base = _config(scenarios[0], "evoeye", budget_s or 0.0, 0, None, n_round, "finetune", epochs,
                    0)
     results = run_experiment(root, scenarios, base,
-                             strategies=MAIN + (ABLATION if ablation else ()),
+                             strategies=strategy or MAIN + (ABLATION if ablation else ()),
                              seeds=range(repetitions), budget_s=budget_s, progress=typer.echo)
     folder = write_experiment_report(root, results, name)
     typer.echo((folder / "rq2.md").read_text(encoding="utf-8"))
