@@ -16,6 +16,7 @@ from html import escape
 from pathlib import Path
 
 import numpy as np
+from scipy.stats import spearmanr
 
 from evoeye.evaluation.plots import line_chart
 from evoeye.evolve.assess import Assessor
@@ -126,12 +127,26 @@ def acquisition(c: Campaign, st: CampaignState) -> dict:
             "near_share": float(np.mean(near)) if near else 0.0}
 
 
+def map_axes(u: np.ndarray, feedback: np.ndarray) -> tuple[int, int]:
+    """The two parameters the feedback varies with most (largest |Spearman ρ|; ties: first)."""
+    ok = np.isfinite(feedback)
+    rho = np.zeros(u.shape[1])
+    if ok.sum() > 2 and np.ptp(feedback[ok]) > 0:
+        for j in range(u.shape[1]):
+            if np.ptp(u[ok, j]) > 0:
+                rho[j] = abs(spearmanr(u[ok, j], feedback[ok]).statistic)
+    first, second = np.argsort(-rho, kind="stable")[:2]
+    return int(first), int(second)
+
+
 def _blind_spots(c: Campaign, st: CampaignState) -> dict:
-    """Feedback of the final records over their first two (normalised) parameters."""
+    """The blind-spot map: every record's feedback under the final monitor over the two
+    (normalised) parameters it depends on most."""
     u = c.space.normalise(st.records.params)
-    return {"names": list(c.space.names[:2]), "u0": u[:, 0].tolist(), "u1": u[:, 1].tolist(),
-            "feedback": np.nan_to_num(st.records.feedback).tolist(),
-            "acquired": [i >= st.n_init for i in range(st.records.n)]}
+    i, j = map_axes(u, st.records.feedback)
+    return {"names": [c.space.names[i], c.space.names[j]], "u0": u[:, i].tolist(),
+            "u1": u[:, j].tolist(), "feedback": np.nan_to_num(st.records.feedback).tolist(),
+            "acquired": [k >= st.n_init for k in range(st.records.n)]}
 
 
 def _value(v: float | None) -> float:

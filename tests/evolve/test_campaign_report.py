@@ -83,3 +83,16 @@ def test_acquisition_counts_runs_within_delta_of_an_earlier_record() -> None:
     assert got["runs"] == 3
     assert got["collision_share"] == 1 / 3
     assert got["near_share"] == 2 / 3
+
+
+def test_map_axes_are_the_parameters_feedback_depends_on_most() -> None:
+    import numpy as np
+
+    from evoeye.evolve.experiment import map_axes
+
+    rng = np.random.default_rng(0)
+    u = rng.random((200, 6))
+    feedback = 3 * u[:, 4] - u[:, 1] + 0.05 * rng.random(200)  # strongly on 4, then on 1
+    feedback[:5] = np.nan  # unscored records are ignored
+    assert map_axes(u, feedback) == (4, 1)
+    assert map_axes(u, np.zeros(200)) == (0, 1)  # no signal: the first two
