@@ -85,6 +85,9 @@ def experiment_command(
     epochs: Annotated[int | None, typer.Option("--epochs")] = None,
     update: Annotated[str, typer.Option(
         "--update", help="Monitor update per round: finetune (from G_r) or retrain.")] = "finetune",
+    monitor: Annotated[str | None, typer.Option(
+        "--monitor", help="G_0 of the first --scenario (default: its newest monitor trained "
+        "from scratch).")] = None,
     ablation: Annotated[bool, typer.Option("--ablation/--no-ablation")] = True,
     strategy: Annotated[list[str] | None, typer.Option(
         "--strategy", help="Run only these strategies (repeatable); default: the RQ2 ones, "
@@ -100,7 +103,8 @@ def experiment_command(
         raise typer.BadParameter(f"unknown strategy {unknown}; known: {sorted(STRATEGIES)}")
     if budget_s is not None and budget_s < 0:
         raise typer.BadParameter(f"--budget-s must be >= 0, got {budget_s}")
-    base = _config(scenarios[0], "evoeye", budget_s or 0.0, 0, None, n_round, update, epochs, 0)
+    base = _config(scenarios[0], "evoeye", budget_s or 0.0, 0, monitor, n_round, update, epochs,
+                   0)
     results = run_experiment(root, scenarios, base,
                              strategies=strategy or MAIN + (ABLATION if ablation else ()),
                              seeds=range(repetitions), budget_s=budget_s, progress=typer.echo)
