@@ -15,6 +15,7 @@ from prefect.cache_policies import NONE
 from pydantic import BaseModel, Field, field_validator
 
 from evoeye.evolve.campaign import UPDATE_MODES, Campaign, CampaignConfig, CampaignState
+from evoeye.evolve.scoring import FEEDBACK_MODES
 from evoeye.evolve.strategies import STRATEGIES
 from evoeye.paths import resolve_root
 from evoeye.scenarios import SCENARIOS
@@ -32,6 +33,7 @@ class EvolveParams(BaseModel):
     monitor: str | None = None  # G_0; default: the newest from-scratch monitor of the scenario
     n_round: int = Field(20, ge=1)
     update: str = Field("finetune", json_schema_extra={"enum": list(UPDATE_MODES)})
+    feedback: str = Field("raw", json_schema_extra={"enum": list(FEEDBACK_MODES)})
     epochs: int | None = Field(None, ge=1)
     max_rounds: int | None = Field(None, ge=1)  # rounds in this flow run (None: to the budget)
     split_seed: int = 0
@@ -64,6 +66,7 @@ class EvolveParams(BaseModel):
         return cls(root=root, scenario=config.scenario, strategy=config.strategy,
                    budget_s=config.budget_s, seed=config.seed, monitor=config.monitor,
                    n_round=config.n_round, update=config.update, epochs=config.epochs,
+                   feedback=config.feedback,
                    split_seed=config.splits.seed, train_frac=config.splits.train_frac,
                    val_frac=config.splits.val_frac, **options)
 
@@ -71,7 +74,7 @@ class EvolveParams(BaseModel):
         return CampaignConfig(
             scenario=self.scenario, strategy=self.strategy, budget_s=self.budget_s,
             seed=self.seed, monitor=self.monitor, n_round=self.n_round, update=self.update,
-            epochs=self.epochs,
+            epochs=self.epochs, feedback=self.feedback,
             splits=SplitSpec(self.split_seed, self.train_frac, self.val_frac),
         )
 

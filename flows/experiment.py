@@ -14,7 +14,7 @@ from prefect import flow, get_run_logger
 from prefect.artifacts import create_markdown_artifact
 from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
-from evoeye.evolve.campaign import CampaignConfig
+from evoeye.evolve.campaign import UPDATE_MODES, CampaignConfig
 from evoeye.evolve.experiment import (
     ABLATION,
     MAIN,
@@ -23,6 +23,7 @@ from evoeye.evolve.experiment import (
     plan_experiment,
     write_experiment_report,
 )
+from evoeye.evolve.scoring import FEEDBACK_MODES
 from evoeye.evolve.strategies import STRATEGIES
 from evoeye.paths import resolve_root
 from evoeye.scenarios import SCENARIOS
@@ -40,6 +41,8 @@ class ExperimentParams(BaseModel):
     budget_s: float | None = Field(None, ge=0.0)  # None: simulated time of the initial data
     n_round: int = Field(20, ge=1)
     epochs: int | None = Field(None, ge=1)
+    update: str = Field("finetune", json_schema_extra={"enum": list(UPDATE_MODES)})
+    feedback: str = Field("raw", json_schema_extra={"enum": list(FEEDBACK_MODES)})
     split_seed: int = Field(SplitSpec().seed, ge=0)
     train_frac: float = Field(SplitSpec().train_frac, ge=0.0, le=1.0)
     val_frac: float = Field(SplitSpec().val_frac, ge=0.0, le=1.0)
@@ -56,7 +59,8 @@ class ExperimentParams(BaseModel):
 
     def base(self) -> CampaignConfig:
         return CampaignConfig(self.scenarios[0], budget_s=self.budget_s or 0.0,
-                              n_round=self.n_round, epochs=self.epochs,
+                              n_round=self.n_round, epochs=self.epochs, update=self.update,
+                              feedback=self.feedback,
                               splits=SplitSpec(self.split_seed, self.train_frac, self.val_frac))
 
 

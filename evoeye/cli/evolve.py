@@ -14,18 +14,21 @@ from evoeye.evolve.strategies import STRATEGIES
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 
+FEEDBACK_HELP = ("ŷ in f_r = mean |ŷ − y|: raw monitor scores, or prior-corrected "
+                 "(undo the training pos_weight).")
 Root = Annotated[Path | None, typer.Option(
     "--root", help="Data root (default: $EVOEYE_HOME or ./evoeye-data).")]
 
 
 def _config(scenario: str, strategy: str, budget_s: float, seed: int, monitor: str | None,
-            n_round: int, update: str, epochs: int | None, split_seed: int) -> CampaignConfig:
+            n_round: int, update: str, epochs: int | None, split_seed: int,
+            feedback: str = "raw") -> CampaignConfig:
     if update not in UPDATE_MODES:
         raise typer.BadParameter(f"--update must be one of {UPDATE_MODES}")
     try:
         return CampaignConfig(scenario=scenario, strategy=strategy, budget_s=budget_s, seed=seed,
                               monitor=monitor, n_round=n_round, update=update, epochs=epochs,
-                              splits=SplitSpec(seed=split_seed))
+                              splits=SplitSpec(seed=split_seed), feedback=feedback)
     except (ValueError, KeyError) as e:
         raise typer.BadParameter(str(e)) from None
 
@@ -43,12 +46,13 @@ def evolve_command(
     epochs: Annotated[int | None, typer.Option("--epochs")] = None,
     max_rounds: Annotated[int | None, typer.Option("--max-rounds")] = None,
     split_seed: Annotated[int, typer.Option("--split-seed")] = 0,
+    feedback: Annotated[str, typer.Option("--feedback", help=FEEDBACK_HELP)] = "raw",
 ) -> None:
     """Run (or resume) an evolution campaign; per round, G_r's F1 / AUPRC on the test set."""
     from evoeye.evolve.assess import Assessor
 
     cfg = _config(scenario, strategy, budget_s, seed, monitor, n_round, update, epochs,
-                  split_seed)
+                  split_seed, feedback)
     data = DataRoot.resolve(root)
     probe = Campaign(data, cfg)
     assess = Assessor(data, cfg.scenario, probe.g0, splits=cfg.splits, horizon_s=cfg.horizon_s)
@@ -88,6 +92,7 @@ def experiment_command(
     monitor: Annotated[str | None, typer.Option(
         "--monitor", help="G_0 of the first --scenario (default: its newest monitor trained "
         "from scratch).")] = None,
+    feedback: Annotated[str, typer.Option("--feedback", help=FEEDBACK_HELP)] = "raw",
     ablation: Annotated[bool, typer.Option("--ablation/--no-ablation")] = True,
     strategy: Annotated[list[str] | None, typer.Option(
         "--strategy", help="Run only these strategies (repeatable); default: the RQ2 ones, "
@@ -104,7 +109,7 @@ def experiment_command(
     if budget_s is not None and budget_s < 0:
         raise typer.BadParameter(f"--budget-s must be >= 0, got {budget_s}")
     base = _config(scenarios[0], "evoeye", budget_s or 0.0, 0, monitor, n_round, update, epochs,
-                   0)
+                   0, feedback)
     results = run_experiment(root, scenarios, base,
                              strategies=strategy or MAIN + (ABLATION if ablation else ()),
                              seeds=range(repetitions), budget_s=budget_s, progress=typer.echo)

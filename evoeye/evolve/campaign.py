@@ -41,7 +41,12 @@ from evoeye.batch import simulate_and_log
 from evoeye.evolve.avfuzzer import criticality
 from evoeye.evolve.protocol import Strategy
 from evoeye.evolve.records import Records
-from evoeye.evolve.scoring import read_logged_run, warehouse_feedback, windows_feedback
+from evoeye.evolve.scoring import (
+    FEEDBACK_MODES,
+    read_logged_run,
+    warehouse_feedback,
+    windows_feedback,
+)
 from evoeye.evolve.strategies import STRATEGIES, make_strategy
 from evoeye.log import read_run
 from evoeye.paths import DataRoot
@@ -79,6 +84,7 @@ class CampaignConfig:
     epochs: int | None = None  # per update; None: 10 when fine-tuning, TrainParams' when not
     patience: int | None = None
     delta: float = DEFAULT_DELTA
+    feedback: str = "raw"  # ŷ of f_r: "raw" scores or "prior-corrected" (see evolve.feedback)
     horizon_s: float = DEFAULT_HORIZON_S
     splits: SplitSpec = field(default_factory=SplitSpec)
     max_run_s: float = MAX_RUN_S
@@ -87,6 +93,8 @@ class CampaignConfig:
         get_scenario(self.scenario)
         if self.strategy not in STRATEGIES:
             raise ValueError(f"unknown strategy {self.strategy!r}; known: {sorted(STRATEGIES)}")
+        if self.feedback not in FEEDBACK_MODES:
+            raise ValueError(f"feedback must be one of {FEEDBACK_MODES}, got {self.feedback!r}")
         if self.update not in UPDATE_MODES:
             raise ValueError(f"update must be one of {UPDATE_MODES}, got {self.update!r}")
         if self.n_round < 1 or self.budget_s < 0 or self.seed < 0 or self.max_run_s <= 0:
@@ -199,10 +207,17 @@ class Campaign:
         """`evo-<strategy>-s<seed>-<hash>` of everything but the budget: same inputs, same id."""
         cfg = asdict(self.config)
         cfg.pop("budget_s")
+        if cfg["feedback"] == "raw":  # the original loop: its campaigns keep their ids
+            cfg.pop("feedback")
         cfg["monitor"] = self.g0
         cfg["initial"] = hashlib.sha256("\n".join(self.initial["scenario_id"]).encode()).hexdigest()
         digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]
         return f"evo-{self.config.strategy}-s{self.config.seed}-{digest}"
+
+    def feedback_key(self, version: str) -> str:
+        """The feedback table's monitor_version of f under `version`: the version itself for
+        raw scores, `<version>+prior` for prior-corrected ones (G_0 is shared by campaigns)."""
+        return version if self.config.feedback == "raw" else f"{version}+prior"
 
     def log_path(self, scenario_id: str) -> Path:
         return self.root.run_log(self.config.scenario, self.campaign_id, scenario_id)
@@ -239,7 +254,7 @@ class Campaign:
             records = records.append(np.asarray(meta["params"], float), **_outcome(meta))
             ok.append(meta["status"] == "ok")
         n_init = len(init["scenario_id"])
-        stored = feedback_of(self.root, last.monitor_version)
+        stored = feedback_of(self.root, self.feedback_key(last.monitor_version))
         records = records.with_feedback(np.array(
             [stored.get(s, np.nan) for s in records.scenario_id], dtype=float))
         options = {"delta": self.config.delta} if self.config.delta != DEFAULT_DELTA else {}
@@ -270,7 +285,7 @@ class Campaign:
                 raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
                                    f"{result.reason}")
             run = read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
-            fb = (windows_feedback(monitor, run.windows).feedback[0]
+            fb = (windows_feedback(monitor, run.windows, cfg.feedback).feedback[0]
                   if run.ok and run.windows is not None else np.nan)
             outcome = _outcome(run.metadata)
             state.strategy.tell(prop.x, outcome["fitness"])
@@ -310,7 +325,7 @@ class Campaign:
                        self.config.seed, state.round + 1, version, list(new_ids),
                        state.acquired, state.spent_s, train_s, self._metrics(version))
         store_round(self.root, row)
-        stored = feedback_of(self.root, version)
+        stored = feedback_of(self.root, self.feedback_key(version))
         state.records = state.records.with_feedback(np.array(
             [stored.get(s, np.nan) for s in state.records.scenario_id], dtype=float))
         state.round, state.monitor = row.round, version
@@ -343,18 +358,20 @@ class Campaign:
     # -- helpers ---------------------------------------------------------------------------------
     def _store_feedback(self, version: str, scenario_ids) -> None:
         """Score ingested runs with `version` and store f (runs already stored are skipped)."""
-        have = feedback_of(self.root, version)
+        have = feedback_of(self.root, self.feedback_key(version))
         todo = [str(s) for s in scenario_ids if s not in have]
         if not todo:
             return
-        fb = warehouse_feedback(self.root, self.monitor(version), todo, self.config.horizon_s)
+        fb = warehouse_feedback(self.root, self.monitor(version), todo, self.config.horizon_s,
+                                self.config.feedback)
         self._write_feedback(version, fb.scenario_id, fb.feedback, fb.n_contexts)
 
     def _write_feedback(self, version: str, ids, feedback, n_contexts=None) -> None:
         ids, feedback = np.asarray(ids, dtype=object), np.asarray(feedback, float)
         keep = np.isfinite(feedback)
         n = np.zeros(len(ids), int) if n_contexts is None else np.asarray(n_contexts)
-        write_feedback(self.root, FeedbackRows(self.config.scenario, version, ids[keep],
+        write_feedback(self.root, FeedbackRows(self.config.scenario, self.feedback_key(version),
+                                               ids[keep],
                                                feedback[keep], n[keep]))
 
     def _metrics(self, version: str) -> str:

@@ -16,7 +16,7 @@ from typing import Any
 
 import numpy as np
 
-from evoeye.evolve.feedback import ScenarioFeedback, scenario_feedback
+from evoeye.evolve.feedback import ScenarioFeedback, prior_corrected, scenario_feedback
 from evoeye.log import read_run
 from evoeye.store.features import FEATURES, frame_features
 from evoeye.store.records import frames_table
@@ -77,13 +77,24 @@ def read_logged_run(path: str | Path, context_len: int, horizon_s: float) -> Log
     return LoggedRun(Path(path), meta, windows)
 
 
-def windows_feedback(monitor, windows: Windows) -> ScenarioFeedback:
-    """f_r per run of `windows` under `monitor` (anything with `.score(windows)`)."""
-    return scenario_feedback(monitor.score(windows), windows.label, windows.scenario_id)
+FEEDBACK_MODES = ("raw", "prior-corrected")  # ŷ as the monitor scores it, or σ(logit − log w)
 
 
-def warehouse_feedback(root, monitor, scenario_ids, horizon_s: float) -> ScenarioFeedback:
+def windows_feedback(monitor, windows: Windows, mode: str = "raw") -> ScenarioFeedback:
+    """f_r per run of `windows` under `monitor` (anything with `.score(windows)`); with
+    "prior-corrected", ŷ first undoes the monitor's training pos_weight (card, default 1)."""
+    if mode not in FEEDBACK_MODES:
+        raise ValueError(f"feedback mode must be one of {FEEDBACK_MODES}, got {mode!r}")
+    scores = monitor.score(windows)
+    if mode == "prior-corrected":
+        card = getattr(monitor, "card", None) or {}
+        scores = prior_corrected(scores, card.get("hyperparameters", {}).get("pos_weight") or 1.0)
+    return scenario_feedback(scores, windows.label, windows.scenario_id)
+
+
+def warehouse_feedback(root, monitor, scenario_ids, horizon_s: float,
+                       mode: str = "raw") -> ScenarioFeedback:
     """f_r of ingested runs, scored from their warehouse windows (the refresh of line 13)."""
     windows = load_windows(root, list(scenario_ids), context_len=monitor.context_len,
                            horizon_s=horizon_s)
-    return windows_feedback(monitor, windows)
+    return windows_feedback(monitor, windows, mode)

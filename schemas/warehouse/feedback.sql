@@ -6,7 +6,7 @@
 CREATE TABLE feedback (
     logical_scenario  VARCHAR  NOT NULL,
     scenario_id       VARCHAR  NOT NULL,
-    monitor_version   VARCHAR  NOT NULL,  -- G_r that scored the run
+    monitor_version   VARCHAR  NOT NULL,  -- G_r that scored the run (`<G_r>+prior`: prior-corrected)
     feedback          DOUBLE   NOT NULL,  -- f_r(x) in [0, 1]
     n_contexts        INTEGER  NOT NULL,  -- windows averaged
     part_id           VARCHAR  NOT NULL,  -- the part the row was written in

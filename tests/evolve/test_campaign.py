@@ -107,6 +107,38 @@ def test_campaign_id_is_stable_and_ignores_the_budget(seeded) -> None:
     assert a == Campaign(root, config(g0, budget_s=900)).campaign_id
     assert a != Campaign(root, config(g0, seed=1)).campaign_id
     assert a != Campaign(root, config(g0, strategy="uniform")).campaign_id
+    assert a != Campaign(root, config(g0, feedback="prior-corrected")).campaign_id
+    with pytest.raises(ValueError, match="feedback"):
+        config(g0, feedback="calibrated")
+
+
+def test_prior_corrected_feedback_is_stored_apart_and_undoes_pos_weight(root_copy) -> None:
+    from evoeye.evolve.feedback import prior_corrected
+
+    root = root_copy("prior")
+    g0 = Campaign(root, config(None)).g0
+    raw = Campaign(root, config(g0))
+    cor = Campaign(root, config(g0, feedback="prior-corrected"))
+    raw.start(), cor.start()  # each scores D_init with G_0 and stores it under its own key
+    fb = read_feedback(root)
+    by_key: dict[str, dict] = {}
+    for v, sid, f in zip(fb.column("monitor_version").to_pylist(),
+                         fb.column("scenario_id").to_pylist(),
+                         fb.column("feedback").to_pylist(), strict=True):
+        by_key.setdefault(v, {})[sid] = f
+    assert set(by_key) == {g0, f"{g0}+prior"}
+    ids = sorted(by_key[g0])
+    assert ids == sorted(by_key[f"{g0}+prior"]) and len(ids) > 0
+    monitor = raw.monitor(g0)
+    w = load_windows(root, ids, context_len=monitor.context_len, horizon_s=3.0)
+    pos_weight = monitor.card["hyperparameters"]["pos_weight"]
+    assert pos_weight > 1  # rare unsafe frames: the correction is not a no-op
+    p = prior_corrected(monitor.score(w), pos_weight)
+    sid = w.scenario_id
+    for one in ids[:3]:
+        k = sid == one
+        assert by_key[f"{g0}+prior"][one] == pytest.approx(np.abs(p[k] - w.label[k]).mean())
+        assert by_key[g0][one] == pytest.approx(np.abs(monitor.score(w)[k] - w.label[k]).mean())
 
 
 def test_budget_is_never_overspent_and_every_round_is_recorded(root_copy) -> None:

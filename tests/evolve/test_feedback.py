@@ -59,3 +59,16 @@ def test_normalised_feedback_spans_zero_to_one_and_keeps_unscored_runs_unscored(
 def test_equal_feedback_normalises_to_zero_instead_of_dividing_by_zero():
     np.testing.assert_array_equal(normalise_feedback(np.full(4, 0.3)), np.zeros(4))
     assert np.isnan(normalise_feedback(np.array([np.nan, np.nan]))).all()
+
+
+def test_prior_corrected_undoes_the_weighted_bce_odds_shift() -> None:
+    from evoeye.evolve.feedback import prior_corrected
+
+    p = np.array([0.01, 0.2, 0.5, 0.9])  # true probabilities
+    w = 24.0
+    weighted_optimum = w * p / (w * p + 1 - p)  # argmin of the pos_weight-w BCE at rate p
+    assert np.allclose(prior_corrected(weighted_optimum, w), p)
+    assert np.allclose(prior_corrected(p, 1.0), p)  # no weight, nothing to undo
+    assert np.all(np.diff(prior_corrected(np.linspace(0, 1, 11), w)) >= 0)  # monotone
+    with pytest.raises(ValueError, match="pos_weight"):
+        prior_corrected(p, 0.0)
