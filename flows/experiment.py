@@ -18,6 +18,7 @@ from evoeye.evolve.campaign import UPDATE_MODES, CampaignConfig
 from evoeye.evolve.experiment import (
     ABLATION,
     MAIN,
+    add_controls,
     collect_results,
     markdown,
     plan_experiment,
@@ -46,6 +47,7 @@ class ExperimentParams(BaseModel):
     split_seed: int = Field(SplitSpec().seed, ge=0)
     train_frac: float = Field(SplitSpec().train_frac, ge=0.0, le=1.0)
     val_frac: float = Field(SplitSpec().val_frac, ge=0.0, le=1.0)
+    controls: int = Field(3, ge=0)  # re-seeded G_0 per scenario (no new data)
     report_name: str | None = None
 
     @field_validator("scenarios", "strategies")
@@ -74,7 +76,7 @@ def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
     for cfg in plan:
         name = f"{cfg.scenario}-{cfg.strategy}-s{cfg.seed}"
         evolution_flow.with_options(flow_run_name=name)(EvolveParams.of(cfg, root, assess=True))
-    results = collect_results(root, plan)
+    results = add_controls(root, plan, collect_results(root, plan), params.controls)
     folder = write_experiment_report(root, results, params.report_name)
     create_markdown_artifact(markdown=markdown(results), key="evoeye-rq2",
                              description=f"RQ2 report, {folder / 'rq2.html'}")

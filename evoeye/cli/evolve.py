@@ -93,6 +93,9 @@ def experiment_command(
         "--monitor", help="G_0 of the first --scenario (default: its newest monitor trained "
         "from scratch).")] = None,
     feedback: Annotated[str, typer.Option("--feedback", help=FEEDBACK_HELP)] = "raw",
+    controls: Annotated[int, typer.Option(
+        "--controls", min=0, help="G_0 retrained on the initial data with this many other "
+        "seeds: the Hard-Set score a new model gets without new data.")] = 3,
     ablation: Annotated[bool, typer.Option("--ablation/--no-ablation")] = True,
     strategy: Annotated[list[str] | None, typer.Option(
         "--strategy", help="Run only these strategies (repeatable); default: the RQ2 ones, "
@@ -112,7 +115,8 @@ def experiment_command(
                    0, feedback)
     results = run_experiment(root, scenarios, base,
                              strategies=strategy or MAIN + (ABLATION if ablation else ()),
-                             seeds=range(repetitions), budget_s=budget_s, progress=typer.echo)
+                             seeds=range(repetitions), budget_s=budget_s, controls=controls,
+                             progress=typer.echo)
     folder = write_experiment_report(root, results, name)
     typer.echo((folder / "rq2.md").read_text(encoding="utf-8"))
     typer.echo(f"report: {folder / 'rq2.html'}")

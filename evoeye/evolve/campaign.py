@@ -158,7 +158,8 @@ def run_seed(campaign_seed: int, k: int) -> int:
 
 
 def initial_monitor(root: DataRoot | str | Path | None, scenario: str) -> str:
-    """The newest full FusionMonitor (all modules, L = 5) trained from scratch on `scenario`."""
+    """The newest full FusionMonitor (all modules, L = 5) trained from scratch on `scenario`'s
+    train split by filter — not on a hand-picked run list (e.g. the experiment's controls)."""
     from evoeye.monitor import list_versions, read_card
     from evoeye.monitor.model import MODULES
 
@@ -166,7 +167,8 @@ def initial_monitor(root: DataRoot | str | Path | None, scenario: str) -> str:
     mine = [(c.get("created_at", ""), v) for c, v in cards  # the full model, not an ablation
             if c.get("logical_scenario") == scenario and not c.get("parent")
             and tuple(c.get("modules", ())) == tuple(MODULES)
-            and c.get("context_len") == DEFAULT_CONTEXT_LEN]
+            and c.get("context_len") == DEFAULT_CONTEXT_LEN
+            and c.get("selection", {}).get("train", {}).get("kind") == "filter"]
     if not mine:
         raise LookupError(f"no monitor trained on {scenario!r} under {root}: train one first "
                           "(`evoeye monitor train`) or name it")

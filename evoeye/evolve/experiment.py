@@ -22,6 +22,7 @@ from evoeye.evaluation.plots import line_chart
 from evoeye.evolve.assess import Assessor
 from evoeye.evolve.campaign import Campaign, CampaignConfig, CampaignState, initial_monitor
 from evoeye.paths import DataRoot
+from evoeye.store import RunFilter
 from evoeye.store.feedback import read_rounds
 
 MAIN = ("uniform", "avfuzzer", "evoeye")
@@ -88,8 +89,9 @@ def collect_results(root: DataRoot | str | Path | None, plan: Sequence[CampaignC
 def run_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str],
                    base: CampaignConfig, *, strategies: Sequence[str] = MAIN + ABLATION,
                    seeds: Sequence[int] = (0, 1, 2), budget_s: float | None = None,
-                   progress: Callable[[str], None] = print) -> dict:
-    """Run (or resume) every campaign of the plan, then `collect_results`."""
+                   controls: int = 3, progress: Callable[[str], None] = print) -> dict:
+    """Run (or resume) every campaign of the plan, then `collect_results`, with `controls`
+    re-seeded G_0 per scenario."""
     root = _root(root)
     plan = plan_experiment(root, scenarios, base, strategies=strategies, seeds=seeds,
                            budget_s=budget_s)
@@ -100,7 +102,55 @@ def run_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str],
                  f"budget {cfg.budget_s:.0f} s")
         c.run(on_round=lambda row, st, s=cfg.strategy: progress(
             f"  {s} round {row.round}: {_brief(row.metrics)}"))
-    return collect_results(root, plan)
+    return add_controls(root, plan, collect_results(root, plan), controls, assess, progress)
+
+
+def add_controls(root: DataRoot | str | Path | None, plan: Sequence[CampaignConfig],
+                 results: dict, k: int, assess: dict[str, Assessor] | None = None,
+                 progress: Callable[[str], None] | None = None) -> dict:
+    """`results` with k re-seeded G_0 controls per scenario under "reseeded"."""
+    if not k:
+        return results
+    assess = assess or assessors(root, plan)
+    for scenario, cfg in {c.scenario: c for c in plan}.items():
+        if scenario in results:
+            if progress:
+                progress(f"{scenario}: {k} re-seeded G_0 controls")
+            results[scenario]["reseeded"] = reseeded_controls(root, cfg, k, assess[scenario])
+    return results
+
+
+CONTROL_SEED = 1000  # training seeds of the re-seeded G_0 controls: 1000, 1001, …
+
+
+def reseeded_controls(root: DataRoot | str | Path | None, cfg: CampaignConfig, k: int,
+                      assess: Assessor) -> list[dict]:
+    """The control without new data: G_0's recipe retrained on D_init with k other seeds.
+
+    The Hard Set is defined by G_0's own misses, so any other model — even one trained on the
+    same data — scores above G_0's 0 on it; a strategy has only improved on the Hard Set by what
+    it adds over these. Versions already trained (same runs, seed, from scratch) are reused.
+    """
+    from evoeye.monitor import list_versions, read_card, train_monitor
+    from evoeye.monitor.card import describe_selection
+
+    root = _root(root)
+    ids = [str(s) for s in Campaign(root, cfg).initial["scenario_id"]]
+    selection = describe_selection(ids)
+    have = {}
+    for v in list_versions(root):
+        card = read_card(root, v)
+        if (card.get("logical_scenario") == cfg.scenario and not card.get("parent")
+                and card.get("selection", {}).get("train") == selection):
+            have[card.get("hyperparameters", {}).get("seed")] = v
+    val = RunFilter(logical_scenario=cfg.scenario, split="val", splits=cfg.splits)
+    out = []
+    for seed in range(CONTROL_SEED, CONTROL_SEED + k):
+        version = have.get(seed) or train_monitor(
+            root, cfg.scenario, train_runs=ids, val_runs=val, seed=seed, splits=cfg.splits,
+            horizon_s=cfg.horizon_s)
+        out.append(assess(version))
+    return out
 
 
 def _root(root: DataRoot | str | Path | None) -> DataRoot:
@@ -171,6 +221,10 @@ def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
     """Rows: method, then mean ± std (in %) of each column on the Test Set and the Hard Set."""
     rows = [["initial (G_0)"] + [_mean_std([_value(res["initial"][s][c])])
                                  for s in ("test", "hard") for c in COLUMNS]]
+    if res.get("reseeded"):
+        rows.append([f"G_0 re-seeded ×{len(res['reseeded'])} (no new data)"]
+                    + [_mean_std([_value(m[s][c]) for m in res["reseeded"]])
+                       for s in ("test", "hard") for c in COLUMNS])
     for strategy in strategies:
         runs = res.get(strategy, [])
         rows.append([strategy] + [_mean_std([_final(r, s, c) for r in runs])
@@ -210,11 +264,9 @@ def markdown(results: dict) -> str:
 
 def _curves(res: dict, split: str, col: str) -> str:
     series = []
-    n_max = max((len(r["rounds"]) for s in res if isinstance(res[s], list) for r in res[s]),
-                default=1)
-    for strategy, runs in res.items():
-        if not isinstance(runs, list) or not runs:
-            continue
+    ran = {s: res[s] for s in MAIN + ABLATION if res.get(s)}
+    n_max = max((len(r["rounds"]) for runs in ran.values() for r in runs), default=1)
+    for strategy, runs in ran.items():
         n = min(len(r["rounds"]) for r in runs)
         ys = [float(np.nanmean([_value(r["rounds"][i][split][col]) for r in runs]))
               for i in range(n)]

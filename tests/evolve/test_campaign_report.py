@@ -38,6 +38,15 @@ def test_table_reports_mean_and_std_of_the_last_round() -> None:
     assert rows["initial (G_0)"][5] == "0.0"  # one value: no spread to report
 
 
+def test_the_reseeded_control_is_a_row_of_its_own() -> None:
+    res = {**RESULTS["highway-cut-in"],
+           "reseeded": [{"test": _m(0.2), "hard": _m(0.2)}, {"test": _m(0.4), "hard": _m(0.3)}]}
+    rows = {r[0]: r for r in table_rows(res, ("uniform",))}
+    row = rows["G_0 re-seeded ×2 (no new data)"]
+    assert row[1] == "30.0 ± 10.0" and row[5] == "25.0 ± 5.0"
+    assert html({"highway-cut-in": res}).count("<svg") == 5  # controls add no curve
+
+
 def test_a_single_seed_shows_no_spread() -> None:
     one = {**RESULTS["highway-cut-in"], "uniform": [_run([0.2, 0.3])]}
     rows = {r[0]: r for r in table_rows(one, ("uniform",))}

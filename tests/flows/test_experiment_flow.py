@@ -8,8 +8,9 @@ from dataclasses import replace
 import pytest
 from pydantic import ValidationError
 
-from evoeye.evolve.campaign import Campaign, CampaignConfig
+from evoeye.evolve.campaign import Campaign, CampaignConfig, initial_monitor
 from evoeye.evolve.experiment import plan_experiment
+from evoeye.monitor import list_versions
 from evoeye.store import SplitSpec
 from evoeye.store.feedback import read_rounds
 from flows.experiment import ExperimentParams, experiment_flow
@@ -47,11 +48,11 @@ def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_serv
     from prefect.client.orchestration import get_client
     from prefect.client.schemas.filters import FlowRunFilter, FlowRunFilterName
 
-    root, _ = seeded
+    root, g0 = seeded
     params = ExperimentParams(root=str(root), scenarios=[SCENARIO],
                               strategies=["uniform", "evoeye"], repetitions=1, budget_s=45.0,
                               n_round=2, epochs=1, train_frac=0.5, val_frac=0.25,
-                              report_name="rq2-test")
+                              controls=1, report_name="rq2-test")
     out = experiment_flow(params)
     res = out["results"][SCENARIO]
     for strategy in ("uniform", "evoeye"):
@@ -73,6 +74,15 @@ def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_serv
     report = json.loads((root / "reports" / "rq2-test" / "rq2.json").read_text())
     assert report[SCENARIO]["evoeye"][0]["campaign_id"] == res["evoeye"][0]["campaign_id"]
     assert "| evoeye |" in (root / "reports" / "rq2-test" / "rq2.md").read_text()
-    # re-running resumes: same campaigns, nothing simulated twice
+    # the control: G_0's recipe on D_init with another seed, assessed like every G_r
+    (control,) = res["reseeded"]
+    assert control["version"] not in (g0, res["evoeye"][0]["rounds"][-1]["version"])
+    assert "| G_0 re-seeded ×1 (no new data) |" in (root / "reports" / "rq2-test" / "rq2.md"
+                                                    ).read_text()
+    assert initial_monitor(root, SCENARIO) == g0  # a control never becomes G_0
+    # re-running resumes: same campaigns, nothing simulated twice, the control reused
+    versions = list_versions(root)
     again = experiment_flow(params)
     assert again["results"][SCENARIO]["evoeye"][0]["rounds"] == res["evoeye"][0]["rounds"]
+    assert again["results"][SCENARIO]["reseeded"] == res["reseeded"]
+    assert list_versions(root) == versions
