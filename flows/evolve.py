@@ -12,7 +12,7 @@ from typing import Any
 
 from prefect import flow, get_run_logger, task
 from prefect.cache_policies import NONE
-from pydantic import BaseModel, Field, field_validator
+from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
 from evoeye.evolve.campaign import UPDATE_MODES, Campaign, CampaignConfig, CampaignState
 from evoeye.evolve.scoring import FEEDBACK_MODES
@@ -20,6 +20,16 @@ from evoeye.evolve.strategies import STRATEGIES
 from evoeye.paths import resolve_root
 from evoeye.scenarios import SCENARIOS
 from evoeye.store import SplitSpec
+
+KNOWN = {"scenario": SCENARIOS, "strategy": STRATEGIES, "update": UPDATE_MODES,
+         "feedback": FEEDBACK_MODES}  # the names a flow parameter of that kind may take
+
+
+def check_known(kind: str, values: list[str]) -> None:
+    """ValueError naming the values of `kind` (a KNOWN key) that are unknown, or no value."""
+    unknown = [v for v in values if v not in KNOWN[kind]]
+    if unknown or not values:
+        raise ValueError(f"unknown {kind} {unknown}; known: {sorted(KNOWN[kind])}")
 
 
 class EvolveParams(BaseModel):
@@ -41,18 +51,10 @@ class EvolveParams(BaseModel):
     val_frac: float = Field(0.125, ge=0.0, le=1.0)
     assess: bool = False  # also score every G_r on the Test Set and the Hard Set
 
-    @field_validator("scenario")
+    @field_validator("scenario", "strategy", "update", "feedback")
     @classmethod
-    def _known_scenario(cls, value: str) -> str:
-        if value not in SCENARIOS:
-            raise ValueError(f"unknown logical scenario {value!r}; known: {sorted(SCENARIOS)}")
-        return value
-
-    @field_validator("strategy")
-    @classmethod
-    def _known_strategy(cls, value: str) -> str:
-        if value not in STRATEGIES:
-            raise ValueError(f"unknown strategy {value!r}; known: {sorted(STRATEGIES)}")
+    def _known(cls, value: str, info: ValidationInfo) -> str:
+        check_known(info.field_name, [value])
         return value
 
     @classmethod

@@ -25,11 +25,10 @@ from evoeye.evolve.experiment import (
     write_experiment_report,
 )
 from evoeye.evolve.scoring import FEEDBACK_MODES
-from evoeye.evolve.strategies import STRATEGIES
 from evoeye.paths import resolve_root
 from evoeye.scenarios import SCENARIOS
 from evoeye.store import SplitSpec
-from flows.evolve import EvolveParams, evolution_flow
+from flows.evolve import EvolveParams, check_known, evolution_flow
 
 
 class ExperimentParams(BaseModel):
@@ -50,13 +49,12 @@ class ExperimentParams(BaseModel):
     controls: int = Field(3, ge=0)  # re-seeded G_0 per scenario (no new data)
     report_name: str | None = None
 
-    @field_validator("scenarios", "strategies")
+    @field_validator("scenarios", "strategies", "update", "feedback")
     @classmethod
-    def _all_known(cls, value: list[str], info: ValidationInfo) -> list[str]:
-        known = SCENARIOS if info.field_name == "scenarios" else STRATEGIES
-        unknown = [v for v in value if v not in known]
-        if unknown or not value:
-            raise ValueError(f"unknown {info.field_name} {unknown}; known: {sorted(known)}")
+    def _known(cls, value: str | list[str], info: ValidationInfo) -> str | list[str]:
+        kind = {"scenarios": "scenario", "strategies": "strategy"}.get(info.field_name,
+                                                                        info.field_name)
+        check_known(kind, value if isinstance(value, list) else [value])
         return value
 
     def base(self) -> CampaignConfig:

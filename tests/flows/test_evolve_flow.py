@@ -17,6 +17,10 @@ def test_params_reject_unknown_strategy() -> None:
         EvolveParams(strategy="grid")
     with pytest.raises(ValidationError, match="budget_s"):
         EvolveParams(budget_s=-1)
+    with pytest.raises(ValidationError, match="unknown feedback"):
+        EvolveParams(feedback="calibrated")
+    with pytest.raises(ValidationError, match="unknown update"):
+        EvolveParams(update="warm")
 
 
 def test_nightly_deployment_has_cron_and_parameter_schema() -> None:
