@@ -47,7 +47,7 @@ from evoeye.evolve.scoring import (
     warehouse_feedback,
     windows_feedback,
 )
-from evoeye.evolve.strategies import STRATEGIES, make_strategy
+from evoeye.evolve.strategies import FEEDBACK_BLIND, STRATEGIES, make_strategy
 from evoeye.log import read_run
 from evoeye.paths import DataRoot
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
@@ -209,7 +209,9 @@ class Campaign:
         """`evo-<strategy>-s<seed>-<hash>` of everything but the budget: same inputs, same id."""
         cfg = asdict(self.config)
         cfg.pop("budget_s")
-        if cfg["feedback"] == "raw":  # the original loop: its campaigns keep their ids
+        # raw: the original loop, whose campaigns keep their ids; a feedback-blind strategy
+        # acquires the same runs and trains the same monitors under either mode
+        if cfg["feedback"] == "raw" or cfg["strategy"] in FEEDBACK_BLIND:
             cfg.pop("feedback")
         cfg["monitor"] = self.g0
         cfg["initial"] = hashlib.sha256("\n".join(self.initial["scenario_id"]).encode()).hexdigest()

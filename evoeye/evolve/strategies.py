@@ -130,6 +130,9 @@ STRATEGIES: dict[str, StrategyFactory] = {
     "uniform": UniformStrategy,
     "avfuzzer": AVFuzzer,
 }
+# Strategies whose proposals never read the records' feedback: the feedback mode cannot change
+# what they acquire (the monitor updates are the same too), so it is not part of their identity.
+FEEDBACK_BLIND = frozenset({"uniform", "avfuzzer", "no-feedback"})
 
 
 def make_strategy(name: str, space: LogicalScenario, seed: int, **options) -> Strategy:

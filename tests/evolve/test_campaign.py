@@ -108,6 +108,10 @@ def test_campaign_id_is_stable_and_ignores_the_budget(seeded) -> None:
     assert a != Campaign(root, config(g0, seed=1)).campaign_id
     assert a != Campaign(root, config(g0, strategy="uniform")).campaign_id
     assert a != Campaign(root, config(g0, feedback="prior-corrected")).campaign_id
+    for blind in ("uniform", "avfuzzer", "no-feedback"):  # they never read the feedback
+        ids = {Campaign(root, config(g0, strategy=blind, feedback=f)).campaign_id
+               for f in ("raw", "prior-corrected")}
+        assert len(ids) == 1, blind
     with pytest.raises(ValueError, match="feedback"):
         config(g0, feedback="calibrated")
 
