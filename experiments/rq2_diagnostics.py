@@ -20,7 +20,8 @@ import argparse
 import numpy as np
 
 from evoeye.evolve.assess import Assessor
-from evoeye.evolve.campaign import Campaign, CampaignConfig, _load_monitor
+from evoeye.evolve.campaign import Campaign, CampaignConfig
+from evoeye.evolve.families import load_version
 from evoeye.evolve.feedback import prior_corrected
 from evoeye.paths import DataRoot
 from evoeye.store import RunFilter
@@ -42,7 +43,7 @@ def _acquired_ids(st) -> list[str]:
 
 
 def feedback_split(a: argparse.Namespace) -> None:
-    m = _load_monitor(a.root, a.monitor)
+    m = load_version(a.root, a.monitor)
     ids = [str(s) for s in Campaign(a.root, CampaignConfig(a.scenario, monitor=a.monitor))
            .initial["scenario_id"]]
     w = load_windows(a.root, ids, context_len=m.context_len, horizon_s=3.0)
@@ -62,7 +63,7 @@ def feedback_split(a: argparse.Namespace) -> None:
 
 
 def blind_frames(a: argparse.Namespace) -> None:
-    m = _load_monitor(a.root, a.monitor)
+    m = load_version(a.root, a.monitor)
     threshold = m.thresholds.at(0.05)
     for strategy, seed, _, st in _campaigns(a):
         w = load_windows(a.root, _acquired_ids(st), context_len=m.context_len, horizon_s=3.0)

@@ -15,6 +15,8 @@ from prefect.cache_policies import NONE
 from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
 from evoeye.evolve.campaign import UPDATE_MODES, Campaign, CampaignConfig, CampaignState
+from evoeye.evolve.experiment import METHODS
+from evoeye.evolve.families import FAMILIES
 from evoeye.evolve.scoring import FEEDBACK_MODES
 from evoeye.evolve.strategies import STRATEGIES
 from evoeye.paths import resolve_root
@@ -22,7 +24,8 @@ from evoeye.scenarios import SCENARIOS
 from evoeye.store import SplitSpec
 
 KNOWN = {"scenario": SCENARIOS, "strategy": STRATEGIES, "update": UPDATE_MODES,
-         "feedback": FEEDBACK_MODES}  # the names a flow parameter of that kind may take
+         "feedback": FEEDBACK_MODES, "family": FAMILIES,
+         "method": METHODS}  # the names a flow parameter of that kind may take
 
 
 def check_known(kind: str, values: list[str]) -> None:
@@ -44,6 +47,8 @@ class EvolveParams(BaseModel):
     n_round: int = Field(20, ge=1)
     update: str = Field("finetune", json_schema_extra={"enum": list(UPDATE_MODES)})
     feedback: str = Field("raw", json_schema_extra={"enum": list(FEEDBACK_MODES)})
+    family: str = Field("fusion", json_schema_extra={"enum": list(FAMILIES)})  # aem: AEM-Evo
+    reference: str | None = None  # aem: the FusionMonitor G_0 whose Hard Set judges
     epochs: int | None = Field(None, ge=1)
     max_rounds: int | None = Field(None, ge=1)  # rounds in this flow run (None: to the budget)
     split_seed: int = 0
@@ -51,7 +56,7 @@ class EvolveParams(BaseModel):
     val_frac: float = Field(0.125, ge=0.0, le=1.0)
     assess: bool = False  # also score every G_r on the Test Set and the Hard Set
 
-    @field_validator("scenario", "strategy", "update", "feedback")
+    @field_validator("scenario", "strategy", "update", "feedback", "family")
     @classmethod
     def _known(cls, value: str, info: ValidationInfo) -> str:
         check_known(info.field_name, [value])
@@ -68,7 +73,7 @@ class EvolveParams(BaseModel):
         return cls(root=root, scenario=config.scenario, strategy=config.strategy,
                    budget_s=config.budget_s, seed=config.seed, monitor=config.monitor,
                    n_round=config.n_round, update=config.update, epochs=config.epochs,
-                   feedback=config.feedback,
+                   feedback=config.feedback, family=config.family, reference=config.reference,
                    split_seed=config.splits.seed, train_frac=config.splits.train_frac,
                    val_frac=config.splits.val_frac, **options)
 
@@ -76,7 +81,8 @@ class EvolveParams(BaseModel):
         return CampaignConfig(
             scenario=self.scenario, strategy=self.strategy, budget_s=self.budget_s,
             seed=self.seed, monitor=self.monitor, n_round=self.n_round, update=self.update,
-            epochs=self.epochs, feedback=self.feedback,
+            epochs=self.epochs, feedback=self.feedback, family=self.family,
+            reference=self.reference,
             splits=SplitSpec(self.split_seed, self.train_frac, self.val_frac),
         )
 
@@ -88,8 +94,7 @@ def make_campaign(params: EvolveParams) -> Campaign:
     if params.assess:
         from evoeye.evolve.assess import Assessor
 
-        g0 = Campaign(root, cfg).g0
-        assess = Assessor(root, cfg.scenario, g0, splits=cfg.splits, horizon_s=cfg.horizon_s)
+        assess = Assessor.of(Campaign(root, cfg))
     return Campaign(root, cfg, assess=assess)
 
 

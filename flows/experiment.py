@@ -1,6 +1,6 @@
-"""Flow: the RQ2 experiment — every (scenario, seed, strategy) campaign as an evolution flow run.
+"""Flow: the RQ2 experiment — every (scenario, seed, method) campaign as an evolution flow run.
 
-Each campaign is a sub-flow run named `<scenario>-<strategy>-s<seed>` whose rounds are in turn
+Each campaign is a sub-flow run named `<scenario>-<method>-s<seed>` whose rounds are in turn
 `round-<r>` flow runs, so the UI shows the experiment's progress round by round. Campaigns are
 resumable, so a crashed experiment flow run is simply started again. The RQ2 and ablation tables
 are written under `<root>/reports/<name>/` and published as a Markdown artifact.
@@ -20,10 +20,10 @@ from evoeye.evolve.experiment import (
     MAIN,
     add_controls,
     collect_results,
-    markdown,
+    method_of,
     plan_experiment,
-    write_experiment_report,
 )
+from evoeye.evolve.report import markdown, write_experiment_report
 from evoeye.evolve.scoring import FEEDBACK_MODES
 from evoeye.paths import resolve_root
 from evoeye.scenarios import SCENARIOS
@@ -52,7 +52,7 @@ class ExperimentParams(BaseModel):
     @field_validator("scenarios", "strategies", "update", "feedback")
     @classmethod
     def _known(cls, value: str | list[str], info: ValidationInfo) -> str | list[str]:
-        kind = {"scenarios": "scenario", "strategies": "strategy"}.get(info.field_name,
+        kind = {"scenarios": "scenario", "strategies": "method"}.get(info.field_name,
                                                                         info.field_name)
         check_known(kind, value if isinstance(value, list) else [value])
         return value
@@ -72,7 +72,7 @@ def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
     plan = plan_experiment(root, params.scenarios, params.base(), strategies=params.strategies,
                            seeds=range(params.repetitions), budget_s=params.budget_s)
     for cfg in plan:
-        name = f"{cfg.scenario}-{cfg.strategy}-s{cfg.seed}"
+        name = f"{cfg.scenario}-{method_of(cfg)}-s{cfg.seed}"
         evolution_flow.with_options(flow_run_name=name)(EvolveParams.of(cfg, root, assess=True))
     results = add_controls(root, plan, collect_results(root, plan), params.controls)
     folder = write_experiment_report(root, results, params.report_name)

@@ -162,14 +162,19 @@ def _threads(n: int):
 
 
 def train_aem(train: Windows, normal: np.ndarray, config: AEMConfig = AEMConfig(), *,
-              threads: int = 1) -> AEMMonitor:
+              init: AEMMonitor | None = None, threads: int = 1) -> AEMMonitor:
     """Fit the autoencoder on the windows `normal` (bool (B,)) of `train`; seeded by config
-    (the same seed, data and thread count give the same weights)."""
+    (the same seed, data and thread count give the same weights). With `init`, fine-tune it:
+    its weights and input standardisation are the start, only the error scale is re-measured."""
     with _threads(threads):
-        return _train(train, normal, config)
+        return _train(train, normal, config, init)
 
 
-def _train(train: Windows, normal: np.ndarray, config: AEMConfig) -> AEMMonitor:
+def _train(train: Windows, normal: np.ndarray, config: AEMConfig,
+           init: AEMMonitor | None = None) -> AEMMonitor:
+    if init is not None and (init.config.hidden, init.config.latent) != (config.hidden,
+                                                                         config.latent):
+        raise ValueError("a fine-tuned AEM keeps its parent's layer sizes")
     if train.context_len != config.context_len:
         raise ValueError(f"windows have L={train.context_len}, config wants {config.context_len}")
     idx = np.flatnonzero(np.asarray(normal, bool))
@@ -180,13 +185,18 @@ def _train(train: Windows, normal: np.ndarray, config: AEMConfig) -> AEMMonitor:
         idx = np.sort(rng.choice(idx, config.max_train_windows, replace=False))
     x = np.concatenate([window_vectors(train, idx[s : s + CHUNK])
                         for s in range(0, len(idx), CHUNK)])
-    mean = x.mean(axis=0)
-    std = x.std(axis=0)
-    std = np.where(std > 1e-3, std, 1.0).astype(np.float32)
+    if init is not None:
+        mean, std = init.mean, init.std
+    else:
+        mean = x.mean(axis=0)
+        std = x.std(axis=0)
+        std = np.where(std > 1e-3, std, 1.0).astype(np.float32)
     xt = torch.from_numpy((x - mean) / std)
 
     torch.manual_seed(config.seed)
     model = AutoEncoder(x.shape[1], config.hidden, config.latent)
+    if init is not None:
+        model.load_state_dict(init.model.state_dict())
     opt = torch.optim.Adam(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)
     gen = torch.Generator().manual_seed(config.seed)
     model.train()

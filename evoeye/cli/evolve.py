@@ -10,7 +10,6 @@ import typer
 
 from evoeye.cli.app import app
 from evoeye.evolve.campaign import UPDATE_MODES, Campaign, CampaignConfig
-from evoeye.evolve.strategies import STRATEGIES
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 
@@ -22,13 +21,14 @@ Root = Annotated[Path | None, typer.Option(
 
 def _config(scenario: str, strategy: str, budget_s: float, seed: int, monitor: str | None,
             n_round: int, update: str, epochs: int | None, split_seed: int,
-            feedback: str = "raw") -> CampaignConfig:
+            feedback: str = "raw", family: str = "fusion") -> CampaignConfig:
     if update not in UPDATE_MODES:
         raise typer.BadParameter(f"--update must be one of {UPDATE_MODES}")
     try:
         return CampaignConfig(scenario=scenario, strategy=strategy, budget_s=budget_s, seed=seed,
                               monitor=monitor, n_round=n_round, update=update, epochs=epochs,
-                              splits=SplitSpec(seed=split_seed), feedback=feedback)
+                              splits=SplitSpec(seed=split_seed), feedback=feedback,
+                              family=family)
     except (ValueError, KeyError) as e:
         raise typer.BadParameter(str(e)) from None
 
@@ -47,15 +47,18 @@ def evolve_command(
     max_rounds: Annotated[int | None, typer.Option("--max-rounds")] = None,
     split_seed: Annotated[int, typer.Option("--split-seed")] = 0,
     feedback: Annotated[str, typer.Option("--feedback", help=FEEDBACK_HELP)] = "raw",
+    family: Annotated[str, typer.Option("--family", help="The monitor evolved: fusion, or aem "
+                                        "(AEM-Evo; judged on the FusionMonitor's Hard Set).")
+                      ] = "fusion",
 ) -> None:
     """Run (or resume) an evolution campaign; per round, G_r's F1 / AUPRC on the test set."""
     from evoeye.evolve.assess import Assessor
 
     cfg = _config(scenario, strategy, budget_s, seed, monitor, n_round, update, epochs,
-                  split_seed, feedback)
+                  split_seed, feedback, family)
     data = DataRoot.resolve(root)
     probe = Campaign(data, cfg)
-    assess = Assessor(data, cfg.scenario, probe.g0, splits=cfg.splits, horizon_s=cfg.horizon_s)
+    assess = Assessor.of(probe)
     campaign = Campaign(data, cfg, assess=assess)
     typer.echo(f"campaign {campaign.campaign_id}: logs in "
                f"{data.runs / cfg.scenario / campaign.campaign_id}, state in "
@@ -98,17 +101,19 @@ def experiment_command(
         "seeds: the Hard-Set score a new model gets without new data.")] = 3,
     ablation: Annotated[bool, typer.Option("--ablation/--no-ablation")] = True,
     strategy: Annotated[list[str] | None, typer.Option(
-        "--strategy", help="Run only these strategies (repeatable); default: the RQ2 ones, "
-        "plus the ablations unless --no-ablation.")] = None,
+        "--strategy", help="Run only these methods (repeatable): a strategy, or aem-evo "
+        "(evoeye evolving the AEM baseline); default: the RQ2 ones, plus the ablations "
+        "(no-feedback, no-density, aem-evo) unless --no-ablation.")] = None,
     name: Annotated[str | None, typer.Option("--name", help="Report folder name.")] = None,
 ) -> None:
     """The RQ2 table (+ evolution ablation): G_0 vs uniform / avfuzzer / evoeye, R seeds."""
-    from evoeye.evolve.experiment import ABLATION, MAIN, run_experiment, write_experiment_report
+    from evoeye.evolve.experiment import ABLATION, MAIN, METHODS, run_experiment
+    from evoeye.evolve.report import write_experiment_report
 
     scenarios = scenario or ["highway-cut-in", "unprotected-intersection"]
-    unknown = sorted(set(strategy or ()) - set(STRATEGIES))
+    unknown = sorted(set(strategy or ()) - set(METHODS))
     if unknown:
-        raise typer.BadParameter(f"unknown strategy {unknown}; known: {sorted(STRATEGIES)}")
+        raise typer.BadParameter(f"unknown method {unknown}; known: {sorted(METHODS)}")
     if budget_s is not None and budget_s < 0:
         raise typer.BadParameter(f"--budget-s must be >= 0, got {budget_s}")
     base = _config(scenarios[0], "evoeye", budget_s or 0.0, 0, monitor, n_round, update, epochs,

@@ -14,6 +14,7 @@ import numpy as np
 
 from evoeye.paths import DataRoot
 from evoeye.store import RunFilter, SplitSpec, Warehouse, load_windows
+from evoeye.store.selection import Runs
 from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S, Windows
 
 OUTCOMES_SQL = """
@@ -97,10 +98,25 @@ def load_split(
     horizon_s: float = DEFAULT_HORIZON_S,
 ) -> SplitWindows:
     """Every window of one split of one logical scenario, with its run's collision time."""
-    wh = root if isinstance(root, Warehouse) else Warehouse(root)
     runs = RunFilter(logical_scenario=logical_scenario, split=split, splits=splits)
+    return load_runs(root, logical_scenario, runs, split, context_len=context_len,
+                     horizon_s=horizon_s)
+
+
+def load_runs(
+    root: Warehouse | DataRoot | str | Path | None,
+    logical_scenario: str,
+    runs: Runs,
+    name: str,
+    *,
+    context_len: int = DEFAULT_CONTEXT_LEN,
+    horizon_s: float = DEFAULT_HORIZON_S,
+) -> SplitWindows:
+    """Every window of any selection of `logical_scenario`'s runs (a RunFilter, ids or SQL),
+    with its run's collision time; `name` labels the selection."""
+    wh = root if isinstance(root, Warehouse) else Warehouse(root)
     windows = load_windows(wh, runs, context_len=context_len, horizon_s=horizon_s)
     tau = collision_times(wh, logical_scenario)
     ids, inverse = np.unique(windows.scenario_id.astype(str), return_inverse=True)
     col = np.array([tau[i] for i in ids], dtype=np.float64)[inverse.reshape(-1)]
-    return SplitWindows(logical_scenario, split, windows, col)
+    return SplitWindows(logical_scenario, name, windows, col)

@@ -58,10 +58,10 @@ class Assessor:
     def __init__(self, root: DataRoot | str | Path | None, scenario: str, g0: str, *,
                  splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen)
                  horizon_s: float = DEFAULT_HORIZON_S) -> None:
-        from evoeye.evolve.campaign import _load_monitor
+        from evoeye.evolve.families import load_version
 
         self.root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
-        self._load = _load_monitor
+        self._load = load_version
         monitor = self._load(self.root, g0)
         self.test: SplitWindows = load_split(self.root, scenario, "test", splits,
                                              context_len=monitor.context_len,
@@ -79,6 +79,13 @@ class Assessor:
         self.hard = np.array([(s, int(f)) in keys for s, f in
                               zip(w.scenario_id.tolist(), w.frame.tolist(), strict=True)])
         self.context_len = monitor.context_len
+
+    @classmethod
+    def of(cls, campaign) -> Assessor:
+        """A campaign's assessor: its scenario's Test Set, its reference G_0's Hard Set."""
+        cfg = campaign.config
+        return cls(campaign.root, cfg.scenario, campaign.reference, splits=cfg.splits,
+                   horizon_s=cfg.horizon_s)
 
     def __call__(self, version: str) -> dict:
         """{"test": metrics, "hard": metrics} of `version` at its own thresholds."""

@@ -39,6 +39,14 @@ import numpy as np
 
 from evoeye.batch import simulate_and_log
 from evoeye.evolve.avfuzzer import criticality
+from evoeye.evolve.families import (
+    FAMILIES,
+    family_of,
+    initial_aem,
+    initial_monitor,
+    load_version,
+    trainer_of,
+)
 from evoeye.evolve.protocol import Strategy
 from evoeye.evolve.records import Records
 from evoeye.evolve.scoring import (
@@ -55,7 +63,7 @@ from evoeye.sim.runner import SimConfig, run_spec
 from evoeye.store import RunFilter, SplitSpec, Warehouse, ingest
 from evoeye.store.feedback import FeedbackRows, RoundRow, feedback_of, read_rounds, write_feedback
 from evoeye.store.feedback import write_round as store_round
-from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S
+from evoeye.store.windows import DEFAULT_HORIZON_S
 
 UPDATE_MODES = ("finetune", "retrain")
 MAX_RUN_S = SimConfig().duration_s  # no run lasts longer than this (20 s)
@@ -72,7 +80,7 @@ ORDER BY s.scenario_id
 
 @dataclass(frozen=True)
 class CampaignConfig:
-    """What a campaign does. Every field but `budget_s` is part of the campaign id."""
+    """What a campaign does. Every field but `budget_s` and `reference` is part of its id."""
 
     scenario: str
     strategy: str = "evoeye"
@@ -85,6 +93,8 @@ class CampaignConfig:
     patience: int | None = None
     delta: float = DEFAULT_DELTA
     feedback: str = "raw"  # ŷ of f_r: "raw" scores or "prior-corrected" (see evolve.feedback)
+    family: str = "fusion"  # the monitor evolved: "fusion", or "aem" (AEM-Evo, evolve.families)
+    reference: str | None = None  # aem: the FusionMonitor G_0 whose Hard Set judges; None: newest
     horizon_s: float = DEFAULT_HORIZON_S
     splits: SplitSpec = field(default_factory=SplitSpec)
     max_run_s: float = MAX_RUN_S
@@ -95,6 +105,10 @@ class CampaignConfig:
             raise ValueError(f"unknown strategy {self.strategy!r}; known: {sorted(STRATEGIES)}")
         if self.feedback not in FEEDBACK_MODES:
             raise ValueError(f"feedback must be one of {FEEDBACK_MODES}, got {self.feedback!r}")
+        if self.family not in FAMILIES:
+            raise ValueError(f"family must be one of {FAMILIES}, got {self.family!r}")
+        if self.monitor and family_of(self.monitor) != self.family:
+            raise ValueError(f"G_0 {self.monitor} is not a {self.family} monitor")
         if self.update not in UPDATE_MODES:
             raise ValueError(f"update must be one of {UPDATE_MODES}, got {self.update!r}")
         if self.n_round < 1 or self.budget_s < 0 or self.seed < 0 or self.max_run_s <= 0:
@@ -138,41 +152,9 @@ Trainer = Callable[..., str]  # train_monitor's signature
 Assessor = Callable[[str], dict]  # monitor version → metrics (stored with the round, as JSON)
 
 
-def _default_trainer(root, scenario, **kwargs) -> str:
-    from evoeye.monitor import train_monitor
-
-    return train_monitor(root, scenario, **kwargs)
-
-
-def _load_monitor(root: DataRoot, version: str):
-    """A version for batch scoring: untraced (tracing pays off only over many calls)."""
-    from evoeye.monitor import FusionMonitor, load_monitor
-
-    m = load_monitor(root, version)
-    return FusionMonitor(m.net, m.version, m.thresholds, m.card, trace=False)
-
-
 def run_seed(campaign_seed: int, k: int) -> int:
     """The simulation seed of proposal k (0-based) of a campaign."""
     return int(np.random.SeedSequence([campaign_seed, k]).generate_state(1)[0])
-
-
-def initial_monitor(root: DataRoot | str | Path | None, scenario: str) -> str:
-    """The newest full FusionMonitor (all modules, L = 5) trained from scratch on `scenario`'s
-    train split by filter — not on a hand-picked run list (e.g. the experiment's controls)."""
-    from evoeye.monitor import list_versions, read_card
-    from evoeye.monitor.model import MODULES
-
-    cards = [(read_card(root, v), v) for v in list_versions(root)]
-    mine = [(c.get("created_at", ""), v) for c, v in cards  # the full model, not an ablation
-            if c.get("logical_scenario") == scenario and not c.get("parent")
-            and tuple(c.get("modules", ())) == tuple(MODULES)
-            and c.get("context_len") == DEFAULT_CONTEXT_LEN
-            and c.get("selection", {}).get("train", {}).get("kind") == "filter"]
-    if not mine:
-        raise LookupError(f"no monitor trained on {scenario!r} under {root}: train one first "
-                          "(`evoeye monitor train`) or name it")
-    return max(mine)[1]
 
 
 class Campaign:
@@ -183,7 +165,7 @@ class Campaign:
         self.root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
         self.config = config
         self.space = get_scenario(config.scenario)
-        self._train = train or _default_trainer
+        self._train = train or trainer_of(config.family)
         self._assess = assess
         self._monitors: dict[str, object] = {}
 
@@ -202,17 +184,40 @@ class Campaign:
 
     @cached_property
     def g0(self) -> str:
-        return self.config.monitor or initial_monitor(self.root, self.config.scenario)
+        cfg = self.config
+        if cfg.monitor:
+            return cfg.monitor
+        if cfg.family == "aem":
+            return initial_aem(self.root, cfg.scenario, list(self.initial["scenario_id"]),
+                               self._val_runs, cfg.horizon_s)
+        return initial_monitor(self.root, cfg.scenario)
+
+    @cached_property
+    def reference(self) -> str:
+        """The FusionMonitor G_0 whose Hard Set judges this campaign (G_0 itself, or for AEM-Evo
+        the configured / newest from-scratch FusionMonitor of the scenario)."""
+        if self.config.family == "fusion":
+            return self.g0
+        return self.config.reference or initial_monitor(self.root, self.config.scenario)
+
+    @property
+    def _val_runs(self) -> RunFilter:
+        """The fixed validation split every G_r is early-stopped and calibrated on."""
+        return RunFilter(logical_scenario=self.config.scenario, split="val",
+                         splits=self.config.splits)
 
     @cached_property
     def campaign_id(self) -> str:
         """`evo-<strategy>-s<seed>-<hash>` of everything but the budget: same inputs, same id."""
         cfg = asdict(self.config)
         cfg.pop("budget_s")
+        cfg.pop("reference")
         # raw: the original loop, whose campaigns keep their ids; a feedback-blind strategy
         # acquires the same runs and trains the same monitors under either mode
         if cfg["feedback"] == "raw" or cfg["strategy"] in FEEDBACK_BLIND:
             cfg.pop("feedback")
+        if cfg["family"] == "fusion":  # likewise
+            cfg.pop("family")
         cfg["monitor"] = self.g0
         cfg["initial"] = hashlib.sha256("\n".join(self.initial["scenario_id"]).encode()).hexdigest()
         digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]
@@ -228,7 +233,7 @@ class Campaign:
 
     def monitor(self, version: str):
         if version not in self._monitors:
-            self._monitors[version] = _load_monitor(self.root, version)
+            self._monitors[version] = load_version(self.root, version)
         return self._monitors[version]
 
     # -- state -----------------------------------------------------------------------------------
@@ -307,10 +312,10 @@ class Campaign:
         """Line 12: G_{r+1} from D_r (train) and the fixed val split; (version, wall seconds)."""
         cfg = self.config
         ids = [str(s) for s, ok in zip(state.records.scenario_id, state.ok, strict=True) if ok]
-        val = RunFilter(logical_scenario=cfg.scenario, split="val", splits=cfg.splits)
         t0 = time.perf_counter()
         version = self._train(
-            self.root, cfg.scenario, train_runs=ids, val_runs=val, horizon_s=cfg.horizon_s,
+            self.root, cfg.scenario, train_runs=ids, val_runs=self._val_runs,
+            horizon_s=cfg.horizon_s,
             seed=cfg.seed * 1000 + state.round + 1, splits=cfg.splits,
             init_from=state.monitor if cfg.update == "finetune" else None,
             context_len=None if cfg.update == "finetune" else self.monitor(self.g0).context_len,

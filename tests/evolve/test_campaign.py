@@ -293,3 +293,42 @@ def test_cli_evolve_prints_the_state_and_round_metrics(root_copy, seeded) -> Non
     assert "test F1@0.05" in res.output and "budget spent after round 0" in res.output
     bad = CliRunner().invoke(app, [*args[:6], "grid"])
     assert bad.exit_code != 0
+
+
+def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_copy,
+                                                                         seeded) -> None:
+    import json
+
+    from evoeye.evaluation.dataset import load_runs
+    from evoeye.evolve.assess import Assessor
+    from evoeye.evolve.families import load_version
+
+    with pytest.raises(ValueError, match="not a aem monitor"):
+        config(seeded[1], family="aem")
+    root = root_copy("aem")
+    assess = Assessor(root, SCENARIO, seeded[1], splits=SPLITS)  # the FusionMonitor's Hard Set
+    cfg = config(None, family="aem", strategy="uniform")
+    c = Campaign(root, cfg, assess=assess)
+    assert c.campaign_id != Campaign(root, config(seeded[1], strategy="uniform")).campaign_id
+    g0 = c.g0
+    assert g0.startswith("aem-") and Campaign(root, cfg).g0 == g0  # found again, not retrained
+    c.run(max_rounds=1)
+    rows = read_rounds(root, c.campaign_id)
+    assert [r.round for r in rows] == [0, 1] and rows[0].monitor_version == g0
+    g1 = load_version(root, rows[1].monitor_version)
+    assert g1.version != g0 and g1.card["parent"] == g0
+    np.testing.assert_array_equal(g1.aem.mean, load_version(root, g0).aem.mean)  # parent's
+    # thresholds calibrated on the eligible safe frames of the validation split
+    val = load_runs(root, SCENARIO, c._val_runs, "val", horizon_s=3.0)
+    safe = val.eligible & (val.windows.label == 0)
+    assert (g1.score(val.windows)[safe] > g1.thresholds.at(0.05)).mean() <= 0.05
+    # every record's feedback under G_1 is the mean |AEM risk − y| of its frames
+    fb = {s: f for v, s, f in snapshot(root, c)["feedback"] if v == g1.version}
+    ids = sorted(fb)[:3]
+    w = load_windows(root, ids, context_len=5, horizon_s=3.0)
+    risk = g1.score(w)
+    for one in ids:
+        k = w.scenario_id == one
+        assert fb[one] == pytest.approx(np.abs(risk[k] - w.label[k]).mean())
+    hard = json.loads(rows[1].metrics)["hard"]
+    assert hard["frames"] == assess(seeded[1])["hard"]["frames"] > 0

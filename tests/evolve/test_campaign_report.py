@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from evoeye.evolve.experiment import (
+from evoeye.evolve.report import (
     acquisition_rows,
     html,
     markdown,
@@ -45,6 +45,17 @@ def test_the_reseeded_control_is_a_row_of_its_own() -> None:
     row = rows["G_0 re-seeded ×2 (no new data)"]
     assert row[1] == "30.0 ± 10.0" and row[5] == "25.0 ± 5.0"
     assert html({"highway-cut-in": res}).count("<svg") == 5  # controls add no curve
+
+
+def test_aem_evo_is_shown_after_its_own_initial_aem() -> None:
+    res = {**RESULTS["highway-cut-in"], "aem-initial": {"test": _m(0.1), "hard": _m(0.3)},
+           "aem-evo": [_run([0.1, 0.12]), _run([0.1, 0.16])]}
+    rows = table_rows(res, ("evoeye", "aem-evo"))
+    assert [r[0] for r in rows] == ["initial (G_0)", "evoeye", "AEM (AEM-Evo's G_0)", "aem-evo"]
+    assert rows[2][1] == "10.0" and rows[2][5] == "30.0"  # the AEM G_0's own figures
+    assert rows[3][1] == "14.0 ± 2.0"
+    assert [r[0] for r in table_rows(RESULTS["highway-cut-in"], ("aem-evo",))] == [
+        "initial (G_0)", "aem-evo"]  # no AEM campaign ran: no AEM row
 
 
 def test_a_single_seed_shows_no_spread() -> None:

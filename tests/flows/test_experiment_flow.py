@@ -41,6 +41,10 @@ def test_plan_is_seed_major_with_the_initial_data_budget(seeded) -> None:
     fixed = plan_experiment(root, [SCENARIO], base, strategies=["uniform"], seeds=[0],
                             budget_s=45.0)
     assert fixed == [replace(plan[0], budget_s=45.0)]
+    (aem,) = plan_experiment(root, [SCENARIO], base, strategies=["aem-evo"], seeds=[0])
+    assert (aem.strategy, aem.family, aem.monitor, aem.reference) == ("evoeye", "aem", None, g0)
+    with pytest.raises(ValueError, match="unknown method"):
+        plan_experiment(root, [SCENARIO], base, strategies=["aem"], seeds=[0])
 
 
 def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_server,
@@ -50,22 +54,25 @@ def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_serv
 
     root, g0 = seeded
     params = ExperimentParams(root=str(root), scenarios=[SCENARIO],
-                              strategies=["uniform", "evoeye"], repetitions=1, budget_s=45.0,
+                              strategies=["uniform", "evoeye", "aem-evo"], repetitions=1,
+                              budget_s=45.0,
                               n_round=2, epochs=1, train_frac=0.5, val_frac=0.25,
                               controls=1, report_name="rq2-test")
     out = experiment_flow(params)
     res = out["results"][SCENARIO]
-    for strategy in ("uniform", "evoeye"):
+    for strategy in ("uniform", "evoeye", "aem-evo"):
         (run,) = res[strategy]
         rows = read_rounds(root, run["campaign_id"])
         sizes = [len(r.scenario_ids) for r in rows]
         assert sizes[0] == 0 and all(1 <= n <= 2 for n in sizes[1:]) and len(sizes) > 1
         # run to the budget: spent, but never overspent (no run lasts more than 20 s)
         assert 45.0 - 20.0 < rows[-1].simulated_s <= 45.0 and run["budget_s"] == 45.0
-        assert run["rounds"][0] == res["initial"]  # G_0's assessment, shared by all campaigns
+        # round 0 is G_0's assessment, shared by all campaigns; AEM-Evo starts from its own AEM
+        assert run["rounds"][0] == res["aem-initial" if strategy == "aem-evo" else "initial"]
+        assert run["rounds"][-1]["hard"]["frames"] == res["initial"]["hard"]["frames"]
         assert set(run["rounds"][-1]) >= {"test", "hard"}
         assert run["acquisition"]["runs"] == sum(sizes)
-    names = ["unprotected-intersection-uniform-s0", "unprotected-intersection-evoeye-s0"]
+    names = [f"unprotected-intersection-{m}-s0" for m in ("uniform", "evoeye", "aem-evo")]
     with get_client(sync_client=True) as client:
         runs = client.read_flow_runs(flow_run_filter=FlowRunFilter(
             name=FlowRunFilterName(any_=names)))
@@ -73,7 +80,9 @@ def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_serv
     assert all(r.state.is_completed() for r in runs)
     report = json.loads((root / "reports" / "rq2-test" / "rq2.json").read_text())
     assert report[SCENARIO]["evoeye"][0]["campaign_id"] == res["evoeye"][0]["campaign_id"]
-    assert "| evoeye |" in (root / "reports" / "rq2-test" / "rq2.md").read_text()
+    md = (root / "reports" / "rq2-test" / "rq2.md").read_text()
+    assert "| evoeye |" in md and "| aem-evo |" in md and "| AEM (AEM-Evo's G_0) |" in md
+    assert res["aem-evo"][0]["rounds"][-1]["version"].startswith("aem-")
     # the control: G_0's recipe on D_init with another seed, assessed like every G_r
     (control,) = res["reseeded"]
     assert control["version"] not in (g0, res["evoeye"][0]["rounds"][-1]["version"])
