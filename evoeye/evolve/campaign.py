@@ -108,7 +108,8 @@ class CampaignConfig:
         if self.family not in FAMILIES:
             raise ValueError(f"family must be one of {FAMILIES}, got {self.family!r}")
         if self.monitor and family_of(self.monitor) != self.family:
-            raise ValueError(f"G_0 {self.monitor} is not a {self.family} monitor")
+            raise ValueError(f"G_0 {self.monitor} is a {family_of(self.monitor)} monitor, but "
+                             f"the campaign evolves the {self.family} family")
         if self.update not in UPDATE_MODES:
             raise ValueError(f"update must be one of {UPDATE_MODES}, got {self.update!r}")
         if self.n_round < 1 or self.budget_s < 0 or self.seed < 0 or self.max_run_s <= 0:

@@ -303,7 +303,7 @@ def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_cop
     from evoeye.evolve.assess import Assessor
     from evoeye.evolve.families import load_version
 
-    with pytest.raises(ValueError, match="not a aem monitor"):
+    with pytest.raises(ValueError, match="is a fusion monitor, but the campaign evolves the aem"):
         config(seeded[1], family="aem")
     root = root_copy("aem")
     assess = Assessor(root, SCENARIO, seeded[1], splits=SPLITS)  # the FusionMonitor's Hard Set
