@@ -209,7 +209,8 @@ class Campaign:
 
     @cached_property
     def campaign_id(self) -> str:
-        """`evo-<strategy>-s<seed>-<hash>` of everything but the budget: same inputs, same id."""
+        """`evo-[aem-]<strategy>-s<seed>-<hash>` of everything but the budget and the reference:
+        same inputs, same id."""
         cfg = asdict(self.config)
         cfg.pop("budget_s")
         cfg.pop("reference")
@@ -222,7 +223,8 @@ class Campaign:
         cfg["monitor"] = self.g0
         cfg["initial"] = hashlib.sha256("\n".join(self.initial["scenario_id"]).encode()).hexdigest()
         digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]
-        return f"evo-{self.config.strategy}-s{self.config.seed}-{digest}"
+        family = "" if self.config.family == "fusion" else f"{self.config.family}-"
+        return f"evo-{family}{self.config.strategy}-s{self.config.seed}-{digest}"
 
     def feedback_key(self, version: str) -> str:
         """The feedback table's monitor_version of f under `version`: the version itself for
