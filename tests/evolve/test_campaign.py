@@ -167,18 +167,23 @@ def test_budget_is_never_overspent_and_every_round_is_recorded(root_copy) -> Non
 
 @pytest.fixture(scope="module")
 def clean_runs(seeded, tmp_path_factory: pytest.TempPathFactory):
-    """strategy → snapshot of an uninterrupted 2-round campaign (computed once per strategy)."""
-    cache: dict[str, dict] = {}
+    """(strategy, family) → snapshot of an uninterrupted 2-round campaign (computed once)."""
+    cache: dict[tuple[str, str], dict] = {}
 
-    def get(strategy: str) -> dict:
-        if strategy not in cache:
+    def get(strategy: str, family: str = "fusion") -> dict:
+        if (strategy, family) not in cache:
             root = DataRoot.resolve(tmp_path_factory.mktemp(f"clean-{strategy}") / "data")
             shutil.copytree(seeded[0], root.path)
-            c = Campaign(root, config(seeded[1], strategy=strategy))
+            c = Campaign(root, family_config(seeded[1], family, strategy=strategy))
             c.run(max_rounds=2)
-            cache[strategy] = snapshot(root, c)
-        return cache[strategy]
+            cache[strategy, family] = snapshot(root, c)
+        return cache[strategy, family]
     return get
+
+
+def family_config(g0: str, family: str, **kw) -> CampaignConfig:
+    """A campaign of the family: the FusionMonitor G_0, or AEM-Evo from its own initial AEM."""
+    return config(g0, **kw) if family == "fusion" else config(None, family=family, **kw)
 
 
 @pytest.mark.parametrize("strategy", ["evoeye", "avfuzzer"])
@@ -208,24 +213,25 @@ def test_killed_mid_round_resumes_to_the_same_records(root_copy, seeded, clean_r
     assert snapshot(root, resumed) == expected
 
 
-def test_killed_during_training_resumes_to_the_same_records(root_copy, seeded,
-                                                            clean_runs) -> None:
-    from evoeye.monitor import train_monitor
+@pytest.mark.parametrize("family", ["fusion", "aem"])
+def test_killed_during_training_resumes_to_the_same_records(root_copy, seeded, clean_runs,
+                                                            family: str) -> None:
+    from evoeye.evolve.families import trainer_of
 
-    cfg = config(seeded[1], strategy="evoeye")
+    cfg = family_config(seeded[1], family, strategy="evoeye")
     calls = {"n": 0}
 
     def dies_in_the_second_update(*args, **kwargs):
         calls["n"] += 1
         if calls["n"] == 2:
             raise RuntimeError("killed mid-training")
-        return train_monitor(*args, **kwargs)
+        return trainer_of(family)(*args, **kwargs)
 
     root = root_copy("killed")
     with pytest.raises(RuntimeError, match="mid-training"):
         Campaign(root, cfg, train=dies_in_the_second_update).run(max_rounds=2)
     Campaign(root, cfg).run(max_rounds=1)
-    assert snapshot(root, Campaign(root, cfg)) == clean_runs("evoeye")
+    assert snapshot(root, Campaign(root, cfg)) == clean_runs("evoeye", family)
 
 
 def test_hard_set_is_the_missed_unsafe_frames_and_the_safe_frames_of_their_runs(seeded) -> None:
