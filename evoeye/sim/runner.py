@@ -18,6 +18,7 @@ from evoeye.ads import ADS, ADSConfig
 from evoeye.scenarios import get_scenario
 from evoeye.scene import RoadMap, SceneState
 from evoeye.sim.episode import STATUS_FAILED, STATUS_OK, Episode, Frame, Outcome, RunSpec
+from evoeye.sim.footprint import min_ego_gap
 from evoeye.sim.highway import build_highway
 from evoeye.sim.intersection import build_intersection
 from evoeye.sim.world import World
@@ -72,15 +73,6 @@ def scene_finite(scene: SceneState) -> bool:
     return bool(np.isfinite(scene.x_m + scene.y_m + scene.heading_rad + scene.speed_mps).all())
 
 
-def _min_gap_m(scene: SceneState) -> float:
-    """Smallest ego–actor centre distance minus both half-lengths (≈ bumper gap, ≥ 0)."""
-    if scene.n < 2:
-        return float("inf")
-    d = np.hypot(scene.x_m[1:] - scene.x_m[0], scene.y_m[1:] - scene.y_m[0])
-    gap = d - 0.5 * (scene.length_m[1:] + scene.length_m[0])
-    return float(max(0.0, gap.min()))
-
-
 def run_episode(
     spec: RunSpec, config: SimConfig | None = None, ads_config: ADSConfig | None = None
 ) -> Episode:
@@ -108,7 +100,7 @@ def run_episode(
             if not (scene_finite(scene) and msgs.all_finite()):
                 raise SimulationError(f"non-finite value at t={scene.t_s:.2f} s")
             frames.append(Frame(scene, msgs))
-            min_gap = min(min_gap, _min_gap_m(scene))
+            min_gap = min(min_gap, min_ego_gap(scene, below=min_gap))  # footprints; 0: touch
             if scene.ego_collision and collision_t is None:
                 collision_t, collision_k, other = scene.t_s, k, scene.collision_actor
             if collision_t is not None and k >= collision_k + post_frames:
