@@ -19,6 +19,7 @@ import numpy as np
 from scipy.stats import spearmanr
 
 from evoeye.evolve.assess import Assessor
+from evoeye.evolve.avfuzzer import CRITICALITY_SCALE_M
 from evoeye.evolve.campaign import Campaign, CampaignConfig, CampaignState, initial_monitor
 from evoeye.evolve.strategies import STRATEGIES
 from evoeye.paths import DataRoot
@@ -183,16 +184,25 @@ def _brief(metrics: str) -> str:
             f"hard F1@0.05 {m['hard']['f1@0.05']:.3f}")
 
 
+NEAR_MISS_M = 1.0  # a collision-free run whose footprints came this close is a near miss
+
+
 def acquisition(c: Campaign, st: CampaignState) -> dict:
-    """What a campaign acquired: runs, their collision share, and the share of runs within δ
-    (Chebyshev) of an earlier record — local mutations, in effect (a uniform sample lands that
-    close with probability ≈ n·(2δ)^dim)."""
+    """What a campaign acquired: runs, their collision share, the share of near misses
+    (collision-free, min footprint gap < 1 m; from the AV-Fuzzer criticality of each record),
+    and the share of runs within δ (Chebyshev) of an earlier record — local mutations, in
+    effect (a uniform sample lands that close with probability ≈ n·(2δ)^dim)."""
     u = c.space.normalise(st.records.params)
     near = [np.abs(u[:i] - u[i]).max(axis=1).min() <= c.config.delta
             for i in range(st.n_init, st.records.n)]
     new = st.records.tail(st.n_init)
-    return {"runs": int(new.n), "collision_share": float(np.mean(new.collided)) if new.n else 0.0,
-            "near_share": float(np.mean(near)) if near else 0.0}
+    if not new.n:
+        return {"runs": 0, "collision_share": 0.0, "near_miss_share": 0.0, "near_share": 0.0}
+    gap_m = (np.full(new.n, np.nan) if new.fitness is None
+             else np.asarray(new.fitness, float) * CRITICALITY_SCALE_M)
+    miss = ~np.asarray(new.collided, bool) & (gap_m < NEAR_MISS_M)
+    return {"runs": int(new.n), "collision_share": float(np.mean(new.collided)),
+            "near_miss_share": float(np.mean(miss)), "near_share": float(np.mean(near))}
 
 
 def map_axes(u: np.ndarray, feedback: np.ndarray) -> tuple[int, int]:

@@ -17,7 +17,8 @@ def _m(f1: float) -> dict:
 
 def _run(f1s: list[float], collisions: float = 0.5) -> dict:
     return {"rounds": [{"test": _m(f), "hard": _m(f / 2)} for f in f1s],
-            "acquisition": {"runs": 40, "collision_share": collisions, "near_share": 0.25},
+            "acquisition": {"runs": 40, "collision_share": collisions, "near_miss_share": 0.1,
+                            "near_share": 0.25},
             "blind_spots": {
         "names": ["a", "b"], "u0": [0.1, 0.9], "u1": [0.5, 0.2], "feedback": [0.0, 0.4],
         "acquired": [False, True]}}
@@ -77,7 +78,7 @@ def test_report_files_hold_tables_curves_and_map(tmp_path) -> None:
 def test_acquisition_table_averages_over_seeds() -> None:
     rows = {r[0]: r for r in acquisition_rows(RESULTS["highway-cut-in"])}
     assert set(rows) == {"uniform", "evoeye"}  # strategies that did not run are left out
-    assert rows["uniform"] == ["uniform", "40 ± 0", "30.0 ± 10.0", "25.0 ± 0.0"]
+    assert rows["uniform"] == ["uniform", "40 ± 0", "30.0 ± 10.0", "10.0 ± 0.0", "25.0 ± 0.0"]
     assert "| uniform | 40 ± 0 | 30.0 ± 10.0 |" in markdown(RESULTS)
 
 
@@ -96,12 +97,14 @@ def test_acquisition_counts_runs_within_delta_of_an_earlier_record() -> None:
                   [0.5] * space.dim,  # 0.25 from the nearest earlier one (0.25): not near
                   [0.65] * space.dim])  # 0.15 from the acquired [0.5]: near an earlier record
     records = Records(params=space.denormalise(u), feedback=np.zeros(5),
-                      collided=np.array([0, 0, 1, 0, 0], bool))
+                      collided=np.array([0, 0, 1, 0, 0], bool),
+                      fitness=np.array([1.0, 1.0, 0.0, 0.05, 0.4]))  # gaps 0 (hit), 0.5, 4 m
     campaign = SimpleNamespace(space=space, config=SimpleNamespace(delta=0.2))
     state = SimpleNamespace(records=records, n_init=2)
     got = acquisition(campaign, state)
     assert got["runs"] == 3
     assert got["collision_share"] == 1 / 3
+    assert got["near_miss_share"] == 1 / 3  # 0.5 m without a collision; 4 m is no near miss
     assert got["near_share"] == 2 / 3
 
 
