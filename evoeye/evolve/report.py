@@ -45,7 +45,8 @@ def _mean_std(values: list[float]) -> str:
 
 
 def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
-    """Rows: method, then mean ± std (in %) of each column on the Test Set and the Hard Set."""
+    """Rows: method (those that ran), then mean ± std (in %) of each column on the Test Set and
+    the Hard Set."""
     rows = [["initial (G_0)"] + [_mean_std([_value(res["initial"][s][c])])
                                  for s in ("test", "hard") for c in COLUMNS]
             ] if res.get("initial") else []
@@ -59,6 +60,8 @@ def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
             rows.append([label] + [_mean_std([_value(res[key][s][c])])
                                    for s in ("test", "hard") for c in COLUMNS])
         runs = res.get(strategy, [])
+        if not runs:  # not part of this experiment
+            continue
         rows.append([strategy] + [_mean_std([_final(r, s, c) for r in runs])
                                   for s in ("test", "hard") for c in COLUMNS])
     return rows
