@@ -11,6 +11,8 @@ closest pair always involves a corner). Vectorised over the other actors.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
+
 import numpy as np
 
 from evoeye.scene import SceneState
@@ -27,30 +29,34 @@ def box_corners(x: np.ndarray, y: np.ndarray, heading: np.ndarray, length: np.nd
                      y[:, None] + s * local[..., 0] + c * local[..., 1]], axis=-1)
 
 
-def _corner_to_edge(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """(N,) smallest distance from a corner of box p[i] (N, 4, 2) to an edge of box q[i]."""
-    a, b = q, np.roll(q, -1, axis=1)  # edges a→b, (N, 4, 2)
-    ab = b - a
-    ap = p[:, :, None, :] - a[:, None, :, :]  # (N, corner, edge, 2)
-    t = np.clip((ap * ab[:, None]).sum(-1) / (ab * ab).sum(-1)[:, None], 0.0, 1.0)
-    closest = a[:, None] + t[..., None] * ab[:, None]
-    return np.linalg.norm(p[:, :, None, :] - closest, axis=-1).min(axis=(1, 2))
-
-
-def _overlap(p: np.ndarray, q: np.ndarray) -> np.ndarray:
-    """(N,) bool: boxes p[i] and q[i] overlap (no separating axis among their edge normals)."""
-    axes = np.concatenate([p[:, 1:3] - p[:, 0:2], q[:, 1:3] - q[:, 0:2]], axis=1)  # (N, 4, 2)
-    proj_p = np.einsum("nkd,nad->nak", p, axes)  # (N, axis, corner)
-    proj_q = np.einsum("nkd,nad->nak", q, axes)
-    separated = (proj_p.max(-1) < proj_q.min(-1)) | (proj_q.max(-1) < proj_p.min(-1))
-    return ~separated.any(axis=1)
-
-
 def box_gaps(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(N,) Euclidean distance between rectangles a[i] and b[i] ((N, 4, 2) corners); 0 if they
-    overlap."""
-    gap = np.minimum(_corner_to_edge(a, b), _corner_to_edge(b, a))
-    return np.where(_overlap(a, b), 0.0, gap)
+    overlap. Separated: the smallest corner-to-edge distance, both ways in one pass."""
+    n = len(a)
+    p, q = np.concatenate([a, b]), np.concatenate([b, a])  # corners of p to edges of q
+    ab = np.roll(q, -1, axis=1) - q  # edges q_m → q_{m+1}
+    ap = p[:, :, None, :] - q[:, None, :, :]  # (2N, corner, edge, 2)
+    t = np.einsum("nkmd,nmd->nkm", ap, ab) / np.einsum("nmd,nmd->nm", ab, ab)[:, None, :]
+    d = ap - np.clip(t, 0.0, 1.0)[..., None] * ab[:, None]
+    dist = np.sqrt(np.einsum("nkmd,nkmd->nkm", d, d).reshape(2 * n, -1).min(axis=1))
+    axes = np.concatenate([a[:, 1:3] - a[:, 0:2], b[:, 1:3] - b[:, 0:2]], axis=1)  # (N, 4, 2)
+    proj_a, proj_b = a @ axes.transpose(0, 2, 1), b @ axes.transpose(0, 2, 1)  # (N, 4, axis)
+    separated = ((proj_a.max(1) < proj_b.min(1)) | (proj_b.max(1) < proj_a.min(1))).any(axis=1)
+    return np.where(separated, np.minimum(dist[:n], dist[n:]), 0.0)
+
+
+def _bbox_gap(x: np.ndarray, y: np.ndarray, h: np.ndarray, length: np.ndarray,
+              width: np.ndarray, ox: np.ndarray, oy: np.ndarray, oh: np.ndarray,
+              olength: np.ndarray, owidth: np.ndarray) -> np.ndarray:
+    """Distance from box (x, y, h, length, width) to the bounding box, in its own frame, of the
+    box o: a lower bound of the footprint distance, exact unless the closest points of the two
+    are corner to corner (the bounding box along an axis reaches exactly o's extreme corner)."""
+    c, s = np.cos(h), np.sin(h)
+    dx, dy = ox - x, oy - y
+    ca, sa = np.abs(np.cos(oh - h)), np.abs(np.sin(oh - h))
+    gap_x = np.abs(c * dx + s * dy) - 0.5 * (length + olength * ca + owidth * sa)
+    gap_y = np.abs(c * dy - s * dx) - 0.5 * (width + olength * sa + owidth * ca)
+    return np.hypot(np.maximum(gap_x, 0.0), np.maximum(gap_y, 0.0))
 
 
 def ego_gaps(scene: SceneState) -> np.ndarray:
@@ -61,20 +67,31 @@ def ego_gaps(scene: SceneState) -> np.ndarray:
     return box_gaps(np.broadcast_to(corners[:1], others.shape), others)
 
 
-def min_ego_gap(scene: SceneState, below: float = np.inf) -> float:
-    """The smallest ego footprint distance if it is below `below`, else +inf (cheaply: actors
-    whose centre distance minus both half-diagonals — a lower bound — is not below are
-    skipped, which is nearly every actor of nearly every frame of a run)."""
-    if scene.n < 2 or below <= 0.0:
+def min_ego_gap(scenes: Sequence[SceneState], batch: int = 16) -> float:
+    """The smallest ego footprint distance over a run's scenes (+inf if the ego was alone).
+
+    Branch and bound: a lower bound for every (frame, actor) pair at once — the larger of each
+    box's distance to the other's bounding box in its own frame, exact unless the closest
+    points are corner to corner — then exact distances in increasing order of the bound, a
+    batch at a time, until the next bound is no smaller than the best exact distance. A run
+    needs a handful of exact distances instead of one per frame."""
+    ego_rows, other_rows = [], []
+    for sc in scenes:
+        if sc.n > 1:
+            a = np.stack([sc.x_m, sc.y_m, sc.heading_rad, sc.length_m, sc.width_m])
+            ego_rows.append(np.repeat(a[:, :1], sc.n - 1, axis=1))
+            other_rows.append(a[:, 1:])
+    if not ego_rows:
         return np.inf
-    half_diag = 0.5 * np.hypot(scene.length_m, scene.width_m)
-    bound = (np.hypot(scene.x_m[1:] - scene.x_m[0], scene.y_m[1:] - scene.y_m[0])
-             - half_diag[1:] - half_diag[0])
-    near = np.flatnonzero(bound < below) + 1
-    if not len(near):
-        return np.inf
-    rows = np.concatenate(([0], near))
-    corners = box_corners(scene.x_m[rows], scene.y_m[rows], scene.heading_rad[rows],
-                          scene.length_m[rows], scene.width_m[rows])
-    gap = float(box_gaps(np.broadcast_to(corners[:1], corners[1:].shape), corners[1:]).min())
-    return gap if gap < below else np.inf
+    ego = np.concatenate(ego_rows, axis=1)  # (5, pairs): x, y, heading, length, width
+    other = np.concatenate(other_rows, axis=1)
+    bound = np.maximum(_bbox_gap(*ego, *other), _bbox_gap(*other, *ego))
+    order = np.argsort(bound, kind="stable")
+    best = np.inf
+    for start in range(0, len(order), batch):
+        idx = order[start:start + batch]
+        if bound[idx[0]] >= best:
+            break
+        best = min(best, float(box_gaps(box_corners(*ego[:, idx]),
+                                        box_corners(*other[:, idx])).min()))
+    return best

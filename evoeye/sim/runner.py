@@ -87,7 +87,6 @@ def run_episode(
     collision_k = -1
     post_frames = int(round(config.post_collision_s * config.rate_hz))
     other: int | None = None
-    min_gap = float("inf")
     road_map = None
     try:
         world, cruise_mps = build_world(spec, world_rng)
@@ -100,7 +99,6 @@ def run_episode(
             if not (scene_finite(scene) and msgs.all_finite()):
                 raise SimulationError(f"non-finite value at t={scene.t_s:.2f} s")
             frames.append(Frame(scene, msgs))
-            min_gap = min(min_gap, min_ego_gap(scene, below=min_gap))  # footprints; 0: touch
             if scene.ego_collision and collision_t is None:
                 collision_t, collision_k, other = scene.t_s, k, scene.collision_actor
             if collision_t is not None and k >= collision_k + post_frames:
@@ -112,6 +110,7 @@ def run_episode(
             duration_s=len(frames) * dt,
         )
     else:
+        min_gap = min_ego_gap([f.scene for f in frames])  # footprint distance; 0: touching
         outcome = Outcome(
             status=STATUS_OK, collided=collision_t is not None, collision_time_s=collision_t,
             other_actor=other, duration_s=len(frames) * dt,

@@ -65,9 +65,18 @@ def _inside(p: np.ndarray, box: np.ndarray) -> bool:
     return bool((edges[:, 0] * rel[:, 1] - edges[:, 1] * rel[:, 0] >= 0).all())
 
 
-def test_min_ego_gap_skips_only_actors_that_cannot_be_nearer() -> None:
-    s = scene((0, 0, 0), (0, 4, 0), (10, 0, 0), (40, 30, 1.0))
-    assert min_ego_gap(s) == pytest.approx(2.0)
-    assert min_ego_gap(s, below=2.5) == pytest.approx(2.0)
-    assert min_ego_gap(s, below=2.0) == np.inf  # nothing strictly nearer than the best so far
-    assert min_ego_gap(scene((0, 0, 0))) == np.inf  # the ego alone
+def test_min_ego_gap_is_the_smallest_exact_gap_over_the_run() -> None:
+    run = [scene((0, 0, 0), (0, 4, 0), (40, 30, 1.0)), scene((0, 0, 0)),
+           scene((0, 0, 0.1), (7, 4, 0), (6.5, 0, 0.2))]
+    exact = min(float(ego_gaps(s).min()) for s in run if s.n > 1)
+    assert exact < 2.0  # the third frame's car ahead, slightly turned, is nearest
+    assert min_ego_gap(run) == exact
+    assert min_ego_gap(run, batch=1) == exact  # however few exact distances a batch holds
+    assert min_ego_gap([scene((0, 0, 0))]) == np.inf  # the ego alone
+
+
+@settings(max_examples=60, deadline=None)
+@given(x=coord, y=coord, h0=angle, h1=angle)
+def test_min_ego_gap_matches_every_pair_computed_exactly(x, y, h0, h1) -> None:
+    run = [scene((0, 0, h0), (x, y, h1), (x + 9, -y, h0)), scene((1, 1, h1), (-x, y, h0))]
+    assert min_ego_gap(run, batch=1) == min(float(ego_gaps(s).min()) for s in run)
