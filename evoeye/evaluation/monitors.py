@@ -44,6 +44,20 @@ def _train_ids(root: DataRoot, scenario: str, splits: SplitSpec) -> list[str]:
     return sorted(runs.column("scenario_id").to_pylist())
 
 
+def aem_training_key(*inputs) -> str:
+    """The key a trained AEM is found again by: a hash of everything its training used."""
+    return hashlib.sha256(json.dumps(list(inputs), sort_keys=True, default=str).encode()
+                          ).hexdigest()
+
+
+def find_aem(root: DataRoot, key: str) -> str | None:
+    """The version of the AEM saved with this training key, if any."""
+    for meta in sorted((root.path / AEM_DIR).glob("*/meta.json")):
+        if json.loads(meta.read_text()).get("training_key") == key:
+            return meta.parent.name
+    return None
+
+
 def fit_aem(root: DataRoot | str | Path | None, scenario: str,
             splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
             config: AEMConfig | None = None, *,
@@ -51,23 +65,19 @@ def fit_aem(root: DataRoot | str | Path | None, scenario: str,
     """The AEM of this scenario's train split: loaded if trained before, else trained and saved.
 
     Trained on the collision-free windows of the split: label 0 and before the run's collision."""
-    from evoeye.baselines.aem import AEMConfig, AEMMonitor, train_aem
+    from evoeye.baselines.aem import AEMConfig, train_aem
 
     config = config or AEMConfig()
     root = _root(root)
     ids = _train_ids(root, scenario, splits)
-    key = hashlib.sha256(json.dumps(
-        [scenario, asdict(splits), asdict(config), horizon_s, ids], sort_keys=True
-    ).encode()).hexdigest()
-    folder = root.path / AEM_DIR
-    for meta in sorted(folder.glob("*/meta.json")):
-        if json.loads(meta.read_text()).get("training_key") == key:
-            return AEMMonitor.load(meta.parent)
+    key = aem_training_key(scenario, asdict(splits), asdict(config), horizon_s, ids)
+    if (version := find_aem(root, key)) is not None:
+        return load_aem(root, version)
     train = load_split(root, scenario, "train", splits, context_len=config.context_len,
                        horizon_s=horizon_s)
     normal = (train.windows.label == 0) & train.eligible
     monitor = train_aem(train.windows, normal, config)
-    monitor.save(folder, {
+    monitor.save(root.path / AEM_DIR, {
         "training_key": key, "logical_scenario": scenario, "splits": asdict(splits),
         "horizon_s": horizon_s, "train_scenarios": len(ids), "train_windows": int(normal.sum()),
     })

@@ -14,7 +14,6 @@ the AEM trained on D_init by the same recipe, found again by its training key.
 
 from __future__ import annotations
 
-import hashlib
 import json
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
@@ -66,17 +65,11 @@ class AEMVersion:
         return self.aem.score(windows)
 
 
-def _aem_dir(root: DataRoot) -> Path:
-    from evoeye.evaluation.monitors import AEM_DIR
-
-    return root.path / AEM_DIR
-
-
 def load_aem_version(root: DataRoot, version: str) -> AEMVersion:
-    from evoeye.evaluation.monitors import load_aem
+    from evoeye.evaluation.monitors import AEM_DIR, load_aem
     from evoeye.monitor.card import thresholds_from_json
 
-    meta = json.loads((_aem_dir(root) / version / "meta.json").read_text())
+    meta = json.loads((root.path / AEM_DIR / version / "meta.json").read_text())
     if "thresholds" not in meta:
         raise KeyError(f"AEM {version} has no calibrated thresholds: it was not trained by a "
                        "campaign (train_aem_version)")
@@ -94,6 +87,7 @@ def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_ru
     from evoeye.baselines.aem import AEMConfig, train_aem
     from evoeye.evaluation.calibration import calibrate
     from evoeye.evaluation.dataset import load_runs
+    from evoeye.evaluation.monitors import AEM_DIR, aem_training_key, find_aem
     from evoeye.monitor.card import describe_selection, thresholds_to_json
 
     parent = load_aem_version(root, init_from) if init_from else None
@@ -101,24 +95,21 @@ def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_ru
         context_len=context_len or DEFAULT_CONTEXT_LEN)
     config = replace(config, seed=seed, **({"epochs": epochs} if epochs else {}))
     selection = {"train": describe_selection(train_runs), "val": describe_selection(val_runs)}
-    key = hashlib.sha256(json.dumps([scenario, selection, asdict(config), init_from, horizon_s],
-                                    sort_keys=True, default=str).encode()).hexdigest()
-    folder = _aem_dir(root)
-    for meta in sorted(folder.glob("*/meta.json")):
-        if json.loads(meta.read_text()).get("training_key") == key:
-            return meta.parent.name
+    key = aem_training_key(scenario, selection, asdict(config), init_from, horizon_s)
+    if (version := find_aem(root, key)) is not None:
+        return version
     train = load_runs(root, scenario, train_runs, "train", context_len=config.context_len,
                       horizon_s=horizon_s)
     val = load_runs(root, scenario, val_runs, "val", context_len=config.context_len,
                     horizon_s=horizon_s)
-    aem = train_aem(train.windows, (train.windows.label == 0) & train.eligible, config,
-                    init=parent.aem if parent else None)
+    normal = (train.windows.label == 0) & train.eligible
+    aem = train_aem(train.windows, normal, config, init=parent.aem if parent else None)
     ok = val.eligible
     thresholds = calibrate(aem.score(val.windows)[ok], val.windows.label[ok])
-    aem.save(folder, {
+    aem.save(root.path / AEM_DIR, {
         "training_key": key, "logical_scenario": scenario, "parent": init_from,
         "horizon_s": horizon_s, "selection": selection,
-        "train_windows": int(((train.windows.label == 0) & train.eligible).sum()),
+        "train_windows": int(normal.sum()),
         "thresholds": thresholds_to_json(thresholds),
     })
     return aem.version
