@@ -14,7 +14,8 @@ from prefect import flow, get_run_logger, task
 from prefect.cache_policies import NONE
 from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
-from evoeye.evolve.campaign import UPDATE_MODES, Campaign, CampaignConfig, CampaignState
+from evoeye.evolve.campaign import Campaign, CampaignState
+from evoeye.evolve.config import UPDATE_MODES, CampaignConfig
 from evoeye.evolve.experiment import METHODS
 from evoeye.evolve.families import FAMILIES
 from evoeye.evolve.scoring import FEEDBACK_MODES

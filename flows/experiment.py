@@ -14,7 +14,7 @@ from prefect import flow, get_run_logger
 from prefect.artifacts import create_markdown_artifact
 from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
-from evoeye.evolve.campaign import UPDATE_MODES, CampaignConfig
+from evoeye.evolve.config import UPDATE_MODES, CampaignConfig
 from evoeye.evolve.experiment import (
     ABLATION,
     MAIN,

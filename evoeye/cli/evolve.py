@@ -9,7 +9,8 @@ from typing import Annotated
 import typer
 
 from evoeye.cli.app import app
-from evoeye.evolve.campaign import UPDATE_MODES, Campaign, CampaignConfig
+from evoeye.evolve.campaign import Campaign
+from evoeye.evolve.config import UPDATE_MODES, CampaignConfig
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 

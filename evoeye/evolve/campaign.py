@@ -31,7 +31,7 @@ import hashlib
 import json
 import time
 from collections.abc import Callable
-from dataclasses import asdict, dataclass, field
+from dataclasses import asdict, dataclass
 from functools import cached_property
 from pathlib import Path
 
@@ -39,35 +39,19 @@ import numpy as np
 
 from evoeye.batch import simulate_and_log
 from evoeye.evolve.avfuzzer import criticality
-from evoeye.evolve.families import (
-    FAMILIES,
-    family_of,
-    initial_aem,
-    initial_monitor,
-    load_version,
-    trainer_of,
-)
+from evoeye.evolve.config import CampaignConfig
+from evoeye.evolve.families import initial_aem, initial_monitor, load_version, trainer_of
 from evoeye.evolve.protocol import Strategy
 from evoeye.evolve.records import Records
-from evoeye.evolve.scoring import (
-    FEEDBACK_MODES,
-    read_logged_run,
-    warehouse_feedback,
-    windows_feedback,
-)
-from evoeye.evolve.strategies import FEEDBACK_BLIND, STRATEGIES, make_strategy
+from evoeye.evolve.scoring import read_logged_run, warehouse_feedback, windows_feedback
+from evoeye.evolve.strategies import FEEDBACK_BLIND, make_strategy
 from evoeye.log import read_run
 from evoeye.paths import DataRoot
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
-from evoeye.sim.runner import SimConfig, run_spec
-from evoeye.store import RunFilter, SplitSpec, Warehouse, ingest
+from evoeye.sim.runner import run_spec
+from evoeye.store import RunFilter, Warehouse, ingest
 from evoeye.store.feedback import FeedbackRows, RoundRow, feedback_of, read_rounds, write_feedback
 from evoeye.store.feedback import write_round as store_round
-from evoeye.store.windows import DEFAULT_HORIZON_S
-
-UPDATE_MODES = ("finetune", "retrain")
-MAX_RUN_S = SimConfig().duration_s  # no run lasts longer than this (20 s)
-FINETUNE_EPOCHS, FINETUNE_PATIENCE = 10, 4
 
 INITIAL_RECORDS_SQL = """
 SELECT s.scenario_id, s.params, s.collided, s.min_distance_m, s.duration_s
@@ -76,55 +60,6 @@ JOIN scenario_splits($seed, $train_frac, $val_frac) AS p USING (scenario_id)
 WHERE s.logical_scenario = $scenario AND s.round = 0 AND p.split = 'train' AND s.status = 'ok'
 ORDER BY s.scenario_id
 """
-
-
-@dataclass(frozen=True)
-class CampaignConfig:
-    """What a campaign does. Every field but `budget_s` and `reference` is part of its id."""
-
-    scenario: str
-    strategy: str = "evoeye"
-    budget_s: float = 600.0  # simulated seconds the acquired runs may use in total
-    seed: int = 0
-    monitor: str | None = None  # G_0; None: the newest from-scratch monitor of the scenario
-    n_round: int = 20  # N_round: runs per round
-    update: str = "finetune"
-    epochs: int | None = None  # per update; None: 10 when fine-tuning, TrainParams' when not
-    patience: int | None = None
-    delta: float = DEFAULT_DELTA
-    feedback: str = "raw"  # ŷ of f_r: "raw" scores or "prior-corrected" (see evolve.feedback)
-    family: str = "fusion"  # the monitor evolved: "fusion", or "aem" (AEM-Evo, evolve.families)
-    reference: str | None = None  # aem: the FusionMonitor G_0 whose Hard Set judges; None: newest
-    horizon_s: float = DEFAULT_HORIZON_S
-    splits: SplitSpec = field(default_factory=SplitSpec)
-    max_run_s: float = MAX_RUN_S
-
-    def __post_init__(self) -> None:
-        get_scenario(self.scenario)
-        if self.strategy not in STRATEGIES:
-            raise ValueError(f"unknown strategy {self.strategy!r}; known: {sorted(STRATEGIES)}")
-        if self.feedback not in FEEDBACK_MODES:
-            raise ValueError(f"feedback must be one of {FEEDBACK_MODES}, got {self.feedback!r}")
-        if self.family not in FAMILIES:
-            raise ValueError(f"family must be one of {FAMILIES}, got {self.family!r}")
-        if self.monitor and family_of(self.monitor) != self.family:
-            raise ValueError(f"G_0 {self.monitor} is a {family_of(self.monitor)} monitor, but "
-                             f"the campaign evolves the {self.family} family")
-        if self.update not in UPDATE_MODES:
-            raise ValueError(f"update must be one of {UPDATE_MODES}, got {self.update!r}")
-        if self.n_round < 1 or self.budget_s < 0 or self.seed < 0 or self.max_run_s <= 0:
-            raise ValueError(f"need n_round >= 1, budget_s >= 0, seed >= 0: {self}")
-
-    def train_overrides(self) -> dict[str, int]:
-        """TrainParams fields of one monitor update."""
-        out = {}
-        epochs = self.epochs or (FINETUNE_EPOCHS if self.update == "finetune" else None)
-        patience = self.patience or (FINETUNE_PATIENCE if self.update == "finetune" else None)
-        if epochs:
-            out["epochs"] = epochs
-        if patience:
-            out["patience"] = patience
-        return out
 
 
 @dataclass
@@ -190,7 +125,7 @@ class Campaign:
             return cfg.monitor
         if cfg.family == "aem":
             return initial_aem(self.root, cfg.scenario, list(self.initial["scenario_id"]),
-                               self._val_runs, cfg.horizon_s)
+                               self.val_runs, cfg.horizon_s)
         return initial_monitor(self.root, cfg.scenario)
 
     @cached_property
@@ -202,7 +137,7 @@ class Campaign:
         return self.config.reference or initial_monitor(self.root, self.config.scenario)
 
     @property
-    def _val_runs(self) -> RunFilter:
+    def val_runs(self) -> RunFilter:
         """The fixed validation split every G_r is early-stopped and calibrated on."""
         return RunFilter(logical_scenario=self.config.scenario, split="val",
                          splits=self.config.splits)
@@ -317,7 +252,7 @@ class Campaign:
         ids = [str(s) for s, ok in zip(state.records.scenario_id, state.ok, strict=True) if ok]
         t0 = time.perf_counter()
         version = self._train(
-            self.root, cfg.scenario, train_runs=ids, val_runs=self._val_runs,
+            self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
             horizon_s=cfg.horizon_s,
             seed=cfg.seed * 1000 + state.round + 1, splits=cfg.splits,
             init_from=state.monitor if cfg.update == "finetune" else None,

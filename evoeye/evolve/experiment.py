@@ -23,7 +23,6 @@ from evoeye.evolve.avfuzzer import CRITICALITY_SCALE_M
 from evoeye.evolve.campaign import Campaign, CampaignConfig, CampaignState, initial_monitor
 from evoeye.evolve.strategies import STRATEGIES
 from evoeye.paths import DataRoot
-from evoeye.store import RunFilter
 from evoeye.store.feedback import read_rounds
 
 MAIN = ("uniform", "avfuzzer", "evoeye")
@@ -154,7 +153,8 @@ def reseeded_controls(root: DataRoot | str | Path | None, cfg: CampaignConfig, k
     from evoeye.monitor.card import describe_selection
 
     root = _root(root)
-    ids = [str(s) for s in Campaign(root, cfg).initial["scenario_id"]]
+    campaign = Campaign(root, cfg)
+    ids = [str(s) for s in campaign.initial["scenario_id"]]
     selection = describe_selection(ids)
     have = {}
     for v in list_versions(root):
@@ -162,12 +162,11 @@ def reseeded_controls(root: DataRoot | str | Path | None, cfg: CampaignConfig, k
         if (card.get("logical_scenario") == cfg.scenario and not card.get("parent")
                 and card.get("selection", {}).get("train") == selection):
             have[card.get("hyperparameters", {}).get("seed")] = v
-    val = RunFilter(logical_scenario=cfg.scenario, split="val", splits=cfg.splits)
     out = []
     for seed in range(CONTROL_SEED, CONTROL_SEED + k):
         version = have.get(seed) or train_monitor(
-            root, cfg.scenario, train_runs=ids, val_runs=val, seed=seed, splits=cfg.splits,
-            horizon_s=cfg.horizon_s)
+            root, cfg.scenario, train_runs=ids, val_runs=campaign.val_runs, seed=seed,
+            splits=cfg.splits, horizon_s=cfg.horizon_s)
         out.append(assess(version))
     return out
 
