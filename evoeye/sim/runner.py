@@ -10,11 +10,13 @@ from __future__ import annotations
 
 from collections.abc import Callable
 from dataclasses import dataclass
+from typing import Protocol
 
 import numpy as np
 
 from evoeye import __version__
 from evoeye.ads import ADS, ADSConfig
+from evoeye.ads.messages import FrameMessages
 from evoeye.scenarios import get_scenario
 from evoeye.scene import RoadMap, SceneState
 from evoeye.sim.episode import STATUS_FAILED, STATUS_OK, Episode, Frame, Outcome, RunSpec
@@ -73,10 +75,30 @@ def scene_finite(scene: SceneState) -> bool:
     return bool(np.isfinite(scene.x_m + scene.y_m + scene.heading_rad + scene.speed_mps).all())
 
 
+class Driver(Protocol):
+    """What drives the ego: the ADS, or a counterfactual stand-in (an oracle-patched ADS, the
+    careful reference driver). One call per frame with the ground truth; returns every message."""
+
+    def step(self, scene: SceneState) -> FrameMessages: ...
+
+
+DriverFactory = Callable[[RoadMap, np.random.Generator, ADSConfig], Driver]
+
+
+def default_driver(road_map: RoadMap, rng: np.random.Generator, config: ADSConfig) -> Driver:
+    """The ADS under monitoring."""
+    return ADS(road_map, rng, config)
+
+
 def run_episode(
-    spec: RunSpec, config: SimConfig | None = None, ads_config: ADSConfig | None = None
+    spec: RunSpec, config: SimConfig | None = None, ads_config: ADSConfig | None = None,
+    *, driver: DriverFactory = default_driver,
 ) -> Episode:
-    """Simulate one run. Never raises for a problem inside the run: it returns a failed Episode."""
+    """Simulate one run. Never raises for a problem inside the run: it returns a failed Episode.
+
+    `driver` builds what drives the ego (default: the ADS); counterfactual re-simulations pass
+    another factory and get the same world, the same random streams and the same frame loop.
+    """
     config = config or SimConfig()
     get_scenario(spec.scenario).validate(spec.params)  # a bad vector is the caller's error: raise
     world_rng, ads_rng = _seeds(spec.seed)
@@ -91,7 +113,7 @@ def run_episode(
     try:
         world, cruise_mps = build_world(spec, world_rng)
         road_map = world.road_map
-        ads = ADS(road_map, ads_rng, (ads_config or ADSConfig()).with_cruise_speed(cruise_mps))
+        ads = driver(road_map, ads_rng, (ads_config or ADSConfig()).with_cruise_speed(cruise_mps))
         for k in range(n_frames):
             scene = world.scene()
             scene.t_s = k * dt  # exact frame time, free of float accumulation
