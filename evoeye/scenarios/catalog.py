@@ -28,7 +28,7 @@ HIGHWAY_CUT_IN = LogicalScenario(
             15.0,
             30.0,
             "m/s",
-            "lead vehicle initial and desired speed",
+            "lead vehicle desired speed (it starts at the ego's speed)",
             actor="lead",
         ),
         P(
@@ -57,8 +57,8 @@ HIGHWAY_CUT_IN = LogicalScenario(
         ),
         P(
             "left_cutin_gap_m",
-            -20.0,
-            40.0,
+            -30.0,
+            60.0,
             "m",
             "left cut-in NPC start, ahead (+) of the ego",
             actor="left_cutin",
@@ -67,23 +67,23 @@ HIGHWAY_CUT_IN = LogicalScenario(
         P(
             "left_cutin_trigger_gap_m",
             2.0,
-            20.0,
+            25.0,
             "m",
-            "the left NPC cuts in once its rear is within this gap ahead of the ego's front",
+            "the left NPC cuts in when its bumper gap ahead of the ego crosses this value",
             actor="left_cutin",
         ),
         P(
             "left_cutin_duration_s",
-            0.6,
-            3.0,
+            2.6,
+            5.0,
             "s",
             "left lane-change duration (lower = sharper)",
             actor="left_cutin",
         ),
         P(
             "right_cutin_gap_m",
-            -20.0,
-            40.0,
+            -30.0,
+            60.0,
             "m",
             "right cut-in NPC start, ahead (+) of the ego",
             actor="right_cutin",
@@ -99,15 +99,15 @@ HIGHWAY_CUT_IN = LogicalScenario(
         P(
             "right_cutin_trigger_gap_m",
             2.0,
-            20.0,
+            25.0,
             "m",
-            "the right NPC cuts in once its rear is within this gap ahead of the ego's front",
+            "the right NPC cuts in when its bumper gap ahead of the ego crosses this value",
             actor="right_cutin",
         ),
         P(
             "right_cutin_duration_s",
-            0.6,
-            3.0,
+            2.6,
+            5.0,
             "s",
             "right lane-change duration",
             actor="right_cutin",
@@ -166,19 +166,20 @@ HIGHWAY_CUT_IN = LogicalScenario(
 INTERSECTION = LogicalScenario(
     name="unprotected-intersection",
     description=(
-        "Four-way intersection without signals; the ego drives straight from south to north. "
-        "Five NPCs: an opposing left turn (north→east), lateral crossings from the west and from "
-        "the east, a right-turn merge into the ego's exit lane (east→north) and a left-turn merge "
-        "(west→north). None of them yields."
+        "Four-way intersection without signals; the ego drives straight from south to north, "
+        "starting a seeded 60–200 m before the box. Five NPCs: an opposing left turn "
+        "(north→east), lateral crossings from the west and from the east, a right-turn merge "
+        "into the ego's exit lane (east→north) and a left-turn merge (west→north), each timed "
+        "relative to the ego's arrival. None of them yields."
     ),
     parameters=(
         P("opp_left_speed_mps", 7.0, 13.0, "m/s", "opposing left-turner speed", actor="opp_left"),
         P(
-            "opp_left_start_s",
-            0.0,
+            "opp_left_offset_s",
+            -4.0,
             4.0,
             "s",
-            "when the opposing left-turner enters",
+            "arrives at its conflict with the ego's path this long after the ego would",
             actor="opp_left",
         ),
         P(
@@ -190,11 +191,11 @@ INTERSECTION = LogicalScenario(
             actor="cross_west",
         ),
         P(
-            "cross_west_start_s",
-            0.0,
+            "cross_west_offset_s",
+            -4.0,
             4.0,
             "s",
-            "when the west crossing vehicle enters",
+            "arrives at its conflict with the ego's path this long after the ego would",
             actor="cross_west",
         ),
         P(
@@ -206,11 +207,11 @@ INTERSECTION = LogicalScenario(
             actor="cross_east",
         ),
         P(
-            "cross_east_start_s",
-            0.0,
+            "cross_east_offset_s",
+            -4.0,
             4.0,
             "s",
-            "when the east crossing vehicle enters",
+            "arrives at its conflict with the ego's path this long after the ego would",
             actor="cross_east",
         ),
         P(
@@ -222,11 +223,11 @@ INTERSECTION = LogicalScenario(
             actor="right_merge",
         ),
         P(
-            "right_merge_start_s",
-            0.0,
+            "right_merge_offset_s",
+            -4.0,
             4.0,
             "s",
-            "when the right-turn merger enters",
+            "arrives at its conflict with the ego's path this long after the ego would",
             actor="right_merge",
         ),
         P(
@@ -238,11 +239,11 @@ INTERSECTION = LogicalScenario(
             actor="left_merge",
         ),
         P(
-            "left_merge_start_s",
-            0.0,
+            "left_merge_offset_s",
+            -4.0,
             4.0,
             "s",
-            "when the left-turn merger enters",
+            "arrives at its conflict with the ego's path this long after the ego would",
             actor="left_merge",
         ),
     ),

@@ -1,4 +1,11 @@
-"""`highway-cut-in` (S1): a three-lane highway, the ego in the middle lane, six scripted NPCs."""
+"""`highway-cut-in` (S1): a three-lane highway, the ego in the middle lane, six scripted NPCs.
+
+Every NPC exists from t = 0 and drives with bounded dynamics (`npc.py`). Placements are not
+critical unless the parameters make them so: the lead starts at the ego's speed and drifts to
+its own desired speed; cut-ins and the overtaker fire on the bumper gap to the ego *crossing*
+their trigger gap (from ahead or from behind), so the critical moment comes when the relative
+motion brings it, not at a fixed time.
+"""
 
 from __future__ import annotations
 
@@ -8,22 +15,23 @@ import numpy as np
 from highway_env.road.road import Road, RoadNetwork
 
 from evoeye.scene import RoadMap
-from evoeye.sim.npc import BrakeEvent, EgoVehicle, LaneChange, ScriptedVehicle
+from evoeye.sim.npc import LANE_WIDTH_M, BrakeEvent, EgoVehicle, LaneChange, Npc
+from evoeye.sim.path import Path
 from evoeye.sim.roadmap import road_map_from_network
-from evoeye.sim.world import Actor, World
+from evoeye.sim.world import World
 
 N_LANES = 3
 ROAD_LENGTH_M = 1400.0
 EGO_LANE = 1  # lanes: 0 left (fast), 1 middle, 2 right
 EGO_START_X_M = 200.0
-MIN_SPACING_M = 9.0  # centre spacing enforced between NPCs spawned in one lane
-OVERTAKER_CUT_BACK_M = 12.0  # the overtaker returns to the ego lane this far ahead of the ego
-OVERTAKER_LANE_CHANGE_S = 2.0
-CUT_IN_EARLIEST_S = 1.0  # no cut-in before the ADS has had a second to track the scene
+MIN_SPACING_M = 9.0  # centre spacing enforced between NPCs placed in one lane
+OVERTAKER_CUT_BACK_M = 12.0  # the overtaker returns to the ego lane at this bumper gap ahead
+OVERTAKER_LANE_CHANGE_S = 3.5
 
 
 def _place(wanted: list[tuple[int, float]]) -> list[float]:
-    """Resolve spawn overlaps: in each lane, a later NPC too close to an earlier one moves back."""
+    """Resolve placement overlaps: in each lane, a later NPC too close to an earlier one moves
+    back."""
     placed: list[tuple[int, float]] = [(EGO_LANE, EGO_START_X_M)]
     out = []
     for lane, x in wanted:
@@ -37,49 +45,48 @@ def _place(wanted: list[tuple[int, float]]) -> list[float]:
     return out
 
 
-def _cut_in(p: dict[str, float], side: str, length_m: float) -> LaneChange:
-    """A cut-in: once the NPC's rear is 0…trigger gap ahead of the ego's front (after 1 s)."""
+def _cut_in(p: dict[str, float], side: str, from_lane: int) -> LaneChange:
     return LaneChange(
-        EGO_LANE, p[f"{side}_cutin_duration_s"], start_s=CUT_IN_EARLIEST_S,
-        ahead_min_m=length_m, ahead_max_m=length_m + p[f"{side}_cutin_trigger_gap_m"],
+        offset_m=(EGO_LANE - from_lane) * LANE_WIDTH_M, duration_s=p[f"{side}_cutin_duration_s"],
+        trigger_gap_m=p[f"{side}_cutin_trigger_gap_m"],
     )
 
 
 @functools.cache
-def _network() -> tuple[RoadNetwork, RoadMap]:
-    """The static road and its map, built once per process (vehicles never modify them)."""
+def _network() -> tuple[RoadNetwork, RoadMap, tuple[Path, ...]]:
+    """The static road, its map and one path per lane, built once per process."""
     net = RoadNetwork.straight_road_network(lanes=N_LANES, length=ROAD_LENGTH_M, speed_limit=40)
-    return net, road_map_from_network("highway-cut-in", net, [("0", "1", EGO_LANE)])
+    paths = tuple(Path.from_lanes([net.get_lane(("0", "1", i))]) for i in range(N_LANES))
+    return net, road_map_from_network("highway-cut-in", net, [("0", "1", EGO_LANE)]), paths
 
 
 def build_highway(p: dict[str, float], rng: np.random.Generator) -> tuple[World, float]:
     """The world for one concrete scenario, and the ego's cruise speed."""
-    net, road_map = _network()
+    net, road_map, paths = _network()
     road = Road(network=net, np_random=rng, record_history=False)
-    lane = lambda i: net.get_lane(("0", "1", i))  # noqa: E731
-
-    ego = EgoVehicle(road, lane(EGO_LANE).position(EGO_START_X_M, 0.0), 0.0, p["ego_speed_mps"])
-    specs = [  # (lane, centre x, speed, brake, lane change)
-        (EGO_LANE, EGO_START_X_M + p["lead_gap_m"] + ego.LENGTH, p["lead_speed_mps"],
+    ego_speed = p["ego_speed_mps"]
+    ego = EgoVehicle(road, paths[EGO_LANE].pose(EGO_START_X_M)[:2], 0.0, ego_speed)
+    lead_x = EGO_START_X_M + ego.LENGTH + p["lead_gap_m"]  # bumper gap, 5 m cars
+    specs = [  # (lane, centre x, initial speed, desired speed, brake, lane change)
+        (EGO_LANE, lead_x, ego_speed, p["lead_speed_mps"],
          BrakeEvent(p["lead_brake_time_s"], p["lead_brake_decel_mps2"],
                     p["lead_brake_duration_s"]), None),
-        (0, EGO_START_X_M + p["left_cutin_gap_m"], p["left_cutin_speed_mps"], None,
-         _cut_in(p, "left", ego.LENGTH)),
-        (2, EGO_START_X_M + p["right_cutin_gap_m"], p["right_cutin_speed_mps"], None,
-         _cut_in(p, "right", ego.LENGTH)),
-        (0, EGO_START_X_M + p["left_follow_gap_m"], p["left_follow_speed_mps"], None, None),
-        (2, EGO_START_X_M + p["right_follow_gap_m"], p["right_follow_speed_mps"], None, None),
-        (0, EGO_START_X_M + p["overtaker_gap_m"], p["overtaker_speed_mps"], None,
-         LaneChange(EGO_LANE, OVERTAKER_LANE_CHANGE_S, ahead_min_m=OVERTAKER_CUT_BACK_M)),
+        (0, EGO_START_X_M + p["left_cutin_gap_m"], p["left_cutin_speed_mps"],
+         p["left_cutin_speed_mps"], None, _cut_in(p, "left", 0)),
+        (2, EGO_START_X_M + p["right_cutin_gap_m"], p["right_cutin_speed_mps"],
+         p["right_cutin_speed_mps"], None, _cut_in(p, "right", 2)),
+        (0, EGO_START_X_M + p["left_follow_gap_m"], p["left_follow_speed_mps"],
+         p["left_follow_speed_mps"], None, None),
+        (2, EGO_START_X_M + p["right_follow_gap_m"], p["right_follow_speed_mps"],
+         p["right_follow_speed_mps"], None, None),
+        (0, EGO_START_X_M + p["overtaker_gap_m"], p["overtaker_speed_mps"],
+         p["overtaker_speed_mps"], None,
+         LaneChange((EGO_LANE - 0) * LANE_WIDTH_M, OVERTAKER_LANE_CHANGE_S, OVERTAKER_CUT_BACK_M)),
     ]
     xs = _place([(s[0], s[1]) for s in specs])
-    npcs = []
-    placed = zip(specs, xs, strict=True)
-    for actor_id, ((lane_i, _, speed, brake, change), x) in enumerate(placed, start=1):
-        v = ScriptedVehicle(
-            road, lane(lane_i).position(x, 0.0), 0.0, speed,
-            target_speed=speed, target_lane_index=("0", "1", lane_i),
-            brake=brake, lane_change=change, ego=ego,
-        )
-        npcs.append(Actor(actor_id, v))
-    return World(road, ego, npcs, road_map), p["ego_speed_mps"]
+    npcs = [
+        Npc(road, paths[lane], x, v_init, desired_speed_mps=v_want, brake=brake,
+            lane_change=change)
+        for (lane, _, v_init, v_want, brake, change), x in zip(specs, xs, strict=True)
+    ]
+    return World(road, ego, npcs, road_map), ego_speed

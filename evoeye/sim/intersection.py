@@ -1,9 +1,16 @@
 """`unprotected-intersection` (S2): a four-way intersection without signals, five NPCs.
 
-The road is highway-env's own intersection (IntersectionEnv's network), with the ego's exit
-extended so a 20 s run never runs off the map. Approaches: 0 south, 1 west, 2 north, 3 east; a
-lane index (o<k>, ir<k>) is the approach from k, (ir<k>, il<j>) the move from k to j.
-The NPCs do not yield (plain Road, not highway-env's RegulatedRoad): the ego must.
+The road is highway-env's own intersection (IntersectionEnv's network) with every approach and
+exit lengthened by `EXTENSION_M`, so every actor exists from t = 0 far beyond the ego's sensors
+and a 20 s run never runs off the map. Approaches: 0 south, 1 west, 2 north, 3 east; a lane
+index (o<k>, ir<k>) is the approach from k, (ir<k>, il<j>) the move from k to j, (e<k>, o<k>)
+and (o<k>, x<k>) the added entry and exit.
+
+Timing is relative, not a clock: the ego starts a seeded 60–200 m before the box (so the
+critical moment comes at a different time in every run), and each NPC is placed so that, at
+its own speed profile, it reaches its first conflict with the ego's path `<name>_offset_s`
+after the ego would at its cruise speed. The NPCs slow for the turns (curvature-limited speed)
+and follow vehicles ahead in their lane, but do not yield: the ego must.
 """
 
 from __future__ import annotations
@@ -16,17 +23,20 @@ from highway_env.road.lane import LineType, StraightLane
 from highway_env.road.road import Road, RoadNetwork
 
 from evoeye.scene import RoadMap
-from evoeye.sim.npc import EgoVehicle, ScriptedVehicle
+from evoeye.sim.npc import DriverModel, EgoVehicle, Npc, curve_speed
+from evoeye.sim.path import Path
 from evoeye.sim.roadmap import road_map_from_network
-from evoeye.sim.world import Actor, World
+from evoeye.sim.world import World
 
-EGO_ROUTE = [("o0", "ir0", 0), ("ir0", "il2", 0), ("il2", "o2", 0), ("o2", "x2", 0)]
-EGO_START_S_M = 50.0  # on the 100 m south approach: 50 m before the intersection
+EXTENSION_M = 320.0
+EGO_ROUTE = [("e0", "o0", 0), ("o0", "ir0", 0), ("ir0", "il2", 0), ("il2", "o2", 0),
+             ("o2", "x2", 0)]
+EGO_APPROACH_M = (60.0, 200.0)  # the ego starts this far (seeded, uniform) before the box
 EGO_CRUISE_MPS = 10.0  # the intersection lanes' speed limit
-NPC_ENTRY_S_M = 65.0  # NPCs appear 35 m before the intersection on their approach
-EXIT_EXTENSION_M = 200.0
+CONFLICT_RADIUS_M = 2.5  # paths closer than this share a conflict point
+MIN_SPACING_M = 10.0  # centre spacing between NPCs placed on one approach
 
-# name → (approach, destination); parameters are f"{name}_speed_mps", f"{name}_start_s"
+# name → (approach, destination); parameters are f"{name}_speed_mps", f"{name}_offset_s"
 NPC_MOVES = {
     "opp_left": (2, 3),  # north → east: left turn across the ego's path
     "cross_west": (1, 3),  # west → east, straight across
@@ -36,9 +46,14 @@ NPC_MOVES = {
 }
 
 
+def _route(src: int, dst: int) -> list[tuple[str, str, int]]:
+    return [(f"e{src}", f"o{src}", 0), (f"o{src}", f"ir{src}", 0), (f"ir{src}", f"il{dst}", 0),
+            (f"il{dst}", f"o{dst}", 0), (f"o{dst}", f"x{dst}", 0)]
+
+
 @functools.cache
 def _network() -> tuple[RoadNetwork, RoadMap]:
-    """highway-env's intersection network (built once per process) plus the exit extension."""
+    """highway-env's intersection network (built once per process) with long approaches."""
     from highway_env.envs.intersection_env import IntersectionEnv
 
     with warnings.catch_warnings():
@@ -47,32 +62,72 @@ def _network() -> tuple[RoadNetwork, RoadMap]:
     env._make_road()
     net = env.road.network
     env.close()
-    end = net.get_lane(("il2", "o2", 0)).position(net.get_lane(("il2", "o2", 0)).length, 0.0)
-    net.add_lane(
-        "o2", "x2",
-        StraightLane(end, end + np.array([0.0, -EXIT_EXTENSION_M]),
-                     line_types=[LineType.NONE, LineType.CONTINUOUS], speed_limit=10.0),
-    )
+    for k in range(4):
+        entry = net.get_lane((f"o{k}", f"ir{k}", 0))
+        net.add_lane(f"e{k}", f"o{k}", StraightLane(
+            entry.start - EXTENSION_M * entry.direction, entry.start,
+            line_types=[LineType.NONE, LineType.CONTINUOUS], speed_limit=EGO_CRUISE_MPS))
+        out = net.get_lane((f"il{k}", f"o{k}", 0))
+        net.add_lane(f"o{k}", f"x{k}", StraightLane(
+            out.end, out.end + EXTENSION_M * out.direction,
+            line_types=[LineType.NONE, LineType.CONTINUOUS], speed_limit=EGO_CRUISE_MPS))
     return net, road_map_from_network("unprotected-intersection", net, EGO_ROUTE)
+
+
+@functools.cache
+def _path(route: tuple[tuple[str, str, int], ...]) -> Path:
+    net, _ = _network()
+    return Path.from_lanes([net.get_lane(idx) for idx in route])
+
+
+@functools.cache
+def _conflict(src: int, dst: int) -> tuple[float, float]:
+    """(s on the NPC's path, s on the ego's path) of the NPC's first conflict with the ego."""
+    hit = _path(tuple(_route(src, dst))).first_conflict(_path(tuple(EGO_ROUTE)), CONFLICT_RADIUS_M)
+    if hit is None:
+        raise ValueError(f"the move {src}→{dst} never meets the ego's path")
+    return hit
+
+
+def _box_entry_s() -> float:
+    net, _ = _network()
+    return sum(net.get_lane(idx).length for idx in EGO_ROUTE[:2])
+
+
+def _start_s(path: Path, speed_mps: float, s_conflict: float, t_arrive_s: float,
+             driver: DriverModel) -> float:
+    """Where to start on `path` to reach s_conflict after t_arrive_s at the path's speed profile
+    (the desired speed, curve-limited)."""
+    v = np.minimum(curve_speed(path, driver), speed_mps)
+    k = path.index(s_conflict)
+    dt = np.diff(path.s[: k + 1]) / np.maximum(0.5 * (v[:k] + v[1 : k + 1]), 0.1)
+    t_to_go = np.concatenate((np.cumsum(dt[::-1])[::-1], [0.0]))  # (k+1,) time to the conflict
+    j = int(np.searchsorted(-t_to_go, -t_arrive_s))  # first sample with t_to_go <= t_arrive
+    return float(path.s[min(j, k)])
 
 
 def build_intersection(p: dict[str, float], rng: np.random.Generator) -> tuple[World, float]:
     """The world for one concrete scenario, and the ego's cruise speed."""
     net, road_map = _network()
-    road = Road(network=net, np_random=rng, record_history=False,
-                neighbour_vehicles_connected_lanes=True)
-    start = net.get_lane(EGO_ROUTE[0])
-    ego = EgoVehicle(road, start.position(EGO_START_S_M, 0.0),
-                     start.heading_at(EGO_START_S_M), EGO_CRUISE_MPS)
+    road = Road(network=net, np_random=rng, record_history=False)
+    ego_path = _path(tuple(EGO_ROUTE))
+    s_ego = _box_entry_s() - float(rng.uniform(*EGO_APPROACH_M))
+    x, y, h = ego_path.pose(s_ego)
+    ego = EgoVehicle(road, [x, y], h, EGO_CRUISE_MPS)
+    driver = DriverModel()
+    placed: dict[int, list[float]] = {}
     npcs = []
-    for actor_id, (name, (src, dst)) in enumerate(NPC_MOVES.items(), start=1):
+    for name, (src, dst) in NPC_MOVES.items():
         speed = p[f"{name}_speed_mps"]
-        route = [(f"o{src}", f"ir{src}", 0), (f"ir{src}", f"il{dst}", 0),
-                 (f"il{dst}", f"o{dst}", 0)]
-        lane = net.get_lane(route[0])
-        v = ScriptedVehicle(
-            road, lane.position(NPC_ENTRY_S_M, 0.0), lane.heading_at(NPC_ENTRY_S_M), speed,
-            target_speed=speed, target_lane_index=route[0], route=route, ego=ego,
-        )
-        npcs.append(Actor(actor_id, v, spawn_s=p[f"{name}_start_s"]))
+        path = _path(tuple(_route(src, dst)))
+        s_npc, s_ego_conflict = _conflict(src, dst)
+        t_ego = (s_ego_conflict - s_ego) / EGO_CRUISE_MPS
+        s0 = _start_s(path, speed, s_npc, t_ego + p[f"{name}_offset_s"], driver)
+        for other in sorted(placed.get(src, []), reverse=True):  # same approach: keep spacing
+            if abs(other - s0) < MIN_SPACING_M:
+                s0 = other - MIN_SPACING_M
+        s0 = max(s0, 0.0)
+        placed.setdefault(src, []).append(s0)
+        v0 = min(speed, float(curve_speed(path, driver)[path.index(s0)]))
+        npcs.append(Npc(road, path, s0, v0, desired_speed_mps=speed, driver=driver))
     return World(road, ego, npcs, road_map), EGO_CRUISE_MPS

@@ -1,17 +1,44 @@
-"""Scripted NPC behaviours on top of highway-env's IDM vehicles.
+"""NPC vehicles that drive like cars: a path, a driver model, and a script that says what, not how.
 
-NPCs drive with highway-env's IDM (longitudinal) and lane-keeping steering; MOBIL's own lane
-changes are off so that every manoeuvre is a deterministic function of the scenario parameters.
-Scripts add what a logical scenario varies: braking events, timed or position-triggered lane
-changes with a given sharpness.
+An NPC moves along its `Path` in the path's Frenet frame. Longitudinally it is an IDM driver
+(following the vehicle ahead in its corridor, slowing for curves along a preview speed profile,
+and running its scripted braking event) whose acceleration is bounded to [−9, 3] m/s².
+Laterally it keeps its lane or changes lanes along a smooth half-cosine offset profile whose
+duration bounds the lateral speed and acceleration. The script — when to brake, when to change
+lanes — only decides *what* happens; these dynamics decide *how fast* it can.
+
+The ego is a highway-env kinematic bicycle driven by the ADS's command (`EgoVehicle`).
 """
 
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 
-from highway_env.vehicle.behavior import IDMVehicle
+import numpy as np
 from highway_env.vehicle.kinematics import Vehicle
+
+from evoeye.sim.path import Path
+
+LANE_WIDTH_M = 4.0
+CATCH_UP_GAIN_PER_S = 2.0  # braking towards a lower desired speed: 2 m/s² per m/s above it
+PROFILE_DECEL_SHARE = 0.6  # curves are planned for at this share of the comfortable braking,
+# so that the speed tracks the profile with a small lag and the curve is entered on it
+
+
+@dataclass(frozen=True)
+class DriverModel:
+    """How an NPC driver accelerates, follows and takes curves."""
+
+    accel_mps2: float = 1.5  # IDM a
+    comfort_decel_mps2: float = 2.5  # IDM b; also the decel planned ahead of curves
+    time_headway_s: float = 1.2  # IDM T
+    min_gap_m: float = 2.0  # IDM s0
+    delta: float = 4.0
+    max_accel_mps2: float = 3.0
+    max_decel_mps2: float = 9.0
+    lat_accel_mps2: float = 3.0  # curve speed: v² · |κ| ≤ this
+    crash_decel_mps2: float = 8.0  # a vehicle in a contact brakes to a standstill
 
 
 @dataclass(frozen=True)
@@ -25,102 +52,140 @@ class BrakeEvent:
 
 @dataclass(frozen=True)
 class LaneChange:
-    """Change into lane `to_lane` once after `start_s`, when the NPC's centre is between
-    `ahead_min_m` and `ahead_max_m` ahead of the ego's centre (the trigger window)."""
+    """Move `offset_m` sideways (+ left of the path) over `duration_s`, once the NPC's bumper gap
+    ahead of the ego (its rear to the ego's front, negative when behind) crosses `trigger_gap_m`
+    in either direction and the target lane is clear of other NPCs."""
 
-    to_lane: int
-    duration_s: float  # time to complete the lateral move; lower is sharper
-    start_s: float = 0.0
-    ahead_min_m: float = -float("inf")
-    ahead_max_m: float = float("inf")
+    offset_m: float
+    duration_s: float
+    trigger_gap_m: float
+
+    def peak_lateral(self) -> tuple[float, float]:
+        """(peak lateral speed m/s, peak lateral acceleration m/s²) of the offset profile."""
+        w, t = abs(self.offset_m), self.duration_s
+        return math.pi * w / (2.0 * t), math.pi**2 * w / (2.0 * t * t)
 
 
-class ScriptedVehicle(IDMVehicle):
-    """An IDM vehicle that follows its route and runs its scripted events."""
+def curve_speed(path: Path, driver: DriverModel) -> np.ndarray:
+    """(K,) the speed profile an NPC driver keeps to on `path` (curves taken within its lateral
+    acceleration, braked for ahead of time)."""
+    return path.speed_profile(driver.lat_accel_mps2,
+                              PROFILE_DECEL_SHARE * driver.comfort_decel_mps2)
+
+
+class Npc(Vehicle):
+    """A scripted NPC on a path; the World decides its leader and triggers, `advance` moves it."""
 
     def __init__(
-        self,
-        road,
-        position,
-        heading: float = 0.0,
-        speed: float = 0.0,
-        *,
-        target_speed: float,
-        route=None,
-        target_lane_index=None,
-        brake: BrakeEvent | None = None,
+        self, road, path: Path, s_m: float, speed_mps: float, *, desired_speed_mps: float,
+        d_m: float = 0.0, driver: DriverModel | None = None, brake: BrakeEvent | None = None,
         lane_change: LaneChange | None = None,
-        ego: Vehicle | None = None,
     ) -> None:
-        super().__init__(
-            road,
-            position,
-            heading=heading,
-            speed=speed,
-            target_lane_index=target_lane_index,
-            target_speed=target_speed,
-            route=route,
-            enable_lane_change=False,
-            timer=0.0,
-        )
-        # NPCs are scripted actors: contacts among them are not simulated (highway-env checks a
-        # pair only if one side checks), so a parameter means what it says; the ego checks all.
-        self.check_collisions = False
+        x, y, h = path.pose(s_m, d_m)
+        super().__init__(road, [x, y], h, speed_mps)
+        self.path = path
+        self.s_m = float(s_m)
+        self.d_m = float(d_m)
+        self.driver = driver or DriverModel()
+        self.desired_speed_mps = float(desired_speed_mps)
         self.brake = brake
         self.lane_change = lane_change
-        self.ego = ego
-        self.clock_s = 0.0  # time since the scenario started (not since spawn)
-        self._lane_change_done = False
+        self.clock_s = 0.0  # time since the scenario started
+        self.accel_mps2 = 0.0
+        self.check_collisions = False  # contacts are the World's (all pairs, vectorised)
+        self._lc_start_s: float | None = None  # when the lane change began
+        self._lc_from_m = self.d_m
+        self._trigger_side: float | None = None  # sign of (gap − trigger) when last seen
+        self._armed = False  # the trigger gap was crossed; waiting for a clear target lane
+        dm = self.driver
+        self._curve_speed = curve_speed(path, dm)
 
-    def act(self, action=None) -> None:
+    # -- the script ------------------------------------------------------------------------------
+    @property
+    def changing_lanes(self) -> bool:
+        return self._lc_start_s is not None and self.clock_s < self._lc_start_s + (
+            self.lane_change.duration_s
+        )
+
+    def lateral_target_m(self) -> float:
+        """Where the NPC is heading laterally, relative to its current offset (0 if nowhere)."""
+        if self.lane_change is None or self._lc_start_s is None:
+            return 0.0
+        return self._lc_from_m + self.lane_change.offset_m - self.d_m
+
+    def wants_lane_change(self, gap_to_ego_m: float) -> bool:
+        """Update the trigger with the current bumper gap ahead of the ego; True once it fired
+        and the change has not started yet."""
+        lc = self.lane_change
+        if lc is None or self._lc_start_s is not None or self.crashed:
+            return False
+        side = math.copysign(1.0, gap_to_ego_m - lc.trigger_gap_m)
+        if self._trigger_side is not None and side != self._trigger_side:
+            self._armed = True
+        self._trigger_side = side
+        if self._armed and gap_to_ego_m < 0.0:  # fell behind the ego again: the moment passed
+            self._armed = False
+        return self._armed
+
+    def start_lane_change(self) -> None:
+        self._lc_start_s = self.clock_s
+        self._lc_from_m = self.d_m
+        self._armed = False
+
+    # -- longitudinal ----------------------------------------------------------------------------
+    def longitudinal(self, gap_m: float, leader_speed_mps: float) -> float:
+        """The bounded acceleration: IDM behind the leader (gap_m bumper to bumper, inf if
+        none) towards the curve-limited desired speed, and the scripted brake."""
+        dm = self.driver
+        v = self.speed
         if self.crashed:
-            return
-        self._maybe_change_lane()
-        super().act()
+            return -dm.crash_decel_mps2 if v > 0.0 else 0.0
+        v0 = max(min(self.desired_speed_mps, float(self._curve_speed[self.path.index(self.s_m)])),
+                 0.1)
+        if v <= v0:
+            a = dm.accel_mps2 * (1.0 - (v / v0) ** dm.delta)
+        else:  # above the desired speed (a curve ahead, a slower set speed): comfortable braking
+            a = -min(dm.comfort_decel_mps2, CATCH_UP_GAIN_PER_S * (v - v0))
+        if math.isfinite(gap_m):
+            closing = v - leader_speed_mps
+            s_star = dm.min_gap_m + max(
+                0.0, v * dm.time_headway_s
+                + v * closing / (2.0 * math.sqrt(dm.accel_mps2 * dm.comfort_decel_mps2)))
+            interaction = (s_star / max(gap_m, 0.1)) ** 2
+            a = min(a, dm.accel_mps2 * (1.0 - (v / v0) ** dm.delta - interaction))
         b = self.brake
         if b is not None and b.start_s <= self.clock_s < b.start_s + b.duration_s:
-            self.action["acceleration"] = min(self.action["acceleration"], -b.decel_mps2)
+            a = min(a, -b.decel_mps2)
+        return min(max(a, -dm.max_decel_mps2), dm.max_accel_mps2)
+
+    # -- motion ------------------------------------------------------------------------------------
+    def advance(self, accel_mps2: float, dt: float) -> None:
+        """Integrate dt: speed never negative, position along the path, lateral offset profile."""
+        v0 = self.speed
+        v1 = max(v0 + accel_mps2 * dt, 0.0)
+        self.accel_mps2 = (v1 - v0) / dt
+        self.s_m = min(self.s_m + 0.5 * (v0 + v1) * dt, self.path.length_m)
+        self.speed = v1
+        self.clock_s += dt
+        d_dot = 0.0
+        lc = self.lane_change
+        if self._lc_start_s is not None and not self.crashed:
+            tau = min((self.clock_s - self._lc_start_s) / lc.duration_s, 1.0)
+            self.d_m = self._lc_from_m + lc.offset_m * 0.5 * (1.0 - math.cos(math.pi * tau))
+            if tau < 1.0:
+                d_dot = lc.offset_m * math.pi / (2.0 * lc.duration_s) * math.sin(math.pi * tau)
+        x, y, h = self.path.pose(self.s_m, self.d_m)
+        self.position[0], self.position[1] = x, y
+        self.heading = h + math.atan2(d_dot, max(v1, 1.0))
+
+    def act(self, action=None) -> None:  # the World drives NPCs; highway-env must not
+        return
 
     def step(self, dt: float) -> None:
-        self.clock_s += dt
-        super().step(dt)
-        _no_reverse(self)
-
-    def _maybe_change_lane(self) -> None:
-        lc = self.lane_change
-        if lc is None or self._lane_change_done or self.clock_s < lc.start_s:
-            return
-        if self.ego is not None:
-            ahead_m = self.position[0] - self.ego.position[0]
-            if not lc.ahead_min_m <= ahead_m <= lc.ahead_max_m:
-                return
-        _from, _to, _ = self.lane_index
-        self.target_lane_index = (_from, _to, lc.to_lane)
-        # highway-env's lateral loop is first order with gain KP_LATERAL: ~95 % of the move in
-        # 3 / KP_LATERAL seconds, so the duration sets the gain (per vehicle, not per class).
-        self.KP_LATERAL = 3.0 / lc.duration_s
-        self._lane_change_done = True
+        return
 
     def on_state_update(self) -> None:
-        # highway-env scans every lane of the network for the closest one; a scripted NPC is
-        # only ever on its current or its target lane (the next route lane once past a lane's
-        # end), so look there: 2 lanes instead of 21 at the intersection.
-        if self.road is None:
-            return
-        net = self.road.network
-        candidates = {self.lane_index, self.target_lane_index}
-        best, best_d = None, float("inf")
-        for idx in candidates:
-            if idx is None or idx[2] is None:
-                continue
-            d = net.get_lane(idx).distance_with_heading(self.position, self.heading, 0.2)
-            if d < best_d:
-                best, best_d = idx, d
-        if best is None:
-            super().on_state_update()
-            return
-        self.lane_index = best
-        self.lane = net.get_lane(best)
+        return
 
 
 class EgoVehicle(Vehicle):
@@ -135,10 +200,5 @@ class EgoVehicle(Vehicle):
 
     def step(self, dt: float) -> None:
         super().step(dt)
-        _no_reverse(self)
-
-
-def _no_reverse(vehicle: Vehicle) -> None:
-    """Braking stops a vehicle; it never drives it backwards (highway-env's model would)."""
-    if vehicle.speed < 0.0:
-        vehicle.speed = 0.0
+        if self.speed < 0.0:  # braking stops a vehicle; it never drives it backwards
+            self.speed = 0.0

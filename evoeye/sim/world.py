@@ -1,116 +1,108 @@
-"""The simulated world: a highway-env Road with the ego and scripted NPCs, stepped directly.
+"""The simulated world: the ego and NPCs on a highway-env road, stepped by us at 20 Hz.
 
-We drive `road.act(); road.step(dt)` ourselves instead of `env.step` (no observation or
-rendering work per step: ~8× faster, DESIGN.md §5). Collisions are highway-env's own checks.
+Every actor exists from t = 0. Each step: the ego takes the ADS's command (highway-env's
+kinematic bicycle), every NPC finds the vehicle ahead in its corridor and fires its script's
+triggers on relative state (`traffic.py`), the NPCs move along their paths with bounded
+dynamics (`npc.py`), and contacts are checked for every pair of vehicles: a contact marks both
+as crashed (recorded in the ground truth) and a crashed vehicle brakes to a standstill, so no
+two vehicles ever pass through each other. We do not call `env.step` (observation and
+rendering work per step: ~8× slower, DESIGN.md §5) nor `road.step` (its pairwise checks are
+per-pair Python); the road network and the ego's dynamics are highway-env's.
 """
 
 from __future__ import annotations
-
-from dataclasses import dataclass, field
 
 import numpy as np
 from highway_env.road.road import Road
 
 from evoeye.scene import EGO_ID, RoadMap, SceneState
-from evoeye.sim.npc import EgoVehicle
-
-SPAWN_CLEARANCE_M = 8.0  # an NPC is not spawned closer than this to a vehicle in its lane …
-SAME_LANE_M = 2.5  # … i.e. one less than this far to its side
-
-
-@dataclass
-class Actor:
-    """A vehicle with a stable actor id, present in the world from `spawn_s` on."""
-
-    actor_id: int
-    vehicle: object  # a highway-env Vehicle
-    spawn_s: float = 0.0
-    prev_speed_mps: float = field(default=0.0, init=False)
+from evoeye.sim.footprint import box_corners, box_gaps
+from evoeye.sim.npc import EgoVehicle, Npc
+from evoeye.sim.traffic import Relations, clear_to_change, leaders
 
 
 class World:
-    """Ego + NPCs on a highway-env road; `scene()` reads it, `step()` advances it by dt."""
+    """Ego + NPCs; `scene()` reads it, `step()` advances it by dt."""
 
-    def __init__(self, road: Road, ego: EgoVehicle, npcs: list[Actor], road_map: RoadMap):
+    def __init__(self, road: Road, ego: EgoVehicle, npcs: list[Npc], road_map: RoadMap):
         self.road = road
         self.road_map = road_map
         self.t_s = 0.0
-        self.ego = Actor(EGO_ID, ego)
-        self.ego.prev_speed_mps = ego.speed
-        self._pending = sorted(npcs, key=lambda a: (a.spawn_s, a.actor_id))
-        self.active: list[Actor] = [self.ego]
-        road.vehicles[:] = [ego]
+        self.ego = ego
+        self.npcs = npcs
+        self.vehicles = [ego, *npcs]
+        road.vehicles[:] = self.vehicles
+        self.actor_id = np.arange(len(self.vehicles), dtype=np.int64)  # ego = EGO_ID = 0
+        self.length_m = np.array([v.LENGTH for v in self.vehicles], dtype=float)
+        self.width_m = np.array([v.WIDTH for v in self.vehicles], dtype=float)
+        self.crashed = np.zeros(len(self.vehicles), dtype=bool)
         self.collision_actor = -1
-        self._accel = np.zeros(1)
-        self._spawn_due()
+        self._accel = np.zeros(len(self.vehicles))
+        assert EGO_ID == 0
 
     # -- reading -------------------------------------------------------------------------------
+    def _state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        vs = self.vehicles
+        pos = np.array([v.position for v in vs], dtype=float)
+        heading = np.array([v.heading for v in vs], dtype=float)
+        speed = np.array([v.speed for v in vs], dtype=float)
+        return pos[:, 0], pos[:, 1], heading, speed
+
     def scene(self) -> SceneState:
-        """Ground truth now. Acceleration is the finite difference over the last step."""
-        vs = [a.vehicle for a in self.active]
-        pos = np.array([v.position for v in vs])
+        """Ground truth now. Acceleration is the one applied over the last step."""
+        x, y, heading, speed = self._state()
         return SceneState(
-            t_s=self.t_s,
-            actor_id=np.array([a.actor_id for a in self.active], dtype=np.int64),
-            x_m=pos[:, 0].copy(),
-            y_m=pos[:, 1].copy(),
-            heading_rad=np.array([v.heading for v in vs]),
-            speed_mps=np.array([v.speed for v in vs]),
-            accel_mps2=self._accel.copy(),
-            length_m=np.array([v.LENGTH for v in vs]),
-            width_m=np.array([v.WIDTH for v in vs]),
-            crashed=np.array([v.crashed for v in vs]),
-            ego_collision=bool(self.ego.vehicle.crashed),
-            collision_actor=self.collision_actor,
+            t_s=self.t_s, actor_id=self.actor_id.copy(), x_m=x, y_m=y, heading_rad=heading,
+            speed_mps=speed, accel_mps2=self._accel.copy(), length_m=self.length_m.copy(),
+            width_m=self.width_m.copy(), crashed=self.crashed.copy(),
+            ego_collision=bool(self.crashed[0]), collision_actor=self.collision_actor,
         )
 
     # -- advancing -----------------------------------------------------------------------------
     def step(self, accel_mps2: float, steering_rad: float, dt: float) -> None:
-        """Apply the ego command, let NPCs act, integrate dt, check collisions, spawn NPCs."""
-        ego = self.ego.vehicle
-        was_crashed = ego.crashed
+        """Apply the ego command, let the NPCs decide and move, integrate dt, check contacts."""
+        x, y, heading, speed = self._state()
+        rel = Relations.of(x, y, heading, speed, self.length_m, self.width_m)
+        shift = np.array([0.0] + [n.lateral_target_m() for n in self.npcs])
+        gap, v_lead = leaders(rel, shift)
+        for i, npc in enumerate(self.npcs, start=1):
+            if npc.wants_lane_change(rel.gap_ahead_of(i, 0)) and clear_to_change(
+                rel, i, npc.lane_change.offset_m
+            ):
+                npc.start_lane_change()
+        accels = [npc.longitudinal(gap[i], v_lead[i]) for i, npc in enumerate(self.npcs, start=1)]
+
+        ego = self.ego
+        v_before = ego.speed
         ego.action = {"acceleration": float(accel_mps2), "steering": float(steering_rad)}
-        for a in self.active:
-            a.prev_speed_mps = a.vehicle.speed
-        self.road.act()  # NPC behaviours decide; the ego keeps the action set above
-        self.road.step(dt)
+        ego.crashed = bool(self.crashed[0])
+        ego.step(dt)
+        for npc, a in zip(self.npcs, accels, strict=True):
+            npc.advance(a, dt)
         self.t_s += dt
-        if ego.crashed and not was_crashed:
-            self.collision_actor = self._partner()
-        self._accel = np.array(
-            [(a.vehicle.speed - a.prev_speed_mps) / dt for a in self.active]
-        )
-        self._spawn_due()
+        self._accel = np.array([(ego.speed - v_before) / dt] + [n.accel_mps2 for n in self.npcs])
+        self._contacts()
 
-    def _spawn_due(self) -> None:
-        """Add NPCs whose time has come; one whose spawn point is occupied waits until clear."""
-        for actor in list(self._pending):
-            if actor.spawn_s > self.t_s + 1e-9:
-                break
-            if self._occupied(actor.vehicle):
-                continue
-            self._pending.remove(actor)
-            actor.prev_speed_mps = actor.vehicle.speed
-            self.active.append(actor)
-            self.road.vehicles.append(actor.vehicle)
-            self._accel = np.append(self._accel, 0.0)
-
-    def _occupied(self, vehicle) -> bool:
-        """Another vehicle within SPAWN_CLEARANCE_M ahead or behind, in the same lane."""
-        c, s = np.cos(vehicle.heading), np.sin(vehicle.heading)
-        for a in self.active:
-            dx, dy = a.vehicle.position - vehicle.position
-            if abs(c * dx + s * dy) < SPAWN_CLEARANCE_M and abs(c * dy - s * dx) < SAME_LANE_M:
-                return True
-        return False
-
-    def _partner(self) -> int:
-        """The crashed NPC nearest the ego: who the ego collided with."""
-        ego_pos = self.ego.vehicle.position
-        best, best_d = -1, float("inf")
-        for a in self.active[1:]:
-            if a.vehicle.crashed:
-                d = float(np.hypot(*(a.vehicle.position - ego_pos)))
-                if d < best_d:
-                    best, best_d = a.actor_id, d
-        return best
+    def _contacts(self) -> None:
+        """Mark every overlapping pair of footprints as crashed; remember the ego's partner."""
+        x, y, heading, _ = self._state()
+        n = len(x)
+        reach = 0.5 * np.hypot(self.length_m, self.width_m)  # (n,) circumscribed radius
+        i, j = np.triu_indices(n, k=1)
+        close = np.hypot(x[i] - x[j], y[i] - y[j]) <= reach[i] + reach[j]
+        if not close.any():
+            return
+        i, j = i[close], j[close]
+        corners = box_corners(x, y, heading, self.length_m, self.width_m)
+        touching = box_gaps(corners[i], corners[j]) <= 0.0
+        if not touching.any():
+            return
+        i, j = i[touching], j[touching]
+        if not self.crashed[0] and (i == 0).any():
+            partners = j[i == 0]
+            d = np.hypot(x[partners] - x[0], y[partners] - y[0])
+            self.collision_actor = int(self.actor_id[partners[int(np.argmin(d))]])
+        self.crashed[i] = True
+        self.crashed[j] = True
+        for k in np.concatenate((i, j)).tolist():
+            self.vehicles[k].crashed = True

@@ -52,7 +52,7 @@ def test_nan_and_wrong_length_are_rejected():
 def test_distance_is_on_normalised_parameters():
     a = CROSSING.low.copy()
     b = a.copy()
-    j = CROSSING.index("opp_left_start_s")
+    j = CROSSING.index("opp_left_offset_s")
     b[j] += 0.5 * CROSSING.parameters[j].span
     assert CROSSING.distance(a, b) == pytest.approx(0.5)
     assert CROSSING.distance(a, a) == 0.0

@@ -77,7 +77,7 @@ def test_a_nan_in_the_world_is_a_failed_episode(monkeypatch):
 
     def poisoned(params, rng):
         world, cruise = real(params, rng)
-        world.active[1].vehicle.speed = float("nan")
+        world.npcs[0].speed = float("nan")
         return world, cruise
 
     monkeypatch.setitem(runner.WORLD_BUILDERS, "highway-cut-in", poisoned)

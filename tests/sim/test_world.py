@@ -1,11 +1,11 @@
-"""The highway-env world and the scripted NPCs, stepped without the ADS."""
+"""The world stepped without the ADS: NPCs that drive like cars, scripts on relative state."""
 
 import numpy as np
 import pytest
 
 from evoeye.scenarios import get_scenario
 from evoeye.sim.highway import EGO_LANE, build_highway
-from evoeye.sim.intersection import NPC_MOVES, build_intersection
+from evoeye.sim.intersection import EGO_APPROACH_M, NPC_MOVES, _box_entry_s, build_intersection
 
 DT = 0.05
 HIGHWAY = get_scenario("highway-cut-in")
@@ -18,25 +18,52 @@ def highway_params(**overrides):
     p = HIGHWAY.as_dict(HIGHWAY.low)
     p.update(ego_speed_mps=25.0, lead_gap_m=70.0, lead_speed_mps=25.0, lead_brake_time_s=16.0,
              lead_brake_decel_mps2=0.0, left_cutin_trigger_gap_m=2.0, right_cutin_trigger_gap_m=2.0,
-             left_cutin_gap_m=40.0, right_cutin_gap_m=40.0, left_cutin_speed_mps=32.0,
+             left_cutin_gap_m=60.0, right_cutin_gap_m=60.0, left_cutin_speed_mps=32.0,
              right_cutin_speed_mps=32.0, left_follow_gap_m=-60.0,
              right_follow_gap_m=-60.0, overtaker_gap_m=-80.0, overtaker_speed_mps=25.0)
     p.update(overrides)
     return HIGHWAY.as_dict(HIGHWAY.from_dict(p))
 
 
+def crossing_params(**overrides):
+    p = CROSSING.as_dict((CROSSING.low + CROSSING.high) / 2.0)
+    p.update(overrides)
+    return CROSSING.as_dict(CROSSING.from_dict(p))
+
+
 def run(world, seconds, accel=0.0, steer=0.0):
-    """Step `seconds` with a fixed ego command; return the scenes, one per frame."""
+    """Step `seconds` with an ego command (a fixed accel, or a function of the scene); return
+    the scenes, one per frame."""
     scenes = []
     for _ in range(int(round(seconds / DT))):
         scenes.append(world.scene())
-        world.step(accel, steer, DT)
+        world.step(accel(scenes[-1]) if callable(accel) else accel, steer, DT)
     return scenes
 
 
-def actor_track(scenes, actor_id, field):
-    return np.array([getattr(s, field)[list(s.actor_id).index(actor_id)] for s in scenes
-                     if actor_id in s.actor_id])
+def make_room(scene):
+    """An ego that brakes once anyone moves towards its lane, so a cut-in is never hit."""
+    off = np.abs(scene.y_m[1:] - EGO_LANE * LANE_W)
+    return -4.0 if ((off > 1e-9) & (off < LANE_W - 1e-9)).any() else 0.0
+
+
+def track(scenes, actor_id, field):
+    return np.array([getattr(s, field)[actor_id] for s in scenes])
+
+
+def times(scenes):
+    return np.array([s.t_s for s in scenes])
+
+
+def lateral_kinematics(scenes, actor_id, road_heading=None):
+    """(|lateral speed| to the road, |a_lat|, |a_lon|) over 0.15 s, as the audit measures."""
+    h, v = track(scenes, actor_id, "heading_rad"), track(scenes, actor_id, "speed_mps")
+    vx, vy = v * np.cos(h), v * np.sin(h)
+    k = 3
+    ax, ay = (vx[k:] - vx[:-k]) / (k * DT), (vy[k:] - vy[:-k]) / (k * DT)
+    c, s = np.cos(h[:-k]), np.sin(h[:-k])
+    lat_v = np.abs(vy) if road_heading is None else None
+    return lat_v, np.abs(-ax * s + ay * c), np.abs(ax * c + ay * s)
 
 
 def test_lead_vehicle_brakes_as_scripted():
@@ -44,72 +71,110 @@ def test_lead_vehicle_brakes_as_scripted():
     world, cruise = build_highway(p, np.random.default_rng(0))
     assert cruise == p["ego_speed_mps"]
     scenes = run(world, 6.0, accel=-2.0)  # the ego slows so the lead stays free
-    v = actor_track(scenes, 1, "speed_mps")
-    t = np.array([s.t_s for s in scenes])
+    v, t = track(scenes, 1, "speed_mps"), times(scenes)
+    assert v[0] == pytest.approx(p["ego_speed_mps"])  # it starts at the ego's speed
     before, after = v[np.searchsorted(t, 2.9)], v[np.searchsorted(t, 5.0)]
     assert before - after == pytest.approx(12.0, abs=1.5)  # 6 m/s² for 2 s
-    a = actor_track(scenes, 1, "accel_mps2")
-    assert a[np.searchsorted(t, 4.0)] == pytest.approx(-6.0, abs=0.5)
+    assert track(scenes, 1, "accel_mps2")[np.searchsorted(t, 4.0)] == pytest.approx(-6.0, abs=0.3)
 
 
-@pytest.mark.parametrize("side,lane_y", [("left", 0.0), ("right", 8.0)])
-def test_cut_in_triggers_when_the_gap_to_the_ego_closes(side, lane_y):
-    # the NPC starts 40 m ahead (centres), 5 m/s slower than the ego: its rear is 10 m ahead of
-    # the ego's front after (40 - 5 - 10) / 5 = 5 s, when a 10 m trigger gap fires
-    p = highway_params(**{f"{side}_cutin_trigger_gap_m": 10.0, f"{side}_cutin_duration_s": 1.5,
+@pytest.mark.parametrize("side,lane_y,actor", [("left", 0.0, 2), ("right", 8.0, 3)])
+def test_a_slower_cut_in_ahead_fires_when_the_gap_closes_to_its_trigger(side, lane_y, actor):
+    # centre 40 m ahead, 5 m/s slower: its bumper gap (35 m) falls to 10 m after 5 s
+    p = highway_params(**{f"{side}_cutin_trigger_gap_m": 10.0, f"{side}_cutin_duration_s": 3.0,
                           f"{side}_cutin_gap_m": 40.0, f"{side}_cutin_speed_mps": 20.0},
-                       ego_speed_mps=25.0, lead_gap_m=70.0, lead_speed_mps=30.0)
-    world, _ = build_highway(p, np.random.default_rng(0))
-    actor = 2 if side == "left" else 3
-    scenes = run(world, 9.0)
-    y = actor_track(scenes, actor, "y_m")
-    t = np.array([s.t_s for s in scenes])
-    assert y[np.searchsorted(t, 4.8)] == pytest.approx(lane_y, abs=0.1)  # not before the trigger
-    start = t[int(np.argmax(np.abs(y - lane_y) > 0.05))]
-    assert start == pytest.approx(5.0, abs=0.3)
-    assert y[np.searchsorted(t, 8.5)] == pytest.approx(EGO_LANE * LANE_W, abs=0.5)
+                       lead_gap_m=70.0, lead_speed_mps=30.0)
+    scenes = run(build_highway(p, np.random.default_rng(0))[0], 10.0, accel=make_room)
+    y, t = track(scenes, actor, "y_m"), times(scenes)
+    start = t[int(np.argmax(np.abs(y - lane_y) > 1e-9))]
+    assert start == pytest.approx(5.0, abs=0.2)
+    assert y[np.searchsorted(t, start + 3.1)] == pytest.approx(EGO_LANE * LANE_W, abs=0.05)
 
 
-def test_a_cut_in_never_fires_outside_its_trigger_window():
+def test_a_faster_cut_in_from_behind_fires_at_its_trigger_gap_not_at_zero():
+    p = highway_params(left_cutin_trigger_gap_m=15.0, left_cutin_duration_s=3.0,
+                       left_cutin_gap_m=-20.0, left_cutin_speed_mps=32.0, ego_speed_mps=22.0)
+    scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0)
+    y = track(scenes, 2, "y_m")
+    k = int(np.argmax(y > 1e-9))
+    assert k > 0
+    bumper_gap = scenes[k].x_m[2] - scenes[k].x_m[0] - 5.0
+    assert bumper_gap == pytest.approx(15.0, abs=1.0)  # a frame at 10 m/s closing is 0.5 m
+
+
+def test_a_cut_in_never_fires_if_its_trigger_gap_is_never_crossed():
     p = highway_params(left_cutin_trigger_gap_m=5.0, left_cutin_gap_m=40.0,
                        left_cutin_speed_mps=30.0, ego_speed_mps=20.0)  # it only pulls away
     scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0)
-    assert np.abs(actor_track(scenes, 2, "y_m")).max() < 0.05
+    assert np.abs(track(scenes, 2, "y_m")).max() < 1e-9
+
+
+@pytest.mark.parametrize("duration_s", [2.6, 3.5, 5.0])
+def test_lane_changes_stay_within_the_lateral_bounds(duration_s):
+    p = highway_params(left_cutin_trigger_gap_m=10.0, left_cutin_duration_s=duration_s,
+                       left_cutin_gap_m=40.0, left_cutin_speed_mps=20.0)
+    scenes = run(build_highway(p, np.random.default_rng(0))[0], 12.0, accel=make_room)
+    lat_v, a_lat, _ = lateral_kinematics(scenes, 2)
+    assert np.abs(track(scenes, 2, "y_m")).max() > 3.9  # the change happened
+    assert lat_v.max() <= 2.5
+    assert a_lat.max() <= 4.0
 
 
 def test_sharper_cut_in_reaches_the_lane_sooner():
     def time_to_enter(duration):
-        p = highway_params(left_cutin_trigger_gap_m=20.0, left_cutin_duration_s=duration,
-                           left_cutin_gap_m=20.0, left_cutin_speed_mps=25.0)
-        scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0)
-        y = actor_track(scenes, 2, "y_m")
-        return scenes[int(np.argmax(y > EGO_LANE * LANE_W - 1.0))].t_s
+        p = highway_params(left_cutin_trigger_gap_m=10.0, left_cutin_duration_s=duration,
+                           left_cutin_gap_m=40.0, left_cutin_speed_mps=20.0)
+        scenes = run(build_highway(p, np.random.default_rng(0))[0], 12.0, accel=make_room)
+        return scenes[int(np.argmax(track(scenes, 2, "y_m") > EGO_LANE * LANE_W - 1.0))].t_s
 
-    assert time_to_enter(0.8) < time_to_enter(3.0) - 0.5
+    assert time_to_enter(2.6) < time_to_enter(5.0) - 1.0
+
+
+def test_a_cut_in_waits_for_a_gap_the_lead_leaves_it():
+    # the lead sits right where the cut-in would land: it must not change lanes onto it
+    p = highway_params(left_cutin_trigger_gap_m=10.0, left_cutin_gap_m=40.0,
+                       left_cutin_speed_mps=20.0, lead_gap_m=30.0, lead_speed_mps=20.0,
+                       ego_speed_mps=20.0)
+    scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0, accel=0.0)
+    assert not any(s.crashed[1:].any() for s in scenes)
+    y, x_lead, x_cut = track(scenes, 2, "y_m"), track(scenes, 1, "x_m"), track(scenes, 2, "x_m")
+    moving = np.abs(y) > 0.01
+    assert not (moving & (np.abs(x_cut - x_lead) < 5.0 + 5.0 + 10.0)).any()
 
 
 def test_overtaker_cuts_back_once_ahead_of_the_ego():
     p = highway_params(overtaker_gap_m=-30.0, overtaker_speed_mps=36.0, ego_speed_mps=22.0,
                        left_follow_gap_m=80.0, left_follow_speed_mps=33.0,
-                       left_cutin_gap_m=40.0, left_cutin_speed_mps=32.0)  # a free left lane
-    world, _ = build_highway(p, np.random.default_rng(0))
-    scenes = run(world, 10.0)
-    x_rel = actor_track(scenes, 6, "x_m") - np.array([s.x_m[0] for s in scenes])
-    y = actor_track(scenes, 6, "y_m")
-    assert y[0] == pytest.approx(0.0, abs=0.1)
-    assert y[-1] == pytest.approx(EGO_LANE * LANE_W, abs=0.5)
-    first_move = int(np.argmax(y > 0.3))
-    assert x_rel[first_move] >= 12.0 - 1.0  # it waited until it was ahead
+                       left_cutin_gap_m=60.0, left_cutin_speed_mps=32.0)  # a free left lane
+    scenes = run(build_highway(p, np.random.default_rng(0))[0], 12.0)
+    x_rel = track(scenes, 6, "x_m") - track(scenes, 0, "x_m")
+    y = track(scenes, 6, "y_m")
+    assert y[0] == pytest.approx(0.0, abs=1e-9)
+    assert y[-1] == pytest.approx(EGO_LANE * LANE_W, abs=0.05)
+    first_move = int(np.argmax(y > 1e-9))
+    assert x_rel[first_move] - 5.0 == pytest.approx(12.0, abs=1.0)  # at its bumper gap
+
+
+def test_npcs_follow_the_vehicle_ahead_instead_of_driving_through_it():
+    # the overtaker (38 m/s) comes up behind a slow left-lane car (18 m/s) 40 m ahead of the
+    # ego, while the ego keeps it from cutting back in front of it by staying level with it
+    p = highway_params(left_follow_gap_m=40.0, left_follow_speed_mps=18.0, overtaker_gap_m=-15.0,
+                       overtaker_speed_mps=38.0, left_cutin_gap_m=60.0, ego_speed_mps=20.0)
+    scenes = run(build_highway(p, np.random.default_rng(0))[0], 15.0, accel=-1.0)
+    assert not any(s.crashed.any() for s in scenes)
+    gap = track(scenes, 4, "x_m") - track(scenes, 6, "x_m")
+    same_lane = np.abs(track(scenes, 6, "y_m") - track(scenes, 4, "y_m")) < 2.0
+    assert (gap[same_lane] > 5.0).all()  # always behind it, bumper to bumper
+    assert track(scenes, 6, "speed_mps").min() < 20.0  # it slowed down for it
 
 
 def test_ego_runs_into_a_stopped_lead_and_the_partner_is_recorded():
     p = highway_params(lead_gap_m=20.0, lead_brake_time_s=2.0, lead_brake_decel_mps2=8.0,
                        lead_brake_duration_s=5.0, lead_speed_mps=20.0, ego_speed_mps=28.0)
-    world, _ = build_highway(p, np.random.default_rng(0))
-    scenes = run(world, 8.0)
+    scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0)
     hit = [s for s in scenes if s.ego_collision]
     assert hit, "the ego never collided"
-    assert hit[0].collision_actor == 1
+    assert hit[0].collision_actor == 1 and hit[0].crashed[1]
     assert not any(s.ego_collision for s in scenes[: scenes.index(hit[0])])
 
 
@@ -121,58 +186,74 @@ def test_a_blocked_vehicle_stops_and_never_reverses():
     assert speeds.min() == 0.0  # someone came to a standstill, and nobody went below it
 
 
-def test_npcs_pass_through_each_other_but_not_through_the_ego():
+def test_overlapping_npcs_are_a_recorded_contact_not_a_pass_through():
     world, _ = build_highway(highway_params(), np.random.default_rng(0))
-    ego, a, b = (act.vehicle for act in world.active[:3])
-    a.position = ego.position + np.array([30.0, 0.0])
-    b.position = ego.position + np.array([31.0, 0.0])  # two NPCs on top of each other
-    world.step(0.0, 0.0, DT)
-    assert not world.scene().crashed.any()
-    b.position = ego.position + np.array([1.0, 0.0])  # an NPC on top of the ego
-    world.step(0.0, 0.0, DT)
+    a, b = world.npcs[3], world.npcs[0]  # left follower, lead
+    a.position[:] = world.ego.position + np.array([30.0, 0.0])
+    b.position[:] = world.ego.position + np.array([31.0, 0.0])
+    world._contacts()
     scene = world.scene()
-    assert scene.ego_collision and scene.collision_actor == world.active[2].actor_id
-
-
-def test_an_npc_may_spawn_beside_the_ego_in_the_next_lane():
-    p = highway_params(right_cutin_gap_m=0.0)  # alongside the ego, one lane to the right
-    world, _ = build_highway(p, np.random.default_rng(0))
-    assert 3 in world.scene().actor_id
+    assert scene.crashed[[1, 4]].all() and not scene.ego_collision
+    world.npcs[1].position[:] = world.ego.position + np.array([1.0, 0.0])
+    world._contacts()
+    scene = world.scene()
+    assert scene.ego_collision and scene.collision_actor == 2
 
 
 def test_same_params_and_seed_give_the_same_world():
-    x = HIGHWAY.sample(np.random.default_rng(9))
-    a = run(build_highway(HIGHWAY.as_dict(x), np.random.default_rng(4))[0], 5.0, accel=0.5)
-    b = run(build_highway(HIGHWAY.as_dict(x), np.random.default_rng(4))[0], 5.0, accel=0.5)
-    for sa, sb in zip(a, b, strict=True):
-        np.testing.assert_array_equal(sa.x_m, sb.x_m)
-        np.testing.assert_array_equal(sa.speed_mps, sb.speed_mps)
+    for space, build in ((HIGHWAY, build_highway), (CROSSING, build_intersection)):
+        x = space.sample(np.random.default_rng(9))
+        a = run(build(space.as_dict(x), np.random.default_rng(4))[0], 5.0, accel=0.5)
+        b = run(build(space.as_dict(x), np.random.default_rng(4))[0], 5.0, accel=0.5)
+        for sa, sb in zip(a, b, strict=True):
+            np.testing.assert_array_equal(sa.x_m, sb.x_m)
+            np.testing.assert_array_equal(sa.speed_mps, sb.speed_mps)
 
 
-def test_intersection_npcs_appear_at_their_start_time_and_follow_their_route():
-    p = CROSSING.as_dict(CROSSING.low)
-    p.update(cross_east_start_s=3.0, cross_east_speed_mps=10.0, opp_left_start_s=0.0,
-             cross_west_start_s=4.0, right_merge_start_s=4.0, left_merge_start_s=4.0)
-    world, _ = build_intersection(CROSSING.as_dict(CROSSING.from_dict(p)), np.random.default_rng(0))
-    scenes = run(world, 12.0, accel=-3.0)  # the ego stays out of the way
-    east = list(NPC_MOVES).index("cross_east") + 1
-    present = [s.t_s for s in scenes if east in s.actor_id]
-    assert present[0] == pytest.approx(3.0, abs=DT)
-    x = actor_track(scenes, east, "x_m")
-    y = actor_track(scenes, east, "y_m")
-    assert x[0] > 30 and x[-1] < -12  # east → west, through the box (|x| < 11 m) and out
-    assert np.abs(y + 2.0).max() < 0.5  # on the westbound lane all the way
+def test_every_intersection_actor_exists_from_the_start_and_the_ego_start_is_seeded():
+    p = crossing_params()
+    starts = []
+    for seed in range(5):
+        world, _ = build_intersection(p, np.random.default_rng(seed))
+        scene = world.scene()
+        assert scene.n == 1 + len(NPC_MOVES)
+        starts.append(scene.y_m[0] - 11.0)  # the ego drives north (−y) to the box at y = 11
+    assert all(EGO_APPROACH_M[0] - 1e-6 <= d <= EGO_APPROACH_M[1] + 1e-6 for d in starts)
+    assert len(set(np.round(starts, 3))) == 5
+    again = build_intersection(p, np.random.default_rng(0))[0].scene().y_m[0] - 11.0
+    assert again == starts[0]
 
 
-def test_npcs_from_one_approach_never_spawn_on_top_of_each_other():
-    p = CROSSING.as_dict(CROSSING.low)
-    p.update(cross_west_start_s=1.0, left_merge_start_s=1.0)  # both from the west at t = 1 s
-    world, _ = build_intersection(CROSSING.as_dict(CROSSING.from_dict(p)), np.random.default_rng(0))
-    scenes = run(world, 6.0, accel=-3.0)
-    west, merge = list(NPC_MOVES).index("cross_west") + 1, list(NPC_MOVES).index("left_merge") + 1
-    both = [s for s in scenes if west in s.actor_id and merge in s.actor_id]
-    assert both, "the second NPC never appeared"
-    s = both[0]
-    i, j = list(s.actor_id).index(west), list(s.actor_id).index(merge)
-    assert np.hypot(s.x_m[i] - s.x_m[j], s.y_m[i] - s.y_m[j]) >= 8.0
-    assert not any(s.crashed[1:].any() for s in scenes)
+@pytest.mark.parametrize("name", list(NPC_MOVES))
+def test_an_npc_meets_the_egos_path_offset_after_the_ego_would(name):
+    from evoeye.sim.intersection import EGO_ROUTE, _conflict, _path
+
+    offset = 1.5
+    p = crossing_params(**{**{f"{n}_offset_s": 4.0 for n in NPC_MOVES}, f"{name}_offset_s": offset})
+    world, cruise = build_intersection(p, np.random.default_rng(3))
+    ego_path = _path(tuple(EGO_ROUTE))
+    s_ego0, _ = ego_path.project(*world.ego.position)
+    s_npc_c, s_ego_c = _conflict(*NPC_MOVES[name])
+    t_ego = (s_ego_c - s_ego0) / cruise
+    npc = world.npcs[list(NPC_MOVES).index(name)]
+    t = 0.0
+    while npc.s_m < s_npc_c and t < 40.0:  # the NPC alone, free road
+        npc.advance(npc.longitudinal(np.inf, 0.0), DT)
+        t += DT
+    assert t - t_ego == pytest.approx(offset, abs=0.5)  # the start is planned on the profile
+
+
+def test_intersection_npcs_slow_for_their_turns():
+    p = crossing_params(**{f"{n}_speed_mps": 13.0 for n in NPC_MOVES})
+    world, _ = build_intersection(p, np.random.default_rng(1))
+    scenes = run(world, 20.0, accel=-5.0)  # the ego stays out of the way
+    for actor in range(1, 6):
+        pre = [k for k, s in enumerate(scenes) if not s.crashed[actor]]
+        sub = [scenes[k] for k in pre]
+        _, a_lat, a_lon = lateral_kinematics(sub, actor)
+        assert a_lat.max() <= 4.5, actor  # "about 4": the profile is planned for 3
+        assert a_lon.max() <= 9.0, actor
+
+
+def test_box_entry_is_where_the_ego_route_enters_the_intersection():
+    assert _box_entry_s() > 300.0

@@ -1,0 +1,109 @@
+"""A driving path: highway-env lanes joined into one dense centre line with arc length.
+
+NPCs move along a path in its Frenet frame (s along it, d to its left), so their kinematics are
+exact and bounded by construction: the speed in a curve is limited by its curvature (preview
+profile below), and a lane change is a smooth lateral offset profile. The path also answers the
+geometric questions a scenario asks at set-up: how far along it a point lies, and where it first
+comes close to another path (a conflict point).
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+
+import numpy as np
+from highway_env.road.lane import StraightLane
+
+SAMPLE_STEP_M = 0.5
+
+
+class Path:
+    """Centre line (K,) samples: x, y, continuous heading and curvature by arc length s."""
+
+    def __init__(self, points: np.ndarray, step_m: float = SAMPLE_STEP_M) -> None:
+        seg = np.linalg.norm(np.diff(points, axis=0), axis=1)
+        points = points[np.concatenate(([True], seg > 1e-6))]  # drop joints shared by lanes
+        raw_s = np.concatenate(([0.0], np.cumsum(np.linalg.norm(np.diff(points, axis=0), axis=1))))
+        n = max(2, int(math.ceil(raw_s[-1] / step_m)) + 1)
+        self.s = np.linspace(0.0, raw_s[-1], n)  # (K,) uniform, so a lookup is an index
+        self.step_m = float(self.s[1] - self.s[0])
+        self.x = np.interp(self.s, raw_s, points[:, 0])
+        self.y = np.interp(self.s, raw_s, points[:, 1])
+        tx, ty = np.gradient(self.x), np.gradient(self.y)  # the tangent at each sample
+        self.h = np.unwrap(np.arctan2(ty, tx))  # (K,) continuous heading
+        kappa = np.gradient(self.h, self.s)
+        if len(kappa) >= 5:
+            kappa = np.convolve(kappa, np.ones(5) / 5.0, mode="same")
+        self.kappa = kappa  # (K,) 1/m, smoothed
+        self.length_m = float(self.s[-1])
+        self._profiles: dict[tuple[float, float], np.ndarray] = {}
+
+    def index(self, s_m: float) -> int:
+        """The sample at or before arc length s_m."""
+        return min(max(int(s_m / self.step_m), 0), len(self.s) - 1)
+
+    @classmethod
+    def from_lanes(cls, lanes: Sequence) -> Path:
+        """The path through highway-env lanes `lanes`, in order."""
+        parts = []
+        for lane in lanes:
+            if isinstance(lane, StraightLane):
+                parts.append(np.stack([lane.start, lane.end]))
+            else:
+                n = max(2, int(math.ceil(lane.length / SAMPLE_STEP_M)) + 1)
+                s = np.linspace(0.0, lane.length, n)
+                parts.append(np.array([lane.position(si, 0.0) for si in s]))
+        return cls(np.concatenate(parts))
+
+    # -- lookups (scalars) ----------------------------------------------------------------------
+    def pose(self, s_m: float, d_m: float = 0.0) -> tuple[float, float, float]:
+        """(x, y, heading) of the point d_m to the left of the centre line at arc length s_m."""
+        x = float(np.interp(s_m, self.s, self.x))
+        y = float(np.interp(s_m, self.s, self.y))
+        h = float(np.interp(s_m, self.s, self.h))
+        if d_m:
+            x -= d_m * math.sin(h)
+            y += d_m * math.cos(h)
+        return x, y, h
+
+    def project(self, x: float, y: float) -> tuple[float, float]:
+        """(s, d) of the nearest point of the centre line (a full search: set-up time only)."""
+        px, py = self.x[:-1], self.y[:-1]
+        dx, dy = np.diff(self.x), np.diff(self.y)
+        seg2 = np.maximum(dx * dx + dy * dy, 1e-12)
+        t = np.clip(((x - px) * dx + (y - py) * dy) / seg2, 0.0, 1.0)
+        cx, cy = px + t * dx, py + t * dy
+        k = int(np.argmin((cx - x) ** 2 + (cy - y) ** 2))
+        s = float(self.s[k] + t[k] * math.sqrt(seg2[k]))
+        h = math.atan2(dy[k], dx[k])
+        return s, float(-(x - cx[k]) * math.sin(h) + (y - cy[k]) * math.cos(h))
+
+    def speed_profile(self, lat_accel_mps2: float, decel_mps2: float) -> np.ndarray:
+        """(K,) the highest speed at each sample from which every curve ahead can be taken within
+        `lat_accel_mps2` by braking at most `decel_mps2` (v² = a_lat/|κ| in curves, then a
+        backward pass: v_k ≤ sqrt(v_{k+1}² + 2·b·Δs)). Memoised: paths are shared by runs."""
+        key = (lat_accel_mps2, decel_mps2)
+        if key in self._profiles:
+            return self._profiles[key]
+        v = np.sqrt(lat_accel_mps2 / np.maximum(np.abs(self.kappa), 1e-6))
+        ds = np.diff(self.s)
+        for k in range(len(v) - 2, -1, -1):
+            v[k] = min(v[k], math.sqrt(v[k + 1] ** 2 + 2.0 * decel_mps2 * ds[k]))
+        self._profiles[key] = v
+        return v
+
+    def first_conflict(self, other: Path, radius_m: float) -> tuple[float, float] | None:
+        """(s on this path, s on `other`) where this path first comes within radius_m of the
+        other's centre line, or None if it never does."""
+        dx = self.x[:, None] - other.x[None, :]
+        dy = self.y[:, None] - other.y[None, :]
+        near = (dx * dx + dy * dy) <= radius_m * radius_m  # (K, K') on the samples
+        rows = near.any(axis=1).nonzero()[0]
+        if not len(rows):
+            return None
+        k = int(rows[0])
+        j = int(near[k].nonzero()[0][0])
+        return float(self.s[k]), float(other.s[j])
+
+

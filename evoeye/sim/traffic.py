@@ -1,0 +1,81 @@
+"""What NPC drivers see of each other: pairwise relations in each vehicle's own frame.
+
+All pairs at once: (n, n) arrays, row i = seen from vehicle i. An NPC follows the nearest
+vehicle ahead in its corridor that drives its way (its lane, and during a lane change also the
+target lane), and starts a scripted lane change only into a gap that other NPCs leave it. The
+ego is not asked: a cut-in is aimed at it, which is the point of the scenario.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+CORRIDOR_MARGIN_M = 0.5  # lateral slack added to the two half-widths
+ALIGNED_COS = 0.5  # a vehicle within ±60° of one's heading drives one's way
+LOOKAHEAD_M = 120.0
+HALF_LANE_M = 2.0
+CLEAR_FRONT_M, CLEAR_FRONT_S = 5.0, 0.5  # a lane change needs this bumper gap ahead …
+CLEAR_REAR_M, CLEAR_REAR_S = 5.0, 0.6  # … and behind (plus 2 s of any closing speed)
+
+
+@dataclass(frozen=True)
+class Relations:
+    """xi, eta: (n, n) position of j along / to the left of i's heading; cos_dh: heading
+    agreement; bumper: (n, n) |xi| minus the two half-lengths."""
+
+    xi: np.ndarray
+    eta: np.ndarray
+    cos_dh: np.ndarray
+    bumper: np.ndarray
+    half_w: np.ndarray  # (n, n) sum of half-widths
+    speed: np.ndarray  # (n,)
+
+    @classmethod
+    def of(cls, x, y, heading, speed, length, width) -> Relations:
+        dx = x[None, :] - x[:, None]
+        dy = y[None, :] - y[:, None]
+        c, s = np.cos(heading)[:, None], np.sin(heading)[:, None]
+        xi = c * dx + s * dy
+        eta = c * dy - s * dx
+        half_l = 0.5 * (length[:, None] + length[None, :])
+        return cls(
+            xi=xi, eta=eta, cos_dh=np.cos(heading[None, :] - heading[:, None]),
+            bumper=np.abs(xi) - half_l, half_w=0.5 * (width[:, None] + width[None, :]),
+            speed=speed,
+        )
+
+    def gap_ahead_of(self, i: int, j: int) -> float:
+        """Bumper gap by which i is ahead of j along i's heading (negative when behind)."""
+        return float(self.bumper[i, j] if self.xi[i, j] < 0.0 else -self.bumper[i, j])
+
+
+def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(gap, leader speed) per vehicle: the nearest vehicle ahead in its corridor (or in its
+    target lane, `shift_m` to the side, during a lane change), driving its way; gap = inf
+    without one. (n,) each."""
+    n = len(rel.speed)
+    reach = rel.half_w + CORRIDOR_MARGIN_M
+    in_lane = np.abs(rel.eta) < reach
+    in_target = (shift_m != 0.0)[:, None] & (np.abs(rel.eta - shift_m[:, None]) < reach)
+    ahead = (rel.xi > 0.0) & (rel.xi < LOOKAHEAD_M) & (rel.cos_dh > ALIGNED_COS)
+    ahead &= ~np.eye(n, dtype=bool)
+    gap = np.where(ahead & (in_lane | in_target), rel.bumper, np.inf)
+    j = gap.argmin(axis=1)
+    rows = np.arange(n)
+    best = gap[rows, j]
+    return best, np.where(np.isfinite(best), rel.speed[j] * rel.cos_dh[rows, j], 0.0)
+
+
+def clear_to_change(rel: Relations, i: int, offset_m: float) -> bool:
+    """Whether NPC i may move `offset_m` sideways: no other NPC (the ego is not asked) in the
+    target lane within the bumper gaps a careful driver leaves ahead and behind."""
+    others = np.ones(len(rel.speed), dtype=bool)
+    others[[0, i]] = False  # row 0 is the ego
+    in_target = np.abs(rel.eta[i] - offset_m) < HALF_LANE_M
+    v_i, v_j = rel.speed[i], rel.speed
+    need_front = CLEAR_FRONT_M + CLEAR_FRONT_S * v_i
+    need_rear = CLEAR_REAR_M + CLEAR_REAR_S * v_j + 2.0 * np.maximum(v_j - v_i, 0.0)
+    need = np.where(rel.xi[i] >= 0.0, need_front, need_rear)
+    return not (others & in_target & (rel.bumper[i] < need)).any()
