@@ -24,23 +24,31 @@ N_LANES = 3
 ROAD_LENGTH_M = 1400.0
 EGO_LANE = 1  # lanes: 0 left (fast), 1 middle, 2 right
 EGO_START_X_M = 200.0
-MIN_SPACING_M = 9.0  # centre spacing enforced between NPCs placed in one lane
+MIN_SPACING_M = 9.0  # centre spacing enforced between NPCs placed in one lane …
+PLACEMENT_DECEL_MPS2 = 3.0  # … plus what a faster car behind needs to slow at this rate
 OVERTAKER_CUT_BACK_M = 12.0  # the overtaker returns to the ego lane at this bumper gap ahead
 OVERTAKER_LANE_CHANGE_S = 3.5
 
 
-def _place(wanted: list[tuple[int, float]]) -> list[float]:
-    """Resolve placement overlaps: in each lane, a later NPC too close to an earlier one moves
-    back."""
-    placed: list[tuple[int, float]] = [(EGO_LANE, EGO_START_X_M)]
+def _spacing_m(v_behind: float, v_ahead: float) -> float:
+    """Centre spacing that leaves the car behind a comfortable stop for a slower one ahead."""
+    return MIN_SPACING_M + max(v_behind - v_ahead, 0.0) ** 2 / (2.0 * PLACEMENT_DECEL_MPS2)
+
+
+def _place(wanted: list[tuple[int, float, float]], ego_speed: float) -> list[float]:
+    """Resolve placements (lane, x, speed): in each lane, a later NPC too close to an earlier one
+    (or to the ego) moves back behind it, by a spacing that grows with its closing speed."""
+    placed: list[tuple[int, float, float]] = [(EGO_LANE, EGO_START_X_M, ego_speed)]
     out = []
-    for lane, x in wanted:
+    for lane, x, v in wanted:
         for _ in range(len(placed) + 1):
-            clash = [px for pl, px in placed if pl == lane and abs(px - x) < MIN_SPACING_M]
+            clash = [(px, pv) for pl, px, pv in placed
+                     if pl == lane and -_spacing_m(pv, v) < px - x < _spacing_m(v, pv)]
             if not clash:
                 break
-            x = min(clash) - MIN_SPACING_M
-        placed.append((lane, x))
+            px, pv = min(clash)
+            x = px - _spacing_m(v, pv)
+        placed.append((lane, x, v))
         out.append(x)
     return out
 
@@ -83,7 +91,7 @@ def build_highway(p: dict[str, float], rng: np.random.Generator) -> tuple[World,
          p["overtaker_speed_mps"], None,
          LaneChange((EGO_LANE - 0) * LANE_WIDTH_M, OVERTAKER_LANE_CHANGE_S, OVERTAKER_CUT_BACK_M)),
     ]
-    xs = _place([(s[0], s[1]) for s in specs])
+    xs = _place([(s[0], s[1], s[2]) for s in specs], ego_speed)
     npcs = [
         Npc(road, paths[lane], x, v_init, desired_speed_mps=v_want, brake=brake,
             lane_change=change)

@@ -26,6 +26,7 @@ from evoeye.scene import RoadMap
 from evoeye.sim.npc import DriverModel, EgoVehicle, Npc, curve_speed
 from evoeye.sim.path import Path
 from evoeye.sim.roadmap import road_map_from_network
+from evoeye.sim.traffic import Conflict
 from evoeye.sim.world import World
 
 EXTENSION_M = 320.0
@@ -33,7 +34,9 @@ EGO_ROUTE = [("e0", "o0", 0), ("o0", "ir0", 0), ("ir0", "il2", 0), ("il2", "o2",
              ("o2", "x2", 0)]
 EGO_APPROACH_M = (60.0, 200.0)  # the ego starts this far (seeded, uniform) before the box
 EGO_CRUISE_MPS = 10.0  # the intersection lanes' speed limit
-CONFLICT_RADIUS_M = 2.5  # paths closer than this share a conflict point
+CONFLICT_RADIUS_M = 2.5  # paths closer than this share a conflict point (timing parameters)
+CROSSING_RADIUS_M = 4.5  # a waiting NPC's centre keeps this far from the other's path (its
+# half-diagonal, 2.7 m, plus the other's half-width and a margin)
 MIN_SPACING_M = 10.0  # centre spacing between NPCs placed on one approach
 
 # name → (approach, destination); parameters are f"{name}_speed_mps", f"{name}_offset_s"
@@ -89,6 +92,25 @@ def _conflict(src: int, dst: int) -> tuple[float, float]:
     return hit
 
 
+@functools.cache
+def _npc_crossings() -> tuple[tuple[int, int, float, float, float, float], ...]:
+    """(row i, row j, s_i, s_j, stop_i, stop_j) for every pair of NPC moves from different
+    approaches whose paths meet (rows as in the world: NPCs from 1)."""
+    moves = list(NPC_MOVES.values())
+    out = []
+    for a in range(len(moves)):
+        for b in range(a + 1, len(moves)):
+            if moves[a][0] == moves[b][0]:  # one approach: they follow each other
+                continue
+            pa, pb = _path(tuple(_route(*moves[a]))), _path(tuple(_route(*moves[b])))
+            hit = pa.first_conflict(pb, CONFLICT_RADIUS_M)
+            if hit is not None:
+                stop_a = pa.stop_before(pb, hit[0], hit[1], CROSSING_RADIUS_M)
+                stop_b = pb.stop_before(pa, hit[1], hit[0], CROSSING_RADIUS_M)
+                out.append((a + 1, b + 1, *hit, stop_a, stop_b))
+    return tuple(out)
+
+
 def _box_entry_s() -> float:
     net, _ = _network()
     return sum(net.get_lane(idx).length for idx in EGO_ROUTE[:2])
@@ -130,4 +152,5 @@ def build_intersection(p: dict[str, float], rng: np.random.Generator) -> tuple[W
         placed.setdefault(src, []).append(s0)
         v0 = min(speed, float(curve_speed(path, driver)[path.index(s0)]))
         npcs.append(Npc(road, path, s0, v0, desired_speed_mps=speed, driver=driver))
-    return World(road, ego, npcs, road_map), EGO_CRUISE_MPS
+    conflicts = [Conflict(*c) for c in _npc_crossings()]
+    return World(road, ego, npcs, road_map, conflicts), EGO_CRUISE_MPS

@@ -106,4 +106,19 @@ class Path:
         j = int(near[k].nonzero()[0][0])
         return float(self.s[k]), float(other.s[j])
 
+    def stop_before(self, other: Path, s_here: float, s_there: float, radius_m: float,
+                    window_m: float = 20.0) -> float:
+        """The last arc length before s_here (within window_m) from which this path keeps
+        radius_m from the stretch of `other` around s_there: where to stop to let it pass.
+        Stretches of `other` parallel to this path (an adjacent lane, either way) count only
+        where they come closer than half a lane (a merge)."""
+        k0, k1 = self.index(s_here - window_m), self.index(s_here)
+        j0, j1 = other.index(s_there - window_m), other.index(s_there + window_m)
+        dx = self.x[k0 : k1 + 1, None] - other.x[None, j0 : j1 + 1]
+        dy = self.y[k0 : k1 + 1, None] - other.y[None, j0 : j1 + 1]
+        d2 = dx * dx + dy * dy
+        across = np.abs(np.sin(self.h[k0 : k1 + 1, None] - other.h[None, j0 : j1 + 1])) > 0.3
+        near = ((d2 <= radius_m * radius_m) & across | (d2 <= 4.0)).any(axis=1)
+        first = int(near.argmax()) if near.any() else len(near) - 1
+        return float(self.s[k0 + max(first - 1, 0)])
 

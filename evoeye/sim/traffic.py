@@ -2,13 +2,15 @@
 
 All pairs at once: (n, n) arrays, row i = seen from vehicle i. An NPC follows the nearest
 vehicle ahead in its corridor that drives its way (its lane, and during a lane change also the
-target lane), and starts a scripted lane change only into a gap that other NPCs leave it. The
-ego is not asked: a cut-in is aimed at it, which is the point of the scenario.
+target lane), starts a scripted lane change only into a gap that other NPCs leave it, and where
+two NPCs' paths cross (`Conflict`), the one that would arrive later waits for the other. The
+ego is not asked: NPCs do not yield to it and a cut-in is aimed at it, which is the point of
+the scenarios.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -17,7 +19,7 @@ ALIGNED_COS = 0.5  # a vehicle within ±60° of one's heading drives one's way
 LOOKAHEAD_M = 120.0
 HALF_LANE_M = 2.0
 CLEAR_FRONT_M, CLEAR_FRONT_S = 5.0, 0.5  # a lane change needs this bumper gap ahead …
-CLEAR_REAR_M, CLEAR_REAR_S = 5.0, 0.6  # … and behind (plus 2 s of any closing speed)
+CLEAR_REAR_M, CLEAR_REAR_S = 5.0, 0.6  # … and behind, each plus 2 s of any closing speed
 
 
 @dataclass(frozen=True)
@@ -75,7 +77,40 @@ def clear_to_change(rel: Relations, i: int, offset_m: float) -> bool:
     others[[0, i]] = False  # row 0 is the ego
     in_target = np.abs(rel.eta[i] - offset_m) < HALF_LANE_M
     v_i, v_j = rel.speed[i], rel.speed
-    need_front = CLEAR_FRONT_M + CLEAR_FRONT_S * v_i
+    need_front = CLEAR_FRONT_M + CLEAR_FRONT_S * v_i + 2.0 * np.maximum(v_i - v_j, 0.0)
     need_rear = CLEAR_REAR_M + CLEAR_REAR_S * v_j + 2.0 * np.maximum(v_j - v_i, 0.0)
     need = np.where(rel.xi[i] >= 0.0, need_front, need_rear)
     return not (others & in_target & (rel.bumper[i] < need)).any()
+
+
+DECIDE_WITHIN_M = 60.0  # a crossing's order is settled once both NPCs are this close to it
+PASSED_M = 6.0  # the first NPC is through once its centre is this far past the crossing point
+
+
+@dataclass
+class Conflict:
+    """NPCs i and j (world rows) whose paths cross at arc lengths s_i and s_j; each waits, if it
+    must, with its centre at stop_i / stop_j."""
+
+    i: int
+    j: int
+    s_i: float
+    s_j: float
+    stop_i: float
+    stop_j: float
+    first: int | None = field(default=None)  # the row that goes first, once settled
+
+    def wait_gap(self, s: dict[int, float], v: dict[int, float]) -> tuple[int, float] | None:
+        """(row that waits, its distance to its stop point) while the first NPC is not through;
+        None once there is nothing to wait for (or nothing settled yet)."""
+        to_i, to_j = self.s_i - s[self.i], self.s_j - s[self.j]
+        if to_i < -PASSED_M or to_j < -PASSED_M:  # one is through: the other may go
+            return None
+        if self.first is None:
+            if max(to_i, to_j) > DECIDE_WITHIN_M:
+                return None
+            t_i, t_j = to_i / max(v[self.i], 1.0), to_j / max(v[self.j], 1.0)
+            self.first = self.i if t_i <= t_j else self.j
+        if self.first == self.i:
+            return self.j, self.stop_j - s[self.j]
+        return self.i, self.stop_i - s[self.i]

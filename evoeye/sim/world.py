@@ -18,14 +18,16 @@ from highway_env.road.road import Road
 from evoeye.scene import EGO_ID, RoadMap, SceneState
 from evoeye.sim.footprint import box_corners, box_gaps
 from evoeye.sim.npc import EgoVehicle, Npc
-from evoeye.sim.traffic import Relations, clear_to_change, leaders
+from evoeye.sim.traffic import Conflict, Relations, clear_to_change, leaders
 
 
 class World:
     """Ego + NPCs; `scene()` reads it, `step()` advances it by dt."""
 
-    def __init__(self, road: Road, ego: EgoVehicle, npcs: list[Npc], road_map: RoadMap):
+    def __init__(self, road: Road, ego: EgoVehicle, npcs: list[Npc], road_map: RoadMap,
+                 conflicts: list[Conflict] | None = None):
         self.road = road
+        self.conflicts = conflicts or []
         self.road_map = road_map
         self.t_s = 0.0
         self.ego = ego
@@ -65,6 +67,7 @@ class World:
         rel = Relations.of(x, y, heading, speed, self.length_m, self.width_m)
         shift = np.array([0.0] + [n.lateral_target_m() for n in self.npcs])
         gap, v_lead = leaders(rel, shift)
+        self._wait_at_crossings(gap, v_lead)
         for i, npc in enumerate(self.npcs, start=1):
             if npc.wants_lane_change(rel.gap_ahead_of(i, 0)) and clear_to_change(
                 rel, i, npc.lane_change.offset_m
@@ -82,6 +85,17 @@ class World:
         self.t_s += dt
         self._accel = np.array([(ego.speed - v_before) / dt] + [n.accel_mps2 for n in self.npcs])
         self._contacts()
+
+    def _wait_at_crossings(self, gap: np.ndarray, v_lead: np.ndarray) -> None:
+        """An NPC waiting for another at a crossing sees a standing car at its stop point."""
+        if not self.conflicts:
+            return
+        s = {i: npc.s_m for i, npc in enumerate(self.npcs, start=1)}
+        v = {i: npc.speed for i, npc in enumerate(self.npcs, start=1)}
+        for c in self.conflicts:
+            wait = c.wait_gap(s, v)
+            if wait is not None and wait[1] < gap[wait[0]]:
+                gap[wait[0]], v_lead[wait[0]] = max(wait[1], 0.0), 0.0
 
     def _contacts(self) -> None:
         """Mark every overlapping pair of footprints as crashed; remember the ego's partner."""

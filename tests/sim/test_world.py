@@ -257,3 +257,23 @@ def test_intersection_npcs_slow_for_their_turns():
 
 def test_box_entry_is_where_the_ego_route_enters_the_intersection():
     assert _box_entry_s() > 300.0
+
+
+def test_npcs_settle_crossings_among_themselves():
+    # every NPC timed to reach the ego's path at once: their own paths cross in the box too
+    p = crossing_params(**{f"{n}_offset_s": 0.0 for n in NPC_MOVES},
+                        **{f"{n}_speed_mps": 10.0 for n in NPC_MOVES})
+    world, _ = build_intersection(p, np.random.default_rng(2))
+    scenes = run(world, 35.0, accel=-5.0)  # the ego stops short of the box
+    assert not any(s.crashed.any() for s in scenes)
+    assert any(c.first is not None for c in world.conflicts)  # someone had to wait
+    exits = [abs(s) > 15.0 for s in (scenes[-1].x_m[1:] + scenes[-1].y_m[1:])]
+    assert all(exits)  # and everyone got through the box in the end
+
+
+def test_a_fast_car_is_never_placed_just_behind_a_slow_one():
+    p = highway_params(left_follow_gap_m=-20.0, left_follow_speed_mps=18.0,
+                       overtaker_gap_m=-25.0, overtaker_speed_mps=38.0)
+    scenes = run(build_highway(p, np.random.default_rng(0))[0], 6.0, accel=-1.0)
+    assert not any(s.crashed.any() for s in scenes)
+    assert scenes[0].x_m[4] - scenes[0].x_m[6] >= 9.0 + 20.0**2 / 6.0 - 1e-9
