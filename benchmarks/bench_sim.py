@@ -1,10 +1,14 @@
 """Simulation throughput: real-time factor of simulate+log vs bare highway-env stepping.
 
 Real-time factor (RTF) = simulated seconds per CPU second of this process, i.e. per core (CPU
-time, not wall time, so other load on the machine does not distort it). The bare
-reference steps the very same world (same vehicles, same scripts) for the same number of frames
-with a fixed ego command, and does nothing else: no ground-truth read, no ADS, no log.
-Targets (issue 2): full stack with logging ≥ 50× real time per core, ≤ 2× the bare cost.
+time, not wall time, so other load on the machine does not distort it). The bare reference is
+highway-env simulating the same vehicles its own way (`road.act(); road.step(dt)` with its IDM
+vehicles at the same poses, speeds and desired speeds, a fixed ego command) for the same number
+of frames, and nothing else: no ground-truth read, no ADS, no log. Our world steps its NPCs
+itself (bounded path dynamics, vectorised relations and contacts), more cheaply than
+highway-env does, so the table also gives the cost relative to our own bare world.
+Targets (issues 2 and 10): full stack with logging ≥ 50× real time per core, ≤ 2× the cost of
+bare highway-env stepping of the same vehicles.
 """
 
 from __future__ import annotations
@@ -16,6 +20,9 @@ import time
 from pathlib import Path
 
 import numpy as np
+from highway_env.road.road import Road
+from highway_env.vehicle.behavior import IDMVehicle
+from highway_env.vehicle.kinematics import Vehicle
 
 from benchmarks.machine import describe
 from evoeye.batch import plan_uniform, run_batch
@@ -39,17 +46,42 @@ def bench_full(specs, out: Path) -> tuple[float, float, float, list[int]]:
     return sim_s, time.process_time() - t0, log_s, frames
 
 
-def bench_bare(specs, frames: list[int]) -> tuple[float, float]:
-    """The same worlds stepped bare for the same number of frames."""
-    sim_s, wall_s = 0.0, 0.0
+def highway_env_road(world) -> Road:
+    """The same vehicles as highway-env's own: a kinematic ego and an IDM vehicle for every NPC
+    (same road, pose, speed, desired speed), as highway-env would simulate them. NPCs check no
+    collisions (only the ego does), which keeps the reference as cheap as it can be."""
+    road = Road(network=world.road.network, np_random=np.random.default_rng(0),
+                record_history=False)
+    ego = Vehicle(road, world.ego.position.copy(), world.ego.heading, world.ego.speed)
+    ego.action = {"acceleration": 0.0, "steering": 0.0}
+    road.vehicles.append(ego)
+    for npc in world.npcs:
+        v = IDMVehicle(road, npc.position.copy(), npc.heading, npc.speed,
+                       target_lane_index=npc.lane_index, target_speed=npc.desired_speed_mps,
+                       enable_lane_change=False)
+        v.check_collisions = False
+        road.vehicles.append(v)
+    return road
+
+
+def bench_bare(specs, frames: list[int]) -> tuple[float, float, float]:
+    """The same vehicles stepped bare for the same number of frames: (simulated s, CPU s with
+    highway-env's own stepping, CPU s with our world's stepping)."""
+    sim_s, henv_s, world_s = 0.0, 0.0, 0.0
     for spec, n in zip(specs, frames, strict=True):
         world, _ = build_world(spec)
+        road = highway_env_road(world)
+        t0 = time.process_time()
+        for _ in range(n):
+            road.act()
+            road.step(DT_S)
+        henv_s += time.process_time() - t0
         t0 = time.process_time()
         for _ in range(n):
             world.step(0.0, 0.0, DT_S)
-        wall_s += time.process_time() - t0
+        world_s += time.process_time() - t0
         sim_s += n * DT_S
-    return sim_s, wall_s
+    return sim_s, henv_s, world_s
 
 
 def bench_workers(scenario: str, n: int, workers: int) -> float:
@@ -65,22 +97,24 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=20, help="runs per logical scenario")
     args = ap.parse_args()
     print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}\n")
-    print("| logical scenario | runs | sim s | full RTF (sim+ADS+log) | bare RTF (world) "
-          "| full / bare cost | full ms/frame | of which log | 1 worker s | 2 workers s "
+    print("| logical scenario | runs | sim s | full RTF (sim+ADS+log) "
+          "| bare RTF (highway-env) | full / bare cost | bare RTF (our world) "
+          "| full / world cost | full ms/frame | of which log | 1 worker s | 2 workers s "
           "| speedup |")
-    print("|---|---|---|---|---|---|---|---|---|---|---|")
+    print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
     for name in WORLD_BUILDERS:
         specs = plan_uniform(name, args.runs, seed=7)
         run_episode(specs[0])  # warm the per-process caches (road networks, imports)
         with tempfile.TemporaryDirectory() as d:
             sim_s, wall_s, log_s, frames = bench_full(specs, Path(d))
-        bare_sim, bare_wall = bench_bare(specs, frames)
-        full_rtf, bare_rtf = sim_s / wall_s, bare_sim / bare_wall
+        bare_sim, henv_wall, world_wall = bench_bare(specs, frames)
+        full_rtf, bare_rtf, world_rtf = sim_s / wall_s, bare_sim / henv_wall, bare_sim / world_wall
         w1 = bench_workers(name, args.runs, 1)
         w2 = bench_workers(name, args.runs, 2)
         n_frames = sum(frames)
         print(f"| {name} | {len(specs)} | {sim_s:.0f} | {full_rtf:.1f}× | {bare_rtf:.1f}× "
-              f"| {bare_rtf / full_rtf:.2f} | {1e3 * wall_s / n_frames:.3f} "
+              f"| {bare_rtf / full_rtf:.2f} | {world_rtf:.1f}× | {world_rtf / full_rtf:.2f} "
+              f"| {1e3 * wall_s / n_frames:.3f} "
               f"| {1e3 * log_s / n_frames:.3f} | {w1:.2f} | {w2:.2f} | {w1 / w2:.2f}× |")
     print(f"\nper-frame budget at 20 Hz for 50×: {1000 * DT_S / 50:.2f} ms; "
           f"numpy {np.__version__}")
