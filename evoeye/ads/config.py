@@ -114,6 +114,9 @@ class ControlConfig:
     speed_kp: float = 1.0  # 1/s
     speed_ki: float = 0.2  # 1/s²
     speed_integral_max_mps: float = 2.0  # anti-windup bound on the integrated speed error
+    accel_lag_s: float = 0.25  # first-order lag of the powertrain / brakes (time constant)
+    steering_lag_s: float = 0.15  # first-order lag of the steering actuator
+    brake_dead_time_s: float = 0.1  # more braking takes effect only this long after it is asked
 
 
 @dataclass(frozen=True)
