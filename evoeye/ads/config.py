@@ -25,21 +25,42 @@ class LocalizationConfig:
 
 @dataclass(frozen=True)
 class SensorConfig:
-    """Which actors are detected, how noisily, and how late."""
+    """The sensor set (360° lidar + long-range front radar), its errors, and the latency."""
 
-    front_range_m: float = 100.0  # forward sensor (camera + radar)
-    front_half_fov_rad: float = math.radians(35.0)  # forward camera + radar: narrow, so side …
-    surround_range_m: float = 12.0  # … is seen late: the 360° sensor is short-ranged
-    detect_prob_near: float = 0.98  # per-frame detection probability at zero range
-    detect_prob_far: float = 0.75  # … at the front sensor's maximum range (quadratic in between)
-    occluded_fraction_max: float = 0.7  # the probability falls linearly to 0 at this occlusion
-    pos_sigma_m: float = 0.10  # position noise at zero range …
-    pos_sigma_per_m: float = 0.006  # … plus this much per metre of range
-    vel_sigma_mps: float = 0.3
+    # lidar: 360°, detection probability falling with range (quadratic) and occlusion
+    lidar_range_m: float = 75.0
+    lidar_detect_prob_near: float = 0.98  # per-frame detection probability at zero range …
+    lidar_detect_prob_far: float = 0.7  # … at the lidar's range
+    occluded_fraction_max: float = 0.7  # the lidar's probability falls linearly to 0 here
+    pos_sigma_m: float = 0.08  # lidar position noise at zero range …
+    pos_sigma_per_m: float = 0.004  # … plus this much per metre of range
+    vel_sigma_mps: float = 0.4  # lidar velocity (point flow) noise …
     vel_sigma_per_m: float = 0.01
     heading_sigma_rad: float = 0.02
     heading_sigma_per_m: float = 0.001
-    latency_s: float = 0.25  # detections published now were made this long ago (0.1–0.3 s)
+    lidar_depth_seen_frac: float = 0.5  # seen end-on, a box's depth is this fraction of the car
+    lidar_merge_gap_m: float = 0.5  # segmentation merges objects whose boxes are this close
+    # radar: long range, narrow, good range and range rate, poor azimuth (lateral) accuracy
+    radar_range_m: float = 180.0
+    radar_half_fov_rad: float = math.radians(12.0)
+    radar_detect_prob_near: float = 0.95
+    radar_detect_prob_far: float = 0.8
+    radar_occluded_fraction_max: float = 1.0  # radar sees partly under and around cars
+    radar_range_sigma_m: float = 0.3
+    radar_azimuth_sigma_rad: float = 0.008  # ≈ 1.2 m across at 150 m
+    radar_range_rate_sigma_mps: float = 0.15
+    radar_vel_sigma_mps: float = 1.0  # of the velocity vector: the tangential part is unmeasured
+    radar_length_m: float = 4.5  # box assumed for a radar-only detection
+    radar_width_m: float = 1.9
+    # false positives: short-lived clutter, and radar multipath ghosts mirrored at a guard-rail
+    clutter_rate_per_frame: float = 0.5  # Poisson mean of clutter detections per frame
+    clutter_max_per_frame: int = 4
+    clutter_min_range_m: float = 5.0
+    ghost_prob: float = 0.5  # per frame, per radar target beyond ghost_min_range_m
+    ghost_min_range_m: float = 30.0
+    ghost_rail_offset_m: float = 8.0  # the guard-rails' lateral distance from the ego
+    latency_s: float = 0.25  # detections reach the tracker this long after capture (0.1–0.3 s)
+    compensate_latency: bool = True  # publish tracks predicted forward to publication time
 
 
 @dataclass(frozen=True)
@@ -134,14 +155,13 @@ class ADSConfig:
 
     @classmethod
     def cautious(cls) -> ADSConfig:
-        """A more careful stack: wide sensors, 100 ms latency, conservative gap acceptance.
+        """A more careful stack: 100 ms latency, conservative gap acceptance, an earlier AEB.
 
         Collides far less often than the defaults; unit tests pin it to test mechanisms
         independently of the tuned defaults.
         """
         return cls(
-            sensor=SensorConfig(front_half_fov_rad=math.radians(60.0), surround_range_m=30.0,
-                                latency_s=0.10),
+            sensor=SensorConfig(latency_s=0.10),
             prediction=PredictionConfig(cutin_lat_speed_mps=0.6),
             planning=PlanningConfig(time_headway_s=1.5, gap_margin_s=0.5, go_accel_mps2=2.0,
                                     yield_decel_max_mps2=5.0, emergency_ttc_s=1.2,

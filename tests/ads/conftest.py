@@ -121,11 +121,15 @@ def rng() -> np.random.Generator:
 
 
 def ideal_sensor(**changes) -> SensorConfig:
-    """A sensor without noise, misses or latency (occlusion and range limits still apply)."""
+    """A sensor set without noise, misses, false positives or latency, seeing whole boxes
+    (occlusion, range limits, segment merging and the radar's missing tangential velocity
+    still apply)."""
     base = dict(
-        detect_prob_near=1.0, detect_prob_far=1.0, pos_sigma_m=0.0, pos_sigma_per_m=0.0,
-        vel_sigma_mps=0.0, vel_sigma_per_m=0.0, heading_sigma_rad=0.0, heading_sigma_per_m=0.0,
-        latency_s=0.0,
+        lidar_detect_prob_near=1.0, lidar_detect_prob_far=1.0, radar_detect_prob_near=1.0,
+        radar_detect_prob_far=1.0, pos_sigma_m=0.0, pos_sigma_per_m=0.0, vel_sigma_mps=0.0,
+        vel_sigma_per_m=0.0, heading_sigma_rad=0.0, heading_sigma_per_m=0.0,
+        radar_range_sigma_m=0.0, radar_azimuth_sigma_rad=0.0, radar_range_rate_sigma_mps=0.0,
+        lidar_depth_seen_frac=1.0, clutter_rate_per_frame=0.0, ghost_prob=0.0, latency_s=0.0,
     )
     base.update(changes)
     return replace(ADSConfig.cautious().sensor, **base)
