@@ -14,6 +14,7 @@ for clutter, one per actor for ghosts) so the random stream stays aligned.
 
 from __future__ import annotations
 
+import bisect
 import math
 
 import numpy as np
@@ -23,16 +24,12 @@ from evoeye.ads.config import SensorConfig
 from evoeye.ads.detections import (
     DET_FIELDS,
     DET_HEADING,
-    DET_LENGTH,
     DET_RANGE,
-    DET_VAR_POS,
-    DET_VAR_VEL,
-    DET_VX,
     DET_VY,
-    DET_WIDTH,
     DET_X,
     DET_Y,
     VAR_FLOOR,
+    pack,
 )
 
 CLUTTER_ID = -1  # actor_id of a clutter detection
@@ -49,30 +46,33 @@ class FalsePositives:
         self.n_max = max(0, int(c.clutter_max_per_frame))
         self.n_uniforms = 1 + 2 * self.n_max  # count, then range and bearing per slot
         # inverse CDF of the (truncated) Poisson count: P(N ≤ k) for k = 0 … n_max − 1
-        self._cdf = poisson.cdf(np.arange(self.n_max), c.clutter_rate_per_frame)
+        self._cdf = poisson.cdf(np.arange(self.n_max), c.clutter_rate_per_frame).tolist()
+        self._none = (np.zeros(0, dtype=np.int64), np.zeros((DET_FIELDS, 0)))
 
     def detect(self, u: np.ndarray, ego_speed_mps: float) -> tuple[np.ndarray, np.ndarray]:
-        """(actor ids, (10, k) detections) of this frame's clutter from n_uniforms uniforms."""
+        """(actor ids, (DET_FIELDS, k) detections) of this frame's clutter from n_uniforms
+        uniforms."""
         c = self.c
-        k = int(np.searchsorted(self._cdf, u[0], side="right"))
+        k = bisect.bisect_right(self._cdf, float(u[0]))
+        if k == 0:
+            return self._none
         r = c.clutter_min_range_m + (c.lidar_range_m - c.clutter_min_range_m) * u[1:1 + k]
         bearing = (2.0 * u[1 + self.n_max:1 + self.n_max + k] - 1.0) * math.pi
-        z = np.empty((DET_FIELDS, k))
-        z[DET_X], z[DET_Y] = r * np.cos(bearing), r * np.sin(bearing)
-        z[DET_VX], z[DET_VY] = -ego_speed_mps, 0.0  # static in the world
-        z[DET_HEADING] = 0.0
-        z[DET_LENGTH] = z[DET_WIDTH] = CLUTTER_SIZE_M
-        z[DET_RANGE] = r
-        z[DET_VAR_POS] = (c.pos_sigma_m + c.pos_sigma_per_m * r) ** 2 + VAR_FLOOR
-        z[DET_VAR_VEL] = (c.vel_sigma_mps + c.vel_sigma_per_m * r) ** 2 + VAR_FLOOR
+        z = pack(
+            r * np.exp(1j * bearing), np.full(k, -ego_speed_mps + 0j),  # static in the world
+            0.0, CLUTTER_SIZE_M, CLUTTER_SIZE_M, r,
+            (c.pos_sigma_m + c.pos_sigma_per_m * r) ** 2 + VAR_FLOOR,
+            (c.vel_sigma_mps + c.vel_sigma_per_m * r) ** 2 + VAR_FLOOR,
+        )
         return np.full(k, CLUTTER_ID, dtype=np.int64), z
 
-    def ghosts(
-        self, radar: np.ndarray, u: np.ndarray, ego_speed_mps: float
-    ) -> tuple[np.ndarray, np.ndarray]:
-        """(actor ids, (10, k) detections) of multipath ghosts of the radar detections (10, m)."""
+    def ghosts(self, radar: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(actor ids, (DET_FIELDS, k) detections) of multipath ghosts of the radar's detections
+        (DET_FIELDS, m), from one uniform per detection."""
         c = self.c
         on = (radar[DET_RANGE] > c.ghost_min_range_m) & (u < c.ghost_prob)
+        if not np.count_nonzero(on):
+            return self._none
         z = radar[:, on]
         rail = np.where(z[DET_Y] >= 0.0, c.ghost_rail_offset_m, -c.ghost_rail_offset_m)
         z[DET_Y] = 2.0 * rail - z[DET_Y]

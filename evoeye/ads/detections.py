@@ -19,3 +19,21 @@ class Detections(NamedTuple):
 
     actor_id: np.ndarray  # (m,)
     z: np.ndarray  # (DET_FIELDS, m)
+
+
+def pack(
+    pos: np.ndarray, vel: np.ndarray, heading_rad, length_m, width_m, range_m, var_pos, var_vel
+) -> np.ndarray:
+    """The (DET_FIELDS, m) detection array from complex positions and velocities (x + iy) (m,)
+    and the other fields (arrays (m,) or scalars)."""
+    m = len(pos)
+    z = np.empty((DET_FIELDS, m))
+    z[DET_X], z[DET_Y] = pos.real, pos.imag
+    z[DET_VX], z[DET_VY] = vel.real, vel.imag
+    z[DET_HEADING] = heading_rad
+    z[DET_LENGTH] = length_m
+    z[DET_WIDTH] = width_m
+    z[DET_RANGE] = range_m
+    z[DET_VAR_POS] = var_pos
+    z[DET_VAR_VEL] = var_vel
+    return z
