@@ -79,13 +79,22 @@ class TrackerConfig:
 
 @dataclass(frozen=True)
 class PredictionConfig:
-    """Lane-following vs constant-velocity prediction."""
+    """Multi-modal prediction: lane keeping, lane changes and lane continuations, CV fallback."""
 
     horizon_s: float = 3.0
     dt_s: float = 0.1
     lane_match_radius_m: float = 3.0  # an obstacle farther than this from every lane centre is "cv"
-    lane_offset_max_m: float = 1.0  # "lane" needs |lateral offset| below this …
-    cutin_lat_speed_mps: float = 1.2  # … and lateral speed below this: a cut-in shows late
+    # lane-change intent: log-odds = v_lat / speed_scale + offset / offset_scale − bias
+    intent_lat_speed_scale_mps: float = 0.4
+    intent_offset_scale_m: float = 1.0
+    intent_change_bias: float = 3.5  # prior against a lane change at zero evidence
+    lane_change_duration_s: float = 3.0  # predicted duration of a change over a whole lane
+    # lane continuations (turns): heading vs each continuation's tangent a little ahead
+    turn_lookahead_s: float = 1.0
+    turn_lookahead_min_m: float = 5.0
+    turn_heading_sigma_rad: float = 0.2
+    successor_join_m: float = 1.5  # a lane starting this close to another's end continues it
+    min_mode_prob: float = 0.05  # less probable modes are dropped (the best one always stays)
     lane_resample_m: float = 1.0  # lane polylines are resampled to this spacing at start-up
     grid_cell_m: float = 1.0  # cell of the lookup grid used to project onto lanes
 
@@ -162,7 +171,7 @@ class ADSConfig:
         """
         return cls(
             sensor=SensorConfig(latency_s=0.10),
-            prediction=PredictionConfig(cutin_lat_speed_mps=0.6),
+            prediction=PredictionConfig(intent_change_bias=2.0),
             planning=PlanningConfig(time_headway_s=1.5, gap_margin_s=0.5, go_accel_mps2=2.0,
                                     yield_decel_max_mps2=5.0, emergency_ttc_s=1.2,
                                     emergency_decel_mps2=8.0),

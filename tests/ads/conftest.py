@@ -159,7 +159,7 @@ def cv_predictions(rows: list[tuple[float, float, float, float]], t_s: float = 0
     t = (np.arange(round(horizon_s / dt_s)) + 1.0) * dt_s
     vx, vy = a[:, 3] * np.cos(a[:, 2]), a[:, 3] * np.sin(a[:, 2])
     return Predictions(
-        t_s=t_s, dt_s=dt_s, track_id=np.arange(1, n + 1), model=["cv"] * n,
+        t_s=t_s, dt_s=dt_s, track_id=np.arange(1, n + 1), model=["cv"] * n, mode_prob=np.ones(n),
         length_m=np.full(n, 5.0), width_m=np.full(n, 2.0),
         x_m=a[:, :1] + vx[:, None] * t, y_m=a[:, 1:2] + vy[:, None] * t,
     )
