@@ -1,10 +1,13 @@
 """Every tuning knob of the ADS, grouped per module, with units in the names.
 
-The defaults describe a plausibly competent stack with realistic weaknesses: a sensor that misses
-far and occluded cars and sees little to its sides, 250 ms of perception latency, a cut-in
-recognised only once lateral motion shows, optimistic gap acceptance that commits early, and a
-late, moderate AEB. They were tuned so that uniform sampling gives collision rates in the bands
-the paper reports (README, "Collision rates"); tune with `dataclasses.replace` on the group.
+The defaults describe a plausibly competent production stack, each imperfection a tunable source
+of failure: a 360° lidar and a long-range radar that miss far and occluded cars, see boxes from
+the visible points, merge close cars, report clutter and multipath ghosts, and hand over 250 ms
+late (compensated by ego motion and track prediction); multi-modal prediction whose intents show
+only once lateral motion or turning shows; planning under uncertainty with gap margins,
+decision hysteresis, a comfort braking limit and a jerk-limited AEB; and actuators with lag and
+a brake dead time. They are not tuned to collision-rate bands; tune with `dataclasses.replace`
+on the group.
 """
 
 from __future__ import annotations
@@ -101,7 +104,7 @@ class PredictionConfig:
 
 @dataclass(frozen=True)
 class PlanningConfig:
-    """Route following, IDM car following, gap acceptance and emergency braking."""
+    """Route following, IDM car following, gap acceptance, hysteresis and braking limits."""
 
     horizon_s: float = 4.0
     dt_s: float = 0.1
@@ -109,22 +112,28 @@ class PlanningConfig:
     ego_width_m: float = 2.0
     corridor_margin_m: float = 0.3  # lateral margin added to both half-widths for "in path"
     max_obstacle_half_length_m: float = 3.0  # bounds the corridor search (route grid reach)
+    mode_prob_min: float = 0.2  # plans against every predicted mode at least this probable
     idm_accel_mps2: float = 2.0  # IDM a: max acceleration
     idm_decel_mps2: float = 3.0  # IDM b: comfortable deceleration
     idm_delta: float = 4.0
     time_headway_s: float = 1.2  # IDM T
     min_gap_m: float = 3.0  # IDM s0, bumper to bumper
-    follow_decel_max_mps2: float = 4.0  # following brakes harder only if the gap demands it …
+    follow_decel_max_mps2: float = 3.0  # following brakes harder only if the gap demands it …
     follow_soft_headway_s: float = 0.6  # … or the gap is below min_gap + v · this
+    comfort_decel_mps2: float = 3.5  # no normal decision brakes harder; beyond it is AEB's job
     follow_range_m: float = 120.0  # leaders farther than this along the route are ignored
     cutin_horizon_s: float = 2.0  # an aligned car predicted in the path within this is a leader
     aligned_max_rad: float = 0.6  # heading gap to the route below which a car "follows"
-    gap_margin_s: float = -1.0  # optimistic: takes a crossing gap up to 1 s shorter than needed
-    go_accel_mps2: float = 3.0  # accel assumed for the ego's arrival estimate (optimistic)
+    gap_margin_s: float = 0.5  # a crossing gap is taken only with this much time to spare …
+    arrival_uncertainty_frac: float = 0.1  # … the other's arrival taken this much earlier
+    go_accel_mps2: float = 2.0  # accel assumed for the ego's arrival estimate
     stop_buffer_m: float = 1.5  # the ego stops this far before a conflict region
     yield_decel_max_mps2: float = 1.5  # beyond this the ego is committed and goes on
-    emergency_ttc_s: float = 0.7  # time to collision below which the ego brakes hard (late AEB)
-    emergency_decel_mps2: float = 6.0  # AEB deceleration
+    proceed_hold_margin_s: float = 0.5  # a proceed is revoked only if the gap is this much short
+    release_frames: int = 6  # a yield / AEB is held until its conflict is clear this many frames
+    emergency_ttc_s: float = 0.8  # time to collision below which the ego brakes hard (AEB)
+    emergency_decel_mps2: float = 8.5  # AEB deceleration …
+    emergency_jerk_mps3: float = 30.0  # … reached at this jerk
     stitch_tolerance_mps: float = 1.0  # replan from the measured speed if the plan drifts more
     route_resample_m: float = 1.0
     grid_cell_m: float = 1.0
@@ -172,9 +181,10 @@ class ADSConfig:
         return cls(
             sensor=SensorConfig(latency_s=0.10),
             prediction=PredictionConfig(intent_change_bias=2.0),
-            planning=PlanningConfig(time_headway_s=1.5, gap_margin_s=0.5, go_accel_mps2=2.0,
-                                    yield_decel_max_mps2=5.0, emergency_ttc_s=1.2,
-                                    emergency_decel_mps2=8.0),
+            planning=PlanningConfig(time_headway_s=1.5, gap_margin_s=1.0,
+                                    arrival_uncertainty_frac=0.2, go_accel_mps2=1.5,
+                                    yield_decel_max_mps2=5.0, comfort_decel_mps2=4.0,
+                                    emergency_ttc_s=1.2),
         )
 
     def with_cruise_speed(self, cruise_speed_mps: float) -> ADSConfig:
