@@ -180,7 +180,8 @@ class RoutePlanner:
                 if kind == "emergency_brake":
                     a, decision, leader, target = -c.emergency_decel_mps2, kind, held, 0.0
                 else:
-                    a_yield = self._idm(v, max(self._stop_s - s_e - self._half_len, 0.0) + c.min_gap_m, v)
+                    to_stop_m = max(self._stop_s - s_e - self._half_len, 0.0)
+                    a_yield = self._idm(v, to_stop_m + c.min_gap_m, v)
                     if a_yield < a:
                         a, decision, leader, target = a_yield, kind, held, 0.0
         else:
