@@ -1,10 +1,13 @@
 """Every tuning knob of the ADS, grouped per module, with units in the names.
 
-The defaults describe a plausibly competent stack with realistic weaknesses: a sensor that misses
-far and occluded cars and sees little to its sides, 250 ms of perception latency, a cut-in
-recognised only once lateral motion shows, optimistic gap acceptance that commits early, and a
-late, moderate AEB. They were tuned so that uniform sampling gives collision rates in the bands
-the paper reports (README, "Collision rates"); tune with `dataclasses.replace` on the group.
+The defaults describe a plausibly competent production stack, each imperfection a tunable source
+of failure: a 360° lidar and a long-range radar that miss far and occluded cars, see boxes from
+the visible points, merge close cars, report clutter and multipath ghosts, and hand over 250 ms
+late (compensated by ego motion and track prediction); multi-modal prediction whose intents show
+only once lateral motion or turning shows; planning under uncertainty with gap margins,
+decision hysteresis, a comfort braking limit and a jerk-limited AEB; and actuators with lag and
+a brake dead time. They are not tuned to collision-rate bands; tune with `dataclasses.replace`
+on the group.
 """
 
 from __future__ import annotations
@@ -25,21 +28,42 @@ class LocalizationConfig:
 
 @dataclass(frozen=True)
 class SensorConfig:
-    """Which actors are detected, how noisily, and how late."""
+    """The sensor set (360° lidar + long-range front radar), its errors, and the latency."""
 
-    front_range_m: float = 100.0  # forward sensor (camera + radar)
-    front_half_fov_rad: float = math.radians(35.0)  # forward camera + radar: narrow, so side …
-    surround_range_m: float = 12.0  # … is seen late: the 360° sensor is short-ranged
-    detect_prob_near: float = 0.98  # per-frame detection probability at zero range
-    detect_prob_far: float = 0.75  # … at the front sensor's maximum range (quadratic in between)
-    occluded_fraction_max: float = 0.7  # the probability falls linearly to 0 at this occlusion
-    pos_sigma_m: float = 0.10  # position noise at zero range …
-    pos_sigma_per_m: float = 0.006  # … plus this much per metre of range
-    vel_sigma_mps: float = 0.3
+    # lidar: 360°, detection probability falling with range (quadratic) and occlusion
+    lidar_range_m: float = 75.0
+    lidar_detect_prob_near: float = 0.98  # per-frame detection probability at zero range …
+    lidar_detect_prob_far: float = 0.7  # … at the lidar's range
+    occluded_fraction_max: float = 0.7  # the lidar's probability falls linearly to 0 here
+    pos_sigma_m: float = 0.08  # lidar position noise at zero range …
+    pos_sigma_per_m: float = 0.004  # … plus this much per metre of range
+    vel_sigma_mps: float = 0.4  # lidar velocity (point flow) noise …
     vel_sigma_per_m: float = 0.01
     heading_sigma_rad: float = 0.02
     heading_sigma_per_m: float = 0.001
-    latency_s: float = 0.25  # detections published now were made this long ago (0.1–0.3 s)
+    lidar_depth_seen_frac: float = 0.5  # seen end-on, a box's depth is this fraction of the car
+    lidar_merge_gap_m: float = 0.5  # segmentation merges objects whose boxes are this close
+    # radar: long range, narrow, good range and range rate, poor azimuth (lateral) accuracy
+    radar_range_m: float = 180.0
+    radar_half_fov_rad: float = math.radians(12.0)
+    radar_detect_prob_near: float = 0.95
+    radar_detect_prob_far: float = 0.8
+    radar_occluded_fraction_max: float = 1.0  # radar sees partly under and around cars
+    radar_range_sigma_m: float = 0.3
+    radar_azimuth_sigma_rad: float = 0.008  # ≈ 1.2 m across at 150 m
+    radar_range_rate_sigma_mps: float = 0.15
+    radar_vel_sigma_mps: float = 1.0  # of the velocity vector: the tangential part is unmeasured
+    radar_length_m: float = 4.5  # box assumed for a radar-only detection
+    radar_width_m: float = 1.9
+    # false positives: short-lived clutter, and radar multipath ghosts mirrored at a guard-rail
+    clutter_rate_per_frame: float = 0.5  # Poisson mean of clutter detections per frame
+    clutter_max_per_frame: int = 4
+    clutter_min_range_m: float = 5.0
+    ghost_prob: float = 0.5  # per frame, per radar target beyond ghost_min_range_m
+    ghost_min_range_m: float = 30.0
+    ghost_rail_offset_m: float = 8.0  # the guard-rails' lateral distance from the ego
+    latency_s: float = 0.25  # detections reach the tracker this long after capture (0.1–0.3 s)
+    compensate_latency: bool = True  # publish tracks predicted forward to publication time
 
 
 @dataclass(frozen=True)
@@ -58,20 +82,29 @@ class TrackerConfig:
 
 @dataclass(frozen=True)
 class PredictionConfig:
-    """Lane-following vs constant-velocity prediction."""
+    """Multi-modal prediction: lane keeping, lane changes and lane continuations, CV fallback."""
 
     horizon_s: float = 3.0
     dt_s: float = 0.1
     lane_match_radius_m: float = 3.0  # an obstacle farther than this from every lane centre is "cv"
-    lane_offset_max_m: float = 1.0  # "lane" needs |lateral offset| below this …
-    cutin_lat_speed_mps: float = 1.2  # … and lateral speed below this: a cut-in shows late
+    # lane-change intent: log-odds = v_lat / speed_scale + offset / offset_scale − bias
+    intent_lat_speed_scale_mps: float = 0.4
+    intent_offset_scale_m: float = 1.0
+    intent_change_bias: float = 3.5  # prior against a lane change at zero evidence
+    lane_change_duration_s: float = 3.0  # predicted duration of a change over a whole lane
+    # lane continuations (turns): heading vs each continuation's tangent a little ahead
+    turn_lookahead_s: float = 1.0
+    turn_lookahead_min_m: float = 5.0
+    turn_heading_sigma_rad: float = 0.2
+    successor_join_m: float = 1.5  # a lane starting this close to another's end continues it
+    min_mode_prob: float = 0.05  # less probable modes are dropped (the best one always stays)
     lane_resample_m: float = 1.0  # lane polylines are resampled to this spacing at start-up
     grid_cell_m: float = 1.0  # cell of the lookup grid used to project onto lanes
 
 
 @dataclass(frozen=True)
 class PlanningConfig:
-    """Route following, IDM car following, gap acceptance and emergency braking."""
+    """Route following, IDM car following, gap acceptance, hysteresis and braking limits."""
 
     horizon_s: float = 4.0
     dt_s: float = 0.1
@@ -79,22 +112,28 @@ class PlanningConfig:
     ego_width_m: float = 2.0
     corridor_margin_m: float = 0.3  # lateral margin added to both half-widths for "in path"
     max_obstacle_half_length_m: float = 3.0  # bounds the corridor search (route grid reach)
+    mode_prob_min: float = 0.2  # plans against every predicted mode at least this probable
     idm_accel_mps2: float = 2.0  # IDM a: max acceleration
     idm_decel_mps2: float = 3.0  # IDM b: comfortable deceleration
     idm_delta: float = 4.0
     time_headway_s: float = 1.2  # IDM T
     min_gap_m: float = 3.0  # IDM s0, bumper to bumper
-    follow_decel_max_mps2: float = 4.0  # following brakes harder only if the gap demands it …
+    follow_decel_max_mps2: float = 3.0  # following brakes harder only if the gap demands it …
     follow_soft_headway_s: float = 0.6  # … or the gap is below min_gap + v · this
+    comfort_decel_mps2: float = 3.5  # no normal decision brakes harder; beyond it is AEB's job
     follow_range_m: float = 120.0  # leaders farther than this along the route are ignored
     cutin_horizon_s: float = 2.0  # an aligned car predicted in the path within this is a leader
     aligned_max_rad: float = 0.6  # heading gap to the route below which a car "follows"
-    gap_margin_s: float = -1.0  # optimistic: takes a crossing gap up to 1 s shorter than needed
-    go_accel_mps2: float = 3.0  # accel assumed for the ego's arrival estimate (optimistic)
+    gap_margin_s: float = 0.5  # a crossing gap is taken only with this much time to spare …
+    arrival_uncertainty_frac: float = 0.1  # … the other's arrival taken this much earlier
+    go_accel_mps2: float = 2.0  # accel assumed for the ego's arrival estimate
     stop_buffer_m: float = 1.5  # the ego stops this far before a conflict region
     yield_decel_max_mps2: float = 1.5  # beyond this the ego is committed and goes on
-    emergency_ttc_s: float = 0.7  # time to collision below which the ego brakes hard (late AEB)
-    emergency_decel_mps2: float = 6.0  # AEB deceleration
+    proceed_hold_margin_s: float = 0.5  # a proceed is revoked only if the gap is this much short
+    release_frames: int = 6  # a yield / AEB is held until its conflict is clear this many frames
+    emergency_ttc_s: float = 0.8  # time to collision below which the ego brakes hard (AEB)
+    emergency_decel_mps2: float = 8.5  # AEB deceleration …
+    emergency_jerk_mps3: float = 30.0  # … reached at this jerk
     stitch_tolerance_mps: float = 1.0  # replan from the measured speed if the plan drifts more
     route_resample_m: float = 1.0
     grid_cell_m: float = 1.0
@@ -114,6 +153,9 @@ class ControlConfig:
     speed_kp: float = 1.0  # 1/s
     speed_ki: float = 0.2  # 1/s²
     speed_integral_max_mps: float = 2.0  # anti-windup bound on the integrated speed error
+    accel_lag_s: float = 0.25  # first-order lag of the powertrain / brakes (time constant)
+    steering_lag_s: float = 0.15  # first-order lag of the steering actuator
+    brake_dead_time_s: float = 0.1  # more braking takes effect only this long after it is asked
 
 
 @dataclass(frozen=True)
@@ -131,18 +173,18 @@ class ADSConfig:
 
     @classmethod
     def cautious(cls) -> ADSConfig:
-        """A more careful stack: wide sensors, 100 ms latency, conservative gap acceptance.
+        """A more careful stack: 100 ms latency, conservative gap acceptance, an earlier AEB.
 
         Collides far less often than the defaults; unit tests pin it to test mechanisms
         independently of the tuned defaults.
         """
         return cls(
-            sensor=SensorConfig(front_half_fov_rad=math.radians(60.0), surround_range_m=30.0,
-                                latency_s=0.10),
-            prediction=PredictionConfig(cutin_lat_speed_mps=0.6),
-            planning=PlanningConfig(time_headway_s=1.5, gap_margin_s=0.5, go_accel_mps2=2.0,
-                                    yield_decel_max_mps2=5.0, emergency_ttc_s=1.2,
-                                    emergency_decel_mps2=8.0),
+            sensor=SensorConfig(latency_s=0.10),
+            prediction=PredictionConfig(intent_change_bias=2.0),
+            planning=PlanningConfig(time_headway_s=1.5, gap_margin_s=1.0,
+                                    arrival_uncertainty_frac=0.2, go_accel_mps2=1.5,
+                                    yield_decel_max_mps2=5.0, comfort_decel_mps2=4.0,
+                                    emergency_ttc_s=1.2),
         )
 
     def with_cruise_speed(self, cruise_speed_mps: float) -> ADSConfig:

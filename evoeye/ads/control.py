@@ -1,5 +1,10 @@
 """Control: pure pursuit on the planned path; PID on speed, the planned acceleration fed forward.
 
+The actuators are part of the module: the command it publishes (and the world applies) is the
+realised one, after a brake dead time (more braking than `brake_dead_time_s` ago takes effect only
+then; releasing is immediate) and a first-order lag on acceleration and on steering. So an AEB
+decision reaches full deceleration only after dead time + ~2 τ, as in a real car.
+
 The command drives highway-env's kinematic bicycle (reference point at the centre, slip angle
 β = atan(½·tan δ), heading rate v·sin β / (L/2)); its centre moves on a circle of curvature
 κ = 2·sin β / L, so pure pursuit's κ = 2·sin α / d maps to β = asin(κ·L/2), δ = atan(2·tan β),
@@ -9,6 +14,7 @@ with α measured from the direction of travel h + β.
 from __future__ import annotations
 
 import math
+from collections import deque
 from typing import Protocol
 
 import numpy as np
@@ -29,14 +35,26 @@ def _clamp(value: float, lo: float, hi: float) -> float:
     return lo if value < lo else hi if value > hi else value
 
 
+def _lag_gain(dt_s: float, tau_s: float) -> float:
+    """The per-step gain of a first-order lag with time constant tau_s (1: no lag)."""
+    return 1.0 - math.exp(-dt_s / tau_s) if tau_s > 0.0 else 1.0
+
+
 class PurePursuitController:
-    """Pure pursuit + PID, with steering angle/rate limits and accel saturation."""
+    """Pure pursuit + PID, with steering angle/rate limits, accel saturation and actuator lag."""
 
     def __init__(self, config: ControlConfig, dt_s: float) -> None:
         self.c = config
         self.dt_s = dt_s
-        self._steering_rad = 0.0
+        self._steering_cmd_rad = 0.0  # the rate-limited steering request
+        self._steering_rad = 0.0  # the realised (lagged) steering angle
+        self._accel_mps2 = 0.0  # the realised (lagged) acceleration
         self._speed_error_integral = 0.0
+        # exact discretisation of the first-order lags: x += (target − x)·(1 − e^(−dt/τ))
+        self._accel_gain = _lag_gain(dt_s, config.accel_lag_s)
+        self._steering_gain = _lag_gain(dt_s, config.steering_lag_s)
+        dead_frames = max(0, round(config.brake_dead_time_s / dt_s))
+        self._requests: deque[float] = deque([0.0] * (dead_frames + 1), maxlen=dead_frames + 1)
 
     def _target(self, plan: PlannedTrajectory, lookahead_m: float) -> tuple[float, float]:
         """The point lookahead_m along the planned path (extended straight past its end)."""
@@ -68,8 +86,10 @@ class PurePursuitController:
         beta_cmd = math.asin(_clamp(0.5 * kappa * c.vehicle_length_m, -0.99, 0.99))
         steer = math.atan(2.0 * math.tan(beta_cmd))
         step = c.max_steering_rate_radps * dt
-        steer = _clamp(steer, self._steering_rad - step, self._steering_rad + step)
+        steer = _clamp(steer, self._steering_cmd_rad - step, self._steering_cmd_rad + step)
         steer = _clamp(steer, -c.max_steering_rad, c.max_steering_rad)
+        self._steering_cmd_rad = steer
+        steer = self._steering_rad + (steer - self._steering_rad) * self._steering_gain
         self._steering_rad = steer
 
         # longitudinal: feed-forward + PID on the plan's current speed
@@ -85,7 +105,7 @@ class PurePursuitController:
             accel = a_ff + c.speed_kp * err + c.speed_ki * integral
             if c.accel_min_mps2 < accel < c.accel_max_mps2:  # anti-windup: integrate if unsaturated
                 self._speed_error_integral = integral
-        accel = _clamp(accel, c.accel_min_mps2, c.accel_max_mps2)
+        accel = self._actuate(_clamp(accel, c.accel_min_mps2, c.accel_max_mps2), v)
         return ControlCommand(
             t_s=plan.t_s,
             throttle=accel / c.accel_max_mps2 if accel > 0.0 else 0.0,
@@ -93,3 +113,14 @@ class PurePursuitController:
             steering_rad=steer,
             accel_cmd_mps2=accel,
         )
+
+    def _actuate(self, request_mps2: float, v_mps: float) -> float:
+        """The acceleration realised this frame for the request: dead time on more braking,
+        then the first-order lag; brakes stop the car but never reverse it."""
+        self._requests.append(request_mps2)
+        target = max(request_mps2, min(self._requests[0], 0.0))  # braking builds up late
+        a = self._accel_mps2 + (target - self._accel_mps2) * self._accel_gain
+        if a < 0.0:
+            a = max(a, -max(v_mps, 0.0) / self.dt_s)
+        self._accel_mps2 = a
+        return a

@@ -61,12 +61,15 @@ class Obstacles(Message):
 
 @dataclass(slots=True)
 class Predictions(Message):
-    """Predicted future centre positions of every tracked obstacle over horizon_s."""
+    """Predicted future centre positions of every tracked obstacle over horizon_s, one row per
+    (track, mode): the rows of a track are contiguous, most probable first, and their
+    `mode_prob` sum to 1 (less the dropped improbable modes)."""
 
     t_s: float
     dt_s: float  # spacing of the K predicted points; point k is at t_s + (k+1)·dt_s
     track_id: np.ndarray  # (n,)
-    model: list[str]  # (n,) "lane" or "cv"
+    model: list[str]  # (n,) one of PREDICTION_MODES
+    mode_prob: np.ndarray  # (n,) probability of the mode
     length_m: np.ndarray  # (n,)
     width_m: np.ndarray  # (n,)
     x_m: np.ndarray  # (n, K)
@@ -89,6 +92,8 @@ class PlannedTrajectory(Message):
     accel_mps2: np.ndarray
 
 
+# constant velocity; along a lane (or one of its continuations); a lane change left or right
+PREDICTION_MODES = ("cv", "lane", "left", "right")
 PLANNING_DECISIONS = ("cruise", "follow", "yield", "proceed", "emergency_brake")
 
 

@@ -59,7 +59,11 @@ class RoutePlanner:
         self._sqrt_ab = math.sqrt(c.idm_accel_mps2 * c.idm_decel_mps2)
         self._plan_v: float | None = None  # speed and accel of the previous plan, for stitching
         self._plan_a = 0.0
-        self._held_id = -1  # the track the previous plan yielded or braked for
+        self._hold_id = -1  # the track the previous plan yielded or braked hard for …
+        self._hold_decision = ""  # … and how
+        self._clear_frames = 0  # frames since that conflict last called for it
+        self._stop_s = 0.0  # route arc length of the stop point of the last yield
+        self._proceeding = np.zeros(0, dtype=np.int64)  # crossing tracks the ego proceeds past
 
     def _idm(self, v: float, gap_m: float, dv_mps: float) -> float:
         """IDM acceleration behind a leader gap_m ahead (bumper to bumper), closing at dv_mps."""
@@ -112,8 +116,16 @@ class RoutePlanner:
         v = max(v, 0.0)
         a = self._idm(v, math.inf, 0.0)  # free road
         decision, leader, target = "cruise", -1, self.cruise_mps
-        if predictions.x_m.shape[0] and predictions.x_m.shape[1] > 1:
-            a, decision, leader, target = self._react(predictions, s_e, v, a)
+        p = self._plausible(predictions)
+        proceeding, self._proceeding = self._proceeding, self._proceeding[:0]
+        if p.x_m.shape[0] and p.x_m.shape[1] > 1:
+            a, decision, leader, target = self._react(p, s_e, v, a, proceeding)
+        a, decision, leader, target = self._hold(s_e, v, a, decision, leader, target)
+        if decision == "emergency_brake":  # AEB ramps up at its jerk
+            a = max(min(self._plan_a, 0.0) - c.emergency_jerk_mps3 * self.frame_dt_s,
+                    -c.emergency_decel_mps2)
+        else:
+            a = max(a, -c.comfort_decel_mps2)
 
         # constant acceleration until t_end, when the speed reaches max(v, cruise) speeding up, or
         # slowing down the cruise speed on a free road (0 otherwise); then constant
@@ -132,15 +144,58 @@ class RoutePlanner:
         s = (v + 0.5 * a * t_acc) * t_acc + v_end * (t - t_acc) + s_e  # route arc length
         x, y = r.xy_at(s)
         self._plan_v, self._plan_a = v, float(accel[0])
-        self._held_id = leader if decision in ("yield", "emergency_brake") else -1
         return PlannedTrajectory(
             t_s=ego.t_s, decision=decision, target_speed_mps=float(target),
             leader_track_id=int(leader), t_rel_s=t, x_m=x, y_m=y, heading_rad=r.heading_at(s),
             speed_mps=speed, accel_mps2=accel,
         )
 
+    def _plausible(self, p: Predictions) -> Predictions:
+        """The predicted modes at least `mode_prob_min` probable, and every track's best one."""
+        n = len(p.track_id)
+        if n < 2:
+            return p
+        keep = p.mode_prob >= self.c.mode_prob_min
+        keep[0] = True
+        keep[1:] |= p.track_id[1:] != p.track_id[:-1]  # the first row of a track is its best
+        if np.count_nonzero(keep) == n:
+            return p
+        i = keep.nonzero()[0]
+        return Predictions(
+            t_s=p.t_s, dt_s=p.dt_s, track_id=p.track_id[i], model=[p.model[j] for j in i.tolist()],
+            mode_prob=p.mode_prob[i], length_m=p.length_m[i], width_m=p.width_m[i],
+            x_m=p.x_m[i], y_m=p.y_m[i],
+        )
+
+    def _hold(
+        self, s_e: float, v: float, a: float, decision: str, leader: int, target: float
+    ) -> tuple[float, str, int, float]:
+        """Decision hysteresis: a yield or AEB is held until its conflict has not called for it
+        for `release_frames` frames (a yield keeps stopping before the same point)."""
+        c = self.c
+        held, kind = self._hold_id, self._hold_decision
+        if held >= 0 and (decision, leader) != (kind, held):
+            self._clear_frames += 1
+            if self._clear_frames < c.release_frames and decision != "emergency_brake":
+                if kind == "emergency_brake":
+                    a, decision, leader, target = -c.emergency_decel_mps2, kind, held, 0.0
+                else:
+                    to_stop_m = max(self._stop_s - s_e - self._half_len, 0.0)
+                    a_yield = self._idm(v, to_stop_m + c.min_gap_m, v)
+                    if a_yield < a:
+                        a, decision, leader, target = a_yield, kind, held, 0.0
+        else:
+            self._clear_frames = 0
+        if decision in ("yield", "emergency_brake"):
+            if (decision, leader) != (kind, held):
+                self._clear_frames = 0
+            self._hold_id, self._hold_decision = leader, decision
+        else:
+            self._hold_id, self._hold_decision = -1, ""
+        return a, decision, leader, target
+
     def _react(
-        self, p: Predictions, s_e: float, v: float, a_free: float
+        self, p: Predictions, s_e: float, v: float, a_free: float, proceeding: np.ndarray
     ) -> tuple[float, str, int, float]:
         """(accel, decision, leader track id, target speed) given the predicted obstacles."""
         c = self.c
@@ -191,16 +246,22 @@ class RoutePlanner:
         if np.count_nonzero(cross):
             lon_ext = hl * cos_abs + hw * sin_abs  # (n, K-1) half extent along the route
             return self._gap_acceptance(
-                p, so, in_path, lon_ext, cross, k_in, s_e, v, a_nom, decision, leader, target
+                p, so, in_path, lon_ext, cross, k_in, s_e, v, a_nom, decision, leader, target,
+                proceeding,
             )
         return max(a_nom, -c.emergency_decel_mps2), decision, leader, target
 
     def _gap_acceptance(
         self, p: Predictions, so: np.ndarray, in_path: np.ndarray, lon_ext: np.ndarray,
         cross: np.ndarray, k_in: np.ndarray, s_e: float, v: float, a_nom: float, decision: str,
-        leader: int, target: float,
+        leader: int, target: float, proceeding: np.ndarray,
     ) -> tuple[float, str, int, float]:
-        """Proceed, yield or brake hard for the obstacles crossing the path (rows `cross`)."""
+        """Proceed, yield or brake hard for the obstacles crossing the path (rows `cross`).
+
+        The gap must hold with `gap_margin_s` to spare against the other's arrival taken
+        `arrival_uncertainty_frac` earlier (and its exit as much later); for a track the ego was
+        already proceeding past, `proceed_hold_margin_s` less, so a marginal change does not
+        revoke the proceed."""
         c = self.c
         i = cross.nonzero()[0]
         dt = p.dt_s
@@ -217,16 +278,21 @@ class RoutePlanner:
         s_hi = np.maximum(so0 + ext0, so1 + ext1)
         t_in = (k0 + 0.5) * dt  # point k is at (k + 1)·dt: half a step before the first one in
         t_out = np.where(k1 == km - 1, np.inf, (k1 + 1.5) * dt)  # still in at the end: never out
+        t_in_early = t_in * (1.0 - c.arrival_uncertainty_frac)
+        t_out_late = t_out * (1.0 + c.arrival_uncertainty_frac)
+        ids = p.track_id[i]
+        margin = np.where(np.isin(ids, proceeding), c.gap_margin_s - c.proceed_hold_margin_s,
+                          c.gap_margin_s)
         d_in = s_lo - s_e - self._half_len  # ego front to the conflict region
         te = self._arrival_s(v, np.concatenate((d_in, s_hi - s_e + self._half_len)))
         te_in, te_out = te[: len(i)], te[len(i):]
         # the ego clears first, or arrives after the other has left; for the obstacle it was
         # already yielding to, only once that one is about to leave (no proceed/brake flapping
         # as braking itself delays the ego's arrival)
-        after = te_in >= t_out + c.gap_margin_s
-        if self._held_id >= 0:
-            after = np.where(p.track_id[i] == self._held_id, t_out <= c.gap_margin_s, after)
-        safe = (te_out + c.gap_margin_s <= t_in) | after
+        after = te_in >= t_out_late + margin
+        if self._hold_id >= 0:
+            after = np.where(ids == self._hold_id, t_out_late <= margin, after)
+        safe = (te_out + margin <= t_in_early) | after
         stoppable = (d_in > 0.0) & (v * v <= 2.0 * c.yield_decel_max_mps2 * d_in)
         # AEB: a conflict the ego can no longer yield to, overlapping within emergency_ttc_s
         urgent = ~safe & ~stoppable & (d_in > -c.ego_length_m) & (
@@ -243,6 +309,8 @@ class RoutePlanner:
             if a_yield < a_nom:
                 a_nom, decision, target = a_yield, "yield", 0.0
                 leader = int(p.track_id[i[j]])
+                self._stop_s = s_e + self._half_len + d_stop
         elif decision == "cruise":
             decision = "proceed"
+            self._proceeding = ids
         return max(a_nom, -c.emergency_decel_mps2), decision, leader, target

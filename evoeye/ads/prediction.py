@@ -1,12 +1,21 @@
-"""Prediction: a future trajectory for every tracked obstacle, lane-following or constant-velocity.
+"""Prediction: multi-modal hypotheses per tracked obstacle, each with a probability.
 
-An obstacle gets the "lane" model when it sits near a lane centre and shows little lateral speed
-relative to it; it then advances along that centre line at its current along-lane speed (the lane:
-the nearest one heading roughly the obstacle's way). Otherwise it gets "cv" (constant
-velocity). The imperfections are deliberate: a cut-in is only recognised once its lateral speed
-exceeds `cutin_lat_speed_mps`; a car on a turning lane is predicted along whichever lane matches
-best, and where lanes coincide (an intersection entry) that may be the straight one; and as the
-map has no lane topology, a lane-following prediction runs straight on past the lane's end.
+An obstacle within `lane_match_radius_m` of a lane centre (of a lane heading roughly its way)
+gets these modes:
+
+* "lane": it follows the lane's centre line at its along-lane speed — one row per continuation
+  of the lane where the map branches (straight on, a turn), the continuations sharing the
+  lane-keeping probability by how well the obstacle's heading matches each continuation's
+  tangent a little ahead (`turn_lookahead_s`): a turn shows only once the car starts turning;
+* "left" / "right": a lane change into the neighbouring lane (where there is one), from its
+  current offset over `lane_change_duration_s` per lane width, with log-odds
+  v_lat / intent_lat_speed_scale_mps + offset / intent_offset_scale_m − intent_change_bias
+  against lane keeping.
+
+Any other obstacle gets one "cv" (constant velocity) mode. Modes below `min_mode_prob` are
+dropped, except each obstacle's most probable one. The hypotheses can be wrong, as a real
+predictor's are: a cut-in is likely only once lateral motion shows, a turn once the heading
+turns, and a driver who changes their mind is not foreseen.
 """
 
 from __future__ import annotations
@@ -17,11 +26,14 @@ import numpy as np
 
 from evoeye.ads.config import PredictionConfig
 from evoeye.ads.geometry import PolylineIndex
-from evoeye.ads.messages import Localization, Obstacles, Predictions
+from evoeye.ads.lanes import LaneGraph
+from evoeye.ads.messages import PREDICTION_MODES, Localization, Obstacles, Predictions
 from evoeye.scene import RoadMap
 
 HEADING_SECTORS = 8  # the lane grid keeps the nearest lane per 45° heading sector
-MODELS = ("cv", "lane")  # indexed by "follows a lane"
+CV, LANE, LEFT, RIGHT = range(4)  # indices into PREDICTION_MODES
+_GRAPHS: dict[tuple, LaneGraph] = {}  # lane graphs by (lane index, parameters)
+GRAPH_CACHE_MAX = 16
 
 
 class Predictor(Protocol):
@@ -30,50 +42,116 @@ class Predictor(Protocol):
     def predict(self, obstacles: Obstacles, ego: Localization) -> Predictions: ...
 
 
-class LaneOrCVPredictor:
-    """Lane-following prediction on the map's lanes, constant velocity as the fallback."""
+def _smoothstep(x: np.ndarray) -> np.ndarray:
+    x = np.clip(x, 0.0, 1.0)
+    return x * x * (3.0 - 2.0 * x)
+
+
+class IntentPredictor:
+    """Lane keeping / lane changes / lane continuations with probabilities; CV off the lanes."""
 
     def __init__(self, road_map: RoadMap, config: PredictionConfig) -> None:
-        self.c = config
-        self.k = int(round(config.horizon_s / config.dt_s))
-        self.t_s = (np.arange(self.k) + 1.0) * config.dt_s  # (K,)
-        self.lanes = PolylineIndex.build(
-            [lane.points for lane in road_map.lanes], config.lane_resample_m,
-            config.lane_match_radius_m, config.grid_cell_m, HEADING_SECTORS,
-        ) if road_map.lanes else None  # a map without lanes: everything is "cv"
+        c = config
+        self.c = c
+        self.k = int(round(c.horizon_s / c.dt_s))
+        self.t_s = (np.arange(self.k) + 1.0) * c.dt_s  # (K,)
+        self.lanes: PolylineIndex | None = None
+        if road_map.lanes:  # a map without lanes: everything is "cv"
+            self.lanes = PolylineIndex.build(
+                [lane.points for lane in road_map.lanes], c.lane_resample_m,
+                c.lane_match_radius_m, c.grid_cell_m, HEADING_SECTORS,
+            )
+            key = (self.lanes, c.successor_join_m, c.lane_resample_m)  # the index: by identity
+            graph = _GRAPHS.get(key)
+            if graph is None:
+                graph = LaneGraph.build(road_map.lanes, self.lanes, c.successor_join_m,
+                                        c.lane_resample_m)
+                if len(_GRAPHS) >= GRAPH_CACHE_MAX:
+                    _GRAPHS.pop(next(iter(_GRAPHS)))
+                _GRAPHS[key] = graph
+            self.graph = graph
 
     def predict(self, obstacles: Obstacles, ego: Localization) -> Predictions:
         c = self.c
         t = self.t_s
+        n = len(obstacles.x_m)
         ox, oy = obstacles.x_m, obstacles.y_m  # (n,)
         vx, vy = obstacles.vx_mps, obstacles.vy_mps
-        x = ox[:, None] + vx[:, None] * t  # (n, K) constant velocity
-        y = oy[:, None] + vy[:, None] * t
-        n = len(ox)
         if n == 0 or self.lanes is None:
-            return self._message(obstacles, x, y, ["cv"] * n)
-        lanes = self.lanes
-        # the nearest lane heading within about ±45° (at most ±67°) of the obstacle
-        v = lanes.candidates(ox, oy, obstacles.heading_rad)  # (n,)
+            x = ox[:, None] + vx[:, None] * t  # (n, K) constant velocity
+            y = oy[:, None] + vy[:, None] * t
+            return self._message(obstacles, np.arange(n), np.zeros(n, np.int64), np.ones(n), x, y)
+        lanes, graph = self.lanes, self.graph
+        v = lanes.candidates(ox, oy, obstacles.heading_rad)  # (n,) nearest lane heading our way
         g, lat, tx, ty = lanes.project(ox, oy, v)
-        # "lane" when near the centre line and moving along it: a heading check is implied for
-        # moving cars (|v_lat| small), and for slow ones both models predict nearly the same
-        on_lane = (np.abs(lat) <= c.lane_offset_max_m) & (
-            np.abs(vy * tx - vx * ty) <= c.cutin_lat_speed_mps
-        )
-        if np.count_nonzero(on_lane):
-            v_along = np.maximum(vx * tx + vy * ty, 0.0)
-            lx, ly = lanes.xy_at(g[:, None] + v_along[:, None] * t)  # (n, K)
-            keep = on_lane[:, None]
-            np.copyto(x, lx, where=keep)
-            np.copyto(y, ly, where=keep)
-        model = [MODELS[b] for b in on_lane.tolist()]
-        return self._message(obstacles, x, y, model)
+        lane = lanes.line.take(v)  # −1: no lane
+        on = (lane >= 0) & (np.abs(lat) <= c.lane_match_radius_m)
+        lane = np.where(on, lane, 0)
+        v_along = np.maximum(vx * tx + vy * ty, 0.0)
+        v_lat = tx * vy - ty * vx  # to the left of the lane
+
+        # lane-change intent against lane keeping (softmax over keep, left, right)
+        evidence = np.clip(v_lat * (1.0 / c.intent_lat_speed_scale_mps) + lat * (
+            1.0 / c.intent_offset_scale_m), -30.0, 30.0)  # off the lanes, lat is huge
+        w_left = np.where(graph.has_left.take(lane), np.exp(evidence - c.intent_change_bias), 0.0)
+        w_right = np.where(graph.has_right.take(lane),
+                           np.exp(-evidence - c.intent_change_bias), 0.0)
+        p_keep = 1.0 / (1.0 + w_left + w_right)
+
+        # continuations: heading against each path's tangent a little ahead
+        paths = graph.lane_paths[lane]  # (n, M) path ids, −1 padded
+        s = g - lanes.offset.take(lane)  # arc length along the lane
+        ahead = s + np.maximum(v_along * c.turn_lookahead_s, c.turn_lookahead_min_m)
+        path_off = graph.paths.offset.take(np.maximum(paths, 0))  # (n, M)
+        dh = graph.paths.heading_at(path_off + ahead[:, None]) - obstacles.heading_rad[:, None]
+        dh = (dh + np.pi) % (2.0 * np.pi) - np.pi
+        w = np.where(paths >= 0, np.exp(dh * dh * (-0.5 / c.turn_heading_sigma_rad**2)), 0.0)
+        p_path = w * (p_keep / np.maximum(w.sum(axis=1), 1e-12))[:, None]  # (n, M)
+
+        # rows (obstacle, mode, probability): lane continuations, left, right, cv
+        m = paths.shape[1]
+        p_all = np.concatenate((p_path, (w_left * p_keep)[:, None], (w_right * p_keep)[:, None],
+                                (~on)[:, None].astype(float)), axis=1)  # (n, M + 3)
+        p_all[~on, : m + 2] = 0.0
+        best = p_all.argmax(axis=1)
+        keep = (p_all >= c.min_mode_prob) | (np.arange(m + 3) == best[:, None])
+        keep &= p_all > 0.0
+        obs, col = keep.nonzero()  # row-major: grouped by obstacle
+        prob = p_all[obs, col]
+        order = np.lexsort((-prob, obs))  # per obstacle, most probable first
+        obs, col, prob = obs[order], col[order], prob[order]
+        mode = np.where(col < m, LANE, col - m + LEFT)  # m → LEFT, m + 1 → RIGHT, m + 2 → CV
+        mode[col == m + 2] = CV
+
+        x = ox.take(obs)[:, None] + vx.take(obs)[:, None] * t  # (r, K) constant velocity
+        y = oy.take(obs)[:, None] + vy.take(obs)[:, None] * t
+        along = s.take(obs)[:, None] + v_along.take(obs)[:, None] * t  # (r, K)
+        is_path = mode == LANE
+        if np.count_nonzero(is_path):
+            p_ids = paths[obs[is_path], col[is_path]]
+            px, py = graph.paths.xy_at(graph.paths.offset.take(p_ids)[:, None] + along[is_path])
+            x[is_path], y[is_path] = px, py
+        change = (mode == LEFT) | (mode == RIGHT)
+        if np.count_nonzero(change):
+            o = obs[change]
+            gl = lanes.offset.take(lane.take(o))[:, None] + along[change]
+            cx, cy = lanes.xy_at(gl)
+            hd = lanes.heading_at(gl)
+            width = graph.width_m.take(lane.take(o))
+            target = np.where(mode[change] == LEFT, width, -width)[:, None]
+            d0 = lat.take(o)[:, None]
+            dur = c.lane_change_duration_s * np.abs(target - d0) / width[:, None]
+            d = d0 + (target - d0) * _smoothstep(t / np.maximum(dur, c.dt_s))
+            x[change], y[change] = cx - d * np.sin(hd), cy + d * np.cos(hd)
+        return self._message(obstacles, obs, mode, prob, x, y)
 
     def _message(
-        self, obstacles: Obstacles, x: np.ndarray, y: np.ndarray, model: list[str]
+        self, obstacles: Obstacles, rows: np.ndarray, mode: np.ndarray, prob: np.ndarray,
+        x: np.ndarray, y: np.ndarray,
     ) -> Predictions:
         return Predictions(
-            t_s=obstacles.t_s, dt_s=self.c.dt_s, track_id=obstacles.track_id, model=model,
-            length_m=obstacles.length_m, width_m=obstacles.width_m, x_m=x, y_m=y,
+            t_s=obstacles.t_s, dt_s=self.c.dt_s, track_id=obstacles.track_id.take(rows),
+            model=[PREDICTION_MODES[i] for i in mode.tolist()], mode_prob=prob,
+            length_m=obstacles.length_m.take(rows), width_m=obstacles.width_m.take(rows),
+            x_m=x, y_m=y,
         )

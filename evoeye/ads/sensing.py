@@ -1,35 +1,42 @@
-"""The sensor model: which actors the ego's sensors detect, and how noisily.
+"""The sensor set: a 360° lidar and a long-range front radar, fused into one detection list.
 
-Detections are made from the ground truth: limited by range and field of view, hidden by nearer
-vehicles (angular shadowing), missed at random more often far away and when partly occluded, and
-perturbed by noise that grows with range. Each detection carries the variances of its noise, as a
-real detector reports its uncertainty; the tracker uses them as its measurement noise.
-Detections are columnar: one row per field (DET_*), one column per detection.
+Detections are made from the ground truth in the ego's sensor frame (x forward, y left) and
+placed in the world with the ego pose *estimated* at capture time (ego-motion compensation), so
+localisation errors move them as in a real stack. The lidar sees all around to `lidar_range_m`;
+it misses more far away and behind nearer cars (angular shadowing), its noise grows with range,
+and its boxes come from the visible points: a car seen end-on is a shorter box shifted towards the
+sensor, and cars closer than `lidar_merge_gap_m` merge into one segment. The radar sees far ahead
+in a narrow cone, with good range and range rate but poor azimuth, and no tangential velocity.
+Where both see an actor, the radar's range and range rate correct the lidar's box along the line
+of sight. False positives come from `evoeye.ads.clutter`. Each detection carries the variances of
+its noise, as a real detector reports its uncertainty; the tracker uses them as its measurement
+noise. Positions and velocities are complex numbers (x + iy) inside this module: a rotation is
+one multiplication, which keeps a frame to a few dozen numpy calls.
 """
 
 from __future__ import annotations
 
+import cmath
 import math
-from typing import NamedTuple
 
 import numpy as np
 
+from evoeye.ads.clutter import FalsePositives
 from evoeye.ads.config import SensorConfig
+from evoeye.ads.detections import (
+    DET_HEADING,
+    DET_VX,
+    DET_VY,
+    DET_X,
+    DET_Y,
+    VAR_FLOOR,
+    Detections,
+    pack,
+)
+from evoeye.ads.messages import Localization
 from evoeye.scene import SceneState
 
-TWO_PI = 2.0 * math.pi
-# rows of the (DET_FIELDS, m) detection array
-DET_X, DET_Y, DET_VX, DET_VY, DET_HEADING, DET_LENGTH, DET_WIDTH, DET_RANGE = range(8)
-DET_VAR_POS, DET_VAR_VEL = 8, 9
-VAR_FLOOR = 1e-4  # (0.01 m)², (0.01 m/s)²: no detector is exact
-DET_FIELDS = 10
-
-
-class Detections(NamedTuple):
-    """One frame of detections; `actor_id` is ground truth, for tests only (trackers ignore it)."""
-
-    actor_id: np.ndarray  # (m,)
-    z: np.ndarray  # (DET_FIELDS, m)
+N_NORMALS = 8  # standard normals per actor and frame: lidar x, y, vx, vy, heading; radar r, az, rr
 
 
 def occluded_fraction(
@@ -48,57 +55,157 @@ def occluded_fraction(
     return np.minimum(np.add.reduce(np.maximum(overlap, 0.0), axis=1) / (hi - lo), 1.0)
 
 
+def merge_segments(
+    pos: np.ndarray, vel: np.ndarray, heading_rad: np.ndarray, length_m: np.ndarray,
+    width_m: np.ndarray, range_m: np.ndarray, gap_m: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Lidar segmentation: merge detections whose true boxes are within gap_m of each other.
+
+    pos, vel (m,) complex in the sensor frame; heading, length, width: the true boxes (m,). A
+    detection with a nearer partner is absorbed by it: the partner's box grows to cover both (in
+    the partner's orientation), its position moves to the merged box's centre and its velocity is
+    averaged. Returns (kept mask, pos, vel, length, width) with the merged values.
+    """
+    rot = np.exp(-1j * heading_rad)  # (m,) into each detection's own frame
+    rel = np.subtract.outer(pos, pos).T * rot[:, None]  # (m, m) j relative to i, in i's frame
+    along, across = rel.real, rel.imag
+    gap = np.maximum(np.abs(along) - 0.5 * np.add.outer(length_m, length_m),
+                     np.abs(across) - 0.5 * np.add.outer(width_m, width_m))
+    absorbs = (gap < gap_m) & np.less.outer(range_m, range_m)  # (m, m) i absorbs the farther j
+    keep = ~absorbs.any(axis=0)
+    group = absorbs & keep[:, None]  # only segments that are kept absorb
+    if not np.count_nonzero(group):
+        return keep, pos, vel, length_m, width_m
+    group |= np.eye(len(pos), dtype=bool)
+    hl, hw = 0.5 * length_m, 0.5 * width_m
+    lo_a = np.where(group, along - hl, np.inf).min(axis=1)
+    hi_a = np.where(group, along + hl, -np.inf).max(axis=1)
+    lo_c = np.where(group, across - hw, np.inf).min(axis=1)
+    hi_c = np.where(group, across + hw, -np.inf).max(axis=1)
+    mid = 0.5 * ((lo_a + hi_a) + 1j * (lo_c + hi_c))
+    return keep, pos + mid / rot, (group @ vel) / group.sum(axis=1), hi_a - lo_a, hi_c - lo_c
+
+
+def to_world(z: np.ndarray, pose: tuple[float, float, float, float]) -> np.ndarray:
+    """Sensor-frame detections (DET_FIELDS, m) → world frame, in place, for the ego pose
+    (x, y, h, v); velocities are relative to the ego in the sensor frame."""
+    x0, y0, h0, v0 = pose
+    c, s = math.cos(h0), math.sin(h0)
+    px, py = z[DET_X].copy(), z[DET_Y].copy()
+    z[DET_X] = x0 + c * px - s * py
+    z[DET_Y] = y0 + s * px + c * py
+    vx, vy = z[DET_VX] + v0, z[DET_VY].copy()  # relative to the ego → absolute, ego-aligned
+    z[DET_VX] = c * vx - s * vy
+    z[DET_VY] = s * vx + c * vy
+    z[DET_HEADING] += h0
+    return z
+
+
 class SensorModel:
-    """Front (limited field of view) and surround sensors, fused into one detection list."""
+    """Lidar + radar + false positives, fused into one detection list per frame."""
 
     def __init__(self, config: SensorConfig, rng: np.random.Generator) -> None:
         c = config
         self.c = c
         self.rng = rng
-        self._sigma_base = np.array([[c.pos_sigma_m], [c.pos_sigma_m], [c.vel_sigma_mps],
-                                     [c.vel_sigma_mps], [c.heading_sigma_rad]])  # (5, 1)
-        self._sigma_slope = np.array([[c.pos_sigma_per_m], [c.pos_sigma_per_m],
-                                      [c.vel_sigma_per_m], [c.vel_sigma_per_m],
-                                      [c.heading_sigma_per_m]])
-        # detection probability near − drop·r², reaching detect_prob_far at the front range
-        self._p_drop_per_m2 = (c.detect_prob_near - c.detect_prob_far) / c.front_range_m**2
-        self._empty = Detections(np.zeros(0, dtype=np.int64), np.zeros((DET_FIELDS, 0)))
+        self.false_positives = FalsePositives(c)
+        # detection probabilities: near − drop·r², reaching the far value at the sensor's range
+        self._lidar_drop = (c.lidar_detect_prob_near - c.lidar_detect_prob_far) / c.lidar_range_m**2
+        self._radar_drop = (c.radar_detect_prob_near - c.radar_detect_prob_far) / c.radar_range_m**2
+        self._inv_occ_lidar = 1.0 / c.occluded_fraction_max
+        self._inv_occ_radar = 1.0 / c.radar_occluded_fraction_max
+        self._radar_var_vel = c.radar_vel_sigma_mps**2 + VAR_FLOOR
+        self._var_range = c.radar_range_sigma_m**2 + VAR_FLOOR  # radar variances, for the fusion
+        self._var_range_rate = c.radar_range_rate_sigma_mps**2 + VAR_FLOOR
 
-    def detect(self, scene: SceneState) -> Detections:
-        """Detections of every actor but the ego (row 0) at scene.t_s."""
+    def detect(self, scene: SceneState, ego: Localization | None = None) -> Detections:
+        """Detections of every actor but the ego (row 0) at scene.t_s, in the world frame placed
+        with `ego` (the localisation estimate at capture; None: the true pose)."""
         c = self.c
         n = len(scene.actor_id) - 1
+        fp = self.false_positives
         # a fixed number of draws per frame, whatever is detected: the stream stays aligned
-        u = self.rng.random(n)
-        noise = self.rng.standard_normal((5, n))
+        u = self.rng.random(3 * n + fp.n_uniforms)
+        g = self.rng.standard_normal(N_NORMALS * n)
+        gc = g[: 4 * n].view(np.complex128)  # (2n,) lidar position noise, velocity noise
+        x, y, h, v = scene.x_m, scene.y_m, scene.heading_rad, scene.speed_mps
+        x0, y0, h0, v0 = float(x[0]), float(y[0]), float(h[0]), float(v[0])
+        pose = (x0, y0, h0, v0) if ego is None else (
+            ego.x_m, ego.y_m, ego.heading_rad, ego.speed_mps)
+        fp_ids, fp_z = fp.detect(u[3 * n:], v0)
         if n == 0:
-            return self._empty
-        x, y, h = scene.x_m, scene.y_m, scene.heading_rad
-        dx, dy = x[1:] - x[0], y[1:] - y[0]
-        r = np.hypot(dx, dy)  # (n,)
-        b = np.arctan2(dy, dx)  # absolute bearing
-        rel = np.remainder(b - (h[0] - math.pi), TWO_PI) - math.pi  # bearing from the ego heading
-        phi = h[1:] - b  # target orientation relative to the line of sight
+            return Detections(fp_ids, to_world(fp_z, pose))
+        # ground truth in the sensor frame (x forward, y left)
+        rel = ((x[1:] - x0) + 1j * (y[1:] - y0)) * cmath.exp(-1j * h0)  # (n,)
+        h_rel = h[1:] - h0
+        e_h = np.exp(1j * h_rel)
+        vrel = v[1:] * e_h - v0  # velocity relative to the ego
+        r = np.abs(rel)
+        bearing = np.angle(rel)  # (−π, π]: the seam is straight behind
+        los = rel / r  # unit line of sight
+        e_phi = e_h / los  # target orientation relative to the line of sight
+        cos_phi, sin_phi = np.abs(e_phi.real), np.abs(e_phi.imag)
         length, width = scene.length_m[1:], scene.width_m[1:]
-        extent = length * np.abs(np.sin(phi)) + width * np.abs(np.cos(phi))  # seen across
-        occ = occluded_fraction(r, rel, np.arctan2(extent, r + r))
-        # detection probability: falls with range and with occlusion (to 0 at
-        # occluded_fraction_max); none out of range (the front range inside the field of view,
-        # the surround range elsewhere)
-        r_max = np.where(np.abs(rel) <= c.front_half_fov_rad, c.front_range_m, c.surround_range_m)
-        p = (c.detect_prob_near - self._p_drop_per_m2 * (r * r)) * (
-            1.0 - occ * (1.0 / c.occluded_fraction_max)
+        occ = occluded_fraction(r, bearing, np.arctan2(length * sin_phi + width * cos_phi, r + r))
+        r2 = r * r
+        p_lidar = (c.lidar_detect_prob_near - self._lidar_drop * r2) * (
+            1.0 - occ * self._inv_occ_lidar)
+        p_radar = (c.radar_detect_prob_near - self._radar_drop * r2) * (
+            1.0 - occ * self._inv_occ_radar)
+        lidar = (u[:n] < p_lidar) & (r <= c.lidar_range_m)
+        radar = (u[n:2 * n] < p_radar) & (r <= c.radar_range_m) & (
+            np.abs(bearing) <= c.radar_half_fov_rad)
+
+        # lidar boxes from the visible points: shorter end-on, centred on the visible part
+        f = c.lidar_depth_seen_frac
+        len_l = length * (f + (1.0 - f) * sin_phi)
+        wid_l = width * (f + (1.0 - f) * cos_phi)
+        shift = 0.5 * ((length - len_l) * cos_phi + (width - wid_l) * sin_phi)
+        sig_p = c.pos_sigma_m + c.pos_sigma_per_m * r
+        sig_v = c.vel_sigma_mps + c.vel_sigma_per_m * r
+        pos_l = rel - shift * los + sig_p * gc[:n]
+        vel_l = vrel + sig_v * gc[n:]
+        head_l = h_rel + (c.heading_sigma_rad + c.heading_sigma_per_m * r) * g[4 * n:5 * n]
+        var_pl, var_vl = sig_p * sig_p + VAR_FLOOR, sig_v * sig_v + VAR_FLOOR
+        if np.count_nonzero(lidar) > 1:
+            i = lidar.nonzero()[0]
+            keep, pos_l[i], vel_l[i], len_l[i], wid_l[i] = merge_segments(
+                pos_l[i], vel_l[i], h_rel[i], length[i], width[i], r[i], c.lidar_merge_gap_m)
+            lidar[i[~keep]] = False
+
+        # radar: range and azimuth → position; range rate → the radial velocity only
+        rm = r + c.radar_range_sigma_m * g[5 * n:6 * n]
+        los_r = np.exp(1j * (bearing + c.radar_azimuth_sigma_rad * g[6 * n:7 * n]))
+        rr = (vrel * los.conj()).real + c.radar_range_rate_sigma_mps * g[7 * n:]
+        pos_r, vel_r = rm * los_r, rr * los_r
+        vel_abs = vel_r + v0
+        head_r = np.where(np.abs(vel_abs) > 1.0, np.angle(vel_abs), 0.0)
+        var_pr = np.maximum(self._var_range, (r * c.radar_azimuth_sigma_rad) ** 2 + VAR_FLOOR)
+
+        # fusion where both see the actor: the radar measures range and range rate only, so it
+        # corrects the lidar along its line of sight (a Kalman update with a radial measurement)
+        both = lidar & radar
+        if np.count_nonzero(both):
+            back = los_r.conj()
+            d_pos = (var_pl / (var_pl + self._var_range)) * (rm - (pos_l * back).real)
+            d_vel = (var_vl / (var_vl + self._var_range_rate)) * (rr - (vel_l * back).real)
+            pos_l = np.where(both, pos_l + d_pos * los_r, pos_l)
+            vel_l = np.where(both, vel_l + d_vel * los_r, vel_l)
+        seen = (lidar | radar).nonzero()[0]
+        lid = lidar[seen]
+        z = pack(
+            np.where(lid, pos_l[seen], pos_r[seen]), np.where(lid, vel_l[seen], vel_r[seen]),
+            np.where(lid, head_l[seen], head_r[seen]),
+            np.where(lid, len_l[seen], c.radar_length_m),
+            np.where(lid, wid_l[seen], c.radar_width_m), r[seen],
+            np.where(lid, var_pl[seen], var_pr[seen]),
+            np.where(lid, var_vl[seen], self._radar_var_vel),
         )
-        idx = ((u < p) & (r <= r_max)).nonzero()[0]
-        if len(idx) == 0:
-            return self._empty
-        speed = scene.speed_mps[1:]
-        truth = np.array((
-            x[1:], y[1:], speed * np.cos(h[1:]), speed * np.sin(h[1:]), h[1:], length, width, r,
-        ))[:, idx]  # (8, m)
-        sigma = self._sigma_base + self._sigma_slope * truth[DET_RANGE]  # (5, m)
-        truth[:5] += sigma * noise[:, idx]
-        # the reported variances have a floor: a Kalman update with R = 0 and a fresh track's
-        # singular covariance would divide by zero
-        z = np.concatenate((truth, sigma[0:3:2] ** 2 + VAR_FLOOR))
-        return Detections(scene.actor_id[1:][idx], z)
+        ids = scene.actor_id[1:][seen]
+        by_radar = radar[seen]
+        ghost_ids, ghosts = fp.ghosts(z[:, by_radar], u[2 * n:3 * n][seen][by_radar])
+        if len(ghost_ids):
+            ids, z = np.concatenate((ids, ghost_ids)), np.concatenate((z, ghosts), axis=1)
+        if len(fp_ids):
+            ids, z = np.concatenate((ids, fp_ids)), np.concatenate((z, fp_z), axis=1)
+        return Detections(ids, to_world(z, pose))

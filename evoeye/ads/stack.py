@@ -10,7 +10,7 @@ from evoeye.ads.localization import Localizer, NoisyLocalizer
 from evoeye.ads.messages import FrameMessages
 from evoeye.ads.perception import Perception, TrackingPerception
 from evoeye.ads.planning import Planner, RoutePlanner
-from evoeye.ads.prediction import LaneOrCVPredictor, Predictor
+from evoeye.ads.prediction import IntentPredictor, Predictor
 from evoeye.scene import RoadMap, SceneState
 
 
@@ -31,7 +31,7 @@ class ADS:
         self.road_map = road_map
         self.localizer: Localizer = NoisyLocalizer(c.localization, rng)
         self.perception: Perception = TrackingPerception(c.sensor, c.tracker, c.frame_dt_s, rng)
-        self.predictor: Predictor = LaneOrCVPredictor(road_map, c.prediction)
+        self.predictor: Predictor = IntentPredictor(road_map, c.prediction)
         self.planner: Planner = RoutePlanner(road_map, c.planning, c.cruise_speed_mps, c.frame_dt_s)
         self.controller: Controller = PurePursuitController(c.control, c.frame_dt_s)
 

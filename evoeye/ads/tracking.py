@@ -16,7 +16,7 @@ import numpy as np
 from scipy.optimize import linear_sum_assignment
 
 from evoeye.ads.config import TrackerConfig
-from evoeye.ads.sensing import (
+from evoeye.ads.detections import (
     DET_HEADING,
     DET_RANGE,
     DET_VAR_POS,
@@ -124,11 +124,11 @@ class CVTracker:
                 confirmed = confirmed[alive]
         self.confirmed = confirmed
 
-    def confidence(self, s: np.ndarray, front_range_m: float) -> np.ndarray:
+    def confidence(self, s: np.ndarray, range_m: float) -> np.ndarray:
         """Confidence in [0, 1] of tracks with states s (13, n), from hits, range and misses."""
         c = self.c
         hits = s[HITS]
         return (hits / (hits + c.confidence_hits_scale)) * (
-            (1.0 - (c.confidence_range_drop / front_range_m) * s[RANGE])  # range ≤ front range
+            (1.0 - (c.confidence_range_drop / range_m) * s[RANGE])  # detection range ≤ range_m
             * c.confidence_coast_decay ** s[MISSES]
         )

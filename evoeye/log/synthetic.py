@@ -83,6 +83,7 @@ def synthetic_frame(
             0.1,
             ids,
             ["lane" if i % 2 else "cv" for i in range(m)],
+            np.ones(m),
             np.full(m, 5.0),
             np.full(m, 2.0),
             rng.uniform(0, 500, (m, k)),

@@ -7,8 +7,9 @@ Per frame, with n = `max_obstacles`, K = `pred_points`, P = `plan_points`:
     perception       (n, 9)    PERCEPTION_FEATURES of the n nearest obstacles, nearest first
     perception_mask  (n,)      True where a slot holds an obstacle (slots fill from 0)
     prediction       (n, K, 2) predicted centre (dx_m, dy_m) at K points, every `pred_stride`-th
-                               point of the ADS's prediction, ending at its horizon; obstacles
-                               ordered by the distance of their first predicted point
+                               point of the ADS's prediction, ending at its horizon, of each
+                               obstacle's most probable mode; obstacles ordered by the distance
+                               of their first predicted point
     prediction_mask  (n,)
     plan             (P, 7)    PLAN_FEATURES at every `plan_stride`-th planned point from now
     plan_mask        (P,)      True where the plan had that point
@@ -215,8 +216,14 @@ def _prediction(t: pa.Table, ego: _EgoPose, spec: FeatureSpec, out: FrameFeature
     has_points = np.diff(inner) > 0
     rows = np.repeat(np.arange(len(t)), np.diff(outer))
     dx, dy = ego.to_ego(x[idx], y[idx], rows[:, None])
-    dist = np.where(has_points, np.hypot(dx[:, 0], dy[:, 0]), np.inf)
+    # one slot per obstacle, its most probable mode: the first of its contiguous rows
+    track = _values(t, "pred_track_id")[1]
+    first = np.ones(len(track), dtype=bool)
+    first[1:] = (track[1:] != track[:-1]) | (rows[1:] != rows[:-1])
+    dist = np.where(has_points & first, np.hypot(dx[:, 0], dy[:, 0]), np.inf)
     item, frame, slot = _nearest_slots(outer, dist, spec.max_obstacles)
+    primary = first[item]
+    item, frame, slot = item[primary], frame[primary], slot[primary]
     item_ok = has_points[item]
     out.prediction[frame, slot] = _finite32(np.stack([dx[item], dy[item]], axis=-1))
     out.prediction_mask[frame, slot] = item_ok

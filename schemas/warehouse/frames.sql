@@ -28,10 +28,11 @@ CREATE TABLE frames (
     obs_length_m           FLOAT[],
     obs_width_m            FLOAT[],
     obs_confidence         FLOAT[],
-    -- prediction: point k of obstacle i is at t_s + (k+1) * pred_dt_s
+    -- prediction: point k of row i (an obstacle's mode) is at t_s + (k+1) * pred_dt_s
     pred_dt_s              DOUBLE,
     pred_track_id          BIGINT[],
-    pred_model             VARCHAR[],
+    pred_model             VARCHAR[],          -- one row per (obstacle, mode), most probable first
+    pred_mode_prob         FLOAT[],
     pred_length_m          FLOAT[],
     pred_width_m           FLOAT[],
     pred_x_m               FLOAT[][],          -- (n, K)

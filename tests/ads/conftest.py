@@ -121,11 +121,15 @@ def rng() -> np.random.Generator:
 
 
 def ideal_sensor(**changes) -> SensorConfig:
-    """A sensor without noise, misses or latency (occlusion and range limits still apply)."""
+    """A sensor set without noise, misses, false positives or latency, seeing whole boxes
+    (occlusion, range limits, segment merging and the radar's missing tangential velocity
+    still apply)."""
     base = dict(
-        detect_prob_near=1.0, detect_prob_far=1.0, pos_sigma_m=0.0, pos_sigma_per_m=0.0,
-        vel_sigma_mps=0.0, vel_sigma_per_m=0.0, heading_sigma_rad=0.0, heading_sigma_per_m=0.0,
-        latency_s=0.0,
+        lidar_detect_prob_near=1.0, lidar_detect_prob_far=1.0, radar_detect_prob_near=1.0,
+        radar_detect_prob_far=1.0, pos_sigma_m=0.0, pos_sigma_per_m=0.0, vel_sigma_mps=0.0,
+        vel_sigma_per_m=0.0, heading_sigma_rad=0.0, heading_sigma_per_m=0.0,
+        radar_range_sigma_m=0.0, radar_azimuth_sigma_rad=0.0, radar_range_rate_sigma_mps=0.0,
+        lidar_depth_seen_frac=1.0, clutter_rate_per_frame=0.0, ghost_prob=0.0, latency_s=0.0,
     )
     base.update(changes)
     return replace(ADSConfig.cautious().sensor, **base)
@@ -155,7 +159,7 @@ def cv_predictions(rows: list[tuple[float, float, float, float]], t_s: float = 0
     t = (np.arange(round(horizon_s / dt_s)) + 1.0) * dt_s
     vx, vy = a[:, 3] * np.cos(a[:, 2]), a[:, 3] * np.sin(a[:, 2])
     return Predictions(
-        t_s=t_s, dt_s=dt_s, track_id=np.arange(1, n + 1), model=["cv"] * n,
+        t_s=t_s, dt_s=dt_s, track_id=np.arange(1, n + 1), model=["cv"] * n, mode_prob=np.ones(n),
         length_m=np.full(n, 5.0), width_m=np.full(n, 2.0),
         x_m=a[:, :1] + vx[:, None] * t, y_m=a[:, 1:2] + vy[:, None] * t,
     )

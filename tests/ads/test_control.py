@@ -1,6 +1,7 @@
 """Control: pure pursuit + PID, in closed loop with the kinematic bicycle, and its limits."""
 
 import math
+from dataclasses import replace
 
 import numpy as np
 from conftest import DT_S, BicycleWorld, curved_road, ego_at, straight_road
@@ -46,17 +47,21 @@ def plan_of(speed, accel, heading=0.0, n=41):
     )
 
 
+IDEAL_ACTUATORS = replace(ControlConfig(), accel_lag_s=0.0, steering_lag_s=0.0,
+                          brake_dead_time_s=0.0)
+
+
 def test_acceleration_saturates_and_maps_to_brake_and_throttle():
-    ctl = PurePursuitController(ControlConfig(), DT_S)
+    ctl = PurePursuitController(IDEAL_ACTUATORS, DT_S)
     hard = ctl.control(plan_of(20.0, -20.0), ego_at(0.0, 10.0, 0.0, 20.0))
     assert hard.accel_cmd_mps2 == -8.0 and hard.brake == 1.0 and hard.throttle == 0.0
-    ctl = PurePursuitController(ControlConfig(), DT_S)
+    ctl = PurePursuitController(IDEAL_ACTUATORS, DT_S)
     gas = ctl.control(plan_of(20.0, 1.5), ego_at(0.0, 10.0, 0.0, 20.0))
     assert gas.accel_cmd_mps2 == 1.5 and math.isclose(gas.throttle, 0.5) and gas.brake == 0.0
 
 
 def test_steering_respects_the_angle_and_rate_limits():
-    config = ControlConfig()
+    config = IDEAL_ACTUATORS
     ctl = PurePursuitController(config, DT_S)
     plan = plan_of(10.0, 0.0, heading=math.pi / 2)  # the path turns away to the left
     steer = [ctl.control(plan, ego_at(0.0, 0.0, 0.0, 10.0)).steering_rad for _ in range(20)]
@@ -66,8 +71,48 @@ def test_steering_respects_the_angle_and_rate_limits():
 
 
 def test_holds_still_without_reversing():
-    ctl = PurePursuitController(ControlConfig(), DT_S)
+    ctl = PurePursuitController(IDEAL_ACTUATORS, DT_S)
     cmd = ctl.control(plan_of(0.0, 0.0), ego_at(0.0, 10.0, 0.0, 0.02))
     assert math.isclose(cmd.accel_cmd_mps2, -0.02 / DT_S)  # exactly to zero in one frame
     cmd = ctl.control(plan_of(0.0, 0.0), ego_at(0.0, 10.0, 0.0, 0.0))
     assert cmd.accel_cmd_mps2 == 0.0
+
+
+def test_brake_dead_time_then_first_order_lag():
+    config = replace(ControlConfig(), accel_lag_s=0.25, brake_dead_time_s=0.1)
+    ctl = PurePursuitController(config, DT_S)
+    ego = ego_at(0.0, 10.0, 0.0, 20.0)
+    a = [ctl.control(plan_of(20.0, -20.0), ego).accel_cmd_mps2 for _ in range(30)]
+    dead = round(0.1 / DT_S)
+    assert a[:dead] == [0.0] * dead  # nothing happens during the dead time
+    t = (np.arange(30 - dead) + 1) * DT_S  # then −8 · (1 − e^(−t/τ))
+    assert np.allclose(a[dead:], -8.0 * (1.0 - np.exp(-t / 0.25)))
+    assert a[dead + 4] > -0.7 * 8.0  # one τ after the dead time: about 63 % of the request
+
+
+def test_releasing_the_brake_has_no_dead_time():
+    ctl = PurePursuitController(replace(ControlConfig(), brake_dead_time_s=0.2), DT_S)
+    ego = ego_at(0.0, 10.0, 0.0, 20.0)
+    for _ in range(20):
+        braking = ctl.control(plan_of(20.0, -20.0), ego).accel_cmd_mps2
+    released = ctl.control(plan_of(20.0, 1.5), ego).accel_cmd_mps2
+    assert braking < -7.0 and released > braking + 1.0
+
+
+def test_steering_is_lagged_behind_the_request():
+    lagged = PurePursuitController(replace(IDEAL_ACTUATORS, steering_lag_s=0.3), DT_S)
+    ideal = PurePursuitController(IDEAL_ACTUATORS, DT_S)
+    plan = plan_of(10.0, 0.0, heading=math.pi / 2)
+    ego = ego_at(0.0, 0.0, 0.0, 10.0)
+    slow = [lagged.control(plan, ego).steering_rad for _ in range(40)]
+    fast = [ideal.control(plan, ego).steering_rad for _ in range(40)]
+    assert all(0.0 < s < f for s, f in zip(slow[:10], fast[:10], strict=True))
+    assert math.isclose(slow[-1], fast[-1], rel_tol=0.05)  # it gets there
+
+
+def test_the_brakes_stop_the_car_but_never_reverse_it():
+    ctl = PurePursuitController(ControlConfig(), DT_S)
+    for _ in range(20):
+        ctl.control(plan_of(20.0, -20.0), ego_at(0.0, 10.0, 0.0, 20.0))
+    cmd = ctl.control(plan_of(20.0, -20.0), ego_at(0.0, 10.0, 0.0, 0.1))
+    assert math.isclose(cmd.accel_cmd_mps2, -0.1 / DT_S)

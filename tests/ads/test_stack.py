@@ -50,8 +50,12 @@ def test_all_outputs_finite_and_well_formed():
     frames, _, _ = run(straight_road(), (0, 0, 0, 20), HIGHWAY_NPCS, 20.0, 6.0, seed=3)
     assert all(m.all_finite() for m in frames)
     for m in frames:
-        n = len(m.obstacles.track_id)
-        assert m.predictions.x_m.shape == (n, 30) and len(m.predictions.model) == n
+        p = m.predictions
+        rows = len(p.track_id)
+        assert set(p.track_id.tolist()) == set(m.obstacles.track_id.tolist())
+        assert p.x_m.shape == (rows, 30) and len(p.model) == rows and p.mode_prob.shape == (rows,)
+        per_track = np.bincount(np.unique(p.track_id, return_inverse=True)[1], p.mode_prob)
+        assert ((per_track > 0.0) & (per_track <= 1.0 + 1e-9)).all()
         assert m.plan.decision in PLANNING_DECISIONS
         assert 0.0 <= m.control.throttle <= 1.0 and 0.0 <= m.control.brake <= 1.0
         assert -8.0 <= m.control.accel_cmd_mps2 <= 3.0 and abs(m.control.steering_rad) <= 0.5

@@ -42,6 +42,7 @@ def _frames(decisions: list[str | None], obstacles_x: list[list[float]]) -> pa.T
         "obs_width_m": [[2.0] * len(xs) for xs in obstacles_x],
         "obs_confidence": [[0.9] * len(xs) for xs in obstacles_x],
         # one predicted track per obstacle: straight ahead (+y) one metre per point
+        "pred_track_id": [list(range(1, len(xs) + 1)) for xs in obstacles_x],
         "pred_x_m": [[[x] * k_raw for x in xs] for xs in obstacles_x],
         "pred_y_m": [[[y + j + 1 for j in range(k_raw)] for y in ys] for ys in obs_y],
         "plan_decision": decisions,
@@ -129,3 +130,22 @@ def test_runtime_messages_give_the_inputs_stored_at_ingest(
     live = frame_features(runtime_table([f.messages for f in episode.frames]), FEATURES)
     for name, arr in stored.arrays().items():
         np.testing.assert_allclose(getattr(live, name), arr, rtol=1e-6, atol=1e-5, err_msg=name)
+
+
+def test_prediction_takes_each_obstacles_most_probable_mode_only() -> None:
+    t = _frames(["cruise"], [[10.0, 7.0]])
+    # obstacle 1 gets a second, less probable mode (listed after its first), nearer to the ego
+    # than its first mode: without the rule it would take obstacle 1's slot
+    t = t.set_column(t.schema.get_field_index("pred_track_id"), "pred_track_id",
+                     pa.array([[1, 1, 2]]))
+    x = t.column("pred_x_m").to_pylist()[0]
+    y = t.column("pred_y_m").to_pylist()[0]
+    t = t.set_column(t.schema.get_field_index("pred_x_m"), "pred_x_m",
+                     pa.array([[x[0], [v - 5.0 for v in x[0]], x[1]]]))
+    t = t.set_column(t.schema.get_field_index("pred_y_m"), "pred_y_m",
+                     pa.array([[y[0], [v - 15.0 for v in y[0]], y[1]]]))
+    f = frame_features(t, SPEC)
+    assert f.prediction_mask[0].tolist() == [True, True]
+    # no slot holds the second mode (5 m to the left): obstacle 1 (0 m) and 2 (3 m) do
+    lateral = sorted(float(v) for v in f.prediction[0, :, 0, 1])
+    assert lateral == pytest.approx([0.0, 3.0], abs=1e-5)
