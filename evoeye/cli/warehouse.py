@@ -149,6 +149,26 @@ def _count_pct(count: int, pct: float | None) -> str:
     return f"{count:,} ({pct:.1f}%)" if pct is not None else f"{count:,}"
 
 
+def attribution_table(rows: list[dict[str, Any]]) -> Table:
+    """Per logical scenario and software version: runs explained, each cause's share, and how
+    many collisions the careful reference driver avoids (rows of view attribution_shares)."""
+    causes = ("perception", "prediction", "planning", "control", "compound")
+    table = Table(title="root causes of collisions (evoeye explain)")
+    for col in ("LS", "version", "#Runs", *causes, "careful driver avoids"):
+        table.add_column(col, justify="left" if col in ("LS", "version") else "right")
+    groups: dict[tuple[str, str], dict[str, Any]] = {}
+    for r in rows:
+        g = groups.setdefault((r["logical_scenario"], r["software_version"]), dict(r))
+        g[r["cause"]] = r["share"]
+    for (ls, version), g in groups.items():
+        careful = (f"{g['careful_avoided']}/{g['careful_runs']} "
+                   f"({100.0 * g['careful_avoided'] / g['careful_runs']:.0f}%)"
+                   if g["careful_runs"] else "–")
+        table.add_row(ls, version, str(g["runs"]),
+                      *(f"{100.0 * g.get(c, 0.0):.0f}%" for c in causes), careful)
+    return table
+
+
 @warehouse_app.command("stats")
 def stats_command(
     root: RootOpt = None,
@@ -179,6 +199,9 @@ def stats_command(
             _count_pct(r["unsafe_frames"], r["unsafe_pct"]), str(r["failed"]),
         )
     _out().print(table)
+    shares = Warehouse(root).query("attribution_shares", logical_scenario=None).to_pylist()
+    if shares:
+        _out().print(attribution_table(shares))
     if not rows:
         _out().print(f"the warehouse under {DataRoot.resolve(root).path} is empty: "
                       "run `evoeye ingest` first")
