@@ -16,6 +16,7 @@ from rich.console import Console
 from rich.table import Table
 
 from evoeye.cli.app import app
+from evoeye.evaluation import report
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse, WarehouseLockedError
 from evoeye.store.ingest import DEFAULT_RUNS_PER_PART, IngestReport, ingest
@@ -150,22 +151,13 @@ def _count_pct(count: int, pct: float | None) -> str:
 
 
 def attribution_table(rows: list[dict[str, Any]]) -> Table:
-    """Per logical scenario and software version: runs explained, each cause's share, and how
-    many collisions the careful reference driver avoids (rows of view attribution_shares)."""
-    causes = ("perception", "prediction", "planning", "control", "compound")
-    table = Table(title="root causes of collisions (evoeye explain)")
-    for col in ("LS", "version", "#Runs", *causes, "careful driver avoids"):
-        table.add_column(col, justify="left" if col in ("LS", "version") else "right")
-    groups: dict[tuple[str, str], dict[str, Any]] = {}
-    for r in rows:
-        g = groups.setdefault((r["logical_scenario"], r["software_version"]), dict(r))
-        g[r["cause"]] = r["share"]
-    for (ls, version), g in groups.items():
-        careful = (f"{g['careful_avoided']}/{g['careful_runs']} "
-                   f"({100.0 * g['careful_avoided'] / g['careful_runs']:.0f}%)"
-                   if g["careful_runs"] else "–")
-        table.add_row(ls, version, str(g["runs"]),
-                      *(f"{100.0 * g.get(c, 0.0):.0f}%" for c in causes), careful)
+    """Root causes by `evoeye explain` (rows of view attribution_shares) as a console table."""
+    shares = report.attribution_table(rows)
+    table = Table(title="root causes of collisions (evoeye explain), %")
+    for i, col in enumerate(shares.header):
+        table.add_column(col, justify="left" if i < 2 else "right")
+    for row in shares.rows:
+        table.add_row(*row)
     return table
 
 
