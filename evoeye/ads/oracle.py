@@ -97,20 +97,17 @@ class TrueFuturePredictor:
 
     def predict(self, obstacles: Obstacles, ego: Localization) -> Predictions:
         n, f = len(obstacles.x_m), self.futures
-        t = obstacles.t_s + (np.arange(self.k + 1)) * self.c.dt_s  # (K+1,) now, then the horizon
-        x_all, y_all = f.positions(t)  # (K+1, A)
-        d = np.hypot(obstacles.x_m[:, None] - x_all[0], obstacles.y_m[:, None] - y_all[0])  # (n, A)
-        if n and d.shape[1]:
-            match = np.nan_to_num(d, nan=np.inf).argmin(axis=1)  # (n,)
-            x, y = x_all[1:, match].T, y_all[1:, match].T  # (n, K)
-            # an obstacle with no present actor (a false positive) keeps its constant velocity
-            cv = ~np.isfinite(x)
-            cx = obstacles.x_m[:, None] + obstacles.vx_mps[:, None] * (t[1:] - t[0])
-            cy = obstacles.y_m[:, None] + obstacles.vy_mps[:, None] * (t[1:] - t[0])
-            x, y = np.where(cv, cx, x), np.where(cv, cy, y)
-        else:
-            x = np.zeros((n, self.k))
-            y = np.zeros((n, self.k))
+        t = obstacles.t_s + np.arange(self.k + 1) * self.c.dt_s  # (K+1,) now, then the horizon
+        # an obstacle without a present actor (a false positive) keeps its constant velocity
+        x = obstacles.x_m[:, None] + obstacles.vx_mps[:, None] * (t[1:] - t[0])  # (n, K)
+        y = obstacles.y_m[:, None] + obstacles.vy_mps[:, None] * (t[1:] - t[0])
+        if n and len(f.actor_id):
+            x_all, y_all = f.positions(t)  # (K+1, A)
+            d = np.hypot(obstacles.x_m[:, None] - x_all[0], obstacles.y_m[:, None] - y_all[0])
+            match = np.nan_to_num(d, nan=np.inf).argmin(axis=1)  # (n,) nearest actor now
+            tx, ty = x_all[1:, match].T, y_all[1:, match].T  # (n, K)
+            known = np.isfinite(tx)
+            x, y = np.where(known, tx, x), np.where(known, ty, y)
         return Predictions(
             t_s=obstacles.t_s, dt_s=self.c.dt_s, track_id=obstacles.track_id,
             model=["truth"] * n, length_m=obstacles.length_m, width_m=obstacles.width_m,

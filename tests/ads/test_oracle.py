@@ -101,3 +101,12 @@ def test_ideal_control_steers_without_a_rate_limit():
     steer = IdealController(config, DT_S).control(plan, ego_at(0.0, 0.0, 0.0, 10.0)).steering_rad
     assert steer > config.max_steering_rate_radps * DT_S * 2  # far beyond one rate-limited step
     assert steer <= config.max_steering_rad
+
+
+def test_an_obstacle_without_a_true_actor_keeps_its_constant_velocity():
+    futures = TrueFutures.from_scenes([make_scene(k * DT_S, [(0, 0, 0, 0)]) for k in range(10)],
+                                      DT_S)  # the ego alone: a detection is a false positive
+    obs = obstacles([(30.0, 2.0, 0.0, 5.0)], t_s=0.2)
+    pred = TrueFuturePredictor(futures, PredictionConfig()).predict(obs, ego_at(0, 0, t_s=0.2))
+    np.testing.assert_allclose(pred.x_m[0], 30.0 + 5.0 * 0.1 * np.arange(1, 31))
+    np.testing.assert_allclose(pred.y_m[0], 2.0)
