@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import time
+from collections import Counter
 from pathlib import Path
 from typing import Annotated
 
@@ -96,6 +97,12 @@ def explain(
     shares = attribution_shares(root, scenario)
     if shares:
         _out().print(attribution_table(shares))
+    sims = Counter((v.simulations, v.converged) for e in done if e.explanation
+                   for v in e.explanation.variants if v.variant == "oracle_prediction")
+    if sims:
+        _out().print("oracle prediction, re-simulations until the outcome repeated: " + ", ".join(
+            f"{n}{'' if ok else ' (not repeated, cap)'}: {sims[n, ok]} runs"
+            for n, ok in sorted(sims)))
     failed = sum(e.explanation is None for e in done)
     _out().print(f"{len(done) - failed} runs explained, {failed} not, "
                  f"in {time.perf_counter() - t0:.1f} s")

@@ -145,6 +145,7 @@ class VariantResult:
     min_distance_m: float | None
     struck_from_behind: bool  # the first collision is another actor running into the ego's rear
     simulations: int = 1  # re-simulations it took (oracle prediction iterates)
+    converged: bool = True  # oracle prediction: the last two outcomes agreed
     react_s: float | None = None  # careful driver: when it started braking
 
 
@@ -185,16 +186,17 @@ def _oracle_prediction(factual: Episode, sim: SimConfig, ads_config: ADSConfig) 
     """True futures from the factual run; since NPCs react to the ego, re-simulate with the
     counterfactual's own ground truth as the futures until (collided, collision time) repeats,
     at most PREDICTION_ITERATIONS times."""
-    source, previous, episode, n = factual, None, factual, 0
+    source, previous, episode, n, converged = factual, None, factual, 0, False
     for n in range(1, PREDICTION_ITERATIONS + 1):  # noqa: B007 - n is reported
         futures = true_futures(source)
         episode = run_episode(factual.spec, sim, ads_config, driver=with_module(
             "predictor", lambda ads, f=futures: TrueFuturePredictor(f, ads.config.prediction)))
         key = (episode.outcome.collided, episode.outcome.collision_time_s)
-        if key == previous:
+        converged = key == previous
+        if converged:
             break
         previous, source = key, episode
-    return result("oracle_prediction", episode, simulations=n)
+    return result("oracle_prediction", episode, simulations=n, converged=converged)
 
 
 def _careful_driver(factual: Episode, sim: SimConfig, ads_config: ADSConfig) -> VariantResult:
