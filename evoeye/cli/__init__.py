@@ -1,6 +1,14 @@
 """The `evoeye` command: each module below registers its commands on the shared app."""
 
-from evoeye.cli import demo, evaluate, evolve, monitor, simulate, warehouse  # noqa: F401
+from evoeye.cli import (  # noqa: F401
+    demo,
+    evaluate,
+    evolve,
+    explain,
+    monitor,
+    simulate,
+    warehouse,
+)
 from evoeye.cli.app import app
 
 __all__ = ["app"]

@@ -16,6 +16,7 @@ from rich.console import Console
 from rich.table import Table
 
 from evoeye.cli.app import app
+from evoeye.evaluation import report
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse, WarehouseLockedError
 from evoeye.store.ingest import DEFAULT_RUNS_PER_PART, IngestReport, ingest
@@ -149,6 +150,17 @@ def _count_pct(count: int, pct: float | None) -> str:
     return f"{count:,} ({pct:.1f}%)" if pct is not None else f"{count:,}"
 
 
+def attribution_table(rows: list[dict[str, Any]]) -> Table:
+    """Root causes by `evoeye explain` (rows of view attribution_shares) as a console table."""
+    shares = report.attribution_table(rows)
+    table = Table(title="root causes of collisions (evoeye explain), %")
+    for i, col in enumerate(shares.header):
+        table.add_column(col, justify="left" if i < 2 else "right")
+    for row in shares.rows:
+        table.add_row(*row)
+    return table
+
+
 @warehouse_app.command("stats")
 def stats_command(
     root: RootOpt = None,
@@ -179,6 +191,9 @@ def stats_command(
             _count_pct(r["unsafe_frames"], r["unsafe_pct"]), str(r["failed"]),
         )
     _out().print(table)
+    shares = Warehouse(root).query("attribution_shares", logical_scenario=None).to_pylist()
+    if shares:
+        _out().print(attribution_table(shares))
     if not rows:
         _out().print(f"the warehouse under {DataRoot.resolve(root).path} is empty: "
                       "run `evoeye ingest` first")

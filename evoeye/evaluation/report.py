@@ -118,6 +118,34 @@ def monitors_table(reports: list[dict]) -> Table:
     return Table(header, rows)
 
 
+CAUSES = ("perception", "prediction", "planning", "control", "compound")
+
+
+def attribution_table(rows: list[dict]) -> Table:
+    """Root causes by `evoeye explain` (rows of view attribution_shares): per logical scenario
+    and software version, the runs explained, each cause's share of them (%), and how many
+    collisions the careful reference driver avoids."""
+    groups: dict[tuple[str, str], dict] = {}
+    for r in rows:
+        g = groups.setdefault((r["logical_scenario"], r["software_version"]), dict(r))
+        g[r["cause"]] = r["share"]
+    out = []
+    for (ls, version), g in groups.items():
+        careful = g["careful_avoided"] / g["careful_runs"] if g["careful_runs"] else None
+        out.append([ls, version, str(g["runs"]), *(pct(g.get(c, 0.0)) for c in CAUSES),
+                    f"{g['careful_avoided']}/{g['careful_runs']} ({pct(careful)}%)"])
+    return Table(["Logical scenario", "Version", "Runs", *CAUSES, "Careful driver avoids"], out)
+
+
+def _attribution_rows(reports: list[dict]) -> list[dict]:
+    return [row for r in reports for row in r.get("attribution", [])]
+
+
+ATTRIBUTION_NOTE = ("Collision runs re-simulated with one module replaced by an oracle; a "
+                    "run's unit of credit is split among the oracles that avoid the collision, "
+                    "'compound' when none does. Shares in %.")
+
+
 def markdown_report(reports: list[dict]) -> str:
     """RQ1 for every logical scenario evaluated, with the dataset and the monitors used."""
     parts = ["# RQ1: monitoring effectiveness", "",
@@ -128,6 +156,9 @@ def markdown_report(reports: list[dict]) -> str:
         parts += [f"## {r['logical_scenario']}", "", rq1_table(r).markdown(), ""]
     parts += ["## Dataset", "", dataset_table(reports).markdown(), "",
               "## Monitors", "", monitors_table(reports).markdown(), ""]
+    if causes := _attribution_rows(reports):
+        parts += ["## Root causes (evoeye explain)", "", ATTRIBUTION_NOTE, "",
+                  attribution_table(causes).markdown(), ""]
     return "\n".join(parts)
 
 
@@ -174,6 +205,10 @@ def html_report(reports: list[dict], title: str = "evoeye RQ1 report") -> str:
     body += [_scenario_html(r) for r in reports]
     body += ["<h2>Dataset</h2>", dataset_table(reports).html(),
              "<h2>Monitors</h2>", monitors_table(reports).html()]
+    if causes := _attribution_rows(reports):
+        body += ["<h2>Root causes (evoeye explain)</h2>",
+                 f'<p class="note">{escape(ATTRIBUTION_NOTE)}</p>',
+                 attribution_table(causes).html()]
     return ("<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">"
             f"<title>{escape(title)}</title><style>{CSS}</style></head><body>"
             + "".join(body) + "</body></html>\n")

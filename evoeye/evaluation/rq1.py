@@ -9,6 +9,7 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from pathlib import Path
 
+from evoeye.evaluation.explain import attribution_shares
 from evoeye.evaluation.harness import SCENARIO_KS, EvaluationReport, evaluate
 from evoeye.evaluation.monitors import baseline_monitors, load_monitors, train_fusion
 from evoeye.evaluation.report import ReportFiles, write_report
@@ -68,5 +69,10 @@ def rq1(
 
 def rq1_report(root: DataRoot | str | Path | None, reports: Sequence[EvaluationReport],
                name: str | None = None) -> ReportFiles:
-    """Write the Markdown, HTML and JSON report of these evaluations."""
-    return write_report(root, [r.to_dict() for r in reports], name)
+    """Write the Markdown, HTML and JSON report of these evaluations, with each logical
+    scenario's root-cause shares (`evoeye explain`) when the warehouse has them."""
+    dicts = [r.to_dict() for r in reports]
+    for d in dicts:
+        if shares := attribution_shares(root, d["logical_scenario"]):
+            d["attribution"] = shares
+    return write_report(root, dicts, name)

@@ -15,6 +15,8 @@ from evoeye.evaluation import evaluate
 from evoeye.evaluation.dataset import load_split
 from evoeye.evaluation.monitors import AEM_DIR, baseline_monitors, fit_aem
 from evoeye.evaluation.report import html_report, markdown_report, write_report
+from evoeye.evaluation.rq1 import rq1_report
+from evoeye.store.attribution import AttributionRow, write_attribution
 from evoeye.store.scores import read_scores, scores_dir, scores_schema
 
 SCENARIO = "highway-cut-in"  # the scenario of eval_root (conftest)
@@ -87,6 +89,24 @@ def test_html_report_is_self_contained_with_every_monitors_curves(report, eval_r
     assert files.html.read_text().startswith("<!DOCTYPE html>")
     assert files.markdown.read_text() == markdown_report([d])
     assert json.loads(files.json.read_text())[0]["logical_scenario"] == SCENARIO
+
+
+def test_the_report_shows_root_cause_shares_once_runs_are_explained(report, eval_root) -> None:
+    assert "Root causes" not in rq1_report(eval_root, [report], "t-no-causes").markdown.read_text()
+    variants = ("careful_driver", "oracle_perception", "oracle_prediction", "oracle_planning",
+                "oracle_control")
+    write_attribution(eval_root, [
+        AttributionRow(SCENARIO, "x-1", "v", v, v != "oracle_prediction", None, None, None)
+        for v in variants
+    ])
+    files = rq1_report(eval_root, [report], "t-causes")
+    md = files.markdown.read_text()
+    assert "## Root causes (evoeye explain)" in md
+    row = next(line for line in md.splitlines() if line.startswith(f"| {SCENARIO} | v |"))
+    assert row.split(" | ")[2:8] == ["1", "0.0", "100.0", "0.0", "0.0", "0.0"]
+    assert "0/1 (0.0%)" in row  # the careful driver collided too
+    assert "Root causes" in files.html.read_text()
+    assert json.loads(files.json.read_text())[0]["attribution"][0]["runs"] == 1
 
 
 def test_aem_is_trained_once_and_evaluated(eval_root, splits) -> None:

@@ -1,0 +1,108 @@
+"""`evoeye explain`: which module's oracle avoids each collision, and could a careful driver?"""
+
+from __future__ import annotations
+
+import time
+from collections import Counter
+from pathlib import Path
+from typing import Annotated
+
+import typer
+from rich.table import Table
+
+from evoeye.cli.app import app
+from evoeye.cli.warehouse import RootOpt, _err, _out, attribution_table
+from evoeye.evaluation.explain import (
+    Explained,
+    attribution_shares,
+    explain_one,
+    explain_runs,
+    pending_runs,
+    spec_of,
+)
+from evoeye.log import LogError, read_run
+from evoeye.store import WarehouseLockedError
+
+ORACLES = ("oracle_perception", "oracle_prediction", "oracle_planning", "oracle_control")
+
+
+def _verdict(collided: bool) -> str:
+    """✓: the variant avoids the collision; ✗: the ego still collides."""
+    return "[red]✗[/]" if collided else "[green]✓[/]"
+
+
+def runs_table(done: list[Explained]) -> Table:
+    """One row per run: each oracle's verdict, the careful driver's, and the cause shares."""
+    table = Table(title="explain (✓ avoids the collision, ✗ still collides)")
+    for col in ("run", "t_col s", *(o.removeprefix("oracle_") for o in ORACLES),
+                "careful (brakes at)", "cause share"):
+        table.add_column(col, justify="left" if col in ("run", "cause share") else "right")
+    for e in done:
+        if e.explanation is None:
+            table.add_row(e.spec.scenario_id, "", *[""] * len(ORACLES), "",
+                          f"[yellow]not explained[/]: {e.error}")
+            continue
+        ex = e.explanation
+        by = {v.variant: v for v in ex.variants}
+        avoiding = [o.removeprefix("oracle_") for o in ORACLES if not by[o].collided]
+        careful = by["careful_driver"]
+        react = f" @{careful.react_s:.2f} s" if careful.react_s is not None else ""
+        behind = " (struck from behind)" if careful.struck_from_behind else ""
+        causes = (" ".join(f"{c} {1 / len(avoiding):.2f}" for c in avoiding)
+                  if avoiding else "compound 1.00")
+        table.add_row(ex.spec.scenario_id, f"{ex.collision_time_s:.2f}",
+                      *(_verdict(by[o].collided) for o in ORACLES),
+                      _verdict(careful.collided) + react + behind, causes)
+    return table
+
+
+@app.command()
+def explain(
+    log: Annotated[Path | None, typer.Argument(
+        help="Explain this one run log (its spec is read from the log's metadata; nothing is "
+             "stored). Without it: every ingested collision run not yet explained.")] = None,
+    root: RootOpt = None,
+    scenario: Annotated[str | None, typer.Option(help="Only this logical scenario.")] = None,
+    batch: Annotated[str | None, typer.Option(help="Only this batch.")] = None,
+    limit: Annotated[int | None, typer.Option(min=1, help="At most this many runs.")] = None,
+    workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 2,
+) -> None:
+    """Re-simulate collision runs with one module at a time replaced by an oracle, and with a
+    careful reference driver; store the outcomes in the warehouse table `attribution`."""
+    t0 = time.perf_counter()
+    if log is not None:
+        try:
+            meta = read_run(log, topics=()).metadata
+        except LogError as exc:
+            _err().print(f"[red]error:[/] {exc}")
+            raise typer.Exit(2) from exc
+        if not meta["collided"]:
+            _out().print(f"{meta['scenario_id']}: no collision in this run, nothing to explain")
+            return
+        spec = spec_of(meta)
+        _out().print(runs_table([explain_one(spec)]))
+        return
+    specs = pending_runs(root, scenario, batch, limit)
+    if not specs:
+        _out().print("nothing to explain: every ingested collision run is explained "
+                     "(or none is ingested: run `evoeye ingest`)")
+        return
+    _out().print(f"explaining {len(specs)} collision runs with {workers} workers …")
+    try:
+        done = explain_runs(root, specs, workers=workers)
+    except WarehouseLockedError as exc:
+        _err().print(f"[red]error:[/] {exc}")
+        raise typer.Exit(1) from exc
+    _out().print(runs_table(done))
+    shares = attribution_shares(root, scenario)
+    if shares:
+        _out().print(attribution_table(shares))
+    sims = Counter((v.simulations, v.converged) for e in done if e.explanation
+                   for v in e.explanation.variants if v.variant == "oracle_prediction")
+    if sims:
+        _out().print("oracle prediction, re-simulations until the outcome repeated: " + ", ".join(
+            f"{n}{'' if ok else ' (not repeated, cap)'}: {sims[n, ok]} runs"
+            for n, ok in sorted(sims)))
+    failed = sum(e.explanation is None for e in done)
+    _out().print(f"{len(done) - failed} runs explained, {failed} not, "
+                 f"in {time.perf_counter() - t0:.1f} s")
