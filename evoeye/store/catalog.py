@@ -15,7 +15,13 @@ import duckdb
 import pyarrow as pa
 
 from evoeye.paths import DataRoot
-from evoeye.store.schema import DDL_SCHEMA, PARTITION_KEYS, TABLES, create_declared_tables
+from evoeye.store.schema import (
+    DDL_SCHEMA,
+    DERIVED_TABLES,
+    PARTITION_KEYS,
+    TABLES,
+    create_declared_tables,
+)
 from evoeye.store.sqlfiles import query, view_scripts
 
 PART_GLOB = "/".join(["*"] * len(PARTITION_KEYS) + ["*.parquet"])  # */*/*.parquet
@@ -44,11 +50,22 @@ def _parquet_view_sql(table: str, table_dir: Path) -> str:
     )
 
 
+def _derived_view_sql(table: str, table_dir: Path) -> str:
+    """The view `<table>` over the flat parts of a derived table, or its empty declared table."""
+    source = f"{DDL_SCHEMA}.{table}"
+    if any(table_dir.glob("*.parquet")):
+        source = (f"read_parquet({_string_literal(str(table_dir / '*.parquet'))}, "
+                  "union_by_name = true)")
+    return f"CREATE OR REPLACE VIEW {table} AS SELECT * FROM {source}"
+
+
 def install_views(con: duckdb.DuckDBPyConnection, root: DataRoot) -> None:
     """Create the declared tables, the Parquet base views and every view script on `con`."""
     create_declared_tables(con)
     for table in TABLES:
         con.execute(_parquet_view_sql(table, root.table_dir(table)))
+    for table in DERIVED_TABLES:
+        con.execute(_derived_view_sql(table, root.table_dir(table)))
     for _, script in view_scripts():
         con.execute(script)
 

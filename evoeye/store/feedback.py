@@ -55,7 +55,7 @@ def _append(root: DataRoot, table: str, columns: dict[str, pa.Array]) -> str:
     n = len(next(iter(columns.values())))
     stamp_col = schema.names[-1]  # written_at / finished_at: each campaign table ends with it
     columns = {**columns, stamp_col: pa.array([stamp] * n, schema.field(stamp_col).type)}
-    if table == FEEDBACK_TABLE:
+    if "part_id" in schema.names:
         columns["part_id"] = pa.array([name] * n, pa.string())
     out = pa.table([columns[f.name] for f in schema], schema=schema)
     return root.relative(_write_part(root.table_dir(table), name, out))

@@ -20,6 +20,9 @@ VIEWS_DIR = PROJECT_DIR / "warehouse" / "views"
 QUERIES_DIR = PROJECT_DIR / "warehouse" / "queries"
 
 TABLES = ("scenarios", "frames", "frame_features")
+# Tables later stages append to, as flat parts under warehouse/<table>/ (no partitions), that
+# every connection sees as a view of the same name (`attribution`: evoeye explain).
+DERIVED_TABLES = ("attribution",)
 # Hive partition keys, in folder order: they are columns of the views, not of the files.
 PARTITION_KEYS = ("logical_scenario", "batch")
 DDL_SCHEMA = "ddl"  # the DuckDB schema holding the declared, always empty, tables
@@ -37,9 +40,9 @@ def create_declared_tables(con: duckdb.DuckDBPyConnection) -> None:
     con.execute(f"CREATE SCHEMA IF NOT EXISTS {DDL_SCHEMA}")
     con.execute(f"SET schema = '{DDL_SCHEMA}'")
     try:
-        for table in TABLES:
+        for table in TABLES + DERIVED_TABLES:
             con.execute(f"DROP TABLE IF EXISTS {table}")
-            con.execute(ddl(table))
+            con.execute((DDL_DIR / f"{table}.sql").read_text(encoding="utf-8"))
     finally:
         con.execute("SET schema = 'main'")
 

@@ -8,6 +8,8 @@
 --   'oracle_prediction'   prediction = the actors' true futures
 --   'oracle_planning'     planning = a careful reference planner
 --   'oracle_control'      control = an ideal actuator (no lag)
+-- "Avoided" means no ego collision at all in the counterfactual: being struck from behind counts
+-- as not avoided (conservative); struck_from_behind tells those collisions apart.
 -- The cause of a run is derived from these rows in SQL (warehouse/views), never stored.
 -- Append-only Parquet parts under warehouse/attribution/; a (scenario_id, variant,
 -- software_version) triple is written at most once.
@@ -19,6 +21,7 @@ CREATE TABLE attribution (
     collided          BOOLEAN  NOT NULL,  -- the ego still collided in the counterfactual
     collision_time_s  DOUBLE,             -- its first collision frame time, if any
     min_distance_m    DOUBLE,             -- min ego–actor footprint distance in the counterfactual
+    struck_from_behind BOOLEAN,           -- its first collision: another actor into the ego's rear
     part_id           VARCHAR  NOT NULL,
     written_at        TIMESTAMP WITH TIME ZONE NOT NULL
 );

@@ -11,6 +11,7 @@ import pytest
 
 from evoeye.paths import DataRoot
 from evoeye.store import Warehouse, ingest
+from evoeye.store.attribution import AttributionRow, write_attribution
 from evoeye.store.schema import (
     PARTITION_KEYS,
     TABLES,
@@ -32,6 +33,9 @@ QUERY_PARAMS = {
         "val_frac": 0.125,
     },
     "windows": {"context_len": 5, "horizon_s": 3.0},
+    "collision_runs": {"logical_scenario": None, "batch": None, "software_version": "other",
+                       "variants": 5},
+    "attribution_shares": {"logical_scenario": "highway-cut-in"},
     "hard_set": {  # every run in test; a monitor scoring 0 everywhere misses every unsafe frame
         "monitor_version": "m", "threshold": 0.5, "logical_scenario": "highway-cut-in",
         "horizon_s": 3.0, "seed": 0, "train_frac": 0.0, "val_frac": 0.0,
@@ -44,6 +48,12 @@ def filled(root: DataRoot, add_run) -> DataRoot:
     add_run("c-0", n_frames=6, collision_frame=4, seed=1)
     add_run("c-1", n_frames=5, seed=2, logical_scenario="unprotected-intersection", batch="b1")
     ingest(root)
+    write_attribution(root, [
+        AttributionRow("highway-cut-in", "c-0", "v", variant, variant != "oracle_planning", None,
+                       1.0, False)
+        for variant in ("careful_driver", "oracle_perception", "oracle_prediction",
+                        "oracle_planning", "oracle_control")
+    ])
     return root
 
 
