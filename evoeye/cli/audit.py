@@ -37,7 +37,7 @@ def audit_command(
     root: RootOpt = None,
     scenario: Annotated[str | None, typer.Option(help="Only this logical scenario.")] = None,
     batch: Annotated[str | None, typer.Option(help="Only this batch.")] = None,
-    workers: Annotated[int, typer.Option(min=1, help="Processes reading logs.")] = 2,
+    workers: Annotated[int, typer.Option(min=1, help="Processes reading logs.")] = 1,
     as_json: Annotated[bool, typer.Option("--json", help="Print the report as JSON.")] = False,
     strict: Annotated[bool, typer.Option(help="Exit 1 when a criterion fails.")] = False,
 ) -> None:
