@@ -27,7 +27,8 @@ class KinematicBounds:
 
 @dataclass(frozen=True)
 class Peak:
-    """The largest value of one quantity over a run's NPCs, where and who."""
+    """The largest value of one quantity over a run's NPCs, who and when (for an acceleration,
+    the end of its 0.15 s window); NO_PEAK when nothing was measured."""
 
     value: float
     actor_id: int
