@@ -1,6 +1,7 @@
 """The `evoeye` command: each module below registers its commands on the shared app."""
 
 from evoeye.cli import (  # noqa: F401
+    audit,
     demo,
     evaluate,
     evolve,

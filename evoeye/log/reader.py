@@ -20,6 +20,7 @@ from mcap.reader import SeekingReader
 from mcap.writer import MCAP0_MAGIC
 
 from evoeye.log.channels import ROAD_MAP_ATTACHMENT, RUN_RECORD
+from evoeye.log.chunks import channel_messages
 from evoeye.log.records import decode_road_map, decode_run
 from evoeye.scene import RoadMap
 
@@ -120,11 +121,14 @@ def read_run(path: str | os.PathLike, topics: Iterable[str] | None = None) -> Ru
         schema_ids = _schema_ids(reader)
         attachments = {a.name: a.data for a in reader.iter_attachments()}
         raw: dict[str, list[tuple[int, bytes]]] = {}
-        if wanted is None or wanted:
-            for _, channel, message in reader.iter_messages(
-                topics=None if wanted is None else list(wanted), log_time_order=False
-            ):
+        if wanted is None:
+            for _, channel, message in reader.iter_messages(log_time_order=False):
                 raw.setdefault(channel.topic, []).append((message.log_time, message.data))
+        elif wanted:  # a few topics: walk the chunks directly (evoeye.log.chunks)
+            summary = reader.get_summary()
+            topic_of = {c.id: c.topic for c in summary.channels.values() if c.topic in wanted}
+            found = channel_messages(data, summary.chunk_indexes, topic_of)
+            raw = {topic_of[c]: pairs for c, pairs in found.items() if pairs}
     except Exception as e:  # the mcap parser raises many kinds on corrupt input
         raise _fail(path, f"corrupt MCAP file ({type(e).__name__}: {e})") from e
     if RUN_RECORD not in records:

@@ -10,13 +10,14 @@ import numpy as np
 import pytest
 
 from evoeye.log import LogError, read_run, write_episode
+from evoeye.log.channels import TOPICS
 from evoeye.log.mcap_writer import McapWriter
 from evoeye.sim.episode import Episode, Frame
 
 
-def expect_log_error(path: Path, match: str) -> None:
+def expect_log_error(path: Path, match: str, topics: list[str] | None = None) -> None:
     with pytest.raises(LogError, match=match) as info:
-        read_run(path)
+        read_run(path, topics=topics)
     assert str(path) in str(info.value)
 
 
@@ -43,13 +44,14 @@ def test_missing_file(tmp_path: Path) -> None:
     expect_log_error(tmp_path / "absent.mcap", "cannot read")
 
 
-def test_corrupt_chunk(log_path: Path, tmp_path: Path) -> None:
+@pytest.mark.parametrize("topics", [None, [TOPICS.ground_truth]])  # mcap's reader; chunks.py
+def test_corrupt_chunk(log_path: Path, tmp_path: Path, topics: list[str] | None) -> None:
     data = bytearray(log_path.read_bytes())
     middle = len(data) // 3
     data[middle : middle + 64] = bytes(64)  # inside the first chunk's compressed data
     bad = tmp_path / "corrupt.mcap"
     bad.write_bytes(bytes(data))
-    expect_log_error(bad, "corrupt")
+    expect_log_error(bad, "corrupt", topics)
 
 
 def test_file_without_run_record(tmp_path: Path) -> None:

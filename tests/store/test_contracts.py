@@ -40,6 +40,8 @@ QUERY_PARAMS = {
         "monitor_version": "m", "threshold": 0.5, "logical_scenario": "highway-cut-in",
         "horizon_s": 3.0, "seed": 0, "train_frac": 0.0, "val_frac": 0.0,
     },
+    "audit_attribution": {"scenario_ids": ["c-0", "c-1"]},
+    "audit_clock_frames": {"scenario_ids": ["c-0", "c-1"], "horizon_s": 3.0},
 }
 
 
