@@ -110,7 +110,8 @@ class TrueFuturePredictor:
             x, y = np.where(known, tx, x), np.where(known, ty, y)
         return Predictions(
             t_s=obstacles.t_s, dt_s=self.c.dt_s, track_id=obstacles.track_id,
-            model=["truth"] * n, length_m=obstacles.length_m, width_m=obstacles.width_m,
+            model=["truth"] * n, mode_prob=np.ones(n), length_m=obstacles.length_m,
+            width_m=obstacles.width_m,
             x_m=np.ascontiguousarray(x), y_m=np.ascontiguousarray(y),
         )
 
@@ -120,8 +121,10 @@ def careful_planning(config: PlanningConfig) -> PlanningConfig:
     margins, cautious arrival estimates, earlier and firmer AEB, yielding up to a firm brake."""
     return replace(
         config, time_headway_s=2.0, min_gap_m=4.0, follow_soft_headway_s=1.2,
-        follow_decel_max_mps2=6.0, corridor_margin_m=0.5, gap_margin_s=1.5, go_accel_mps2=1.5,
-        yield_decel_max_mps2=6.0, emergency_ttc_s=2.0, emergency_decel_mps2=8.0,
+        follow_decel_max_mps2=6.0, comfort_decel_mps2=6.0, corridor_margin_m=0.5,
+        gap_margin_s=1.5, arrival_uncertainty_frac=0.2, go_accel_mps2=1.5,
+        yield_decel_max_mps2=6.0, emergency_ttc_s=2.0,
+        emergency_decel_mps2=max(config.emergency_decel_mps2, 8.0),
     )
 
 

@@ -42,7 +42,7 @@ HIGHWAY_CUT_IN = LogicalScenario(
         P(
             "lead_brake_decel_mps2",
             0.0,
-            8.0,
+            6.5,
             "m/s²",
             "how hard the lead vehicle brakes",
             actor="lead",
@@ -167,7 +167,7 @@ INTERSECTION = LogicalScenario(
     name="unprotected-intersection",
     description=(
         "Four-way intersection without signals; the ego drives straight from south to north, "
-        "starting a seeded 60–200 m before the box. Five NPCs: an opposing left turn "
+        "starting a seeded 20–160 m before the box. Five NPCs: an opposing left turn "
         "(north→east), lateral crossings from the west and from the east, a right-turn merge "
         "into the ego's exit lane (east→north) and a left-turn merge (west→north), each timed "
         "relative to the ego's arrival. None of them yields."

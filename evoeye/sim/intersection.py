@@ -6,7 +6,7 @@ and a 20 s run never runs off the map. Approaches: 0 south, 1 west, 2 north, 3 e
 index (o<k>, ir<k>) is the approach from k, (ir<k>, il<j>) the move from k to j, (e<k>, o<k>)
 and (o<k>, x<k>) the added entry and exit.
 
-Timing is relative, not a clock: the ego starts a seeded 60–200 m before the box (so the
+Timing is relative, not a clock: the ego starts a seeded 20–160 m before the box (so the
 critical moment comes at a different time in every run), and each NPC is placed so that, at
 its own speed profile, it reaches its first conflict with the ego's path `<name>_offset_s`
 after the ego would at its cruise speed. The NPCs slow for the turns (curvature-limited speed)
@@ -32,7 +32,7 @@ from evoeye.sim.world import World
 EXTENSION_M = 320.0
 EGO_ROUTE = [("e0", "o0", 0), ("o0", "ir0", 0), ("ir0", "il2", 0), ("il2", "o2", 0),
              ("o2", "x2", 0)]
-EGO_APPROACH_M = (60.0, 200.0)  # the ego starts this far (seeded, uniform) before the box
+EGO_APPROACH_M = (20.0, 160.0)  # the ego starts this far (seeded, uniform) before the box
 EGO_CRUISE_MPS = 10.0  # the intersection lanes' speed limit
 CONFLICT_RADIUS_M = 2.5  # paths closer than this share a conflict point (timing parameters)
 CROSSING_RADIUS_M = 4.5  # a waiting NPC's centre keeps this far from the other's path (its

@@ -21,6 +21,7 @@ from highway_env.vehicle.kinematics import Vehicle
 from evoeye.sim.path import Path
 
 LANE_WIDTH_M = 4.0
+CUT_IN_MIN_TTC_S = 2.5  # a cut-in waits while the ego would reach it sooner than this
 CATCH_UP_GAIN_PER_S = 2.0  # braking towards a lower desired speed: 2 m/s² per m/s above it
 PROFILE_DECEL_SHARE = 0.6  # curves are planned for at this share of the comfortable braking,
 # so that the speed tracks the profile with a small lag and the curve is entered on it
@@ -113,9 +114,10 @@ class Npc(Vehicle):
             return 0.0
         return self._lc_from_m + self.lane_change.offset_m - self.d_m
 
-    def wants_lane_change(self, gap_to_ego_m: float) -> bool:
-        """Update the trigger with the current bumper gap ahead of the ego; True once it fired
-        and the change has not started yet."""
+    def wants_lane_change(self, gap_to_ego_m: float, ego_closing_mps: float) -> bool:
+        """Update the trigger with the current bumper gap ahead of the ego and the speed at which
+        the ego closes it; True once it fired, the ego is at least `CUT_IN_MIN_TTC_S` away (an
+        aggressive driver, not a suicidal one) and the change has not started yet."""
         lc = self.lane_change
         if lc is None or self._lc_start_s is not None or self.crashed:
             return False
@@ -125,7 +127,7 @@ class Npc(Vehicle):
         self._trigger_side = side
         if self._armed and gap_to_ego_m < 0.0:  # fell behind the ego again: the moment passed
             self._armed = False
-        return self._armed
+        return self._armed and gap_to_ego_m >= CUT_IN_MIN_TTC_S * max(ego_closing_mps, 0.0)
 
     def start_lane_change(self) -> None:
         self._lc_start_s = self.clock_s

@@ -15,7 +15,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 CORRIDOR_MARGIN_M = 0.5  # lateral slack added to the two half-widths
-ALIGNED_COS = 0.5  # a vehicle within ±60° of one's heading drives one's way
+ALIGNED_COS = 0.5  # a vehicle within ±60° of one's heading drives one's way …
+BLOCKING_M = 25.0  # … and any vehicle this close in one's corridor blocks it, whatever its way
 LOOKAHEAD_M = 120.0
 HALF_LANE_M = 2.0
 CLEAR_FRONT_M, CLEAR_FRONT_S = 5.0, 0.5  # a lane change needs this bumper gap ahead …
@@ -54,20 +55,22 @@ class Relations:
 
 
 def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(gap, leader speed) per vehicle: the nearest vehicle ahead in its corridor (or in its
-    target lane, `shift_m` to the side, during a lane change), driving its way; gap = inf
-    without one. (n,) each."""
+    """(gap, leader speed along one's heading) per vehicle: the nearest vehicle ahead in its
+    corridor (or in its target lane, `shift_m` to the side, during a lane change) that drives
+    its way, or that blocks it within `BLOCKING_M`; gap = inf without one. (n,) each."""
     n = len(rel.speed)
     reach = rel.half_w + CORRIDOR_MARGIN_M
     in_lane = np.abs(rel.eta) < reach
     in_target = (shift_m != 0.0)[:, None] & (np.abs(rel.eta - shift_m[:, None]) < reach)
-    ahead = (rel.xi > 0.0) & (rel.xi < LOOKAHEAD_M) & (rel.cos_dh > ALIGNED_COS)
+    ahead = (rel.xi > 0.0) & (rel.xi < LOOKAHEAD_M) & (
+        (rel.cos_dh > ALIGNED_COS) | (rel.xi < BLOCKING_M))
     ahead &= ~np.eye(n, dtype=bool)
     gap = np.where(ahead & (in_lane | in_target), rel.bumper, np.inf)
     j = gap.argmin(axis=1)
     rows = np.arange(n)
     best = gap[rows, j]
-    return best, np.where(np.isfinite(best), rel.speed[j] * rel.cos_dh[rows, j], 0.0)
+    v_along = np.maximum(rel.speed[j] * rel.cos_dh[rows, j], 0.0)  # a crossing car: ~0 along
+    return best, np.where(np.isfinite(best), v_along, 0.0)
 
 
 def clear_to_change(rel: Relations, i: int, offset_m: float) -> bool:

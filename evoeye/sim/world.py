@@ -69,7 +69,8 @@ class World:
         gap, v_lead = leaders(rel, shift)
         self._wait_at_crossings(gap, v_lead)
         for i, npc in enumerate(self.npcs, start=1):
-            if npc.wants_lane_change(rel.gap_ahead_of(i, 0)) and clear_to_change(
+            closing = speed[0] - speed[i] * rel.cos_dh[0, i]
+            if npc.wants_lane_change(rel.gap_ahead_of(i, 0), closing) and clear_to_change(
                 rel, i, npc.lane_change.offset_m
             ):
                 npc.start_lane_change()

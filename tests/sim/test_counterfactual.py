@@ -118,10 +118,10 @@ def test_ground_truth_perception_avoids_collisions_of_a_blind_ads():
     truth the same stack must avoid some of those collisions."""
     config = ADSConfig()
     blind = dataclasses.replace(config, sensor=dataclasses.replace(
-        config.sensor, front_range_m=0.5, surround_range_m=0.5))
+        config.sensor, lidar_range_m=0.5, radar_range_m=0.5))
     sim = SimConfig(duration_s=10.0)
     collided = avoided = 0
-    for spec in plan_uniform("highway-cut-in", 5, 0):
+    for spec in plan_uniform("highway-cut-in", 10, 0):
         try:
             ex = explain_run(spec, sim, blind, variants=("oracle_perception",))
         except ValueError:

@@ -80,14 +80,15 @@ def test_lead_vehicle_brakes_as_scripted():
 
 @pytest.mark.parametrize("side,lane_y,actor", [("left", 0.0, 2), ("right", 8.0, 3)])
 def test_a_slower_cut_in_ahead_fires_when_the_gap_closes_to_its_trigger(side, lane_y, actor):
-    # centre 40 m ahead, 5 m/s slower: its bumper gap (35 m) falls to 10 m after 5 s
-    p = highway_params(**{f"{side}_cutin_trigger_gap_m": 10.0, f"{side}_cutin_duration_s": 3.0,
+    # centre 40 m ahead, 5 m/s slower: its bumper gap (35 m) falls to 15 m after 4 s, when the
+    # ego is 3 s away (at least CUT_IN_MIN_TTC_S)
+    p = highway_params(**{f"{side}_cutin_trigger_gap_m": 15.0, f"{side}_cutin_duration_s": 3.0,
                           f"{side}_cutin_gap_m": 40.0, f"{side}_cutin_speed_mps": 20.0},
                        lead_gap_m=70.0, lead_speed_mps=30.0)
     scenes = run(build_highway(p, np.random.default_rng(0))[0], 10.0, accel=make_room)
     y, t = track(scenes, actor, "y_m"), times(scenes)
     start = t[int(np.argmax(np.abs(y - lane_y) > 1e-9))]
-    assert start == pytest.approx(5.0, abs=0.2)
+    assert start == pytest.approx(4.0, abs=0.2)
     assert y[np.searchsorted(t, start + 3.1)] == pytest.approx(EGO_LANE * LANE_W, abs=0.05)
 
 
@@ -102,6 +103,14 @@ def test_a_faster_cut_in_from_behind_fires_at_its_trigger_gap_not_at_zero():
     assert bumper_gap == pytest.approx(15.0, abs=1.0)  # a frame at 10 m/s closing is 0.5 m
 
 
+def test_a_cut_in_waits_while_the_ego_would_reach_it_too_soon():
+    # trigger at 5 m with the ego closing at 10 m/s: 0.5 s to contact, so it holds its lane
+    p = highway_params(left_cutin_trigger_gap_m=5.0, left_cutin_gap_m=30.0,
+                       left_cutin_speed_mps=15.0, ego_speed_mps=25.0)
+    scenes = run(build_highway(p, np.random.default_rng(0))[0], 6.0)
+    assert np.abs(track(scenes, 2, "y_m")).max() < 1e-9
+
+
 def test_a_cut_in_never_fires_if_its_trigger_gap_is_never_crossed():
     p = highway_params(left_cutin_trigger_gap_m=5.0, left_cutin_gap_m=40.0,
                        left_cutin_speed_mps=30.0, ego_speed_mps=20.0)  # it only pulls away
@@ -111,7 +120,7 @@ def test_a_cut_in_never_fires_if_its_trigger_gap_is_never_crossed():
 
 @pytest.mark.parametrize("duration_s", [2.6, 3.5, 5.0])
 def test_lane_changes_stay_within_the_lateral_bounds(duration_s):
-    p = highway_params(left_cutin_trigger_gap_m=10.0, left_cutin_duration_s=duration_s,
+    p = highway_params(left_cutin_trigger_gap_m=15.0, left_cutin_duration_s=duration_s,
                        left_cutin_gap_m=40.0, left_cutin_speed_mps=20.0)
     scenes = run(build_highway(p, np.random.default_rng(0))[0], 12.0, accel=make_room)
     lat_v, a_lat, _ = lateral_kinematics(scenes, 2)
@@ -122,7 +131,7 @@ def test_lane_changes_stay_within_the_lateral_bounds(duration_s):
 
 def test_sharper_cut_in_reaches_the_lane_sooner():
     def time_to_enter(duration):
-        p = highway_params(left_cutin_trigger_gap_m=10.0, left_cutin_duration_s=duration,
+        p = highway_params(left_cutin_trigger_gap_m=15.0, left_cutin_duration_s=duration,
                            left_cutin_gap_m=40.0, left_cutin_speed_mps=20.0)
         scenes = run(build_highway(p, np.random.default_rng(0))[0], 12.0, accel=make_room)
         return scenes[int(np.argmax(track(scenes, 2, "y_m") > EGO_LANE * LANE_W - 1.0))].t_s
@@ -132,7 +141,7 @@ def test_sharper_cut_in_reaches_the_lane_sooner():
 
 def test_a_cut_in_waits_for_a_gap_the_lead_leaves_it():
     # the lead sits right where the cut-in would land: it must not change lanes onto it
-    p = highway_params(left_cutin_trigger_gap_m=10.0, left_cutin_gap_m=40.0,
+    p = highway_params(left_cutin_trigger_gap_m=15.0, left_cutin_gap_m=40.0,
                        left_cutin_speed_mps=20.0, lead_gap_m=30.0, lead_speed_mps=20.0,
                        ego_speed_mps=20.0)
     scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0, accel=0.0)
@@ -169,7 +178,7 @@ def test_npcs_follow_the_vehicle_ahead_instead_of_driving_through_it():
 
 
 def test_ego_runs_into_a_stopped_lead_and_the_partner_is_recorded():
-    p = highway_params(lead_gap_m=20.0, lead_brake_time_s=2.0, lead_brake_decel_mps2=8.0,
+    p = highway_params(lead_gap_m=20.0, lead_brake_time_s=2.0, lead_brake_decel_mps2=6.5,
                        lead_brake_duration_s=5.0, lead_speed_mps=20.0, ego_speed_mps=28.0)
     scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0)
     hit = [s for s in scenes if s.ego_collision]
@@ -180,7 +189,7 @@ def test_ego_runs_into_a_stopped_lead_and_the_partner_is_recorded():
 
 def test_a_blocked_vehicle_stops_and_never_reverses():
     p = highway_params(lead_gap_m=15.0, lead_speed_mps=20.0, lead_brake_time_s=2.0,
-                       lead_brake_decel_mps2=8.0, lead_brake_duration_s=5.0)
+                       lead_brake_decel_mps2=6.5, lead_brake_duration_s=5.0)
     scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0, accel=-8.0)
     speeds = np.concatenate([s.speed_mps for s in scenes])
     assert speeds.min() == 0.0  # someone came to a standstill, and nobody went below it
