@@ -118,6 +118,14 @@ class SensorModel:
         self._var_range = c.radar_range_sigma_m**2 + VAR_FLOOR  # radar variances, for the fusion
         self._var_range_rate = c.radar_range_rate_sigma_mps**2 + VAR_FLOOR
 
+    def _may_merge(self, pos: np.ndarray, length_m: np.ndarray, width_m: np.ndarray) -> bool:
+        """Whether any two lidar detections at pos (m,) complex may be close enough to merge:
+        boxes within the gap have centres within hypot(L + gap, W + gap) of the largest car."""
+        g = self.c.lidar_merge_gap_m
+        reach = math.hypot(float(length_m.max()) + g, float(width_m.max()) + g)
+        d = np.abs(np.subtract.outer(pos, pos))  # (m, m)
+        return np.count_nonzero(d < reach) > len(pos)  # the diagonal is 0
+
     def detect(self, scene: SceneState, ego: Localization | None = None) -> Detections:
         """Detections of every actor but the ego (row 0) at scene.t_s, in the world frame placed
         with `ego` (the localisation estimate at capture; None: the true pose)."""
@@ -167,7 +175,7 @@ class SensorModel:
         vel_l = vrel + sig_v * gc[n:]
         head_l = h_rel + (c.heading_sigma_rad + c.heading_sigma_per_m * r) * g[4 * n:5 * n]
         var_pl, var_vl = sig_p * sig_p + VAR_FLOOR, sig_v * sig_v + VAR_FLOOR
-        if np.count_nonzero(lidar) > 1:
+        if np.count_nonzero(lidar) > 1 and self._may_merge(pos_l[lidar], length, width):
             i = lidar.nonzero()[0]
             keep, pos_l[i], vel_l[i], len_l[i], wid_l[i] = merge_segments(
                 pos_l[i], vel_l[i], h_rel[i], length[i], width[i], r[i], c.lidar_merge_gap_m)
@@ -191,16 +199,14 @@ class SensorModel:
             d_vel = (var_vl / (var_vl + self._var_range_rate)) * (rr - (vel_l * back).real)
             pos_l = np.where(both, pos_l + d_pos * los_r, pos_l)
             vel_l = np.where(both, vel_l + d_vel * los_r, vel_l)
+        z = pack(pos_l, vel_l, head_l, len_l, wid_l, r, var_pl, var_vl)  # (DET_FIELDS, n)
+        radar_only = radar & ~lidar
+        if np.count_nonzero(radar_only):
+            j = radar_only.nonzero()[0]
+            z[:, j] = pack(pos_r[j], vel_r[j], head_r[j], c.radar_length_m, c.radar_width_m,
+                           r[j], var_pr[j], self._radar_var_vel)
         seen = (lidar | radar).nonzero()[0]
-        lid = lidar[seen]
-        z = pack(
-            np.where(lid, pos_l[seen], pos_r[seen]), np.where(lid, vel_l[seen], vel_r[seen]),
-            np.where(lid, head_l[seen], head_r[seen]),
-            np.where(lid, len_l[seen], c.radar_length_m),
-            np.where(lid, wid_l[seen], c.radar_width_m), r[seen],
-            np.where(lid, var_pl[seen], var_pr[seen]),
-            np.where(lid, var_vl[seen], self._radar_var_vel),
-        )
+        z = z[:, seen]
         ids = scene.actor_id[1:][seen]
         by_radar = radar[seen]
         ghost_ids, ghosts = fp.ghosts(z[:, by_radar], u[2 * n:3 * n][seen][by_radar])
