@@ -94,7 +94,7 @@ class IntentPredictor:
         # lane-change intent against lane keeping (softmax over keep, left, right)
         evidence = v_lat * (1.0 / c.intent_lat_speed_scale_mps) + lat * (
             1.0 / c.intent_offset_scale_m)
-        np.clip(evidence, -30.0, 30.0, out=evidence)  # off the lanes, lat is huge
+        evidence = np.minimum(np.maximum(evidence, -30.0), 30.0)  # off the lanes, lat is huge
         w_left = np.exp(evidence - c.intent_change_bias) * graph.has_left.take(lane)
         w_right = np.exp(-evidence - c.intent_change_bias) * graph.has_right.take(lane)
         p_keep = on / (1.0 + w_left + w_right)  # 0 off the lanes
@@ -119,17 +119,22 @@ class IntentPredictor:
         best = p_all.max(axis=1, keepdims=True)
         obs, col = ((p_all >= np.minimum(best, c.min_mode_prob)) & (p_all > 0.0)).nonzero()
         prob = p_all[obs, col]
-        order = np.argsort(obs - 0.5 * prob, kind="stable")  # per obstacle, most probable first
+        order = (obs - 0.5 * prob).argsort(kind="stable")  # per obstacle, most probable first
         obs, col, prob = obs.take(order), col.take(order), prob.take(order)
         mode = MODE_AFTER_PATHS.take(np.maximum(col - (m - 1), 0))  # col m → LEFT, m+1 …
-        x = ox.take(obs)[:, None] + vx.take(obs)[:, None] * t  # (r, K) constant velocity
-        y = oy.take(obs)[:, None] + vy.take(obs)[:, None] * t
+        x = np.empty((len(obs), self.k))  # (r, K)
+        y = np.empty((len(obs), self.k))
         along = s.take(obs)[:, None] + v_along.take(obs)[:, None] * t  # (r, K)
         is_path = mode == LANE
         if np.count_nonzero(is_path):
             p_ids = paths[obs[is_path], col[is_path]]
             px, py = graph.paths.xy_at(graph.paths.offset.take(p_ids)[:, None] + along[is_path])
             x[is_path], y[is_path] = px, py
+        is_cv = mode == CV
+        if np.count_nonzero(is_cv):
+            o = obs[is_cv]
+            x[is_cv] = ox.take(o)[:, None] + vx.take(o)[:, None] * t
+            y[is_cv] = oy.take(o)[:, None] + vy.take(o)[:, None] * t
         change = (mode == LEFT) | (mode == RIGHT)
         if np.count_nonzero(change):
             o = obs[change]

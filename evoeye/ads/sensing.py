@@ -149,7 +149,7 @@ class SensorModel:
         e_h = np.exp(1j * h_rel)
         vrel = v[1:] * e_h - v0  # velocity relative to the ego
         r = np.abs(rel)
-        bearing = np.angle(rel)  # (−π, π]: the seam is straight behind
+        bearing = np.arctan2(rel.imag, rel.real)  # (−π, π]: the seam is straight behind
         los = rel / r  # unit line of sight
         e_phi = e_h / los  # target orientation relative to the line of sight
         cos_phi, sin_phi = np.abs(e_phi.real), np.abs(e_phi.imag)
@@ -185,10 +185,6 @@ class SensorModel:
         rm = r + c.radar_range_sigma_m * g[5 * n:6 * n]
         los_r = np.exp(1j * (bearing + c.radar_azimuth_sigma_rad * g[6 * n:7 * n]))
         rr = (vrel * los.conj()).real + c.radar_range_rate_sigma_mps * g[7 * n:]
-        pos_r, vel_r = rm * los_r, rr * los_r
-        vel_abs = vel_r + v0
-        head_r = np.where(np.abs(vel_abs) > 1.0, np.angle(vel_abs), 0.0)
-        var_pr = np.maximum(self._var_range, (r * c.radar_azimuth_sigma_rad) ** 2 + VAR_FLOOR)
 
         # fusion where both see the actor: the radar measures range and range rate only, so it
         # corrects the lidar along its line of sight (a Kalman update with a radial measurement)
@@ -203,14 +199,20 @@ class SensorModel:
         radar_only = radar & ~lidar
         if np.count_nonzero(radar_only):
             j = radar_only.nonzero()[0]
-            z[:, j] = pack(pos_r[j], vel_r[j], head_r[j], c.radar_length_m, c.radar_width_m,
-                           r[j], var_pr[j], self._radar_var_vel)
-        seen = (lidar | radar).nonzero()[0]
-        z = z[:, seen]
-        ids = scene.actor_id[1:][seen]
-        by_radar = radar[seen]
-        ghost_ids, ghosts = fp.ghosts(z[:, by_radar], u[2 * n:3 * n][seen][by_radar])
-        if len(ghost_ids):
+            pos_r, vel_r = rm[j] * los_r[j], rr[j] * los_r[j]
+            vel_abs = vel_r + v0
+            head_r = np.where(np.abs(vel_abs) > 1.0, np.arctan2(vel_abs.imag, vel_abs.real), 0.0)
+            var_pr = np.maximum(self._var_range, (r[j] * c.radar_azimuth_sigma_rad) ** 2
+                                + VAR_FLOOR)
+            z[:, j] = pack(pos_r, vel_r, head_r, c.radar_length_m, c.radar_width_m, r[j], var_pr,
+                           self._radar_var_vel)
+        ids = scene.actor_id[1:]
+        multipath = radar & (u[2 * n:3 * n] < c.ghost_prob) & (r > c.ghost_min_range_m)
+        seen = lidar | radar
+        if np.count_nonzero(seen) < n:
+            ids, z, multipath = ids[seen], z[:, seen], multipath[seen]
+        if np.count_nonzero(multipath):
+            ghost_ids, ghosts = fp.ghosts(z[:, multipath])
             ids, z = np.concatenate((ids, ghost_ids)), np.concatenate((z, ghosts), axis=1)
         if len(fp_ids):
             ids, z = np.concatenate((ids, fp_ids)), np.concatenate((z, fp_z), axis=1)
