@@ -9,7 +9,8 @@
 
 Detections are in the sensor frame (x forward, y left, velocity relative to the ego), in the
 layout of `evoeye.ads.detections`. A fixed number of uniforms is consumed per frame (`n_uniforms`
-for clutter, one per actor for ghosts) so the random stream stays aligned.
+for clutter, and the sensor model draws one per actor for ghosts) so the random stream stays
+aligned.
 """
 
 from __future__ import annotations
@@ -66,14 +67,11 @@ class FalsePositives:
         )
         return np.full(k, CLUTTER_ID, dtype=np.int64), z
 
-    def ghosts(self, radar: np.ndarray, u: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-        """(actor ids, (DET_FIELDS, k) detections) of multipath ghosts of the radar's detections
-        (DET_FIELDS, m), from one uniform per detection."""
+    def ghosts(self, radar: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(actor ids, (DET_FIELDS, k) detections) of the multipath ghosts of these radar
+        detections (DET_FIELDS, m): the ones the sensor model drew to have one."""
         c = self.c
-        on = (radar[DET_RANGE] > c.ghost_min_range_m) & (u < c.ghost_prob)
-        if not np.count_nonzero(on):
-            return self._none
-        z = radar[:, on]
+        z = radar.copy()
         rail = np.where(z[DET_Y] >= 0.0, c.ghost_rail_offset_m, -c.ghost_rail_offset_m)
         z[DET_Y] = 2.0 * rail - z[DET_Y]
         z[DET_VY] = -z[DET_VY]

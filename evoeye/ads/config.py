@@ -41,7 +41,7 @@ class SensorConfig:
     vel_sigma_per_m: float = 0.01
     heading_sigma_rad: float = 0.02
     heading_sigma_per_m: float = 0.001
-    lidar_depth_seen_frac: float = 0.5  # seen end-on, a box's depth is this fraction of the car
+    lidar_depth_seen_frac: float = 0.8  # seen end-on, a box's depth is this fraction of the car
     lidar_merge_gap_m: float = 0.5  # segmentation merges objects whose boxes are this close
     # radar: long range, narrow, good range and range rate, poor azimuth (lateral) accuracy
     radar_range_m: float = 180.0

@@ -281,8 +281,10 @@ class RoutePlanner:
         t_in_early = t_in * (1.0 - c.arrival_uncertainty_frac)
         t_out_late = t_out * (1.0 + c.arrival_uncertainty_frac)
         ids = p.track_id[i]
-        margin = np.where(np.isin(ids, proceeding), c.gap_margin_s - c.proceed_hold_margin_s,
-                          c.gap_margin_s)
+        margin = c.gap_margin_s
+        if len(proceeding):
+            was = (ids[:, None] == proceeding).any(axis=1)
+            margin = np.where(was, c.gap_margin_s - c.proceed_hold_margin_s, c.gap_margin_s)
         d_in = s_lo - s_e - self._half_len  # ego front to the conflict region
         te = self._arrival_s(v, np.concatenate((d_in, s_hi - s_e + self._half_len)))
         te_in, te_out = te[: len(i)], te[len(i):]

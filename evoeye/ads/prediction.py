@@ -32,6 +32,7 @@ from evoeye.scene import RoadMap
 
 HEADING_SECTORS = 8  # the lane grid keeps the nearest lane per 45° heading sector
 CV, LANE, LEFT, RIGHT = range(4)  # indices into PREDICTION_MODES
+MODE_AFTER_PATHS = np.array([LANE, LEFT, RIGHT, CV])  # the mode of columns M − 1, M, M + 1, M + 2
 _GRAPHS: dict[tuple, LaneGraph] = {}  # lane graphs by (lane index, parameters)
 GRAPH_CACHE_MAX = 16
 
@@ -43,7 +44,7 @@ class Predictor(Protocol):
 
 
 def _smoothstep(x: np.ndarray) -> np.ndarray:
-    x = np.clip(x, 0.0, 1.0)
+    x = np.minimum(np.maximum(x, 0.0), 1.0)
     return x * x * (3.0 - 2.0 * x)
 
 
@@ -91,46 +92,49 @@ class IntentPredictor:
         v_lat = tx * vy - ty * vx  # to the left of the lane
 
         # lane-change intent against lane keeping (softmax over keep, left, right)
-        evidence = np.clip(v_lat * (1.0 / c.intent_lat_speed_scale_mps) + lat * (
-            1.0 / c.intent_offset_scale_m), -30.0, 30.0)  # off the lanes, lat is huge
-        w_left = np.where(graph.has_left.take(lane), np.exp(evidence - c.intent_change_bias), 0.0)
-        w_right = np.where(graph.has_right.take(lane),
-                           np.exp(-evidence - c.intent_change_bias), 0.0)
-        p_keep = 1.0 / (1.0 + w_left + w_right)
+        evidence = v_lat * (1.0 / c.intent_lat_speed_scale_mps) + lat * (
+            1.0 / c.intent_offset_scale_m)
+        evidence = np.minimum(np.maximum(evidence, -30.0), 30.0)  # off the lanes, lat is huge
+        w_left = np.exp(evidence - c.intent_change_bias) * graph.has_left.take(lane)
+        w_right = np.exp(-evidence - c.intent_change_bias) * graph.has_right.take(lane)
+        p_keep = on / (1.0 + w_left + w_right)  # 0 off the lanes
 
         # continuations: heading against each path's tangent a little ahead
-        paths = graph.lane_paths[lane]  # (n, M) path ids, −1 padded
+        paths = graph.lane_paths.take(lane, axis=0)  # (n, M) path ids, −1 padded
         s = g - lanes.offset.take(lane)  # arc length along the lane
-        ahead = s + np.maximum(v_along * c.turn_lookahead_s, c.turn_lookahead_min_m)
-        path_off = graph.paths.offset.take(np.maximum(paths, 0))  # (n, M)
-        dh = graph.paths.heading_at(path_off + ahead[:, None]) - obstacles.heading_rad[:, None]
-        dh = (dh + np.pi) % (2.0 * np.pi) - np.pi
-        w = np.where(paths >= 0, np.exp(dh * dh * (-0.5 / c.turn_heading_sigma_rad**2)), 0.0)
-        p_path = w * (p_keep / np.maximum(w.sum(axis=1), 1e-12))[:, None]  # (n, M)
-
-        # rows (obstacle, mode, probability): lane continuations, left, right, cv
         m = paths.shape[1]
-        p_all = np.concatenate((p_path, (w_left * p_keep)[:, None], (w_right * p_keep)[:, None],
-                                (~on)[:, None].astype(float)), axis=1)  # (n, M + 3)
-        p_all[~on, : m + 2] = 0.0
-        best = p_all.argmax(axis=1)
-        keep = (p_all >= c.min_mode_prob) | (np.arange(m + 3) == best[:, None])
-        keep &= p_all > 0.0
-        obs, col = keep.nonzero()  # row-major: grouped by obstacle
-        prob = p_all[obs, col]
-        order = np.lexsort((-prob, obs))  # per obstacle, most probable first
-        obs, col, prob = obs[order], col[order], prob[order]
-        mode = np.where(col < m, LANE, col - m + LEFT)  # m → LEFT, m + 1 → RIGHT, m + 2 → CV
-        mode[col == m + 2] = CV
+        if m == 1:  # no lane branches: lane keeping is one mode
+            p_path = p_keep[:, None]
+        else:
+            ahead = s + np.maximum(v_along * c.turn_lookahead_s, c.turn_lookahead_min_m)
+            path_off = graph.paths.offset.take(np.maximum(paths, 0))  # (n, M)
+            dh = graph.paths.heading_at(path_off + ahead[:, None]) - obstacles.heading_rad[:, None]
+            dh = (dh + np.pi) % (2.0 * np.pi) - np.pi
+            w = np.exp(dh * dh * (-0.5 / c.turn_heading_sigma_rad**2)) * (paths >= 0)
+            p_path = w * (p_keep / np.maximum(w.sum(axis=1), 1e-12))[:, None]  # (n, M)
 
-        x = ox.take(obs)[:, None] + vx.take(obs)[:, None] * t  # (r, K) constant velocity
-        y = oy.take(obs)[:, None] + vy.take(obs)[:, None] * t
+        # rows (obstacle, mode, probability): columns lane continuations, left, right, cv
+        p_all = np.concatenate((p_path, (w_left * p_keep)[:, None], (w_right * p_keep)[:, None],
+                                (~on)[:, None]), axis=1)  # (n, M + 3)
+        best = p_all.max(axis=1, keepdims=True)
+        obs, col = ((p_all >= np.minimum(best, c.min_mode_prob)) & (p_all > 0.0)).nonzero()
+        prob = p_all[obs, col]
+        order = (obs - 0.5 * prob).argsort(kind="stable")  # per obstacle, most probable first
+        obs, col, prob = obs.take(order), col.take(order), prob.take(order)
+        mode = MODE_AFTER_PATHS.take(np.maximum(col - (m - 1), 0))  # col m → LEFT, m+1 …
+        x = np.empty((len(obs), self.k))  # (r, K)
+        y = np.empty((len(obs), self.k))
         along = s.take(obs)[:, None] + v_along.take(obs)[:, None] * t  # (r, K)
         is_path = mode == LANE
         if np.count_nonzero(is_path):
             p_ids = paths[obs[is_path], col[is_path]]
             px, py = graph.paths.xy_at(graph.paths.offset.take(p_ids)[:, None] + along[is_path])
             x[is_path], y[is_path] = px, py
+        is_cv = mode == CV
+        if np.count_nonzero(is_cv):
+            o = obs[is_cv]
+            x[is_cv] = ox.take(o)[:, None] + vx.take(o)[:, None] * t
+            y[is_cv] = oy.take(o)[:, None] + vy.take(o)[:, None] * t
         change = (mode == LEFT) | (mode == RIGHT)
         if np.count_nonzero(change):
             o = obs[change]

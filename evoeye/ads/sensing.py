@@ -118,6 +118,14 @@ class SensorModel:
         self._var_range = c.radar_range_sigma_m**2 + VAR_FLOOR  # radar variances, for the fusion
         self._var_range_rate = c.radar_range_rate_sigma_mps**2 + VAR_FLOOR
 
+    def _may_merge(self, pos: np.ndarray, length_m: np.ndarray, width_m: np.ndarray) -> bool:
+        """Whether any two lidar detections at pos (m,) complex may be close enough to merge:
+        boxes within the gap have centres within hypot(L + gap, W + gap) of the largest car."""
+        g = self.c.lidar_merge_gap_m
+        reach = math.hypot(float(length_m.max()) + g, float(width_m.max()) + g)
+        d = np.abs(np.subtract.outer(pos, pos))  # (m, m)
+        return np.count_nonzero(d < reach) > len(pos)  # the diagonal is 0
+
     def detect(self, scene: SceneState, ego: Localization | None = None) -> Detections:
         """Detections of every actor but the ego (row 0) at scene.t_s, in the world frame placed
         with `ego` (the localisation estimate at capture; None: the true pose)."""
@@ -141,7 +149,7 @@ class SensorModel:
         e_h = np.exp(1j * h_rel)
         vrel = v[1:] * e_h - v0  # velocity relative to the ego
         r = np.abs(rel)
-        bearing = np.angle(rel)  # (−π, π]: the seam is straight behind
+        bearing = np.arctan2(rel.imag, rel.real)  # (−π, π]: the seam is straight behind
         los = rel / r  # unit line of sight
         e_phi = e_h / los  # target orientation relative to the line of sight
         cos_phi, sin_phi = np.abs(e_phi.real), np.abs(e_phi.imag)
@@ -167,7 +175,7 @@ class SensorModel:
         vel_l = vrel + sig_v * gc[n:]
         head_l = h_rel + (c.heading_sigma_rad + c.heading_sigma_per_m * r) * g[4 * n:5 * n]
         var_pl, var_vl = sig_p * sig_p + VAR_FLOOR, sig_v * sig_v + VAR_FLOOR
-        if np.count_nonzero(lidar) > 1:
+        if np.count_nonzero(lidar) > 1 and self._may_merge(pos_l[lidar], length, width):
             i = lidar.nonzero()[0]
             keep, pos_l[i], vel_l[i], len_l[i], wid_l[i] = merge_segments(
                 pos_l[i], vel_l[i], h_rel[i], length[i], width[i], r[i], c.lidar_merge_gap_m)
@@ -177,10 +185,6 @@ class SensorModel:
         rm = r + c.radar_range_sigma_m * g[5 * n:6 * n]
         los_r = np.exp(1j * (bearing + c.radar_azimuth_sigma_rad * g[6 * n:7 * n]))
         rr = (vrel * los.conj()).real + c.radar_range_rate_sigma_mps * g[7 * n:]
-        pos_r, vel_r = rm * los_r, rr * los_r
-        vel_abs = vel_r + v0
-        head_r = np.where(np.abs(vel_abs) > 1.0, np.angle(vel_abs), 0.0)
-        var_pr = np.maximum(self._var_range, (r * c.radar_azimuth_sigma_rad) ** 2 + VAR_FLOOR)
 
         # fusion where both see the actor: the radar measures range and range rate only, so it
         # corrects the lidar along its line of sight (a Kalman update with a radial measurement)
@@ -191,20 +195,24 @@ class SensorModel:
             d_vel = (var_vl / (var_vl + self._var_range_rate)) * (rr - (vel_l * back).real)
             pos_l = np.where(both, pos_l + d_pos * los_r, pos_l)
             vel_l = np.where(both, vel_l + d_vel * los_r, vel_l)
-        seen = (lidar | radar).nonzero()[0]
-        lid = lidar[seen]
-        z = pack(
-            np.where(lid, pos_l[seen], pos_r[seen]), np.where(lid, vel_l[seen], vel_r[seen]),
-            np.where(lid, head_l[seen], head_r[seen]),
-            np.where(lid, len_l[seen], c.radar_length_m),
-            np.where(lid, wid_l[seen], c.radar_width_m), r[seen],
-            np.where(lid, var_pl[seen], var_pr[seen]),
-            np.where(lid, var_vl[seen], self._radar_var_vel),
-        )
-        ids = scene.actor_id[1:][seen]
-        by_radar = radar[seen]
-        ghost_ids, ghosts = fp.ghosts(z[:, by_radar], u[2 * n:3 * n][seen][by_radar])
-        if len(ghost_ids):
+        z = pack(pos_l, vel_l, head_l, len_l, wid_l, r, var_pl, var_vl)  # (DET_FIELDS, n)
+        radar_only = radar & ~lidar
+        if np.count_nonzero(radar_only):
+            j = radar_only.nonzero()[0]
+            pos_r, vel_r = rm[j] * los_r[j], rr[j] * los_r[j]
+            vel_abs = vel_r + v0
+            head_r = np.where(np.abs(vel_abs) > 1.0, np.arctan2(vel_abs.imag, vel_abs.real), 0.0)
+            var_pr = np.maximum(self._var_range, (r[j] * c.radar_azimuth_sigma_rad) ** 2
+                                + VAR_FLOOR)
+            z[:, j] = pack(pos_r, vel_r, head_r, c.radar_length_m, c.radar_width_m, r[j], var_pr,
+                           self._radar_var_vel)
+        ids = scene.actor_id[1:]
+        multipath = radar & (u[2 * n:3 * n] < c.ghost_prob) & (r > c.ghost_min_range_m)
+        seen = lidar | radar
+        if np.count_nonzero(seen) < n:
+            ids, z, multipath = ids[seen], z[:, seen], multipath[seen]
+        if np.count_nonzero(multipath):
+            ghost_ids, ghosts = fp.ghosts(z[:, multipath])
             ids, z = np.concatenate((ids, ghost_ids)), np.concatenate((z, ghosts), axis=1)
         if len(fp_ids):
             ids, z = np.concatenate((ids, fp_ids)), np.concatenate((z, fp_z), axis=1)

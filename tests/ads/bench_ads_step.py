@@ -16,6 +16,7 @@ from pathlib import Path
 import numpy as np
 
 sys.path.insert(0, str(Path(__file__).parent))
+sys.path.insert(0, str(Path(__file__).parents[2]))  # this checkout's evoeye, not an installed one
 from conftest import BicycleWorld, crossing_road, straight_road  # noqa: E402
 
 from evoeye.ads import ADS, ADSConfig  # noqa: E402

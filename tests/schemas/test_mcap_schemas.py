@@ -180,3 +180,14 @@ def test_foxglove_schema_is_parsable_by_the_viewers() -> None:
         assert field.get("type") in VIEWER_TYPES, where
         if field["type"] == "array":
             assert field["items"].get("type") in VIEWER_TYPES - {"array"}, where
+
+
+def test_enumerated_message_values_equal_the_schema_enums() -> None:
+    from evoeye.ads.messages import PLANNING_DECISIONS, PREDICTION_MODES
+
+    def enum(schema_file: str, field: str) -> list[str]:
+        prop = json.loads((SCHEMA_DIR / schema_file).read_text())["properties"][field]
+        return prop.get("enum") or prop["items"]["enum"]
+
+    assert enum("predictions.v1.json", "model") == list(PREDICTION_MODES)
+    assert enum("planned_trajectory.v1.json", "decision") == list(PLANNING_DECISIONS)
