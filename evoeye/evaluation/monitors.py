@@ -64,7 +64,8 @@ def fit_aem(root: DataRoot | str | Path | None, scenario: str,
             horizon_s: float = DEFAULT_HORIZON_S) -> AEMMonitor:
     """The AEM of this scenario's train split: loaded if trained before, else trained and saved.
 
-    Trained on the collision-free windows of the split: label 0 and before the run's collision."""
+    Trained on the collision-free windows of the split: label 0 (all windows are before their
+    run's collision, see `load_windows`)."""
     from evoeye.baselines.aem import AEMConfig, train_aem
 
     config = config or AEMConfig()
@@ -75,7 +76,7 @@ def fit_aem(root: DataRoot | str | Path | None, scenario: str,
         return load_aem(root, version)
     train = load_split(root, scenario, "train", splits, context_len=config.context_len,
                        horizon_s=horizon_s)
-    normal = (train.windows.label == 0) & train.eligible
+    normal = train.windows.label == 0
     monitor = train_aem(train.windows, normal, config)
     monitor.save(root.path / AEM_DIR, {
         "training_key": key, "logical_scenario": scenario, "splits": asdict(splits),
