@@ -87,7 +87,7 @@ def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_ru
     from evoeye.baselines.aem import AEMConfig, train_aem
     from evoeye.evaluation.calibration import calibrate_on_validation
     from evoeye.evaluation.dataset import load_runs
-    from evoeye.evaluation.monitors import AEM_DIR, aem_training_key, find_aem
+    from evoeye.evaluation.monitors import AEM_DIR, find_aem, training_key
     from evoeye.monitor.card import describe_selection, thresholds_to_json
 
     parent = load_aem_version(root, init_from) if init_from else None
@@ -95,7 +95,7 @@ def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_ru
         context_len=context_len or DEFAULT_CONTEXT_LEN)
     config = replace(config, seed=seed, **({"epochs": epochs} if epochs else {}))
     selection = {"train": describe_selection(train_runs), "val": describe_selection(val_runs)}
-    key = aem_training_key(scenario, selection, asdict(config), init_from, horizon_s)
+    key = training_key(scenario, selection, asdict(config), init_from, horizon_s)
     if (version := find_aem(root, key)) is not None:
         return version
     train = load_runs(root, scenario, train_runs, "train", context_len=config.context_len,
