@@ -40,7 +40,8 @@ def evaluate_command(
     monitor: Annotated[list[str] | None, typer.Option(
         "--monitor", help="Trained monitor version to evaluate (repeatable).")] = None,
     baselines: Annotated[str, typer.Option(
-        help="Comma-separated baselines: ttc, rss, aem ('none' for none).")] = "ttc,rss,aem",
+        help="Comma-separated baselines: ttc, rss, aem, context-only ('none' for none).")
+    ] = ",".join(BASELINES),
     fusion: Annotated[bool, typer.Option(
         "--train-fusion/--no-train-fusion",
         help="Also train a FusionMonitor per scenario (seed 0, L = 5) and evaluate it.")] = False,

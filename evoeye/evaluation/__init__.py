@@ -1,6 +1,6 @@
 """Evaluation: calibration, the paper's metrics, scenario-level detection, lead time, reports."""
 
-from evoeye.evaluation.calibration import alarms, calibrate
+from evoeye.evaluation.calibration import alarms, calibrate, calibrate_on_validation
 from evoeye.evaluation.harness import EvaluationReport, MonitorResult, evaluate
 from evoeye.evaluation.metrics import PRF, FrameMetrics, frame_metrics, prf
 from evoeye.evaluation.monitors import BASELINES, baseline_monitors, load_monitors, train_fusion
@@ -19,6 +19,7 @@ __all__ = [
     "alarms",
     "baseline_monitors",
     "calibrate",
+    "calibrate_on_validation",
     "evaluate",
     "frame_metrics",
     "load_monitors",

@@ -1,4 +1,8 @@
-"""Thresholds for a target false-positive rate, chosen on validation scores (paper §V "Metrics")."""
+"""Thresholds for a target false-positive rate, chosen on validation scores (paper §V "Metrics").
+
+One convention for RQ1, RQ2 and the AEM: `calibrate_on_validation`, on a monitor's scores of the
+validation windows `load_windows` returns — pre-collision frames only (view eligible_frames).
+"""
 
 from __future__ import annotations
 
@@ -7,6 +11,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from evoeye.monitor.protocol import TARGET_FPRS, Thresholds
+from evoeye.store.windows import Windows
 
 
 def calibrate(scores: np.ndarray, labels: np.ndarray,
@@ -23,6 +28,16 @@ def calibrate(scores: np.ndarray, labels: np.ndarray,
             raise ValueError(f"target FPR must be in (0, 1), got {fpr}")
         out[float(fpr)] = float(np.quantile(neg, 1.0 - fpr, method="higher"))
     return Thresholds(out)
+
+
+def calibrate_on_validation(scores: np.ndarray, val: Windows,
+                            fprs: Iterable[float] = TARGET_FPRS) -> Thresholds:
+    """Thresholds from a monitor's (B,) scores of the validation windows `val` (from
+    `load_windows`, so no frame at or after a collision), against their labels."""
+    scores = np.asarray(scores)
+    if scores.shape != (len(val),):
+        raise ValueError(f"{scores.shape} scores for {len(val)} validation windows")
+    return calibrate(scores, val.label, fprs)
 
 
 def alarms(scores: np.ndarray, threshold: float) -> np.ndarray:

@@ -1,8 +1,8 @@
 """The windows a monitor is evaluated on: one split of one logical scenario, with run outcomes.
 
-Frames at or after a run's first collision are kept in the windows but are not *eligible*:
-Definition 1 labels them 0 because no collision lies ahead, not because they are safe, and a
-run of the paper's setup ends at the collision. Metrics and calibration use eligible frames.
+The windows hold eligible frames only (`load_windows`, view eligible_frames): a frame at or
+after a run's first collision is no sample of "collision ahead or not" — a run of the paper's
+setup ends at the collision — so it enters no calibration and no metric.
 """
 
 from __future__ import annotations
@@ -22,7 +22,6 @@ SELECT scenario_id, collided, collision_time_s
 FROM scenarios
 WHERE logical_scenario = $logical_scenario
 """
-TIME_EPS_S = 1e-6  # frame times are floats on a 20 Hz grid
 
 
 @dataclass
@@ -38,11 +37,6 @@ class SplitWindows:
         return len(self.windows)
 
     @property
-    def eligible(self) -> np.ndarray:
-        """(B,) bool: frames strictly before their run's collision (all frames of safe runs)."""
-        return self.windows.t_s < self.collision_time_s - TIME_EPS_S
-
-    @property
     def n_scenarios(self) -> int:
         return len(np.unique(self.windows.scenario_id))
 
@@ -52,13 +46,12 @@ class SplitWindows:
         return int(np.isfinite(self.collision_time_s[first]).sum())
 
     def stats(self) -> dict[str, int]:
-        """Scenarios, violations, eligible frames and unsafe frames of the split."""
-        ok = self.eligible
+        """Scenarios, violations, (eligible) frames and unsafe frames of the split."""
         return {
             "scenarios": self.n_scenarios,
             "violations": self.n_violations,
-            "frames": int(ok.sum()),
-            "unsafe_frames": int(self.windows.label[ok].sum()),
+            "frames": len(self.windows),
+            "unsafe_frames": int(self.windows.label.sum()),
         }
 
 
@@ -72,7 +65,7 @@ def narrow(windows: Windows, context_len: int) -> Windows:
     return Windows(
         windows.features, windows.context[:, -context_len:],
         windows.context_mask[:, -context_len:], windows.label, windows.scenario_id,
-        windows.frame, windows.t_s, windows.horizon_s, windows.spec,
+        windows.frame, windows.t_s, windows.horizon_s, windows.spec, windows.ego_xy_m,
     )
 
 

@@ -3,8 +3,8 @@
 Per monitor: thresholds for each target FPR are calibrated on the validation frames and applied
 unchanged to the test frames; frame-level P / R / F1, AUROC and AUPRC; scenario-level
 detection for each K with warning lead times; optionally CPU latency. Every scored frame (val and
-test) goes to the warehouse table monitor_scores. Frames at or after a run's collision are not
-eligible for any metric (see `dataset.py`).
+test) goes to the warehouse table monitor_scores. The windows hold no frame at or after a run's
+collision (see `dataset.py`), so none enters calibration or a metric.
 """
 
 from __future__ import annotations
@@ -15,7 +15,7 @@ from pathlib import Path
 
 import numpy as np
 
-from evoeye.evaluation.calibration import calibrate
+from evoeye.evaluation.calibration import calibrate_on_validation
 from evoeye.evaluation.dataset import SplitWindows, load_split, narrow
 from evoeye.evaluation.latency import Latency, measure_latency
 from evoeye.evaluation.metrics import Curves, FrameMetrics, frame_metrics
@@ -96,15 +96,14 @@ def evaluate_monitor(monitor: Monitor, val: SplitWindows, test: SplitWindows, ru
     L = monitor_context_len(monitor)
     s_val = check_scores(monitor, monitor.score(narrow(val.windows, L)), len(val))
     s_test = check_scores(monitor, monitor.score(narrow(test.windows, L)), len(test))
-    ev, et = val.eligible, test.eligible
-    y_val, y_test = val.windows.label[ev], test.windows.label[et]
-    thr = calibrate(s_val[ev], y_val, fprs)
-    val_fpr = {f: float((s_val[ev][y_val == 0] > thr.at(f)).mean()) for f in fprs}
+    y_val, y_test = val.windows.label, test.windows.label
+    thr = calibrate_on_validation(s_val, val.windows, fprs)
+    val_fpr = {f: float((s_val[y_val == 0] > thr.at(f)).mean()) for f in fprs}
     result = MonitorResult(
         monitor.name, monitor.version, L, dict(thr.by_fpr), val_fpr,
-        frame_metrics(s_test[et], y_test, thr, fprs),
+        frame_metrics(s_test, y_test, thr, fprs),
         {k: scenario_metrics(s_test, runs, thr, k, fprs) for k in ks},
-        Curves.of(s_test[et], y_test),
+        Curves.of(s_test, y_test),
         measure_latency(monitor, narrow(test.windows, L)) if latency else None,
     )
     return result, s_val, s_test
@@ -134,7 +133,7 @@ def evaluate(
         if len(part) == 0:
             raise ValueError(f"{scenario}: the {part.split} split has no frames; ingest more runs")
     runs = Runs.of(test.windows.scenario_id, test.windows.frame, test.windows.t_s,
-                   test.collision_time_s, test.eligible)
+                   test.collision_time_s)
     report = EvaluationReport(scenario, splits, horizon_s, tuple(fprs), tuple(ks),
                               {"val": val.stats(), "test": test.stats()})
     for monitor in monitors:

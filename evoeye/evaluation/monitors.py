@@ -1,9 +1,10 @@
 """Which monitors to evaluate: the baselines by name, FusionMonitors by version (a registry).
 
-TTC and RSS are rules and need no data. AEM is trained on the train split of the logical
-scenario and kept under `<root>/baselines/aem/<version>/`; a later call with the same training
-set, split and config loads it instead of training again. FusionMonitors come from
-`evoeye.monitor` (`load_monitor`, `train_monitor`), imported only when asked for.
+TTC and RSS are rules and need no data. AEM and the context-only control are trained on the
+train split of the logical scenario and kept under `<root>/baselines/<aem|context-only>/<version>/`;
+a later call with the same training set, split and config loads one instead of training again.
+FusionMonitors come from `evoeye.monitor` (`load_monitor`, `train_monitor`), imported only when
+asked for.
 """
 
 from __future__ import annotations
@@ -25,10 +26,12 @@ from evoeye.paths import DataRoot
 from evoeye.store import RunFilter, SplitSpec, Warehouse, select_runs
 from evoeye.store.windows import DEFAULT_HORIZON_S
 
-if TYPE_CHECKING:  # torch is imported when an AEM is asked for
+if TYPE_CHECKING:  # torch / scikit-learn are imported when an AEM / the control is asked for
     from evoeye.baselines.aem import AEMConfig, AEMMonitor
+    from evoeye.baselines.context import ContextConfig, ContextOnlyMonitor
 
 AEM_DIR = Path("baselines") / "aem"
+CONTEXT_DIR = Path("baselines") / "context-only"
 
 
 def _root(root: DataRoot | str | Path | None) -> DataRoot:
@@ -44,18 +47,24 @@ def _train_ids(root: DataRoot, scenario: str, splits: SplitSpec) -> list[str]:
     return sorted(runs.column("scenario_id").to_pylist())
 
 
-def aem_training_key(*inputs) -> str:
-    """The key a trained AEM is found again by: a hash of everything its training used."""
+def training_key(*inputs) -> str:
+    """The key a trained baseline (AEM, context-only) is found again by: a hash of everything
+    its training used."""
     return hashlib.sha256(json.dumps(list(inputs), sort_keys=True, default=str).encode()
                           ).hexdigest()
 
 
-def find_aem(root: DataRoot, key: str) -> str | None:
-    """The version of the AEM saved with this training key, if any."""
-    for meta in sorted((root.path / AEM_DIR).glob("*/meta.json")):
+def find_saved(root: DataRoot, folder: Path, key: str) -> str | None:
+    """The version saved under `<root>/<folder>/` with this training key, if any."""
+    for meta in sorted((root.path / folder).glob("*/meta.json")):
         if json.loads(meta.read_text()).get("training_key") == key:
             return meta.parent.name
     return None
+
+
+def find_aem(root: DataRoot, key: str) -> str | None:
+    """The version of the AEM saved with this training key, if any."""
+    return find_saved(root, AEM_DIR, key)
 
 
 def fit_aem(root: DataRoot | str | Path | None, scenario: str,
@@ -64,34 +73,73 @@ def fit_aem(root: DataRoot | str | Path | None, scenario: str,
             horizon_s: float = DEFAULT_HORIZON_S) -> AEMMonitor:
     """The AEM of this scenario's train split: loaded if trained before, else trained and saved.
 
-    Trained on the collision-free windows of the split: label 0 and before the run's collision."""
+    Trained on the collision-free windows of the split: label 0 (all windows are before their
+    run's collision, see `load_windows`)."""
     from evoeye.baselines.aem import AEMConfig, train_aem
 
     config = config or AEMConfig()
     root = _root(root)
     ids = _train_ids(root, scenario, splits)
-    key = aem_training_key(scenario, asdict(splits), asdict(config), horizon_s, ids)
+    key = training_key(scenario, asdict(splits), asdict(config), horizon_s, ids)
     if (version := find_aem(root, key)) is not None:
         return load_aem(root, version)
     train = load_split(root, scenario, "train", splits, context_len=config.context_len,
                        horizon_s=horizon_s)
-    normal = (train.windows.label == 0) & train.eligible
+    normal = train.windows.label == 0
     monitor = train_aem(train.windows, normal, config)
-    monitor.save(root.path / AEM_DIR, {
-        "training_key": key, "logical_scenario": scenario, "splits": asdict(splits),
-        "horizon_s": horizon_s, "train_scenarios": len(ids), "train_windows": int(normal.sum()),
-    })
+    monitor.save(root.path / AEM_DIR, _training_meta(key, scenario, splits, horizon_s, ids,
+                                                     int(normal.sum())))
     return monitor
+
+
+def _training_meta(key: str, scenario: str, splits: SplitSpec, horizon_s: float,
+                   ids: list[str], n_windows: int) -> dict:
+    """What meta.json records of an RQ1 baseline's training (the key it is found again by)."""
+    return {"training_key": key, "logical_scenario": scenario, "splits": asdict(splits),
+            "horizon_s": horizon_s, "train_scenarios": len(ids), "train_windows": n_windows}
+
+
+def _version_dir(root: DataRoot | str | Path | None, folder: Path, version: str) -> Path:
+    """`<root>/<folder>/<version>/`, or a KeyError if no version is saved there."""
+    path = _root(root).path / folder / version
+    if not (path / "meta.json").is_file():
+        raise KeyError(f"no version {version!r} under {path.parent}")
+    return path
 
 
 def load_aem(root: DataRoot | str | Path | None, version: str) -> AEMMonitor:
     """A saved AEM by version."""
     from evoeye.baselines.aem import AEMMonitor
 
-    folder = _root(root).path / AEM_DIR / version
-    if not (folder / "model.pt").is_file():
-        raise KeyError(f"no AEM version {version!r} under {folder.parent}")
-    return AEMMonitor.load(folder)
+    return AEMMonitor.load(_version_dir(root, AEM_DIR, version))
+
+
+def fit_context_only(root: DataRoot | str | Path | None, scenario: str,
+                     splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
+                     config: ContextConfig | None = None, *,
+                     horizon_s: float = DEFAULT_HORIZON_S) -> ContextOnlyMonitor:
+    """The context-only control of this scenario's train split: loaded if trained before, else
+    trained on every (eligible) training window and saved."""
+    from evoeye.baselines.context import ContextConfig, train_context_only
+
+    config = config or ContextConfig()
+    root = _root(root)
+    ids = _train_ids(root, scenario, splits)
+    key = training_key("context-only", scenario, asdict(splits), asdict(config), horizon_s, ids)
+    if (version := find_saved(root, CONTEXT_DIR, key)) is not None:
+        return load_context_only(root, version)
+    train = load_split(root, scenario, "train", splits, context_len=1, horizon_s=horizon_s)
+    monitor = train_context_only(train.windows, config)
+    monitor.save(root.path / CONTEXT_DIR, _training_meta(key, scenario, splits, horizon_s, ids,
+                                                         len(train)))
+    return monitor
+
+
+def load_context_only(root: DataRoot | str | Path | None, version: str) -> ContextOnlyMonitor:
+    """A saved context-only control by version."""
+    from evoeye.baselines.context import ContextOnlyMonitor
+
+    return ContextOnlyMonitor.load(_version_dir(root, CONTEXT_DIR, version))
 
 
 BaselineBuilder = Callable[[DataRoot, str, SplitSpec], Monitor]
@@ -99,6 +147,11 @@ BASELINES: dict[str, BaselineBuilder] = {
     "ttc": lambda root, scenario, splits: TTCMonitor(),
     "rss": lambda root, scenario, splits: RSSMonitor(),
     "aem": lambda root, scenario, splits: fit_aem(root, scenario, splits),
+    "context-only": lambda root, scenario, splits: fit_context_only(root, scenario, splits),
+}
+SAVED_BASELINES: dict[str, Callable[[DataRoot, str], Monitor]] = {  # version prefix → loader
+    "aem-": load_aem,
+    "ctx-": load_context_only,
 }
 
 
@@ -128,11 +181,13 @@ def fusion_api() -> tuple[Callable, Callable] | None:
 
 
 def load_monitors(root: DataRoot | str | Path | None, versions: Iterable[str]) -> list[Monitor]:
-    """Trained monitors by version: AEM versions from here, every other from evoeye.monitor."""
+    """Trained monitors by version: saved baselines (AEM, context-only) from here, every other
+    from evoeye.monitor."""
     out: list[Monitor] = []
     for v in versions:
-        if v.startswith("aem-"):
-            out.append(load_aem(root, v))
+        loader = next((f for p, f in SAVED_BASELINES.items() if v.startswith(p)), None)
+        if loader is not None:
+            out.append(loader(_root(root), v))
             continue
         api = fusion_api()
         if api is None:

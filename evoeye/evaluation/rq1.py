@@ -11,7 +11,7 @@ from pathlib import Path
 
 from evoeye.evaluation.explain import attribution_shares
 from evoeye.evaluation.harness import SCENARIO_KS, EvaluationReport, evaluate
-from evoeye.evaluation.monitors import baseline_monitors, load_monitors, train_fusion
+from evoeye.evaluation.monitors import BASELINES, baseline_monitors, load_monitors, train_fusion
 from evoeye.evaluation.report import ReportFiles, write_report
 from evoeye.monitor.protocol import Monitor
 from evoeye.paths import DataRoot
@@ -35,7 +35,7 @@ def rq1(
     root: DataRoot | str | Path | None,
     scenarios: Sequence[str] | None = None,
     *,
-    baselines: Sequence[str] = ("ttc", "rss", "aem"),
+    baselines: Sequence[str] = tuple(BASELINES),
     monitor_versions: Sequence[str] = (),
     fusion: bool = False,
     splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)

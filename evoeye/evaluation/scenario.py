@@ -1,12 +1,12 @@
 """Scenario-level detection and warning lead time (paper §V-RQ1).
 
 A monitor *warns* in a run at the first frame that completes K consecutive alarms (frames
-t-K+1 … t of the run all alarm; K = 1 is a single alarm). Only frames before the run's first
-collision count (all frames of a run without one). A violation run with a warning is detected
+t-K+1 … t of the run all alarm; K = 1 is a single alarm). The frames are the eligible ones,
+before the run's first collision (`load_windows`). A violation run with a warning is detected
 (TP), without one missed (FN); a safe run with a warning is a false positive (FP). The lead time
 of a detected violation is tau_col − tau_w, tau_w the time of the frame that completes the
 warning. For AUROC / AUPRC over runs, a run's score is the largest score the monitor holds for
-K consecutive eligible frames (max over t of the min over t-K+1 … t): the run warns at a
+K consecutive frames (max over t of the min over t-K+1 … t): the run warns at a
 threshold exactly when this score exceeds it.
 """
 
@@ -32,11 +32,10 @@ class Runs:
     scenario_id: np.ndarray  # (R,) str
     collision_time_s: np.ndarray  # (R,) float64, +inf if no collision
     t_s: np.ndarray  # (N,) sorted frame times
-    eligible: np.ndarray  # (N,) sorted: frame before its run's collision
 
     @classmethod
     def of(cls, scenario_id: np.ndarray, frame: np.ndarray, t_s: np.ndarray,
-           collision_time_s: np.ndarray, eligible: np.ndarray) -> Runs:
+           collision_time_s: np.ndarray) -> Runs:
         ids = np.asarray(scenario_id).astype(str)
         order = np.lexsort((np.asarray(frame), ids))
         sids = ids[order]
@@ -45,7 +44,7 @@ class Runs:
         start = np.flatnonzero(new_run)
         return cls(order, start, np.cumsum(new_run) - 1, sids[start],
                    np.asarray(collision_time_s, float)[order][start],
-                   np.asarray(t_s, float)[order], np.asarray(eligible, bool)[order])
+                   np.asarray(t_s, float)[order])
 
     @property
     def violated(self) -> np.ndarray:
@@ -118,8 +117,8 @@ class ScenarioMetrics:
 
 
 def warnings_at(runs: Runs, alarm_sorted: np.ndarray, k: int) -> np.ndarray:
-    """(R,) time of each run's first eligible K-consecutive alarm; NaN where it never warns."""
-    confirmed = (consecutive_counts(alarm_sorted, runs.start) >= k) & runs.eligible
+    """(R,) time of each run's first K-consecutive alarm; NaN where it never warns."""
+    confirmed = consecutive_counts(alarm_sorted, runs.start) >= k
     first = np.full(len(runs), np.nan)
     hit = np.flatnonzero(confirmed)
     if len(hit):
@@ -142,8 +141,8 @@ def scenario_metrics(scores: np.ndarray, runs: Runs, thresholds: Thresholds, k: 
         leads = runs.collision_time_s[warned & violated] - warn_t[warned & violated]
         lead[f] = LeadTimes(int((warned & violated).sum()), int(violated.sum()),
                             np.round(leads, 4).tolist())
-    windowed = np.where(runs.eligible, k_window_min(s, runs.start, k), -np.inf)
+    windowed = k_window_min(s, runs.start, k)
     run_score = np.maximum.reduceat(windowed, runs.start) if len(s) else np.zeros(0)
-    run_score = np.where(np.isfinite(run_score), run_score, 0.0)
+    run_score = np.where(np.isfinite(run_score), run_score, 0.0)  # runs shorter than K
     return ScenarioMetrics(k, at_fpr, lead, auroc(run_score, violated),
                            auprc(run_score, violated), len(runs), int(violated.sum()))

@@ -66,7 +66,6 @@ class Assessor:
         self.test: SplitWindows = load_split(self.root, scenario, "test", splits,
                                              context_len=monitor.context_len,
                                              horizon_s=horizon_s)
-        self.eligible = self.test.eligible
         w = self.test.windows
         if not set(w.scenario_id.tolist()) <= scored_scenarios(self.root, g0):
             write_scores(self.root, ScoreRows(monitor.name, g0, scenario, w.scenario_id,
@@ -92,9 +91,8 @@ class Assessor:
         monitor = self._load(self.root, version)
         scores = monitor.score(self.test.windows)
         labels = self.test.windows.label
-        ok = self.eligible
         return {
             "version": version,
-            "test": metrics_dict(scores[ok], labels[ok], monitor.thresholds),
+            "test": metrics_dict(scores, labels, monitor.thresholds),
             "hard": metrics_dict(scores[self.hard], labels[self.hard], monitor.thresholds),
         }

@@ -81,13 +81,13 @@ def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_ru
                       horizon_s: float = DEFAULT_HORIZON_S, epochs: int | None = None,
                       splits: SplitSpec | None = None, **_ignored: Any) -> str:
     """Train (or fine-tune, `init_from`) an AEM on the collision-free windows of `train_runs`,
-    calibrate its thresholds on the eligible frames of `val_runs`, save it; its version. A
+    calibrate its thresholds on `val_runs` (`calibrate_on_validation`), save it; its version. A
     version with the same training key (selection, seed, recipe, parent) is reused.
     `splits` and other FusionMonitor options (patience, …) do not apply and are ignored."""
     from evoeye.baselines.aem import AEMConfig, train_aem
-    from evoeye.evaluation.calibration import calibrate
+    from evoeye.evaluation.calibration import calibrate_on_validation
     from evoeye.evaluation.dataset import load_runs
-    from evoeye.evaluation.monitors import AEM_DIR, aem_training_key, find_aem
+    from evoeye.evaluation.monitors import AEM_DIR, find_aem, training_key
     from evoeye.monitor.card import describe_selection, thresholds_to_json
 
     parent = load_aem_version(root, init_from) if init_from else None
@@ -95,17 +95,16 @@ def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_ru
         context_len=context_len or DEFAULT_CONTEXT_LEN)
     config = replace(config, seed=seed, **({"epochs": epochs} if epochs else {}))
     selection = {"train": describe_selection(train_runs), "val": describe_selection(val_runs)}
-    key = aem_training_key(scenario, selection, asdict(config), init_from, horizon_s)
+    key = training_key(scenario, selection, asdict(config), init_from, horizon_s)
     if (version := find_aem(root, key)) is not None:
         return version
     train = load_runs(root, scenario, train_runs, "train", context_len=config.context_len,
                       horizon_s=horizon_s)
     val = load_runs(root, scenario, val_runs, "val", context_len=config.context_len,
                     horizon_s=horizon_s)
-    normal = (train.windows.label == 0) & train.eligible
+    normal = train.windows.label == 0
     aem = train_aem(train.windows, normal, config, init=parent.aem if parent else None)
-    ok = val.eligible
-    thresholds = calibrate(aem.score(val.windows)[ok], val.windows.label[ok])
+    thresholds = calibrate_on_validation(aem.score(val.windows), val.windows)
     aem.save(root.path / AEM_DIR, {
         "training_key": key, "logical_scenario": scenario, "parent": init_from,
         "horizon_s": horizon_s, "selection": selection,

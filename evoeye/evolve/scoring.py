@@ -1,8 +1,9 @@
 """Feedback f_r(x) of runs under a monitor: from a fresh run log, or from the warehouse.
 
 A new record is scored straight from its MCAP log, through the warehouse's own conversion
-(`frames_table` → `frame_features`, contexts and labels as `windows.sql` and `frame_labels_h`
-build them), so it needs no ingest and gives the scores its warehouse windows would get.
+(`frames_table` → `frame_features`, eligible frames, contexts and labels as `eligible_frames`,
+`windows.sql` and `frame_labels_h` build them), so it needs no ingest and gives the scores its
+warehouse windows would get: no frame at or after the run's collision enters its feedback.
 Reading the log (not the in-memory Episode) makes a freshly simulated run and one found on disk
 by a resumed campaign go through exactly the same code, so their feedback is bit-identical.
 Runs already ingested (the refresh after a monitor update) are scored from the warehouse.
@@ -15,6 +16,7 @@ from pathlib import Path
 from typing import Any
 
 import numpy as np
+import pyarrow as pa
 
 from evoeye.evolve.feedback import ScenarioFeedback, prior_corrected, scenario_feedback
 from evoeye.log import read_run
@@ -22,7 +24,7 @@ from evoeye.store.features import FEATURES, frame_features
 from evoeye.store.records import frames_table
 from evoeye.store.windows import Windows, load_windows
 
-LABEL_EPS_S = 1e-6  # as frame_labels_h: frame times sit on a float 20 Hz grid
+LABEL_EPS_S = 1e-6  # as eligible_frames / frame_labels_h: frame times sit on a float 20 Hz grid
 
 
 @dataclass(frozen=True)
@@ -42,6 +44,15 @@ class LoggedRun:
         return float(self.metadata["duration_s"])
 
 
+def eligible_frames(t_s: np.ndarray, collided: np.ndarray) -> np.ndarray:
+    """(N,) bool, as the view eligible_frames: frames strictly before the first collided frame
+    (all frames of a run without one)."""
+    hit = np.flatnonzero(collided)
+    if len(hit) == 0:
+        return np.ones(len(t_s), bool)
+    return t_s[hit[0]] - t_s > LABEL_EPS_S
+
+
 def frame_labels(t_s: np.ndarray, collided: np.ndarray, horizon_s: float) -> np.ndarray:
     """y_t (Definition 1): 1 iff 0 < tau_col − t ≤ H, tau_col the first collided frame's time."""
     hit = np.flatnonzero(collided)
@@ -58,21 +69,26 @@ def run_contexts(n_frames: int, context_len: int) -> tuple[np.ndarray, np.ndarra
 
 
 def read_logged_run(path: str | Path, context_len: int, horizon_s: float) -> LoggedRun:
-    """A run log's metadata and its labelled windows, as the warehouse would build them."""
+    """A run log's metadata and its labelled windows, as the warehouse would build them (one per
+    eligible frame; None if the run has none)."""
     run = read_run(path)
     meta = dict(run.metadata)
     sid = str(meta["scenario_id"])
     frames = frames_table(run, sid, "in-memory")
+    t_s = frames.column("t_s").to_numpy()
+    collided = frames.column("gt_ego_collision").to_numpy(zero_copy_only=False)
+    keep = eligible_frames(t_s, collided)
+    labels = frame_labels(t_s, collided, horizon_s)[keep]
+    frames, t_s = frames.filter(pa.array(keep)), t_s[keep]
     n = frames.num_rows
     if n == 0:
         return LoggedRun(Path(path), meta, None)
-    t_s = frames.column("t_s").to_numpy()
-    labels = frame_labels(t_s, frames.column("gt_ego_collision").to_numpy(zero_copy_only=False),
-                          horizon_s)
     ctx, mask = run_contexts(n, context_len)
+    xy = np.stack([frames.column(c).to_numpy(zero_copy_only=False).astype(np.float64)
+                   for c in ("loc_x_m", "loc_y_m")], axis=1)  # (N, 2)
     windows = Windows(
         frame_features(frames, FEATURES), ctx, mask, labels, np.full(n, sid, dtype=object),
-        frames.column("frame").to_numpy().astype(np.int32), t_s, horizon_s, FEATURES,
+        frames.column("frame").to_numpy().astype(np.int32), t_s, horizon_s, FEATURES, xy,
     )
     return LoggedRun(Path(path), meta, windows)
 

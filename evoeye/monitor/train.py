@@ -1,5 +1,8 @@
 """Train a FusionMonitor on SQL-selected warehouse windows and save it as a version with a card.
 
+The windows are the eligible frames of the selected runs (`load_windows`): no frame at or after
+a run's collision enters training, `pos_weight`, early stopping or calibration.
+
 Loss: binary cross-entropy on the logit (`BCEWithLogitsLoss`) with `pos_weight` = negatives /
 positives of the training windows. Unsafe frames are rare (≈ 4 % in S1, ≈ 16 % in S2), so
 unweighted BCE is dominated by the easy safe frames; weighting the positives balances the two
@@ -30,7 +33,7 @@ import torch
 from torch import nn
 
 from evoeye import __version__
-from evoeye.evaluation.calibration import calibrate
+from evoeye.evaluation.calibration import calibrate_on_validation
 from evoeye.monitor.card import (
     data_summary,
     describe_selection,
@@ -216,7 +219,7 @@ def train_monitor(
             net.fit_normalizers(_frames_of(train))
         result = fit(net, train, val, params, progress)
     scores = FusionMonitor(result.net, "training", None).score(val)  # type: ignore[arg-type]
-    thresholds = calibrate(scores, val.label)
+    thresholds = calibrate_on_validation(scores, val)
     card = {
         "name": FusionMonitor.name,
         "created_at": datetime.now(UTC).isoformat(timespec="seconds"),

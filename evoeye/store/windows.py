@@ -1,7 +1,8 @@
 """Training windows: runtime contexts c_t (Definition 2) with labels y_t (Definition 1), from SQL.
 
-`warehouse/queries/windows.sql` returns every frame of the selected runs with its label, its
-monitor inputs (table frame_features) and the rows of its L context frames (`ctx_row`,
+`warehouse/queries/windows.sql` returns every eligible frame of the selected runs (none at or
+after a run's collision: view eligible_frames) with its label, its monitor inputs (table
+frame_features), the ego's localization estimate and the rows of its L context frames (`ctx_row`,
 `ctx_mask`). The frames' inputs are kept once; a window is `features[ctx_row]`, gathered when
 asked for (all at once, or per training batch), so N frames cost N feature rows, not N·L.
 """
@@ -61,6 +62,7 @@ class Windows:
     t_s: np.ndarray  # (B,) float64
     horizon_s: float
     spec: FeatureSpec
+    ego_xy_m: np.ndarray | None = None  # (B, 2) float64, localization x, y (map frame) at t
 
     def __len__(self) -> int:
         return int(self.label.shape[0])
@@ -89,7 +91,7 @@ class Windows:
         return Windows(
             self.features, self.context[index], self.context_mask[index], self.label[index],
             self.scenario_id[index], self.frame[index], self.t_s[index], self.horizon_s,
-            self.spec,
+            self.spec, None if self.ego_xy_m is None else self.ego_xy_m[index],
         )
 
 
@@ -116,6 +118,7 @@ class _WindowsBuilder:
         self.scenario_id = np.empty(n_frames, object)
         self.frame = np.zeros(n_frames, np.int32)
         self.t_s = np.zeros(n_frames, np.float64)
+        self.ego_xy_m = np.zeros((n_frames, 2), np.float64)
         self.n_arrived = 0
         self.horizon_s, self.spec = horizon_s, spec
 
@@ -134,6 +137,8 @@ class _WindowsBuilder:
         self.scenario_id[rows] = batch.column("scenario_id").to_numpy(zero_copy_only=False)
         self.frame[rows] = batch.column("frame").to_numpy()
         self.t_s[rows] = batch.column("t_s").to_numpy()
+        for i, name in enumerate(("loc_x_m", "loc_y_m")):
+            self.ego_xy_m[rows, i] = batch.column(name).to_numpy(zero_copy_only=False)
 
     def build(self) -> Windows:
         if self.n_arrived != len(self.arrival) or (self.arrival < 0).any():
@@ -141,7 +146,7 @@ class _WindowsBuilder:
             raise RuntimeError(f"{missing} frames of the selected runs have no frame_features")
         return Windows(
             self.features, self.arrival[self.context], self.context_mask, self.label,
-            self.scenario_id, self.frame, self.t_s, self.horizon_s, self.spec,
+            self.scenario_id, self.frame, self.t_s, self.horizon_s, self.spec, self.ego_xy_m,
         )
 
 
@@ -152,7 +157,8 @@ def load_windows(
     context_len: int = DEFAULT_CONTEXT_LEN,
     horizon_s: float = DEFAULT_HORIZON_S,
 ) -> Windows:
-    """Every window of the selected runs (default: all runs with status 'ok'), labelled for H.
+    """Every window of the selected runs (default: all runs with status 'ok'), labelled for H,
+    one per eligible frame: no frame at or after a run's collision.
 
     `runs` is a RunFilter, a list of scenario ids or a SQL query returning scenario_id (see
     `select_runs`). Windows come in (scenario_id, frame) order.

@@ -34,7 +34,8 @@ def test_metrics_use_frames_before_the_collision_only(report, eval_root, splits,
     n_viol, after = stats["violations"], layout.n_frames - layout.collision_frame
     assert stats["frames"] == stats["scenarios"] * layout.n_frames - n_viol * after
     assert stats["unsafe_frames"] == n_viol * 3 * layout.rate_hz  # H = 3 s before the collision
-    assert report.monitors[0].frame.frames == stats["frames"] == int(test.eligible.sum())
+    assert report.monitors[0].frame.frames == stats["frames"] == len(test)
+    assert (test.windows.t_s < test.collision_time_s - 1e-6).all()
 
 
 def test_thresholds_come_from_validation(report) -> None:

@@ -65,7 +65,8 @@ def test_one_risk_message_per_frame_with_alarms_above_the_threshold(
     scores = np.array([r["score"] for r in risk])
     batch = monitor.score(load_windows(tiny.root, [sid], context_len=5,
                                        horizon_s=tiny.horizon_s))
-    np.testing.assert_allclose(scores, batch, rtol=0, atol=1e-5)
+    # the replay scores every frame of the log; the warehouse windows stop before a collision
+    np.testing.assert_allclose(scores[:len(batch)], batch, rtol=0, atol=1e-5)
     threshold = monitor.thresholds.at(0.05)
     assert {r["threshold"] for r in risk} == {threshold}
     assert {r["monitor_version"] for r in risk} == {trained}

@@ -49,11 +49,13 @@ def test_card_records_data_hyperparameters_metrics_and_thresholds(
     params = card["selection"]["train"]["params"]
     assert params["logical_scenario"] == tiny.scenario and params["split"] == "train"
     assert card["data"]["train"]["runs"] == len(tiny.ids["train"]) == 6
-    assert card["data"]["val"]["frames"] == 80 and card["data"]["val"]["unsafe_frames"] == 20
+    # val: one colliding run (frames 0 … 29, before its collision) and one safe run (40 frames)
+    assert card["data"]["val"]["frames"] == 70 and card["data"]["val"]["unsafe_frames"] == 20
     assert len(card["data"]["train"]["fingerprint"]) == 16
     hp = card["hyperparameters"]
     assert hp["seed"] == 0 and hp["epochs"] == tiny.fast["epochs"] and hp["lr"] == tiny.fast["lr"]
-    assert hp["pos_weight"] == pytest.approx(180 / 60)  # negatives / positives of train
+    # negatives / positives of train: 3 × 30 + 3 × 40 frames before any collision, 60 unsafe
+    assert hp["pos_weight"] == pytest.approx(150 / 60)
     assert card["horizon_s"] == tiny.horizon_s and card["context_len"] == 5
     assert 20_000 <= card["n_parameters"] <= 30_000
     assert set(card["thresholds"]) == {"0.05", "0.01"}

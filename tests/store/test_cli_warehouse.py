@@ -63,8 +63,9 @@ def test_stats_prints_the_dataset_table(ingested: DataRoot) -> None:
     assert result.exit_code == 0, result.output
     row = next(line for line in result.output.splitlines() if "highway-cut-in" in line)
     cells = [c.strip() for c in row.split("│") if c.strip()]
-    # both runs train; 1 violation of 2; 60 frames; frames 0 < 1.5 - t <= 3 -> 30 unsafe
-    assert cells == ["highway-cut-in", "train", "2", "1 (50.0%)", "60", "30 (50.0%)", "0"]
+    # both runs train; 1 violation of 2; 50 eligible frames (cli-0's 10 from its collision on
+    # are not); frames 0 < 1.5 - t <= 3 -> 30 unsafe
+    assert cells == ["highway-cut-in", "train", "2", "1 (50.0%)", "50", "30 (60.0%)", "0"]
 
 
 def test_ingest_refused_while_another_writer_holds_the_lock(root: DataRoot) -> None:

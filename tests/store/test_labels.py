@@ -35,13 +35,18 @@ def test_macro_takes_any_horizon(labelled: Warehouse, h: float, first: int) -> N
     assert _positives(labelled, sql, h=h) == list(range(first, 120))
 
 
-def test_collision_frame_and_later_frames_are_safe(labelled: Warehouse) -> None:
+def test_collision_frame_and_later_frames_have_no_label(labelled: Warehouse) -> None:
     rows = labelled.sql(
         "SELECT frame, label, collision_time_s FROM frame_labels_h(100.0) "
         "WHERE scenario_id = 'hit' AND frame >= 119 ORDER BY frame"
     ).to_pylist()
-    assert rows[0]["label"] == 1 and all(r["label"] == 0 for r in rows[1:])
+    assert [(r["frame"], r["label"]) for r in rows] == [(119, 1)]
     assert rows[0]["collision_time_s"] == pytest.approx(6.0)
+    # the log keeps its tail for viewing: frames 120 … 159 are in frames, not eligible
+    n = labelled.sql("SELECT count(*) AS n FROM frames WHERE scenario_id = 'hit'").to_pylist()
+    eligible = labelled.sql("SELECT max(frame) AS last, count(*) AS n FROM eligible_frames "
+                            "WHERE scenario_id = 'hit'").to_pylist()
+    assert n == [{"n": 160}] and eligible == [{"last": 119, "n": 120}]
 
 
 def test_runs_without_collision_are_all_safe(labelled: Warehouse) -> None:

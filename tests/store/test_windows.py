@@ -29,8 +29,8 @@ def _slot_frames(windows, index=None) -> np.ndarray:
 
 def test_l5_windows_hold_the_last_five_frames_in_order_padded_at_the_start(two_runs) -> None:
     w = load_windows(two_runs, context_len=5)
-    assert len(w) == 19 and w.context_len == 5
-    assert list(w.scenario_id[:12]) == ["a"] * 12 and list(w.frame[:12]) == list(range(12))
+    assert len(w) == 17 and w.context_len == 5  # a: frames 0 … 9, before its collision; b: 7
+    assert list(w.scenario_id[:10]) == ["a"] * 10 and list(w.frame[:10]) == list(range(10))
     slots = _slot_frames(w)
     for i, t in enumerate(w.frame):
         expected = [max(0, t - 4 + k) for k in range(5)]  # m_max(1, t-L+1+k), 0-based
@@ -44,8 +44,31 @@ def test_l5_windows_hold_the_last_five_frames_in_order_padded_at_the_start(two_r
 
 def test_l1_windows_are_single_frames(two_runs) -> None:
     w = load_windows(two_runs, context_len=1)
-    assert w.context.shape == (19, 1) and w.context_mask.all()
+    assert w.context.shape == (17, 1) and w.context_mask.all()
     assert list(_slot_frames(w)[:, 0]) == list(w.frame)
+
+
+def test_no_frame_at_or_after_the_collision_is_a_window(two_runs) -> None:
+    wh = Warehouse(two_runs)
+    tails = wh.sql("SELECT scenario_id, frame FROM frames WHERE gt_ego_collision").to_pylist()
+    assert {(r["scenario_id"], r["frame"]) for r in tails} == {("a", 10), ("a", 11)}
+    for L in (1, 5):
+        w = load_windows(two_runs, context_len=L, horizon_s=100.0)
+        a = w.scenario_id == "a"
+        assert w.frame[a].max() == 9 and w.label[a].all()  # every frame before it is unsafe
+        assert _slot_frames(w).max() <= 11 and (_slot_frames(w)[a] <= 9).all()
+
+
+def test_windows_carry_the_localization_position(two_runs) -> None:
+    w = load_windows(two_runs, context_len=2)
+    loc = Warehouse(two_runs).sql(
+        "SELECT loc_x_m, loc_y_m FROM runtime_frames ORDER BY scenario_id, frame").to_pydict()
+    # frames of a from its collision on are not windows
+    keep = [i for i in range(19) if not 10 <= i < 12]
+    assert w.ego_xy_m.shape == (17, 2)
+    np.testing.assert_allclose(w.ego_xy_m[:, 0], np.array(loc["loc_x_m"])[keep])
+    np.testing.assert_allclose(w.ego_xy_m[:, 1], np.array(loc["loc_y_m"])[keep])
+    np.testing.assert_array_equal(w.subset(np.array([3, 12])).ego_xy_m, w.ego_xy_m[[3, 12]])
 
 
 def test_labels_follow_definition_1(two_runs) -> None:

@@ -1,4 +1,5 @@
--- How many frames the runs listed in `selected_runs` have (sizes the arrays of windows.sql).
-SELECT coalesce(sum(s.n_frames), 0)::BIGINT AS n_frames
-FROM scenarios AS s
-SEMI JOIN selected_runs AS sel ON s.scenario_id = sel.scenario_id;
+-- How many eligible frames (view eligible_frames) the runs listed in `selected_runs` have: the
+-- rows windows.sql returns, which sizes its arrays.
+SELECT count(*)::BIGINT AS n_frames
+FROM eligible_frames AS e
+SEMI JOIN selected_runs AS sel ON e.scenario_id = sel.scenario_id;

@@ -1,6 +1,6 @@
 -- Hard Set (paper §V, RQ2): the unsafe test frames the initial monitor misses at its threshold
 -- (score <= $threshold, the threshold calibrated for FPR 0.05), plus the safe frames of those
--- same runs. Frames at or after a run's collision are not eligible, as in every evaluation.
+-- same runs. Only eligible frames have labels (frame_labels_h), as in every evaluation.
 -- The caller registers `monitor_scores` (the table of that name, e.g. read_scores(...)).
 -- Parameters: $monitor_version, $threshold, $logical_scenario, $horizon_s, and the split
 -- ($seed, $train_frac, $val_frac). One row per frame: scenario_id, frame, t_s, label, score.
@@ -12,7 +12,6 @@ WITH scored AS (
     WHERE s.monitor_version = $monitor_version
         AND p.logical_scenario = $logical_scenario
         AND p.split = 'test'
-        AND (l.collision_time_s IS NULL OR l.t_s < l.collision_time_s - 1e-6)
 ),
 missed AS (
     SELECT DISTINCT scenario_id FROM scored WHERE label = 1 AND score <= $threshold

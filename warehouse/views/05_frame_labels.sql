@@ -1,18 +1,13 @@
--- Frame labels, paper Definition 1:  y_t = 1  iff  0 < tau_col - tau_t <= H.
--- tau_col is the time of the first frame whose ground truth has the ego in a collision
--- (gt_ego_collision); runs without one have tau_col = +inf and every label 0. The collision frame
--- itself (tau_col - tau_t = 0) and every later frame are 0.
--- Frame times are floats on a 20 Hz grid, so both bounds allow 1 microsecond of rounding
--- (a frame exactly H before the collision is labelled 1, as the definition says).
-CREATE OR REPLACE MACRO frame_labels_h(h) AS TABLE
-SELECT
-    scenario_id,
-    frame,
-    t_s,
-    collision_time_s,
-    coalesce(
-        collision_time_s - t_s > 1e-6 AND collision_time_s - t_s <= h + 1e-6, false
-    )::INTEGER AS label
+-- eligible_frames: the frames that may enter anything learned or measured — every frame of a
+-- run without a collision, and the frames strictly before the first collision of a run with
+-- one. A log keeps its post-collision tail for viewing (table frames), but a frame at or after
+-- the collision is no sample of "collision ahead or not": in the paper's setup the run ends
+-- there. Every labelled frame, window, calibration set, feedback and metric is drawn from here.
+-- tau_col (collision_time_s) is the time of the first frame whose ground truth has the ego in a
+-- collision (gt_ego_collision); NULL for runs without one. Frame times are floats on a 20 Hz
+-- grid, so the bound allows 1 microsecond of rounding.
+CREATE OR REPLACE VIEW eligible_frames AS
+SELECT scenario_id, frame, t_s, collision_time_s
 FROM (
     SELECT
         scenario_id,
@@ -21,7 +16,20 @@ FROM (
         min(t_s) FILTER (WHERE gt_ego_collision) OVER (PARTITION BY scenario_id)
             AS collision_time_s
     FROM frames
-);
+)
+WHERE collision_time_s IS NULL OR collision_time_s - t_s > 1e-6;
+
+-- Frame labels, paper Definition 1:  y_t = 1  iff  0 < tau_col - tau_t <= H, on the eligible
+-- frames (so tau_col - tau_t > 0 always holds; runs without a collision are all 0). A frame
+-- exactly H before the collision is labelled 1, as the definition says (1 microsecond slack).
+CREATE OR REPLACE MACRO frame_labels_h(h) AS TABLE
+SELECT
+    scenario_id,
+    frame,
+    t_s,
+    collision_time_s,
+    coalesce(collision_time_s - t_s <= h + 1e-6, false)::INTEGER AS label
+FROM eligible_frames;
 
 -- frame_labels: the labels at the paper's horizon H = 3 s.
 CREATE OR REPLACE VIEW frame_labels AS
