@@ -21,7 +21,7 @@ from highway_env.vehicle.kinematics import Vehicle
 from evoeye.sim.path import Path
 
 LANE_WIDTH_M = 4.0
-CUT_IN_MIN_TTC_S = 2.5  # a cut-in waits while the ego would reach it sooner than this
+CUT_IN_MIN_TTC_S = 2.0  # a cut-in waits while the ego would reach it sooner than this
 CATCH_UP_GAIN_PER_S = 2.0  # braking towards a lower desired speed: 2 m/s² per m/s above it
 PROFILE_DECEL_SHARE = 0.6  # curves are planned for at this share of the comfortable braking,
 # so that the speed tracks the profile with a small lag and the curve is entered on it

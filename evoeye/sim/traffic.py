@@ -54,23 +54,24 @@ class Relations:
         return float(self.bumper[i, j] if self.xi[i, j] < 0.0 else -self.bumper[i, j])
 
 
-def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """(gap, leader speed along one's heading) per vehicle: the nearest vehicle ahead in its
-    corridor (or in its target lane, `shift_m` to the side, during a lane change) that drives
-    its way, or that blocks it within `BLOCKING_M`; gap = inf without one. (n,) each."""
+def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(gap, leader speed along one's heading, blocking gap) per vehicle: the nearest vehicle
+    ahead in its corridor (or in its target lane, `shift_m` to the side, during a lane change)
+    that drives its way; and the nearest one across its way that blocks its corridor within
+    `BLOCKING_M` (a crossing car, which a driver answers only after a reaction time). Gaps are
+    inf without one. (n,) each."""
     n = len(rel.speed)
     reach = rel.half_w + CORRIDOR_MARGIN_M
     in_lane = np.abs(rel.eta) < reach
     in_target = (shift_m != 0.0)[:, None] & (np.abs(rel.eta - shift_m[:, None]) < reach)
-    ahead = (rel.xi > 0.0) & (rel.xi < LOOKAHEAD_M) & (
-        (rel.cos_dh > ALIGNED_COS) | (rel.xi < BLOCKING_M))
-    ahead &= ~np.eye(n, dtype=bool)
-    gap = np.where(ahead & (in_lane | in_target), rel.bumper, np.inf)
+    ahead = (rel.xi > 0.0) & ~np.eye(n, dtype=bool) & (in_lane | in_target)
+    aligned = rel.cos_dh > ALIGNED_COS
+    gap = np.where(ahead & aligned & (rel.xi < LOOKAHEAD_M), rel.bumper, np.inf)
+    block = np.where(ahead & ~aligned & (rel.xi < BLOCKING_M), rel.bumper, np.inf).min(axis=1)
     j = gap.argmin(axis=1)
     rows = np.arange(n)
     best = gap[rows, j]
-    v_along = np.maximum(rel.speed[j] * rel.cos_dh[rows, j], 0.0)  # a crossing car: ~0 along
-    return best, np.where(np.isfinite(best), v_along, 0.0)
+    return best, np.where(np.isfinite(best), rel.speed[j] * rel.cos_dh[rows, j], 0.0), block
 
 
 def clear_to_change(rel: Relations, i: int, offset_m: float) -> bool:

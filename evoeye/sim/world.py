@@ -20,6 +20,8 @@ from evoeye.sim.footprint import box_corners, box_gaps
 from evoeye.sim.npc import EgoVehicle, Npc
 from evoeye.sim.traffic import Conflict, Relations, clear_to_change, leaders
 
+NPC_REACTION_S = 1.0  # an NPC driver brakes for a car crossing its way after this long
+
 
 class World:
     """Ego + NPCs; `scene()` reads it, `step()` advances it by dt."""
@@ -40,6 +42,7 @@ class World:
         self.crashed = np.zeros(len(self.vehicles), dtype=bool)
         self.collision_actor = -1
         self._accel = np.zeros(len(self.vehicles))
+        self._blocked_s = np.zeros(len(self.vehicles))  # how long a crossing car has blocked each
         assert EGO_ID == 0
 
     # -- reading -------------------------------------------------------------------------------
@@ -66,7 +69,11 @@ class World:
         x, y, heading, speed = self._state()
         rel = Relations.of(x, y, heading, speed, self.length_m, self.width_m)
         shift = np.array([0.0] + [n.lateral_target_m() for n in self.npcs])
-        gap, v_lead = leaders(rel, shift)
+        gap, v_lead, block = leaders(rel, shift)
+        self._blocked_s = np.where(np.isfinite(block), self._blocked_s + dt, 0.0)
+        seen = self._blocked_s > NPC_REACTION_S  # a crossing car, answered after a reaction time
+        gap, v_lead = np.where(seen & (block < gap), block, gap), np.where(
+            seen & (block < gap), 0.0, v_lead)
         self._wait_at_crossings(gap, v_lead)
         for i, npc in enumerate(self.npcs, start=1):
             closing = speed[0] - speed[i] * rel.cos_dh[0, i]
