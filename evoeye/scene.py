@@ -31,6 +31,8 @@ class SceneState:
     crashed: np.ndarray  # (N,) bool
     ego_collision: bool  # the ego is in a collision at t_s
     collision_actor: int  # the actor the ego collided with first, -1 if none
+    # static boxes that block the line of sight (buildings), (K, 4) [x_min, y_min, x_max, y_max]
+    occluders: np.ndarray | None = None
 
     @property
     def n(self) -> int:

@@ -39,6 +39,23 @@ from evoeye.scene import SceneState
 N_NORMALS = 8  # standard normals per actor and frame: lidar x, y, vx, vy, heading; radar r, az, rr
 
 
+def line_of_sight_blocked(x0: float, y0: float, x: np.ndarray, y: np.ndarray,
+                          boxes: np.ndarray | None) -> np.ndarray:
+    """(n,) whether the segment from (x0, y0) to each (x, y) crosses a static box (K, 4)
+    [x_min, y_min, x_max, y_max] (slab test, all pairs at once)."""
+    if boxes is None or not len(boxes):
+        return np.zeros(len(x), dtype=bool)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv_dx, inv_dy = 1.0 / (x - x0), 1.0 / (y - y0)  # (n,)
+        tx1 = (boxes[None, :, 0] - x0) * inv_dx[:, None]  # (n, K)
+        tx2 = (boxes[None, :, 2] - x0) * inv_dx[:, None]
+        ty1 = (boxes[None, :, 1] - y0) * inv_dy[:, None]
+        ty2 = (boxes[None, :, 3] - y0) * inv_dy[:, None]
+    t_in = np.maximum(np.fmin(tx1, tx2), np.fmin(ty1, ty2))  # fmin/fmax: a NaN (0·inf) is
+    t_out = np.minimum(np.fmax(tx1, tx2), np.fmax(ty1, ty2))  # an axis the segment runs along
+    return ((t_out >= np.maximum(t_in, 0.0)) & (t_in <= 1.0)).any(axis=1)
+
+
 def occluded_fraction(
     range_m: np.ndarray, bearing_rad: np.ndarray, half_width_rad: np.ndarray
 ) -> np.ndarray:
@@ -155,6 +172,8 @@ class SensorModel:
         cos_phi, sin_phi = np.abs(e_phi.real), np.abs(e_phi.imag)
         length, width = scene.length_m[1:], scene.width_m[1:]
         occ = occluded_fraction(r, bearing, np.arctan2(length * sin_phi + width * cos_phi, r + r))
+        if scene.occluders is not None:  # a building between: nothing to see
+            occ = np.where(line_of_sight_blocked(x0, y0, x[1:], y[1:], scene.occluders), 1.0, occ)
         r2 = r * r
         p_lidar = (c.lidar_detect_prob_near - self._lidar_drop * r2) * (
             1.0 - occ * self._inv_occ_lidar)

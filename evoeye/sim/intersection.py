@@ -26,7 +26,7 @@ from evoeye.scene import RoadMap
 from evoeye.sim.npc import DriverModel, EgoVehicle, Npc, curve_speed
 from evoeye.sim.path import Path
 from evoeye.sim.roadmap import road_map_from_network
-from evoeye.sim.traffic import Conflict
+from evoeye.sim.traffic import Conflict, YieldToEgo
 from evoeye.sim.world import World
 
 EXTENSION_M = 320.0
@@ -39,6 +39,10 @@ CROSSING_RADIUS_M = 4.5  # a waiting NPC's centre keeps this far from the other'
 # half-diagonal, 2.7 m, plus the other's half-width and a margin)
 MIN_SPACING_M = 10.0  # centre spacing between NPCs placed on one approach
 
+BUILDING_FROM_M, BUILDING_TO_M = 12.5, 90.0  # a building fills each corner between these
+# distances from the centre lines, both ways: crossing traffic shows late, as at a city corner
+EGO_CLEARANCE_M = 6.5  # a turning NPC yielding to the ego stops this far from its route
+TURN_GAP_S = 2.0  # a turning NPC goes if the ego would reach the crossing this much after it
 # name → (approach, destination); parameters are f"{name}_speed_mps", f"{name}_offset_s"
 NPC_MOVES = {
     "opp_left": (2, 3),  # north → east: left turn across the ego's path
@@ -47,6 +51,9 @@ NPC_MOVES = {
     "right_merge": (3, 2),  # east → north: right turn into the ego's exit lane
     "left_merge": (1, 2),  # west → north: left turn into the ego's exit lane
 }
+# turning traffic yields to the ego's straight movement (accepting short gaps); the crossing
+# traffic on the major road does not
+TURNS_YIELD = ("opp_left", "right_merge", "left_merge")
 
 
 def _route(src: int, dst: int) -> list[tuple[str, str, int]]:
@@ -111,6 +118,15 @@ def _npc_crossings() -> tuple[tuple[int, int, float, float, float, float], ...]:
     return tuple(out)
 
 
+@functools.cache
+def _ego_crossing(src: int, dst: int) -> tuple[float, float, float]:
+    """(s on the NPC's path, s on the ego's route, the NPC's stop point) where it meets the ego."""
+    s_npc, s_ego = _conflict(src, dst)
+    stop = _path(tuple(_route(src, dst))).stop_before(
+        _path(tuple(EGO_ROUTE)), s_npc, s_ego, EGO_CLEARANCE_M)
+    return s_npc, s_ego, stop
+
+
 def _box_entry_s() -> float:
     net, _ = _network()
     return sum(net.get_lane(idx).length for idx in EGO_ROUTE[:2])
@@ -153,4 +169,16 @@ def build_intersection(p: dict[str, float], rng: np.random.Generator) -> tuple[W
         v0 = min(speed, float(curve_speed(path, driver)[path.index(s0)]))
         npcs.append(Npc(road, path, s0, v0, desired_speed_mps=speed, driver=driver))
     conflicts = [Conflict(*c) for c in _npc_crossings()]
-    return World(road, ego, npcs, road_map, conflicts), EGO_CRUISE_MPS
+    yields = [YieldToEgo(row, *_ego_crossing(*NPC_MOVES[name]), gap_s=TURN_GAP_S)
+              for row, name in enumerate(NPC_MOVES, start=1) if name in TURNS_YIELD]
+    return World(road, ego, npcs, road_map, conflicts, yields, ego_path,
+                 occluders=_buildings()), EGO_CRUISE_MPS
+
+
+@functools.cache
+def _buildings() -> np.ndarray:
+    """(4, 4) one building per corner, [x_min, y_min, x_max, y_max]."""
+    a, b = BUILDING_FROM_M, BUILDING_TO_M
+    return np.array([[sx * a if sx > 0 else -b, sy * a if sy > 0 else -b,
+                      b if sx > 0 else -a, b if sy > 0 else -a]
+                     for sx in (1, -1) for sy in (1, -1)], dtype=float)

@@ -67,15 +67,21 @@ class Path:
             y += d_m * math.cos(h)
         return x, y, h
 
-    def project(self, x: float, y: float) -> tuple[float, float]:
-        """(s, d) of the nearest point of the centre line (a full search: set-up time only)."""
-        px, py = self.x[:-1], self.y[:-1]
-        dx, dy = np.diff(self.x), np.diff(self.y)
+    def project(self, x: float, y: float, near_s: float | None = None,
+                window_m: float = 10.0) -> tuple[float, float]:
+        """(s, d) of the nearest point of the centre line: a full search, or one within
+        window_m of `near_s` (for a vehicle followed from step to step)."""
+        k0, k1 = 0, len(self.s) - 1
+        if near_s is not None:
+            k0 = self.index(near_s - window_m)
+            k1 = min(self.index(near_s + window_m) + 1, len(self.s) - 1)
+        px, py = self.x[k0:k1], self.y[k0:k1]
+        dx, dy = np.diff(self.x[k0 : k1 + 1]), np.diff(self.y[k0 : k1 + 1])
         seg2 = np.maximum(dx * dx + dy * dy, 1e-12)
         t = np.clip(((x - px) * dx + (y - py) * dy) / seg2, 0.0, 1.0)
         cx, cy = px + t * dx, py + t * dy
         k = int(np.argmin((cx - x) ** 2 + (cy - y) ** 2))
-        s = float(self.s[k] + t[k] * math.sqrt(seg2[k]))
+        s = float(self.s[k0 + k] + t[k] * math.sqrt(seg2[k]))
         h = math.atan2(dy[k], dx[k])
         return s, float(-(x - cx[k]) * math.sin(h) + (y - cy[k]) * math.cos(h))
 

@@ -118,3 +118,32 @@ class Conflict:
         if self.first == self.i:
             return self.j, self.stop_j - s[self.j]
         return self.i, self.stop_i - s[self.i]
+
+
+@dataclass
+class YieldToEgo:
+    """NPC row i turns across or into the ego's path and yields to it: it goes only if the ego
+    would reach the crossing at least `gap_s` after it (an assertive driver's accepted gap),
+    otherwise it waits with its centre at stop_i. Once past its stop point it is committed."""
+
+    i: int
+    s_i: float  # arc length of the crossing on the NPC's path
+    s_ego: float  # … and on the ego's route
+    stop_i: float
+    gap_s: float
+    going: bool = field(default=False)
+
+    def wait_gap(self, s: float, v: float, s_ego: float, v_ego: float) -> float | None:
+        """The NPC's distance to its stop point while it waits; None when it may go."""
+        if self.going or s > self.stop_i or self.s_i - s > DECIDE_WITHIN_M:
+            return None
+        to_ego = self.s_ego - s_ego
+        if to_ego < -PASSED_M:  # the ego is through
+            self.going = True
+            return None
+        t_npc = (self.s_i - s) / max(v, 1.0)
+        t_ego = to_ego / max(v_ego, 0.1)
+        if t_ego > t_npc + self.gap_s:
+            self.going = True
+            return None
+        return self.stop_i - s

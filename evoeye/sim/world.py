@@ -18,7 +18,8 @@ from highway_env.road.road import Road
 from evoeye.scene import EGO_ID, RoadMap, SceneState
 from evoeye.sim.footprint import box_corners, box_gaps
 from evoeye.sim.npc import EgoVehicle, Npc
-from evoeye.sim.traffic import Conflict, Relations, clear_to_change, leaders
+from evoeye.sim.path import Path
+from evoeye.sim.traffic import Conflict, Relations, YieldToEgo, clear_to_change, leaders
 
 NPC_REACTION_S = 1.0  # an NPC driver brakes for a car crossing its way after this long
 
@@ -27,9 +28,14 @@ class World:
     """Ego + NPCs; `scene()` reads it, `step()` advances it by dt."""
 
     def __init__(self, road: Road, ego: EgoVehicle, npcs: list[Npc], road_map: RoadMap,
-                 conflicts: list[Conflict] | None = None):
+                 conflicts: list[Conflict] | None = None, yields: list[YieldToEgo] | None = None,
+                 ego_path: Path | None = None, occluders: np.ndarray | None = None):
         self.road = road
+        self.occluders = occluders  # (K, 4) buildings: they block sight, not motion
         self.conflicts = conflicts or []
+        self.yields = yields or []
+        self.ego_path = ego_path  # the ego's route, to time it to crossings NPCs yield at
+        self._ego_s = ego_path.project(*ego.position)[0] if ego_path is not None else 0.0
         self.road_map = road_map
         self.t_s = 0.0
         self.ego = ego
@@ -61,6 +67,7 @@ class World:
             speed_mps=speed, accel_mps2=self._accel.copy(), length_m=self.length_m.copy(),
             width_m=self.width_m.copy(), crashed=self.crashed.copy(),
             ego_collision=bool(self.crashed[0]), collision_actor=self.collision_actor,
+            occluders=self.occluders,
         )
 
     # -- advancing -----------------------------------------------------------------------------
@@ -95,14 +102,19 @@ class World:
         self._contacts()
 
     def _wait_at_crossings(self, gap: np.ndarray, v_lead: np.ndarray) -> None:
-        """An NPC waiting for another at a crossing sees a standing car at its stop point."""
-        if not self.conflicts:
+        """An NPC waiting at a crossing (for another NPC, or yielding to the ego) sees a
+        standing car at its stop point."""
+        if not (self.conflicts or self.yields):
             return
         s = {i: npc.s_m for i, npc in enumerate(self.npcs, start=1)}
         v = {i: npc.speed for i, npc in enumerate(self.npcs, start=1)}
-        for c in self.conflicts:
-            wait = c.wait_gap(s, v)
-            if wait is not None and wait[1] < gap[wait[0]]:
+        waits = [c.wait_gap(s, v) for c in self.conflicts]
+        if self.yields:
+            self._ego_s = self.ego_path.project(*self.ego.position, near_s=self._ego_s)[0]
+            waits += [(y.i, y.wait_gap(s[y.i], v[y.i], self._ego_s, self.ego.speed))
+                      for y in self.yields]
+        for wait in waits:
+            if wait is not None and wait[1] is not None and wait[1] < gap[wait[0]]:
                 gap[wait[0]], v_lead[wait[0]] = max(wait[1], 0.0), 0.0
 
     def _contacts(self) -> None:

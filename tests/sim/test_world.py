@@ -18,8 +18,8 @@ def highway_params(**overrides):
     p = HIGHWAY.as_dict(HIGHWAY.low)
     p.update(ego_speed_mps=25.0, lead_gap_m=70.0, lead_speed_mps=25.0, lead_brake_time_s=16.0,
              lead_brake_decel_mps2=0.0, left_cutin_trigger_gap_m=2.0, right_cutin_trigger_gap_m=2.0,
-             left_cutin_gap_m=60.0, right_cutin_gap_m=60.0, left_cutin_speed_mps=32.0,
-             right_cutin_speed_mps=32.0, left_follow_gap_m=-60.0,
+             left_cutin_gap_m=60.0, right_cutin_gap_m=60.0, left_cutin_speed_mps=30.0,
+             right_cutin_speed_mps=30.0, left_follow_gap_m=-60.0,
              right_follow_gap_m=-60.0, overtaker_gap_m=-80.0, overtaker_speed_mps=25.0)
     p.update(overrides)
     return HIGHWAY.as_dict(HIGHWAY.from_dict(p))
@@ -94,7 +94,7 @@ def test_a_slower_cut_in_ahead_fires_when_the_gap_closes_to_its_trigger(side, la
 
 def test_a_faster_cut_in_from_behind_fires_at_its_trigger_gap_not_at_zero():
     p = highway_params(left_cutin_trigger_gap_m=15.0, left_cutin_duration_s=3.0,
-                       left_cutin_gap_m=-20.0, left_cutin_speed_mps=32.0, ego_speed_mps=22.0)
+                       left_cutin_gap_m=-20.0, left_cutin_speed_mps=30.0, ego_speed_mps=22.0)
     scenes = run(build_highway(p, np.random.default_rng(0))[0], 8.0)
     y = track(scenes, 2, "y_m")
     k = int(np.argmax(y > 1e-9))
@@ -154,7 +154,7 @@ def test_a_cut_in_waits_for_a_gap_the_lead_leaves_it():
 def test_overtaker_cuts_back_once_ahead_of_the_ego():
     p = highway_params(overtaker_gap_m=-30.0, overtaker_speed_mps=36.0, ego_speed_mps=22.0,
                        left_follow_gap_m=80.0, left_follow_speed_mps=33.0,
-                       left_cutin_gap_m=60.0, left_cutin_speed_mps=32.0)  # a free left lane
+                       left_cutin_gap_m=60.0, left_cutin_speed_mps=30.0)  # a free left lane
     scenes = run(build_highway(p, np.random.default_rng(0))[0], 12.0)
     x_rel = track(scenes, 6, "x_m") - track(scenes, 0, "x_m")
     y = track(scenes, 6, "y_m")
@@ -286,3 +286,43 @@ def test_a_fast_car_is_never_placed_just_behind_a_slow_one():
     scenes = run(build_highway(p, np.random.default_rng(0))[0], 6.0, accel=-1.0)
     assert not any(s.crashed.any() for s in scenes)
     assert scenes[0].x_m[4] - scenes[0].x_m[6] >= 9.0 + 20.0**2 / 6.0 - 1e-9
+
+
+def test_a_turning_npc_yields_to_the_ego_unless_the_gap_is_long_enough():
+    from evoeye.sim.intersection import _ego_crossing
+
+    left = list(NPC_MOVES).index("opp_left") + 1
+    s_cross = _ego_crossing(*NPC_MOVES["opp_left"])[0]
+
+    def through_before_the_ego(ego_accel):
+        p = crossing_params(**{**{f"{n}_offset_s": 4.0 for n in NPC_MOVES}, "opp_left_offset_s": 0.0})
+        world, _ = build_intersection(p, np.random.default_rng(5))
+        for _ in range(int(25.0 / DT)):
+            world.step(ego_accel if world.ego.speed > 0.0 else 0.0, 0.0, DT)
+            npc = world.npcs[left - 1]
+            if npc.s_m > s_cross:  # the NPC crossed the ego's path …
+                return world.ego.position[1] > 0.0  # … with the ego not yet through the box
+        return False
+
+    assert not through_before_the_ego(0.0)  # the ego keeps coming: the NPC waits for it
+    assert through_before_the_ego(-4.0)  # the ego stops short: the NPC goes first
+
+
+def test_a_crossing_npc_brakes_for_a_car_blocking_its_way_after_a_reaction_time():
+    from evoeye.sim.world import NPC_REACTION_S
+
+    east = list(NPC_MOVES).index("cross_east") + 1
+    p = crossing_params(**{**{f"{n}_offset_s": 4.0 for n in NPC_MOVES}, "cross_east_offset_s": -2.0})
+    world, _ = build_intersection(p, np.random.default_rng(5))
+    npc = world.npcs[east - 1]
+    while npc.position[0] > 30.0:  # park the ego across its way, 20 m ahead of it
+        world.step(0.0, 0.0, DT)
+    world.ego.position[:] = [npc.position[0] - 20.0, npc.position[1]]
+    world.ego.heading, world.ego.speed = -np.pi / 2, 0.0
+    v0, decel_at = npc.speed, None
+    for k in range(int(3.0 / DT)):
+        world.step(0.0, 0.0, DT)
+        if decel_at is None and npc.accel_mps2 < -1.0:
+            decel_at = (k + 1) * DT
+    assert decel_at is not None and decel_at == pytest.approx(NPC_REACTION_S, abs=2 * DT)
+    assert npc.speed < v0
