@@ -295,7 +295,8 @@ def test_a_turning_npc_yields_to_the_ego_unless_the_gap_is_long_enough():
     s_cross = _ego_crossing(*NPC_MOVES["opp_left"])[0]
 
     def through_before_the_ego(ego_accel):
-        p = crossing_params(**{**{f"{n}_offset_s": 4.0 for n in NPC_MOVES}, "opp_left_offset_s": 0.0})
+        late = {f"{n}_offset_s": 4.0 for n in NPC_MOVES}
+        p = crossing_params(**{**late, "opp_left_offset_s": 0.0})
         world, _ = build_intersection(p, np.random.default_rng(5))
         for _ in range(int(25.0 / DT)):
             world.step(ego_accel if world.ego.speed > 0.0 else 0.0, 0.0, DT)
@@ -312,7 +313,8 @@ def test_a_crossing_npc_brakes_for_a_car_blocking_its_way_after_a_reaction_time(
     from evoeye.sim.world import NPC_REACTION_S
 
     east = list(NPC_MOVES).index("cross_east") + 1
-    p = crossing_params(**{**{f"{n}_offset_s": 4.0 for n in NPC_MOVES}, "cross_east_offset_s": -2.0})
+    late = {f"{n}_offset_s": 4.0 for n in NPC_MOVES}
+    p = crossing_params(**{**late, "cross_east_offset_s": -2.0})
     world, _ = build_intersection(p, np.random.default_rng(5))
     npc = world.npcs[east - 1]
     while npc.position[0] > 30.0:  # park the ego across its way, 20 m ahead of it
