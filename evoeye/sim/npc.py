@@ -162,16 +162,22 @@ class Npc(Vehicle):
 
     # -- motion ------------------------------------------------------------------------------------
     def advance(self, accel_mps2: float, dt: float) -> None:
-        """Integrate dt: speed never negative, position along the path, lateral offset profile."""
+        """Integrate dt: speed never negative, position along the path, lateral offset profile.
+        A crashed NPC leaves its path: it slides on along its heading to a standstill."""
         v0 = self.speed
         v1 = max(v0 + accel_mps2 * dt, 0.0)
         self.accel_mps2 = (v1 - v0) / dt
-        self.s_m = min(self.s_m + 0.5 * (v0 + v1) * dt, self.path.length_m)
         self.speed = v1
         self.clock_s += dt
+        if self.crashed:
+            step = 0.5 * (v0 + v1) * dt
+            self.position[0] += step * math.cos(self.heading)
+            self.position[1] += step * math.sin(self.heading)
+            return
+        self.s_m = min(self.s_m + 0.5 * (v0 + v1) * dt, self.path.length_m)
         d_dot = 0.0
         lc = self.lane_change
-        if self._lc_start_s is not None and not self.crashed:
+        if self._lc_start_s is not None:
             tau = min((self.clock_s - self._lc_start_s) / lc.duration_s, 1.0)
             self.d_m = self._lc_from_m + lc.offset_m * 0.5 * (1.0 - math.cos(math.pi * tau))
             if tau < 1.0:

@@ -328,3 +328,16 @@ def test_a_crossing_npc_brakes_for_a_car_blocking_its_way_after_a_reaction_time(
             decel_at = (k + 1) * DT
     assert decel_at is not None and decel_at == pytest.approx(NPC_REACTION_S, abs=2 * DT)
     assert npc.speed < v0
+
+
+def test_a_crashed_npc_slides_on_along_its_heading_to_a_standstill():
+    world, _ = build_highway(highway_params(), np.random.default_rng(0))
+    npc = world.npcs[1]
+    npc.heading = 0.1  # as in the middle of a lane change
+    npc.crashed = True
+    x0, y0 = npc.position.copy()
+    for _ in range(int(5.0 / DT)):
+        world.step(0.0, 0.0, DT)
+    assert npc.heading == 0.1 and npc.speed == 0.0
+    dx, dy = npc.position - (x0, y0)
+    assert dy / dx == pytest.approx(np.tan(0.1))
