@@ -1,0 +1,33 @@
+"""Where commands print: stdout and stderr consoles, and tables that never cut a value.
+
+When stdout is not a terminal (a pipe, a file, CI), rich would fit tables to 80 columns and cut
+identifiers (`highway-cu…`); `out()` is then wide enough for any table, and every column folds
+rather than truncating when a terminal is too narrow.
+"""
+
+from __future__ import annotations
+
+from rich.console import Console
+from rich.table import Table
+
+PIPE_WIDTH = 4096  # characters; wider than any table evoeye prints
+
+
+def out() -> Console:
+    """A stdout console sized at call time (a terminal's width, else PIPE_WIDTH)."""
+    console = Console()
+    return console if console.is_terminal else Console(width=PIPE_WIDTH)
+
+
+def err() -> Console:
+    return Console(stderr=True)
+
+
+def table(title: str | None, columns: list[str], *, left: tuple[str, ...] = (),
+          show_header: bool = True) -> Table:
+    """A table whose cells fold instead of being cut; `left` columns are left-justified, the
+    rest right-justified (numbers)."""
+    t = Table(title=title, show_header=show_header)
+    for col in columns:
+        t.add_column(col, justify="left" if col in left else "right", overflow="fold")
+    return t
