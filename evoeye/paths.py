@@ -7,6 +7,7 @@ Layout under the root (default `./evoeye-data`, or `$EVOEYE_HOME`, or `--root`):
     warehouse/evoeye.duckdb                              views over the Parquet, for DuckDB's CLI
     quarantine/…                                         logs that could not be read, and why
     monitors/<version>/{model.pt,card.json}              trained monitor versions (cards)
+    replays/<log>.<monitor>.risk.mcap                    logs with a monitor's risk (`replay`)
 """
 
 from __future__ import annotations
@@ -89,6 +90,11 @@ class DataRoot:
     @property
     def monitors(self) -> Path:
         return self.path / "monitors"
+
+    @property
+    def replays(self) -> Path:
+        """Run logs copied with a monitor's risk channel (`evoeye replay`); never ingested."""
+        return self.path / "replays"
 
     @property
     def reports(self) -> Path:

@@ -46,9 +46,12 @@ KNOWN_ERRORS: dict[str, str] = {
     "evoeye.scenarios.space.ScenarioError": "",
     "evoeye.monitor.registry.MonitorLoadError": "list the versions with `ls <root>/monitors`, "
                                                 "or train one: `evoeye train --scenario NAME`",
-    "evoeye.baselines.aem.AEMLoadError": "retrain it: `evoeye evaluate --baselines aem`",
+    "evoeye.baselines.aem.AEMLoadError": "remove that AEM folder; the next `evoeye evaluate` "
+                                          "trains it again",
     "evoeye.evolve.families.NoMonitorError": "train one first: `evoeye train --scenario NAME`, "
                                              "or name it with --monitor",
+    "evoeye.evolve.families.NoInitialDataError": "simulate and ingest the scenario's initial "
+                                                 "runs: `evoeye simulate …`, `evoeye ingest`",
     "evoeye.store.lock.WarehouseLockedError": "wait for the other writer to finish, then run "
                                               "again",
     "builtins.PermissionError": ROOT_HINT,

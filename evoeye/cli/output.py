@@ -7,6 +7,8 @@ rather than truncating when a terminal is too narrow.
 
 from __future__ import annotations
 
+import sys
+
 from rich.console import Console
 from rich.table import Table
 
@@ -31,3 +33,23 @@ def table(title: str | None, columns: list[str], *, left: tuple[str, ...] = (),
     for col in columns:
         t.add_column(col, justify="left" if col in left else "right", overflow="fold")
     return t
+
+
+class StepBar:
+    """A progress bar (tqdm, on stderr) for a library that reports steps through a
+    `progress(message)` callback: each message is one step, printed above the bar."""
+
+    def __init__(self, desc: str, *, unit: str = "step", total: int | None = None) -> None:
+        from tqdm import tqdm
+
+        self.bar = tqdm(total=total, desc=desc, unit=unit)
+
+    def __call__(self, message: str) -> None:
+        self.bar.write(message, file=sys.stderr)
+        self.bar.update(1)
+
+    def __enter__(self) -> StepBar:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.bar.close()
