@@ -16,13 +16,13 @@ def test_help_defaults_equal_their_sources() -> None:
     from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S
 
     split = SplitSpec()
-    assert defaults.SCENARIO_NAMES == tuple(SCENARIOS)
-    assert (defaults.SPLIT_SEED, defaults.TRAIN_FRAC, defaults.VAL_FRAC) == (
-        split.seed, split.train_frac, split.val_frac)
-    assert defaults.CONTEXT_LEN == DEFAULT_CONTEXT_LEN
-    assert defaults.HORIZON_S == DEFAULT_HORIZON_S
-    assert defaults.TARGET_FPRS == TARGET_FPRS
-    assert defaults.RUNS_PER_PART == DEFAULT_RUNS_PER_PART
-    assert defaults.BASELINE_NAMES == tuple(BASELINES)
-    assert defaults.UPDATE_MODES == UPDATE_MODES
-    assert defaults.MODULE_NAMES == MODULES and defaults.ABLATION_NAMES == tuple(ABLATIONS)
+    pairs = {
+        "SCENARIO_NAMES": tuple(SCENARIOS),
+        "SPLIT_SEED": split.seed, "TRAIN_FRAC": split.train_frac, "VAL_FRAC": split.val_frac,
+        "CONTEXT_LEN": DEFAULT_CONTEXT_LEN, "HORIZON_S": DEFAULT_HORIZON_S,
+        "TARGET_FPRS": TARGET_FPRS, "RUNS_PER_PART": DEFAULT_RUNS_PER_PART,
+        "BASELINE_NAMES": tuple(BASELINES), "UPDATE_MODES": UPDATE_MODES,
+        "MODULE_NAMES": MODULES, "ABLATION_NAMES": tuple(ABLATIONS),
+    }
+    shown = {name: getattr(defaults, name) for name in pairs}
+    assert shown == pairs

@@ -28,8 +28,9 @@ def _modules_after(*args: str) -> set[str]:
 
 
 def _commands() -> list[list[str]]:
-    from evoeye.cli import app
     from typer.main import get_command
+
+    from evoeye.cli import app
 
     group = get_command(app)
     out = []
