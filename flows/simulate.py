@@ -60,3 +60,9 @@ def simulate_flow(specs: list[RunSpec], root: str) -> list[RunResult]:
     for r in failed:
         logger.warning("%s %s: %s", r.status, r.scenario_id, r.reason)
     return results
+
+
+if __name__ == "__main__":
+    from flows.command_line import run_from_command_line
+
+    run_from_command_line(SimulateParams, simulate_batch_flow, __doc__)
