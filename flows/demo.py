@@ -60,8 +60,12 @@ def main() -> None:
     ap.add_argument("--n", type=int, default=40)
     ap.add_argument("--workers", type=int, default=2)
     args = ap.parse_args()
+    try:
+        params = DemoParams(root=args.root, n=args.n, workers=args.workers)
+    except ValueError as exc:  # pydantic's ValidationError: one line per field, no traceback
+        ap.error(" ".join(str(exc).split()))
     say_what_we_wait_for()
-    result = demo_flow(DemoParams(root=args.root, n=args.n, workers=args.workers))
+    result = demo_flow(params)
     data = DataRoot.resolve(args.root)
     print("\nevoeye demo finished. Results:")
     print(f"  MCAP logs (Foxglove / Lichtblick): {result['runs']}")

@@ -68,3 +68,22 @@ def test_the_temporary_server_gets_a_generous_start_up_timeout(monkeypatch) -> N
     monkeypatch.setenv("PREFECT_SERVER_EPHEMERAL_STARTUP_TIMEOUT_SECONDS", "45")
     importlib.reload(flows)  # a user's own setting wins
     assert os.environ["PREFECT_SERVER_EPHEMERAL_STARTUP_TIMEOUT_SECONDS"] == "45"
+
+
+def test_the_flows_refuse_a_batch_that_is_not_a_plain_name() -> None:
+    from flows.simulate import SimulateParams
+
+    with pytest.raises(ValueError, match="plain name"):
+        SimulateParams(batch="../../../x")
+    assert SimulateParams(batch="nightly-2.b_1").batch == "nightly-2.b_1"
+
+
+def test_demo_with_too_small_an_n_is_one_line(monkeypatch, capsys) -> None:
+    monkeypatch.setattr(sys, "argv", ["/x/flows/demo.py", "--n", "3"])
+    from flows.demo import main
+
+    with pytest.raises(SystemExit) as done:
+        main()
+    err = capsys.readouterr().err
+    assert done.value.code == 2 and "greater than or equal to 8" in err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 2  # usage + error
