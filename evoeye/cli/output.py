@@ -37,19 +37,25 @@ def table(title: str | None, columns: list[str], *, left: tuple[str, ...] = (),
 
 class StepBar:
     """A progress bar (tqdm, on stderr) for a library that reports steps through a
-    `progress(message)` callback: each message is one step, printed above the bar."""
+    `progress(message)` callback: each message starts a step (and ends the one before), and is
+    printed above the bar; leaving the `with` block without an error ends the last step."""
 
     def __init__(self, desc: str, *, unit: str = "step", total: int | None = None) -> None:
         from tqdm import tqdm
 
         self.bar = tqdm(total=total, desc=desc, unit=unit)
+        self.running = False
 
     def __call__(self, message: str) -> None:
         self.bar.write(message, file=sys.stderr)
-        self.bar.update(1)
+        if self.running:
+            self.bar.update(1)
+        self.running = True
 
     def __enter__(self) -> StepBar:
         return self
 
-    def __exit__(self, *exc: object) -> None:
+    def __exit__(self, exc_type: type[BaseException] | None, *exc: object) -> None:
+        if exc_type is None and self.running:
+            self.bar.update(1)
         self.bar.close()

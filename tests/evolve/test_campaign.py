@@ -297,6 +297,7 @@ def test_cli_evolve_prints_the_state_and_round_metrics(root_copy, seeded) -> Non
     assert res.exit_code == 0, res.output
     assert "campaign evo-uniform-s0-" in res.output and "round 0:" in res.output
     assert "test F1@0.05" in res.output and "budget spent after round 0" in res.output
+    assert "evolve: " in res.stderr and "sim s" in res.stderr  # the progress bar
     bad = CliRunner().invoke(app, [*args[:6], "grid"])
     assert bad.exit_code != 0
 

@@ -28,6 +28,8 @@ def ingested(root: DataRoot, add_run) -> DataRoot:
     assert result.exit_code == ExitCode.PARTIAL, result.output  # one log quarantined
     assert "quarantined" in result.output and "cli-bad.mcap" in result.output
     assert "creating a new warehouse" in result.output
+    assert "ingest: 100%" in result.stderr and "3/3 [" in result.stderr  # the progress bar
+    assert "log/s]" in result.stderr or "s/log]" in result.stderr
     return root
 
 
