@@ -14,7 +14,7 @@ def test_a_step_ends_when_the_next_begins_and_the_last_on_success(capsys) -> Non
             assert bar.bar.n == ("campaign a", "  round 1", "  round 2").index(msg)
     assert bar.bar.n == 3
     err = capsys.readouterr().err
-    assert "campaign a" in err and "  round 2" in err and "3 [" in err
+    assert "campaign a" in err and "  round 2" in err and "3step [" in err
 
 
 def test_a_failed_step_is_not_counted() -> None:
