@@ -13,7 +13,8 @@ import pytest
 
 from evoeye.paths import DataRoot
 
-pytestmark = pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc")
+pytestmark = [pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="needs /proc"),
+              pytest.mark.slow]  # two interpreters start highway-env: ≈ 20 s, more under load
 
 
 def _stat(pid: int) -> list[str] | None:
