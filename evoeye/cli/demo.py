@@ -9,7 +9,8 @@ import typer
 from evoeye.cli.app import app, exit_with
 from evoeye.cli.defaults import SCENARIO_NAMES
 from evoeye.cli.errors import ExitCode
-from evoeye.cli.simulate import RootOpt, console, failures_code, simulate_batch, summary_table
+from evoeye.cli.output import out
+from evoeye.cli.simulate import RootOpt, failures_code, simulate_batch, summary_table
 from evoeye.cli.warehouse import ingest_command, stats_command
 from evoeye.paths import DataRoot
 
@@ -28,14 +29,14 @@ def demo(
     data = DataRoot.resolve(root)
     rows = [(name, simulate_batch(name, n, seed, data, workers, batch="demo"))
             for name in SCENARIO_NAMES]
-    console.print(summary_table("evoeye demo: simulate", rows))
+    out().print(summary_table("evoeye demo: simulate", rows))
     code = failures_code(rows)
     try:
         ingest_command(root=data.path)
     except typer.Exit as partial:
         code = ExitCode(partial.exit_code)
     stats_command(root=data.path)
-    console.print(f"\nMCAP logs (open in Foxglove or Lichtblick): {data.runs}")
-    console.print(f"warehouse (Parquet + DuckDB): {data.warehouse}")
-    console.print(f'try: evoeye sql --root {data.path} "SELECT * FROM dataset_stats"')
+    out().print(f"\nMCAP logs (open in Foxglove or Lichtblick): {data.runs}")
+    out().print(f"warehouse (Parquet + DuckDB): {data.warehouse}")
+    out().print(f'try: evoeye sql --root {data.path} "SELECT * FROM dataset_stats"')
     exit_with(code)

@@ -6,18 +6,16 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.console import Console
 from rich.table import Table
 
 from evoeye.cli.app import app, exit_with
 from evoeye.cli.defaults import SCENARIO_NAMES
 from evoeye.cli.errors import ExitCode, UserError
+from evoeye.cli.output import err, out, table
 from evoeye.paths import BadNameError, DataRoot, check_batch_name
 
 if TYPE_CHECKING:
     from evoeye.batch import BatchSummary
-
-console = Console()
 
 RootOpt = Annotated[
     Path | None,
@@ -40,17 +38,15 @@ BatchOpt = Annotated[str | None, typer.Option(
 
 def summary_table(title: str, rows: list[tuple[str, BatchSummary]]) -> Table:
     """One row per batch: runs, collisions, failures, skipped, simulated and wall time."""
-    table = Table(title=title)
-    for col in ("scenario", "runs", "collisions", "failures", "skipped", "sim s", "wall s", "× rt"):
-        table.add_column(col, justify="left" if col == "scenario" else "right",
-                         overflow="fold", no_wrap=col != "scenario")
+    t = table(title, ["scenario", "runs", "collisions", "failures", "skipped", "sim s", "wall s",
+                      "× rt"], left=("scenario",))
     for name, s in rows:
         done = s.runs - s.skipped
         share = f"{s.collisions} ({100.0 * s.collisions / max(1, s.runs):.0f} %)"
         rtf = f"{s.simulated_s / s.wall_s:.0f}" if done and s.wall_s > 0 else "-"
-        table.add_row(name, str(s.runs), share, str(s.failures), str(s.skipped),
-                      f"{s.simulated_s:.0f}", f"{s.wall_s:.1f}", rtf)
-    return table
+        t.add_row(name, str(s.runs), share, str(s.failures), str(s.skipped),
+                  f"{s.simulated_s:.0f}", f"{s.wall_s:.1f}", rtf)
+    return t
 
 
 def simulate_batch(scenario: str, n: int, seed: int, data: DataRoot, workers: int,
@@ -69,10 +65,10 @@ def simulate_batch(scenario: str, n: int, seed: int, data: DataRoot, workers: in
     bar = lambda it: tqdm(it, total=len(specs), desc=scenario, unit="run")  # noqa: E731
     summary = run_batch(specs, data.path, workers=workers, progress=bar)
     for path in summary.stale_removed:
-        console.print(f"[dim]removed the unfinished log of a killed run: {path}[/]")
+        out().print(f"[dim]removed the unfinished log of a killed run: {path}[/]")
     for r in summary.results:
         if r.status != "ok":
-            console.print(f"[yellow]{r.status}[/] {r.scenario_id}: {r.reason}")
+            out().print(f"[yellow]{r.status}[/] {r.scenario_id}: {r.reason}")
     return summary
 
 
@@ -82,7 +78,7 @@ def failures_code(rows: list[tuple[str, BatchSummary]]) -> ExitCode:
     if not failed:
         return ExitCode.OK
     total = sum(s.runs for _, s in rows)
-    Console(stderr=True).print(f"[red]{failed} of {total} runs failed[/] (their reasons are "
+    err().print(f"[red]{failed} of {total} runs failed[/] (their reasons are "
                                "above); exit code 3")
     return ExitCode.PARTIAL
 
@@ -102,6 +98,6 @@ def simulate(
     """
     data = DataRoot.resolve(root)
     summary = simulate_batch(scenario, n, seed, data, workers, batch)
-    console.print(summary_table("simulate", [(scenario, summary)]))
-    console.print(f"logs: {data.runs / scenario}")
+    out().print(summary_table("simulate", [(scenario, summary)]))
+    out().print(f"logs: {data.runs / scenario}")
     exit_with(failures_code([(scenario, summary)]))

@@ -60,3 +60,10 @@ def test_debug_shows_the_traceback(tmp_path) -> None:
     (tmp_path / "root").write_text("not a folder")
     result = runner.invoke(app, ["--debug", *SIM, "--root", str(tmp_path / "root")])
     assert result.exit_code != 0 and isinstance(result.exception, OSError)
+
+
+def test_the_summary_keeps_the_scenario_name_whole_in_a_pipe(tmp_path) -> None:
+    result = CliRunner(env={"COLUMNS": "40"}).invoke(app, [*SIM, "--root", str(tmp_path)])
+    assert result.exit_code == ExitCode.OK, result.output
+    row = next(line for line in result.stdout.splitlines() if "highway-cut" in line)
+    assert "highway-cut-in" in row and "…" not in result.stdout
