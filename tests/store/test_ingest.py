@@ -194,6 +194,11 @@ def test_metadata_that_does_not_fit_its_logical_scenario_is_quarantined(
         # a forged id: the genuine run's id on another vector, written first
         genuine_id: _edited(episode_factory("forged", seed=8), batch="a-first",
                             scenario_id=genuine_id),
+        # an id in another scenario's namespace, and one in its own that is not canonical
+        "unprotected-intersection-0123456789ab": _edited(
+            episode_factory("other", seed=9), scenario_id="unprotected-intersection-0123456789ab"),
+        "highway-cut-in-x": _edited(episode_factory("x", seed=10),
+                                    scenario_id="highway-cut-in-x"),
     }
     for episode in bad.values():
         log_writer(root, episode)
@@ -202,8 +207,10 @@ def test_metadata_that_does_not_fit_its_logical_scenario_is_quarantined(
     log_writer(root, genuine)
     report = ingest(root)
     reasons = dict(report.quarantined)
-    assert report.ingested == [genuine_id] and len(reasons) == 3
+    assert report.ingested == [genuine_id] and len(reasons) == 5
     assert "outside" in reasons["runs/highway-cut-in/b000/out-of-range.mcap"]
     assert "unknown logical scenario" in reasons["runs/no-such-scenario/b000/unknown.mcap"]
     assert "does not match" in reasons[f"runs/highway-cut-in/a-first/{genuine_id}.mcap"]
+    for sid in ("unprotected-intersection-0123456789ab", "highway-cut-in-x"):
+        assert "does not match" in reasons[f"runs/highway-cut-in/b000/{sid}.mcap"]
     assert (root.quarantine / "highway-cut-in" / "a-first" / f"{genuine_id}.mcap").exists()
