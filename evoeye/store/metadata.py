@@ -10,18 +10,13 @@ from __future__ import annotations
 import re
 from typing import Any
 
-from evoeye.scenarios import SCENARIOS, ScenarioError, get_scenario
+from evoeye.scenarios import ScenarioError, get_scenario
 from evoeye.store.records import RunRecordError
 
-# `LogicalScenario.scenario_id` gives `<logical scenario>-<12 hex>`. An id of that form, or in a
-# known scenario's namespace (`<scenario>-…`), must be the one its vector and seed give; other
-# ids (hand-made runs, tests) cannot collide with a simulated run's, so they need only be unique.
+# `LogicalScenario.scenario_id` gives `<logical scenario>-<12 hex>`. An id of that form (of any
+# scenario) must be the one its vector and seed give; other ids (synthetic logs, hand-made runs,
+# tests) cannot collide with a simulated run's id, so they need only be unique.
 CANONICAL_ID = re.compile(r".+-[0-9a-f]{12}")
-
-
-def _simulator_id(sid: str) -> bool:
-    return bool(CANONICAL_ID.fullmatch(sid)) or any(sid.startswith(f"{name}-")
-                                                    for name in SCENARIOS)
 
 
 def check_metadata(meta: dict[str, Any]) -> None:
@@ -41,6 +36,6 @@ def check_metadata(meta: dict[str, Any]) -> None:
         raise RunRecordError(f"run metadata does not fit its logical scenario: {e}") from None
     sid = str(meta.get("scenario_id"))
     expected = space.scenario_id(x, seed)
-    if _simulator_id(sid) and sid != expected:
+    if CANONICAL_ID.fullmatch(sid) and sid != expected:
         raise RunRecordError(f"scenario_id {sid} does not match its parameters and seed "
                              f"(they give {expected})")
