@@ -20,7 +20,10 @@ $(STAMP): pyproject.toml | $(BIN)/python
 
 install: $(STAMP)
 
+# Without PREFECT_API_URL the flow starts a temporary Prefect server first (flows/__init__.py
+# gives it 300 s on a busy machine); `prefect server start` + PREFECT_API_URL skips that wait.
 demo: $(STAMP)
+	@echo "make demo: simulate $(N) runs per scenario, ingest, train + evaluate, one evolution round"
 	$(BIN)/python -m flows.demo --root $(ROOT) --n $(N) --workers $(WORKERS)
 
 test: $(STAMP)

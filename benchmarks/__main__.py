@@ -3,7 +3,7 @@
 import runpy
 import sys
 
-for module in ("benchmarks.bench_sim", "benchmarks.bench_warehouse"):
+for module in ("benchmarks.bench_sim", "benchmarks.bench_warehouse", "benchmarks.bench_cli"):
     print(f"\n## {module}\n", flush=True)
     sys.argv = [module]
     runpy.run_module(module, run_name="__main__")

@@ -1,8 +1,16 @@
 """evoeye: self-evolving runtime monitoring of autonomous driving systems."""
 
-from importlib.metadata import PackageNotFoundError, version
+from typing import Any
 
-try:
-    __version__ = version("evoeye")
-except PackageNotFoundError:  # running from a source tree without an install
-    __version__ = "0.0.0+local"
+
+def __getattr__(name: str) -> Any:
+    # __version__ is looked up on first use: importlib.metadata costs ~0.1 s at start-up,
+    # which `evoeye --help` should not pay.
+    if name == "__version__":
+        from importlib.metadata import PackageNotFoundError, version
+
+        try:
+            return version("evoeye")
+        except PackageNotFoundError:  # running from a source tree without an install
+            return "0.0.0+local"
+    raise AttributeError(f"module 'evoeye' has no attribute {name!r}")

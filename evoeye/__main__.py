@@ -1,4 +1,4 @@
-"""`python -m evoeye`: the `evoeye` command."""
+"""`python -m evoeye …` runs the `evoeye` command."""
 
 from evoeye.cli import app
 

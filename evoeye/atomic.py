@@ -33,6 +33,29 @@ def atomic_file(path: Path, tmp: Path | None = None) -> Iterator[BinaryIO]:
         raise
 
 
+def _alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's process
+        return True
+    return True
+
+
+def remove_stale_temps(folder: Path) -> list[Path]:
+    """Remove the `<name>.<pid>.tmp` files in `folder` whose writer process is gone; them."""
+    if not folder.is_dir():
+        return []
+    stale = []
+    for tmp in folder.glob("*.tmp"):
+        pid = tmp.suffixes[-2].lstrip(".") if len(tmp.suffixes) >= 2 else ""
+        if pid.isdigit() and int(pid) != os.getpid() and not _alive(int(pid)):
+            tmp.unlink(missing_ok=True)
+            stale.append(tmp)
+    return sorted(stale)
+
+
 def fsync_dir(folder: Path) -> None:
     """Make a rename inside `folder` durable (the directory entry itself is fsynced)."""
     fd = os.open(folder, os.O_RDONLY)

@@ -2,12 +2,14 @@
 
 A run's log path is a function of (logical scenario, batch, scenario id), and logs are written
 atomically, so a batch can be killed at any point and re-run: finished runs are skipped, an
-unfinished one (a `.tmp` file) is simulated again.
+unfinished one (a `.tmp` file) is simulated again, and the `.tmp` files of writers that are gone
+are removed first. Workers die with the parent process that started them.
 """
 
 from __future__ import annotations
 
 import multiprocessing as mp
+import os
 import time
 from collections.abc import Callable, Iterable, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
@@ -16,8 +18,10 @@ from pathlib import Path
 
 import numpy as np
 
+from evoeye.atomic import remove_stale_temps
+from evoeye.lifeline import die_with_parent
 from evoeye.log import LogError, read_run, write_episode
-from evoeye.paths import DataRoot
+from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import get_scenario
 from evoeye.sim.episode import STATUS_OK, RunSpec
 from evoeye.sim.runner import run_episode, run_spec
@@ -33,9 +37,9 @@ def plan_uniform(
     if seed < 0:
         raise ValueError(f"--seed must be non-negative, got {seed}")
     space = get_scenario(scenario)
+    batch = check_batch_name(batch or f"{source}-seed{seed}")
     xs = space.sample(np.random.default_rng(seed), n)
     run_seeds = np.random.SeedSequence(seed).generate_state(n)
-    batch = batch or f"{source}-seed{seed}"
     return [
         run_spec(scenario, x, int(s), batch=batch, source=source, round=round)
         for x, s in zip(xs, run_seeds, strict=True)
@@ -75,10 +79,18 @@ def simulate_and_log(spec: RunSpec, root: str | Path) -> RunResult:
                      sim_time_s=o.duration_s)
 
 
+def remove_stale_logs(specs: Sequence[RunSpec], root: str | Path) -> list[Path]:
+    """Check every batch name, then remove the `.tmp` logs of dead writers in their folders."""
+    data = DataRoot.at(root)
+    folders = {data.batch_dir(s.scenario, s.batch) for s in specs}
+    return [p for folder in sorted(folders) for p in remove_stale_temps(folder)]
+
+
 @dataclass
 class BatchSummary:
     results: list[RunResult] = field(default_factory=list)
     wall_s: float = 0.0
+    stale_removed: list[Path] = field(default_factory=list)  # `.tmp` logs of killed writers
 
     @property
     def runs(self) -> int:
@@ -117,13 +129,14 @@ def run_batch(
     if workers < 1:
         raise ValueError(f"--workers must be at least 1, got {workers}")
     t0 = time.perf_counter()
-    summary = BatchSummary()
+    summary = BatchSummary(stale_removed=remove_stale_logs(specs, root))
     wrap = progress or (lambda it: it)
     if workers == 1:
         for spec in wrap(specs):
             summary.results.append(_guarded(spec, root))
     else:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=_context()) as pool:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=_context(),
+                                 initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
             futures: dict[Future, RunSpec] = {
                 pool.submit(simulate_and_log, s, str(root)): s for s in specs
             }

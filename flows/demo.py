@@ -16,6 +16,7 @@ from pydantic import BaseModel, Field
 
 from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
+from flows.command_line import API_NOTE, say_what_we_wait_for
 from flows.evaluate import EvaluateParams, evaluate_flow
 from flows.evolve import EvolveParams, evolution_flow
 from flows.ingest import IngestParams, ingest_flow
@@ -53,12 +54,18 @@ def demo_flow(params: DemoParams) -> dict[str, Any]:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__)
+    ap = argparse.ArgumentParser(prog="python -m flows.demo", description=__doc__,
+                                 epilog=API_NOTE)
     ap.add_argument("--root", default=None)
     ap.add_argument("--n", type=int, default=40)
     ap.add_argument("--workers", type=int, default=2)
     args = ap.parse_args()
-    result = demo_flow(DemoParams(root=args.root, n=args.n, workers=args.workers))
+    try:
+        params = DemoParams(root=args.root, n=args.n, workers=args.workers)
+    except ValueError as exc:  # pydantic's ValidationError: one line per field, no traceback
+        ap.error(" ".join(str(exc).split()))
+    say_what_we_wait_for()
+    result = demo_flow(params)
     data = DataRoot.resolve(args.root)
     print("\nevoeye demo finished. Results:")
     print(f"  MCAP logs (Foxglove / Lichtblick): {result['runs']}")

@@ -69,3 +69,9 @@ def evaluate_flow(params: EvaluateParams | None = None) -> dict[str, Any]:
                              description=f"RQ1 report, {files.html}")
     get_run_logger().info("RQ1 report for %s: %s", ", ".join(scenarios), files.html)
     return {"reports": reports, "report_dir": str(files.folder)}
+
+
+if __name__ == "__main__":
+    from flows.command_line import run_from_command_line
+
+    run_from_command_line(EvaluateParams, evaluate_flow, __doc__)

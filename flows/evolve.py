@@ -162,3 +162,9 @@ def evolution_flow(params: EvolveParams | None = None) -> dict[str, Any]:
     return {"campaign_id": campaign.campaign_id, "rounds": rounds, "round": state.round,
             "monitor": state.monitor, "simulated_s": state.spent_s,
             "done": campaign.done(state), "root": str(campaign.root.path)}
+
+
+if __name__ == "__main__":
+    from flows.command_line import run_from_command_line
+
+    run_from_command_line(EvolveParams, evolution_flow, __doc__)

@@ -80,3 +80,9 @@ def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
                              description=f"RQ2 report, {folder / 'rq2.html'}")
     get_run_logger().info("RQ2 report: %s", folder / "rq2.html")
     return {"report_dir": str(folder), "campaigns": len(plan), "results": results}
+
+
+if __name__ == "__main__":
+    from flows.command_line import run_from_command_line
+
+    run_from_command_line(ExperimentParams, experiment_flow, __doc__)

@@ -45,3 +45,9 @@ def ingest_flow(params: IngestParams | None = None) -> dict[str, Any]:
     if report["catalog_error"]:
         logger.warning("views not refreshed: %s", report["catalog_error"])
     return report
+
+
+if __name__ == "__main__":
+    from flows.command_line import run_from_command_line
+
+    run_from_command_line(IngestParams, ingest_flow, __doc__)

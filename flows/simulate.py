@@ -8,7 +8,7 @@ from prefect import flow, get_run_logger, task
 from pydantic import BaseModel, Field
 
 from evoeye.batch import RunResult, plan_uniform, simulate_and_log
-from evoeye.paths import resolve_root
+from evoeye.paths import check_batch_name, resolve_root
 from evoeye.scenarios import SCENARIOS
 from evoeye.sim.episode import RunSpec
 from flows.runners import task_runner
@@ -29,6 +29,8 @@ class SimulateParams(BaseModel):
         if self.scenario not in SCENARIOS:
             known = sorted(SCENARIOS)
             raise ValueError(f"unknown logical scenario {self.scenario!r}; known: {known}")
+        if self.batch is not None:
+            check_batch_name(self.batch)  # a plain name: logs never leave the data root
 
 
 @task(retries=1, retry_delay_seconds=1, task_run_name="run-{spec.scenario_id}")
@@ -60,3 +62,9 @@ def simulate_flow(specs: list[RunSpec], root: str) -> list[RunResult]:
     for r in failed:
         logger.warning("%s %s: %s", r.status, r.scenario_id, r.reason)
     return results
+
+
+if __name__ == "__main__":
+    from flows.command_line import run_from_command_line
+
+    run_from_command_line(SimulateParams, simulate_batch_flow, __doc__)

@@ -71,3 +71,9 @@ def train_flow(params: TrainFlowParams | None = None) -> dict[str, Any]:
         card["training"]["time_s"])
     return {"version": version, "card": str(version_dir(root, version) / CARD_FILE),
             "parent": card["parent"], "metrics": val, "thresholds": card["thresholds"]}
+
+
+if __name__ == "__main__":
+    from flows.command_line import run_from_command_line
+
+    run_from_command_line(TrainFlowParams, train_flow, __doc__)

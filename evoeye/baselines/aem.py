@@ -134,13 +134,27 @@ class AEMMonitor:
             "error_scale": float(self.error_scale),
         }, buf)
         (out / "model.pt").write_bytes(buf.getvalue())
-        info = {"version": self.version, "name": self.name, "config": asdict(self.config)}
+        info = {"version": self.version, "name": self.name, "config": asdict(self.config),
+                "model_sha256": hashlib.sha256(buf.getvalue()).hexdigest()}
         (out / "meta.json").write_text(json.dumps({**info, **(meta or {})}, indent=2) + "\n")
         return out
 
     @classmethod
     def load(cls, version_dir: Path) -> AEMMonitor:
-        blob = torch.load(Path(version_dir) / "model.pt", weights_only=True)
+        """The AEM saved in `version_dir`, checked against the sha256 in its meta.json (as a
+        FusionMonitor against its card); AEMLoadError if the hash is missing or differs."""
+        model, meta = Path(version_dir) / "model.pt", Path(version_dir) / "meta.json"
+        try:
+            data = model.read_bytes()
+            expected = json.loads(meta.read_text(encoding="utf-8")).get("model_sha256")
+        except (OSError, ValueError) as e:
+            raise AEMLoadError(f"{version_dir}: cannot read the AEM ({e})") from e
+        if not expected:
+            raise AEMLoadError(f"{meta}: no model_sha256, so {model} cannot be checked")
+        if hashlib.sha256(data).hexdigest() != expected:
+            raise AEMLoadError(f"{model}: checkpoint is corrupt or was modified (its sha256 "
+                               "differs from the one in meta.json)")
+        blob = torch.load(io.BytesIO(data), weights_only=True)
         cfg = dict(blob["config"])
         cfg["hidden"] = tuple(cfg["hidden"])
         config = AEMConfig(**cfg)
@@ -148,6 +162,10 @@ class AEMMonitor:
         model = AutoEncoder(len(mean), config.hidden, config.latent)
         model.load_state_dict(blob["state_dict"])
         return cls(config, model, mean, std, float(blob["error_scale"]))
+
+
+class AEMLoadError(Exception):
+    """A saved AEM that cannot be loaded: unreadable, without a hash, or not matching it."""
 
 
 @contextmanager

@@ -1,15 +1,17 @@
-"""The `evoeye` command: each module below registers its commands on the shared app."""
+"""The `evoeye` command: each module in COMMAND_MODULES registers its commands on the shared app.
 
-from evoeye.cli import (  # noqa: F401
-    audit,
-    demo,
-    evaluate,
-    evolve,
-    explain,
-    monitor,
-    simulate,
-    warehouse,
-)
+To add a command, see the module docstring of `evoeye.cli.app` (one new module, one name here).
+"""
+
+from importlib import import_module
+
 from evoeye.cli.app import app
 
-__all__ = ["app"]
+COMMAND_MODULES = (
+    "simulate", "warehouse", "monitor", "evaluate", "evolve", "demo", "audit", "explain",
+)
+
+for _name in COMMAND_MODULES:
+    import_module(f"evoeye.cli.{_name}")
+
+__all__ = ["COMMAND_MODULES", "app"]

@@ -6,11 +6,13 @@ from typing import Annotated
 
 import typer
 
-from evoeye.cli.app import app
-from evoeye.cli.simulate import RootOpt, console, simulate_batch, summary_table
+from evoeye.cli.app import app, exit_with
+from evoeye.cli.defaults import SCENARIO_NAMES
+from evoeye.cli.errors import ExitCode
+from evoeye.cli.output import out
+from evoeye.cli.simulate import RootOpt, failures_code, simulate_batch, summary_table
 from evoeye.cli.warehouse import ingest_command, stats_command
 from evoeye.paths import DataRoot
-from evoeye.scenarios import SCENARIOS
 
 
 @app.command()
@@ -20,13 +22,21 @@ def demo(
     seed: Annotated[int, typer.Option(min=0)] = 0,
     workers: Annotated[int, typer.Option(min=1)] = 2,
 ) -> None:
-    """Simulate both logical scenarios, ingest the logs, print the dataset and where it all is."""
+    """Simulate both logical scenarios, ingest the logs, print the dataset and where it all is.
+
+    Exits 3 if any run failed or any log was quarantined.
+    """
     data = DataRoot.resolve(root)
-    rows = [(name, simulate_batch(name, n, seed, data.path, workers, batch="demo"))
-            for name in SCENARIOS]
-    console.print(summary_table("evoeye demo: simulate", rows))
-    ingest_command(root=data.path)
+    rows = [(name, simulate_batch(name, n, seed, data, workers, batch="demo"))
+            for name in SCENARIO_NAMES]
+    out().print(summary_table("evoeye demo: simulate", rows))
+    code = failures_code(rows)
+    try:
+        ingest_command(root=data.path)
+    except typer.Exit as partial:
+        code = ExitCode(partial.exit_code)
     stats_command(root=data.path)
-    console.print(f"\nMCAP logs (open in Foxglove or Lichtblick): {data.runs}")
-    console.print(f"warehouse (Parquet + DuckDB): {data.warehouse}")
-    console.print(f'try: evoeye sql --root {data.path} "SELECT * FROM dataset_stats"')
+    out().print(f"\nMCAP logs (open in Foxglove or Lichtblick): {data.runs}")
+    out().print(f"warehouse (Parquet + DuckDB): {data.warehouse}")
+    out().print(f'try: evoeye sql --root {data.path} "SELECT * FROM dataset_stats"')
+    exit_with(code)

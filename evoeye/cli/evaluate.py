@@ -8,25 +8,20 @@ from pathlib import Path
 from typing import Annotated
 
 import typer
-from rich.console import Console
 
 from evoeye.cli.app import app
-from evoeye.evaluation.monitors import BASELINES
-from evoeye.evaluation.report import markdown_report
-from evoeye.evaluation.rq1 import rq1, rq1_report
-from evoeye.store import SplitSpec, WarehouseLockedError
-
-
-def _err() -> Console:
-    return Console(stderr=True)
+from evoeye.cli.defaults import BASELINE_NAMES, SPLIT_SEED, TRAIN_FRAC, VAL_FRAC
+from evoeye.cli.errors import UserError
+from evoeye.cli.output import StepBar
+from evoeye.paths import DataRoot
 
 
 def parse_baselines(text: str) -> list[str]:
     """'ttc,rss,aem' → names; '' or 'none' → none."""
     names = [n.strip() for n in text.split(",") if n.strip() and n.strip() != "none"]
-    unknown = [n for n in names if n not in BASELINES]
+    unknown = [n for n in names if n not in BASELINE_NAMES]
     if unknown:
-        raise typer.BadParameter(f"unknown baseline(s) {unknown}; known: {sorted(BASELINES)}")
+        raise typer.BadParameter(f"unknown baseline(s) {unknown}; known: {list(BASELINE_NAMES)}")
     return names
 
 
@@ -45,11 +40,10 @@ def evaluate_command(
     fusion: Annotated[bool, typer.Option(
         "--train-fusion/--no-train-fusion",
         help="Also train a FusionMonitor per scenario (seed 0, L = 5) and evaluate it.")] = False,
-    split_seed: Annotated[int, typer.Option(help="Split seed.")] = SplitSpec().seed,
-    train_frac: Annotated[float, typer.Option(help="Train share of round-0 runs.")] =
-        SplitSpec().train_frac,
+    split_seed: Annotated[int, typer.Option(help="Split seed.")] = SPLIT_SEED,
+    train_frac: Annotated[float, typer.Option(help="Train share of round-0 runs.")] = TRAIN_FRAC,
     val_frac: Annotated[float, typer.Option(help="Validation share of round-0 runs.")] =
-        SplitSpec().val_frac,
+        VAL_FRAC,
     latency: Annotated[bool, typer.Option(
         "--latency/--no-latency", help="Time inference on CPU (batch 1 and 1024).")] = True,
     store: Annotated[bool, typer.Option(
@@ -60,22 +54,29 @@ def evaluate_command(
         "--json", help="Print the figures as JSON instead of the Markdown table.")] = False,
 ) -> None:
     """Score val and test splits, calibrate on val, and report the RQ1 figures on test."""
+    from evoeye.evaluation.report import markdown_report
+    from evoeye.evaluation.rq1 import rq1, rq1_report
+    from evoeye.store import SplitSpec
+
     names = parse_baselines(baselines)
     if not names and not monitor and not fusion:
         raise typer.BadParameter("nothing to evaluate: give --monitor, --train-fusion or "
                                  "--baselines")
-    err = _err()
     try:
         splits = SplitSpec(split_seed, train_frac, val_frac)
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from exc
+    root = DataRoot.existing(root).path
+    per_scenario = int(fusion) + int(bool(names)) + 1  # the steps rq1 reports per scenario
+    total = per_scenario * len(scenario) if scenario else None
     try:
-        reports = rq1(root, scenario, baselines=names, monitor_versions=monitor or (),
-                      fusion=fusion, splits=splits, latency=latency, store_scores=store,
-                      progress=lambda msg: err.print(f"[dim]{msg}[/]"))
-    except (ValueError, KeyError, RuntimeError, WarehouseLockedError) as exc:
-        err.print(f"[red]error:[/] {exc}")
-        raise typer.Exit(1) from exc
+        with StepBar("evaluate", total=total) as bar:
+            reports = rq1(root, scenario, baselines=names, monitor_versions=monitor or (),
+                          fusion=fusion, splits=splits, latency=latency, store_scores=store,
+                          progress=bar)
+    except (ValueError, KeyError, RuntimeError) as exc:
+        raise UserError(str(exc).strip("'\""), "check --scenario and --monitor, and that "
+                        "`evoeye ingest` has run") from exc
     files = rq1_report(root, reports, name)
     dicts = [r.to_dict() for r in reports]
     if as_json:

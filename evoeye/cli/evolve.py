@@ -4,15 +4,17 @@ from __future__ import annotations
 
 import json
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
 
 from evoeye.cli.app import app
-from evoeye.evolve.campaign import Campaign
-from evoeye.evolve.config import UPDATE_MODES, CampaignConfig
+from evoeye.cli.defaults import UPDATE_MODES
+from evoeye.cli.output import StepBar
 from evoeye.paths import DataRoot
-from evoeye.store import SplitSpec
+
+if TYPE_CHECKING:
+    from evoeye.evolve.config import CampaignConfig
 
 FEEDBACK_HELP = ("ŷ in f_r = mean |ŷ − y|: raw monitor scores, or prior-corrected "
                  "(undo the training pos_weight).")
@@ -23,6 +25,9 @@ Root = Annotated[Path | None, typer.Option(
 def _config(scenario: str, strategy: str, budget_s: float, seed: int, monitor: str | None,
             n_round: int, update: str, epochs: int | None, split_seed: int,
             feedback: str = "raw", family: str = "fusion") -> CampaignConfig:
+    from evoeye.evolve.config import CampaignConfig
+    from evoeye.store import SplitSpec
+
     if update not in UPDATE_MODES:
         raise typer.BadParameter(f"--update must be one of {UPDATE_MODES}")
     try:
@@ -53,11 +58,14 @@ def evolve_command(
                       ] = "fusion",
 ) -> None:
     """Run (or resume) an evolution campaign; per round, G_r's F1 / AUPRC on the test set."""
+    from tqdm import tqdm
+
     from evoeye.evolve.assess import Assessor
+    from evoeye.evolve.campaign import Campaign
 
     cfg = _config(scenario, strategy, budget_s, seed, monitor, n_round, update, epochs,
                   split_seed, feedback, family)
-    data = DataRoot.resolve(root)
+    data = DataRoot.existing(root)
     probe = Campaign(data, cfg)
     assess = Assessor.of(probe)
     campaign = Campaign(data, cfg, assess=assess)
@@ -65,17 +73,25 @@ def evolve_command(
                f"{data.runs / cfg.scenario / campaign.campaign_id}, state in "
                f"{data.table_dir('campaign_rounds')} and {data.table_dir('feedback')}")
 
+    # the bar counts simulated seconds of the budget; each round's line is printed above it
+    bar = tqdm(total=round(cfg.budget_s), desc="evolve", unit="sim s")
+
     def show(row, state) -> None:
         m = json.loads(row.metrics) if row.metrics else {}
         t, h = m.get("test", {}), m.get("hard", {})
-        typer.echo(f"round {row.round}: {len(row.scenario_ids)} runs, {row.simulated_s:.0f}/"
-                   f"{cfg.budget_s:.0f} s, monitor {row.monitor_version} | test F1@0.05 "
-                   f"{t.get('f1@0.05', 0):.3f} AUPRC {t.get('auprc') or 0:.3f} | hard F1@0.05 "
-                   f"{h.get('f1@0.05', 0):.3f}")
+        bar.write(f"round {row.round}: {len(row.scenario_ids)} runs, {row.simulated_s:.0f}/"
+                  f"{cfg.budget_s:.0f} s, monitor {row.monitor_version} | test F1@0.05 "
+                  f"{t.get('f1@0.05', 0):.3f} AUPRC {t.get('auprc') or 0:.3f} | hard F1@0.05 "
+                  f"{h.get('f1@0.05', 0):.3f}")
+        bar.update(max(0, min(round(state.spent_s), bar.total) - bar.n))
+        bar.set_postfix_str(f"round {row.round}")
 
-    state = campaign.start()
-    show(state.rounds[-1], state)
-    state = campaign.run(max_rounds=max_rounds, on_round=show)
+    try:
+        state = campaign.start()
+        show(state.rounds[-1], state)
+        state = campaign.run(max_rounds=max_rounds, on_round=show)
+    finally:
+        bar.close()
     typer.echo(f"{'budget spent' if campaign.done(state) else 'paused'} after round "
                f"{state.round}: {state.acquired} runs, {state.spent_s:.0f} s; monitor "
                f"{state.monitor}")
@@ -111,6 +127,7 @@ def experiment_command(
     from evoeye.evolve.experiment import ABLATION, MAIN, METHODS, run_experiment
     from evoeye.evolve.report import write_experiment_report
 
+    root = DataRoot.existing(root).path
     scenarios = scenario or ["highway-cut-in", "unprotected-intersection"]
     unknown = sorted(set(strategy or ()) - set(METHODS))
     if unknown:
@@ -119,10 +136,11 @@ def experiment_command(
         raise typer.BadParameter(f"--budget-s must be >= 0, got {budget_s}")
     base = _config(scenarios[0], "evoeye", budget_s or 0.0, 0, monitor, n_round, update, epochs,
                    0, feedback)
-    results = run_experiment(root, scenarios, base,
-                             strategies=strategy or MAIN + (ABLATION if ablation else ()),
-                             seeds=range(repetitions), budget_s=budget_s, controls=controls,
-                             progress=typer.echo)
+    with StepBar("experiment") as bar:  # a step: a campaign started or a round done
+        results = run_experiment(root, scenarios, base,
+                                 strategies=strategy or MAIN + (ABLATION if ablation else ()),
+                                 seeds=range(repetitions), budget_s=budget_s, controls=controls,
+                                 progress=bar)
     folder = write_experiment_report(root, results, name)
     typer.echo((folder / "rq2.md").read_text(encoding="utf-8"))
     typer.echo(f"report: {folder / 'rq2.html'}")

@@ -3,28 +3,28 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
-from rich.console import Console
-from rich.table import Table
 
 from evoeye.cli.app import app
-from evoeye.monitor.inputs import ABLATIONS, MODULES, parse_modules
-from evoeye.monitor.protocol import TARGET_FPRS
-from evoeye.store import SplitSpec
-from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S
+from evoeye.cli.defaults import ABLATION_NAMES as ABLATIONS
+from evoeye.cli.defaults import CONTEXT_LEN as DEFAULT_CONTEXT_LEN
+from evoeye.cli.defaults import HORIZON_S as DEFAULT_HORIZON_S
+from evoeye.cli.defaults import MODULE_NAMES as MODULES
+from evoeye.cli.defaults import SPLIT_SEED, TARGET_FPRS
+from evoeye.cli.errors import UserError
+from evoeye.cli.output import err, out, table
+from evoeye.paths import DataRoot
+
+if TYPE_CHECKING:
+    from rich.table import Table
 
 RootOpt = Annotated[
     Path | None,
     typer.Option("--root", help="Data root (default: $EVOEYE_HOME or ./evoeye-data)."),
 ]
 MonitorOpt = Annotated[str, typer.Option("--monitor", help="Monitor version, e.g. fusion-…")]
-
-
-def _fail(message: str, code: int = 1) -> typer.Exit:
-    Console(stderr=True).print(f"[red]error:[/] {message}")
-    return typer.Exit(code)
 
 
 def _pct(value: float | None) -> str:
@@ -34,15 +34,14 @@ def _pct(value: float | None) -> str:
 def metrics_table(card: dict[str, Any]) -> Table:
     """Validation metrics of a card: AUROC, AUPRC and precision / recall / F1 per target FPR."""
     val = card["metrics"]["val"]
-    table = Table(title=f"{card['version']} on validation (%)")
-    for col in ("AUROC", "AUPRC", "target FPR", "threshold", "Prec.", "Rec.", "F1", "FPR"):
-        table.add_column(col, justify="right")
+    t = table(f"{card['version']} on validation (%)",
+              ["AUROC", "AUPRC", "target FPR", "threshold", "Prec.", "Rec.", "F1", "FPR"])
     for i, fpr in enumerate(sorted((float(f) for f in card["thresholds"]), reverse=True)):
         m = val[f"fpr_{fpr:g}"]
-        table.add_row(_pct(val["auroc"]) if i == 0 else "", _pct(val["auprc"]) if i == 0 else "",
-                      f"{fpr:g}", f"{m['threshold']:.4f}", _pct(m["precision"]),
-                      _pct(m["recall"]), _pct(m["f1"]), _pct(m["fpr"]))
-    return table
+        t.add_row(_pct(val["auroc"]) if i == 0 else "", _pct(val["auprc"]) if i == 0 else "",
+                  f"{fpr:g}", f"{m['threshold']:.4f}", _pct(m["precision"]),
+                  _pct(m["recall"]), _pct(m["f1"]), _pct(m["fpr"]))
+    return t
 
 
 @app.command("train")
@@ -59,7 +58,7 @@ def train_command(
         f"{', '.join(MODULES)} (default: all).")] = None,
     seed: Annotated[int, typer.Option(help="Training seed.")] = 0,
     split_seed: Annotated[int, typer.Option(help="Seed of the train/val/test split.")] =
-        SplitSpec().seed,
+        SPLIT_SEED,
     epochs: Annotated[int, typer.Option(min=1, help="At most this many epochs.")] = 40,
     patience: Annotated[int, typer.Option(min=1, help="Early-stopping patience.")] = 8,
     batch_size: Annotated[int, typer.Option(min=1)] = 256,
@@ -74,10 +73,13 @@ def train_command(
     quiet: Annotated[bool, typer.Option("--quiet", help="No per-epoch lines.")] = False,
 ) -> None:
     """Train a FusionMonitor on the scenario's train split, calibrate it on val, save a version."""
-    from evoeye.monitor.registry import CARD_FILE, MonitorLoadError, read_card, version_dir
+    from evoeye.monitor.inputs import parse_modules
+    from evoeye.monitor.registry import CARD_FILE, read_card, version_dir
     from evoeye.monitor.train import train_monitor
+    from evoeye.store import SplitSpec
 
-    console = Console()
+    root = DataRoot.existing(root).path
+    console = out()
 
     def progress(row: dict[str, Any]) -> None:
         if not quiet:
@@ -92,8 +94,8 @@ def train_command(
             modules=parse_modules(modules), dropout=dropout, seed=seed,
             splits=SplitSpec(seed=split_seed), init_from=init_from, epochs=epochs,
             patience=patience, batch_size=batch_size, lr=lr, progress=progress, **extra)
-    except (ValueError, MonitorLoadError) as exc:
-        raise _fail(str(exc)) from exc
+    except ValueError as exc:
+        raise UserError(str(exc), "check --scenario, and that `evoeye ingest` has run") from exc
     card = read_card(root, version)
     console.print(metrics_table(card))
     t = card["training"]
@@ -109,40 +111,51 @@ def replay_command(
                                         dir_okay=False)],
     monitor: MonitorOpt,
     root: RootOpt = None,
-    out: Annotated[Path | None, typer.Option(
-        "--out", help="Output log (default: <log>.risk.mcap beside it).")] = None,
+    output: Annotated[Path | None, typer.Option(
+        "--out", help="Output log (default: <root>/replays/<log name>.<monitor>.risk.mcap, "
+        "outside runs/ so that ingest never sees it).")] = None,
     fpr: Annotated[float, typer.Option(help=f"Alarm threshold's target FPR, one of "
                                        f"{TARGET_FPRS}.")] = TARGET_FPRS[0],
     consecutive: Annotated[int, typer.Option(
         "--consecutive", min=1, help="Frames above the threshold before the alarm (K).")] = 1,
 ) -> None:
-    """Copy a run log with the monitor's risk channel and alarm markers (Foxglove/Lichtblick)."""
-    from evoeye.log import LogError
-    from evoeye.monitor.registry import MonitorLoadError, load_monitor
+    """Copy a run log with the monitor's risk channel and alarm markers (Foxglove/Lichtblick).
+
+    Warns when the monitor was trained on another logical scenario than the log's.
+    """
+    from evoeye.log import LogError, read_run
+    from evoeye.monitor.registry import load_monitor
     from evoeye.monitor.replay import replay
 
+    data = DataRoot.existing(root)
+    fusion = load_monitor(data, monitor)
     try:
-        report = replay(log, load_monitor(root, monitor), out, fpr=fpr, consecutive=consecutive)
-    except (MonitorLoadError, LogError, ValueError, KeyError) as exc:
-        raise _fail(str(exc)) from exc
+        logged = str(read_run(log, topics=()).metadata.get("logical_scenario"))
+        if output is None:
+            data.replays.mkdir(parents=True, exist_ok=True)
+            output = data.replays / f"{log.stem}.{monitor}.risk.mcap"
+        report = replay(log, fusion, output, fpr=fpr, consecutive=consecutive)
+    except (LogError, ValueError, KeyError) as exc:
+        raise UserError(str(exc), "give a run log (.mcap) written by `evoeye simulate`") from exc
+    trained = fusion.card.get("logical_scenario")
+    if trained and trained != logged:
+        err().print(f"[yellow]warning:[/] {monitor} was trained on {trained}, the log is of "
+                    f"{logged}: its risk there is not calibrated")
     first = "none" if report.first_alarm_t_s is None else f"t = {report.first_alarm_t_s:.2f} s"
-    Console().print(f"{report.frames} frames, {report.alarm_frames} alarm frames (threshold "
-                    f"{report.threshold:.4f}), first alarm: {first}")
-    Console().print(f"wrote {report.out}")
+    out().print(f"{report.frames} frames, {report.alarm_frames} alarm frames (threshold "
+                f"{report.threshold:.4f}), first alarm: {first}")
+    out().print(f"wrote {report.out}")
 
 
 @app.command("export")
 def export_command(
     monitor: MonitorOpt,
-    out: Annotated[Path, typer.Option("--out", help="ONNX file to write.")],
+    output: Annotated[Path, typer.Option("--out", help="ONNX file to write.")],
     root: RootOpt = None,
 ) -> None:
     """Export a monitor version to ONNX (dynamic batch axis; output: risk in [0, 1])."""
     from evoeye.monitor.export import export_onnx
-    from evoeye.monitor.registry import MonitorLoadError, load_monitor
+    from evoeye.monitor.registry import load_monitor
 
-    try:
-        path = export_onnx(load_monitor(root, monitor), out)
-    except MonitorLoadError as exc:
-        raise _fail(str(exc)) from exc
-    Console().print(f"wrote {path} (inputs: see `evoeye.monitor.model.INPUTS`)")
+    path = export_onnx(load_monitor(DataRoot.existing(root), monitor), output)
+    out().print(f"wrote {path} (inputs: see `evoeye.monitor.model.INPUTS`)")

@@ -3,19 +3,19 @@
 from __future__ import annotations
 
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.console import Console
 from rich.table import Table
-from tqdm import tqdm
 
-from evoeye.batch import BatchSummary, plan_uniform, run_batch
-from evoeye.cli.app import app
-from evoeye.paths import DataRoot
-from evoeye.scenarios import SCENARIOS, ScenarioError
+from evoeye.cli.app import app, exit_with
+from evoeye.cli.defaults import SCENARIO_NAMES
+from evoeye.cli.errors import ExitCode, UserError
+from evoeye.cli.output import err, out, table
+from evoeye.paths import BadNameError, DataRoot, check_batch_name
 
-console = Console()
+if TYPE_CHECKING:
+    from evoeye.batch import BatchSummary
 
 RootOpt = Annotated[
     Path | None,
@@ -23,47 +23,81 @@ RootOpt = Annotated[
 ]
 
 
+def plain_batch(name: str | None) -> str | None:
+    """Typer callback: refuse a --batch that is not a plain name before anything runs."""
+    try:
+        return None if name is None else check_batch_name(name)
+    except BadNameError as exc:
+        raise typer.BadParameter(str(exc)) from None
+
+
+BatchOpt = Annotated[str | None, typer.Option(
+    callback=plain_batch, help="Batch name (default uniform-seed<S>): letters, digits, '.', '_', "
+    "'-'.")]
+
+
 def summary_table(title: str, rows: list[tuple[str, BatchSummary]]) -> Table:
     """One row per batch: runs, collisions, failures, skipped, simulated and wall time."""
-    table = Table(title=title)
-    for col in ("scenario", "runs", "collisions", "failures", "skipped", "sim s", "wall s", "× rt"):
-        table.add_column(col, justify="left" if col == "scenario" else "right")
+    t = table(title, ["scenario", "runs", "collisions", "failures", "skipped", "sim s", "wall s",
+                      "× rt"], left=("scenario",))
     for name, s in rows:
         done = s.runs - s.skipped
         share = f"{s.collisions} ({100.0 * s.collisions / max(1, s.runs):.0f} %)"
         rtf = f"{s.simulated_s / s.wall_s:.0f}" if done and s.wall_s > 0 else "-"
-        table.add_row(name, str(s.runs), share, str(s.failures), str(s.skipped),
-                      f"{s.simulated_s:.0f}", f"{s.wall_s:.1f}", rtf)
-    return table
+        t.add_row(name, str(s.runs), share, str(s.failures), str(s.skipped),
+                  f"{s.simulated_s:.0f}", f"{s.wall_s:.1f}", rtf)
+    return t
 
 
-def simulate_batch(scenario: str, n: int, seed: int, root: Path, workers: int,
+def simulate_batch(scenario: str, n: int, seed: int, data: DataRoot, workers: int,
                    batch: str | None = None) -> BatchSummary:
-    """Plan, run with a progress bar, and report failures by scenario id."""
-    specs = plan_uniform(scenario, n, seed, batch=batch)
+    """Plan, check the root can be written (PermissionError & co. if not), run with a progress
+    bar, and report failures by scenario id."""
+    from tqdm import tqdm
+
+    from evoeye.batch import plan_uniform, run_batch
+
+    try:
+        specs = plan_uniform(scenario, n, seed, batch=batch)
+    except ValueError as exc:  # includes ScenarioError and BadNameError
+        raise UserError(str(exc), "see `evoeye simulate --help`") from exc
+    data.runs.mkdir(parents=True, exist_ok=True)
     bar = lambda it: tqdm(it, total=len(specs), desc=scenario, unit="run")  # noqa: E731
-    summary = run_batch(specs, root, workers=workers, progress=bar)
+    summary = run_batch(specs, data.path, workers=workers, progress=bar)
+    for path in summary.stale_removed:
+        out().print(f"[dim]removed the unfinished log of a killed run: {path}[/]")
     for r in summary.results:
         if r.status != "ok":
-            console.print(f"[yellow]{r.status}[/] {r.scenario_id}: {r.reason}")
+            out().print(f"[yellow]{r.status}[/] {r.scenario_id}: {r.reason}")
     return summary
+
+
+def failures_code(rows: list[tuple[str, BatchSummary]]) -> ExitCode:
+    """PARTIAL (and a line saying how many) if any run failed, else OK."""
+    failed = sum(s.failures for _, s in rows)
+    if not failed:
+        return ExitCode.OK
+    total = sum(s.runs for _, s in rows)
+    err().print(f"[red]{failed} of {total} runs failed[/] (their reasons are "
+                               "above); exit code 3")
+    return ExitCode.PARTIAL
 
 
 @app.command()
 def simulate(
-    scenario: Annotated[str, typer.Option(help=f"Logical scenario: {', '.join(SCENARIOS)}.")],
+    scenario: Annotated[str, typer.Option(help=f"Logical scenario: {', '.join(SCENARIO_NAMES)}.")],
     n: Annotated[int, typer.Option("--n", min=1, help="Number of runs.")] = 10,
     seed: Annotated[int, typer.Option(min=0, help="Batch seed: fixes vectors and run seeds.")] = 0,
     root: RootOpt = None,
     workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 1,
-    batch: Annotated[str | None, typer.Option(help="Batch name (default uniform-seed<S>).")] = None,
+    batch: BatchOpt = None,
 ) -> None:
-    """Simulate N uniformly sampled concrete scenarios and write one MCAP log per run."""
-    data = DataRoot.at(root)
-    try:
-        summary = simulate_batch(scenario, n, seed, data.path, workers, batch)
-    except (ScenarioError, ValueError) as exc:
-        console.print(f"[red]error:[/] {exc}")
-        raise typer.Exit(2) from exc
-    console.print(summary_table("simulate", [(scenario, summary)]))
-    console.print(f"logs: {data.runs / scenario}")
+    """Simulate N uniformly sampled concrete scenarios and write one MCAP log per run.
+
+    Exits 3 if any run failed (the table and the lines above say which and why).
+    """
+    data = DataRoot.resolve(root)
+    summary = simulate_batch(scenario, n, seed, data, workers, batch)
+    out().print(summary_table("simulate", [(scenario, summary)]))
+    out().print(f"logs: {data.runs / scenario}")
+    exit_with(failures_code([(scenario, summary)]))

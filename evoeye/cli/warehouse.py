@@ -6,29 +6,21 @@ import csv
 import sys
 from enum import StrEnum
 from pathlib import Path
-from typing import Annotated, Any
+from typing import TYPE_CHECKING, Annotated, Any
 
-import duckdb
-import orjson
-import pyarrow as pa
 import typer
-from rich.console import Console
-from rich.table import Table
 
-from evoeye.cli.app import app
-from evoeye.evaluation import report
+from evoeye.cli.app import app, exit_with
+from evoeye.cli.defaults import HORIZON_S, RUNS_PER_PART, SPLIT_SEED, TRAIN_FRAC, VAL_FRAC
+from evoeye.cli.errors import ExitCode, UserError
+from evoeye.cli.output import err, out, table
 from evoeye.paths import DataRoot
-from evoeye.store import SplitSpec, Warehouse, WarehouseLockedError
-from evoeye.store.ingest import DEFAULT_RUNS_PER_PART, IngestReport, ingest
 
+if TYPE_CHECKING:
+    import pyarrow as pa
+    from rich.table import Table
 
-def _out() -> Console:
-    """A console sized at call time (so COLUMNS set by the caller applies)."""
-    return Console()
-
-
-def _err() -> Console:
-    return Console(stderr=True)
+    from evoeye.store.ingest import IngestReport
 
 warehouse_app = typer.Typer(no_args_is_help=True, help="Inspect the Parquet/DuckDB warehouse.")
 app.add_typer(warehouse_app, name="warehouse")
@@ -46,16 +38,14 @@ class Format(StrEnum):
 
 
 def report_table(report: IngestReport) -> Table:
-    table = Table(title="ingest", show_header=False)
-    table.add_column(justify="left")
-    table.add_column(justify="right")
-    table.add_row("runs ingested", str(len(report.ingested)))
-    table.add_row("frames ingested", f"{report.frames:,}")
-    table.add_row("already in the warehouse", str(report.skipped))
-    table.add_row("duplicate scenario ids", str(len(report.duplicates)))
-    table.add_row("quarantined", str(len(report.quarantined)))
-    table.add_row("parts of a killed ingest removed", str(len(report.orphans_removed)))
-    return table
+    t = table("ingest", ["what", "count"], left=("what",), show_header=False)
+    t.add_row("runs ingested", str(len(report.ingested)))
+    t.add_row("frames ingested", f"{report.frames:,}")
+    t.add_row("already in the warehouse", str(report.skipped))
+    t.add_row("duplicate scenario ids", str(len(report.duplicates)))
+    t.add_row("quarantined", str(len(report.quarantined)))
+    t.add_row("parts of a killed ingest removed", str(len(report.orphans_removed)))
+    return t
 
 
 @app.command("ingest")
@@ -63,26 +53,42 @@ def ingest_command(
     root: RootOpt = None,
     runs_per_part: Annotated[
         int, typer.Option(min=1, help="Runs per Parquet part file.")
-    ] = DEFAULT_RUNS_PER_PART,
+    ] = RUNS_PER_PART,
 ) -> None:
-    """Append every run log under <root>/runs not yet ingested to the warehouse."""
+    """Append every run log under <root>/runs not yet ingested to the warehouse.
+
+    Exits 3 if any log was quarantined (listed with its reason).
+    """
+    from tqdm import tqdm
+
+    from evoeye.store import ingest
+
     data = DataRoot.resolve(root)
+    if not data.warehouse.is_dir():
+        where = "" if data.path.is_dir() else " (the data root does not exist yet)"
+        err().print(f"creating a new warehouse at {data.warehouse}{where}")
+    bars: list[tqdm] = []  # made once ingest knows how many logs it will read
     try:
-        with _out().status("ingesting…") as status:
-            report = ingest(data, runs_per_part=runs_per_part,
-                            on_log=lambda p: status.update(f"ingesting {p.name}"))
-    except WarehouseLockedError as exc:
-        _err().print(f"[red]error:[/] {exc}")
-        raise typer.Exit(1) from exc
-    _out().print(report_table(report))
+        report = ingest(data, runs_per_part=runs_per_part,
+                        on_start=lambda n: bars.append(tqdm(total=n, desc="ingest", unit="log")),
+                        on_log=lambda p: bars[0].update(1))
+    finally:
+        for bar in bars:
+            bar.close()
+    console = out()
+    console.print(report_table(report))
     for log, reason in report.quarantined:
-        _out().print(f"[yellow]quarantined[/] {log}: {reason}")
+        console.print(f"[yellow]quarantined[/] {log}: {reason}")
     for log in report.duplicates:
-        _out().print(f"[yellow]duplicate[/] {log}: its scenario id is already ingested")
+        console.print(f"[yellow]duplicate[/] {log}: its scenario id is already ingested")
     if report.catalog_error:
-        _out().print(f"[yellow]warning:[/] views not refreshed ({report.catalog_error}); "
+        console.print(f"[yellow]warning:[/] views not refreshed ({report.catalog_error}); "
                       "the data is in, the next ingest refreshes them")
-    _out().print(f"warehouse: {data.warehouse}  (DuckDB: {data.duckdb_file})")
+    console.print(f"warehouse: {data.warehouse}  (DuckDB: {data.duckdb_file})")
+    if report.quarantined:
+        err().print(f"[red]{len(report.quarantined)} logs quarantined[/] under {data.quarantine}"
+                    " (reasons above); exit code 3")
+        exit_with(ExitCode.PARTIAL)
 
 
 def _cell(value: Any, max_items: int = 4) -> str:
@@ -98,28 +104,30 @@ def _cell(value: Any, max_items: int = 4) -> str:
 
 
 def print_table(result: pa.Table, max_rows: int) -> None:
-    table = Table()
-    for name in result.column_names:
-        table.add_column(name, overflow="fold")
+    t = table(None, result.column_names, left=tuple(result.column_names))
     for row in result.slice(0, max_rows).to_pylist():
-        table.add_row(*(_cell(v) for v in row.values()))
-    _out().print(table)
+        t.add_row(*(_cell(v) for v in row.values()))
+    out().print(t)
     if result.num_rows > max_rows:
-        _out().print(f"… {result.num_rows - max_rows} more rows (--max-rows, or --format csv)")
+        out().print(f"… {result.num_rows - max_rows} more rows (--max-rows, or --format csv)")
 
 
 def _csv_cell(value: Any) -> Any:
+    import orjson
+
     return orjson.dumps(value, default=str).decode() if isinstance(value, list | dict) else value
 
 
 def write_csv(result: pa.Table) -> None:
-    out = csv.writer(sys.stdout, lineterminator="\n")
-    out.writerow(result.column_names)
+    writer = csv.writer(sys.stdout, lineterminator="\n")
+    writer.writerow(result.column_names)
     for row in result.to_pylist():
-        out.writerow([_csv_cell(v) for v in row.values()])
+        writer.writerow([_csv_cell(v) for v in row.values()])
 
 
 def write_json(result: pa.Table) -> None:
+    import orjson
+
     sys.stdout.write(orjson.dumps(result.to_pylist(), default=str,
                                   option=orjson.OPT_SERIALIZE_NUMPY).decode() + "\n")
 
@@ -131,13 +139,26 @@ def sql_command(
     root: RootOpt = None,
     fmt: Annotated[Format, typer.Option("--format", help="Output format.")] = Format.table,
     max_rows: Annotated[int, typer.Option(min=1, help="Rows shown in table format.")] = 50,
+    allow_files: Annotated[bool, typer.Option(
+        "--allow-files", help="Also let the query read files outside the warehouse "
+        "(read_csv, read_parquet, …); it still cannot write.")] = False,
 ) -> None:
-    """Run a SQL query against the warehouse (read-only: reads the Parquet directly)."""
+    """Run a read-only query against the warehouse views (SELECT / EXPLAIN only; no ATTACH,
+    COPY, INSTALL or SET, and no file outside the warehouse unless --allow-files)."""
+    import duckdb
+
+    from evoeye.store import Warehouse
+    from evoeye.store.catalog import ReadOnlyQueryError
+
+    data = DataRoot.existing(root)
     try:
-        result = Warehouse(root).sql(query)
+        result = Warehouse(data).read_only_sql(query, allow_files=allow_files)
+    except ReadOnlyQueryError as exc:
+        raise UserError(str(exc), "`evoeye ingest` is the only writer") from exc
+    except duckdb.PermissionException as exc:
+        raise UserError(str(exc), "--allow-files lets a query read other files") from exc
     except duckdb.Error as exc:
-        _err().print(f"[red]error:[/] {exc}")
-        raise typer.Exit(1) from exc
+        raise UserError(str(exc), "the views are listed in docs/warehouse.md") from exc
     if fmt is Format.csv:
         write_csv(result)
     elif fmt is Format.json:
@@ -152,48 +173,49 @@ def _count_pct(count: int, pct: float | None) -> str:
 
 def attribution_table(rows: list[dict[str, Any]]) -> Table:
     """Root causes by `evoeye explain` (rows of view attribution_shares) as a console table."""
+    from evoeye.evaluation import report
+
     shares = report.attribution_table(rows)
-    table = Table(title="root causes of collisions (evoeye explain), %")
-    for i, col in enumerate(shares.header):
-        table.add_column(col, justify="left" if i < 2 else "right")
+    t = table("root causes of collisions (evoeye explain), %", shares.header,
+              left=tuple(shares.header[:2]))
     for row in shares.rows:
-        table.add_row(*row)
-    return table
+        t.add_row(*row)
+    return t
 
 
 @warehouse_app.command("stats")
 def stats_command(
     root: RootOpt = None,
-    horizon_s: Annotated[float, typer.Option(min=0.0, help="Label horizon H, s.")] = 3.0,
-    seed: Annotated[int, typer.Option(help="Split seed.")] = SplitSpec().seed,
-    train_frac: Annotated[float, typer.Option(help="Train share of round-0 runs.")] =
-        SplitSpec().train_frac,
+    horizon_s: Annotated[float, typer.Option(min=0.0, help="Label horizon H, s.")] = HORIZON_S,
+    seed: Annotated[int, typer.Option(help="Split seed.")] = SPLIT_SEED,
+    train_frac: Annotated[float, typer.Option(help="Train share of round-0 runs.")] = TRAIN_FRAC,
     val_frac: Annotated[float, typer.Option(help="Validation share of round-0 runs.")] =
-        SplitSpec().val_frac,
+        VAL_FRAC,
 ) -> None:
     """Per logical scenario and split: scenarios, violations, frames, unsafe frames."""
+    from evoeye.store import SplitSpec, Warehouse
+
+    data = DataRoot.existing(root)
     try:
         splits = SplitSpec(seed, train_frac, val_frac)
     except ValueError as exc:
-        _err().print(f"[red]error:[/] {exc}")
-        raise typer.Exit(2) from exc
-    rows = Warehouse(root).query(
+        raise UserError(str(exc), "see `evoeye warehouse stats --help`") from exc
+    rows = Warehouse(data).query(
         "dataset_stats", horizon_s=horizon_s, seed=splits.seed,
         train_frac=splits.train_frac, val_frac=splits.val_frac,
     ).to_pylist()
-    table = Table(title=f"dataset statistics (H = {horizon_s:g} s, split seed {splits.seed})")
-    for col in ("LS", "Set", "#Scena.", "#Viol. (%)", "#Frame", "#Unsafe (%)", "#Failed"):
-        table.add_column(col, justify="left" if col in ("LS", "Set") else "right")
+    t = table(f"dataset statistics (H = {horizon_s:g} s, split seed {splits.seed})",
+              ["LS", "Set", "#Scena.", "#Viol. (%)", "#Frame", "#Unsafe (%)", "#Failed"],
+              left=("LS", "Set"))
     for r in rows:
-        table.add_row(
+        t.add_row(
             r["logical_scenario"], r["split"], f"{r['scenarios']:,}",
             _count_pct(r["violations"], r["violations_pct"]), f"{r['frames']:,}",
             _count_pct(r["unsafe_frames"], r["unsafe_pct"]), str(r["failed"]),
         )
-    _out().print(table)
-    shares = Warehouse(root).query("attribution_shares", logical_scenario=None).to_pylist()
+    out().print(t)
+    shares = Warehouse(data).query("attribution_shares", logical_scenario=None).to_pylist()
     if shares:
-        _out().print(attribution_table(shares))
+        out().print(attribution_table(shares))
     if not rows:
-        _out().print(f"the warehouse under {DataRoot.resolve(root).path} is empty: "
-                      "run `evoeye ingest` first")
+        out().print(f"the warehouse under {data.path} is empty: run `evoeye ingest` first")

@@ -40,7 +40,13 @@ import numpy as np
 from evoeye.batch import simulate_and_log
 from evoeye.evolve.avfuzzer import criticality
 from evoeye.evolve.config import CampaignConfig
-from evoeye.evolve.families import initial_aem, initial_monitor, load_version, trainer_of
+from evoeye.evolve.families import (
+    NoInitialDataError,
+    initial_aem,
+    initial_monitor,
+    load_version,
+    trainer_of,
+)
 from evoeye.evolve.protocol import Strategy
 from evoeye.evolve.records import Records
 from evoeye.evolve.scoring import read_logged_run, warehouse_feedback, windows_feedback
@@ -113,7 +119,7 @@ class Campaign:
         t = Warehouse(self.root).sql(INITIAL_RECORDS_SQL, {
             "scenario": cfg.scenario, **asdict(cfg.splits)}).to_pydict()
         if not t["scenario_id"]:
-            raise LookupError(f"no initial (round 0) training runs of {cfg.scenario!r} in "
+            raise NoInitialDataError(f"no initial (round 0) training runs of {cfg.scenario!r} in "
                               f"{self.root.warehouse}: simulate and ingest them first")
         return {k: np.asarray(v, dtype=object if k == "scenario_id" else None)
                 for k, v in t.items()}

@@ -29,6 +29,14 @@ from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S
 FAMILIES = ("fusion", "aem")
 
 
+class NoMonitorError(LookupError):
+    """A campaign needs a G_0 and none was named or trained for its scenario."""
+
+
+class NoInitialDataError(LookupError):
+    """A campaign needs the scenario's initial (round 0) runs in the warehouse."""
+
+
 def family_of(version: str) -> str:
     return "aem" if version.startswith("aem-") else "fusion"
 
@@ -127,8 +135,8 @@ def initial_monitor(root: DataRoot | str | Path | None, scenario: str) -> str:
             and c.get("context_len") == DEFAULT_CONTEXT_LEN
             and c.get("selection", {}).get("train", {}).get("kind") == "filter"]
     if not mine:
-        raise LookupError(f"no monitor trained on {scenario!r} under {root}: train one first "
-                          "(`evoeye monitor train`) or name it")
+        raise NoMonitorError(f"no monitor trained on {scenario!r} under {root}: train one "
+                             f"first (`evoeye train --scenario {scenario}`) or name it")
     return max(mine)[1]
 
 

@@ -1,7 +1,9 @@
 """DuckDB over the warehouse Parquet: the connection every reader uses, and the catalog file.
 
 Readers never open the DuckDB file for writing and take no lock: `Warehouse.connect()` gives an
-in-memory DuckDB whose views read the Parquet parts directly. The file
+in-memory DuckDB whose views read the Parquet parts directly; `Warehouse.read_only_sql` runs a
+user's query there with reads only and, by default, external access off except for the
+warehouse folder. The file
 `<root>/warehouse/evoeye.duckdb` holds the same views for the DuckDB CLI and other tools; only
 the ingester (under the writer lock) rewrites it.
 """
@@ -24,6 +26,7 @@ from evoeye.store.schema import (
 )
 from evoeye.store.sqlfiles import query, view_scripts
 
+READ_ONLY_STATEMENTS = frozenset({duckdb.StatementType.SELECT, duckdb.StatementType.EXPLAIN})
 PART_GLOB = "/".join(["*"] * len(PARTITION_KEYS) + ["*.parquet"])  # */*/*.parquet
 
 
@@ -70,6 +73,17 @@ def install_views(con: duckdb.DuckDBPyConnection, root: DataRoot) -> None:
         con.execute(script)
 
 
+class ReadOnlyQueryError(ValueError):
+    """A query given to `Warehouse.read_only_sql` that is not a read."""
+
+
+def _lock_down(con: duckdb.DuckDBPyConnection, readable: Path) -> None:
+    """No file outside `readable`, no ATTACH, no INSTALL, and no way to turn that back on."""
+    con.execute("SET allowed_directories = ?", [[str(readable) + "/"]])
+    con.execute("SET enable_external_access = false")
+    con.execute("SET lock_configuration = true")
+
+
 class Warehouse:
     """Read access to the warehouse of one data root."""
 
@@ -91,6 +105,27 @@ class Warehouse:
         con = self.connect()
         try:
             return con.sql(text, params=params).to_arrow_table()
+        finally:
+            con.close()
+
+    def read_only_sql(self, text: str, *, allow_files: bool = False) -> pa.Table:
+        """Run a user's query: SELECT / EXPLAIN statements only (ReadOnlyQueryError otherwise),
+        and unless `allow_files`, no file but the warehouse's own Parquet (duckdb's
+        PermissionException otherwise); the last statement's result as Arrow."""
+        con = self.connect()
+        try:
+            statements = con.extract_statements(text)
+            refused = sorted({s.type.name for s in statements} - {t.name for t in
+                                                                   READ_ONLY_STATEMENTS})
+            if refused or not statements:
+                raise ReadOnlyQueryError(
+                    f"the warehouse is read-only here: only SELECT and EXPLAIN are run, not "
+                    f"{', '.join(refused) or 'an empty query'}")
+            if not allow_files:
+                _lock_down(con, self.root.warehouse)
+            for statement in statements[:-1]:
+                con.execute(statement.query).fetchall()
+            return con.sql(statements[-1].query).to_arrow_table()
         finally:
             con.close()
 

@@ -5,7 +5,8 @@
 * Crash-safe: a part's frames and frame_features are written before its scenarios rows (see
   `parts.py`); the views hide uncommitted parts, and the next ingest deletes them and ingests
   those runs again.
-* Bad logs: a log that `read_run` rejects, or that cannot be a record, is moved to
+* Bad logs: a log that `read_run` rejects, whose metadata does not fit its logical scenario
+  (`metadata.py`), or that cannot be a record, is moved to
   `<root>/quarantine/` with a `.reason.txt` beside it, and the rest is ingested.
 * One writer: everything runs under the writer lock (`lock.py`).
 """
@@ -26,6 +27,7 @@ from evoeye.log import LogError, read_run
 from evoeye.paths import LOG_SUFFIX, DataRoot
 from evoeye.store.catalog import Warehouse, write_catalog
 from evoeye.store.lock import WriterLock
+from evoeye.store.metadata import check_metadata
 from evoeye.store.parts import PartStore
 from evoeye.store.records import (
     FRAME_CLOCK,
@@ -98,12 +100,14 @@ class Ingester:
         *,
         runs_per_part: int = DEFAULT_RUNS_PER_PART,
         on_log: Callable[[Path], None] | None = None,
+        on_start: Callable[[int], None] | None = None,
     ) -> None:
         if runs_per_part < 1:
             raise ValueError(f"runs_per_part must be at least 1, got {runs_per_part}")
         self.root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
         self.runs_per_part = runs_per_part
         self.on_log = on_log  # progress callback, called before each log is read
+        self.on_start = on_start  # called once with the number of logs to read
         self.store = PartStore(self.root)
         self.quarantine = Quarantine(self.root)
         self.topics = sorted({FRAME_CLOCK, *(t for t, _ in frame_column_sources().values())})
@@ -115,7 +119,10 @@ class Ingester:
             ledger = Warehouse(self.root).query("committed_runs")
             done_paths = set(ledger.column("log_path").to_pylist())
             done_ids = set(ledger.column("scenario_id").to_pylist())
-            self._ingest(self._pending(report, done_paths, done_ids), done_ids, report)
+            pending = list(self._pending(report, done_paths, done_ids))
+            if self.on_start is not None:
+                self.on_start(len(pending))
+            self._ingest(iter(pending), done_ids, report)
             try:
                 write_catalog(self.root)
             except duckdb.Error as e:
@@ -146,6 +153,7 @@ class Ingester:
             try:
                 run = read_run(log, topics=self.topics)
                 meta = run.metadata
+                check_metadata(meta)
                 scenario_id = str(meta["scenario_id"])
                 if scenario_id in done_ids:
                     report.duplicates.append(rel)
@@ -184,6 +192,8 @@ def ingest(
     *,
     runs_per_part: int = DEFAULT_RUNS_PER_PART,
     on_log: Callable[[Path], None] | None = None,
+    on_start: Callable[[int], None] | None = None,
 ) -> IngestReport:
-    """Ingest every log under `<root>/runs` not yet in the warehouse (see the module doc)."""
-    return Ingester(root, runs_per_part=runs_per_part, on_log=on_log).run()
+    """Ingest every log under `<root>/runs` not yet in the warehouse (see the module doc);
+    `on_start(n)` learns how many logs will be read, `on_log(path)` is called before each."""
+    return Ingester(root, runs_per_part=runs_per_part, on_log=on_log, on_start=on_start).run()

@@ -7,7 +7,13 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from evoeye.baselines.aem import AEMConfig, AEMMonitor, train_aem, window_vectors
+from evoeye.baselines.aem import (
+    AEMConfig,
+    AEMLoadError,
+    AEMMonitor,
+    train_aem,
+    window_vectors,
+)
 from evoeye.monitor.protocol import Monitor
 
 SMALL = AEMConfig(context_len=1, hidden=(48,), latent=4, epochs=30, batch_size=64, seed=3)
@@ -62,6 +68,23 @@ def test_seeded_save_and_load(windows_of, obs, tmp_path: Path) -> None:
     assert folder.name == a.version and (folder / "meta.json").is_file()
     loaded = AEMMonitor.load(folder)  # torch.load(weights_only=True) inside
     assert loaded.version == a.version and np.allclose(loaded.score(probe), a.score(probe))
+
+
+def test_load_checks_the_sha256_in_meta(windows_of, obs, tmp_path: Path) -> None:
+    import json
+
+    train = traffic(100, 0, windows_of, obs)
+    folder = train_aem(train, np.ones(len(train), bool), SMALL).save(tmp_path)
+    meta = json.loads((folder / "meta.json").read_text())
+    model = (folder / "model.pt").read_bytes()
+    (folder / "model.pt").write_bytes(model[:-1] + bytes([model[-1] ^ 1]))
+    with pytest.raises(AEMLoadError, match="sha256 differs"):
+        AEMMonitor.load(folder)
+    (folder / "model.pt").write_bytes(model)
+    del meta["model_sha256"]
+    (folder / "meta.json").write_text(json.dumps(meta))
+    with pytest.raises(AEMLoadError, match="no model_sha256"):
+        AEMMonitor.load(folder)
 
 
 def test_padded_context_slots_are_zeroed(windows_of, obs) -> None:

@@ -52,6 +52,8 @@ def test_json_and_markdown_carry_the_same_numbers(eval_root, splits) -> None:
     as_md = RUNNER.invoke(app, _args(eval_root, splits, "--name", "cli-md"))
     assert as_md.exit_code == 0, as_md.output
     assert "report: " in as_md.stdout and "cli-md/report.html" in as_md.stdout
+    assert "evaluate: 100%" in as_md.stderr and "2/2 [" in as_md.stderr  # the progress bar
+    assert "step/s]" in as_md.stderr or "s/step]" in as_md.stderr
     rows = _markdown_rows(as_md.stdout)
     sections = ["Frame-level", "Scenario-level (K=1)", "Scenario-level (K=3)"]
     assert set(rows) == {(s, m) for s in sections for m in ("ttc", "rss")}

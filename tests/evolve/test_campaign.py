@@ -297,8 +297,28 @@ def test_cli_evolve_prints_the_state_and_round_metrics(root_copy, seeded) -> Non
     assert res.exit_code == 0, res.output
     assert "campaign evo-uniform-s0-" in res.output and "round 0:" in res.output
     assert "test F1@0.05" in res.output and "budget spent after round 0" in res.output
+    assert "evolve: " in res.stderr and "sim s" in res.stderr  # the progress bar
     bad = CliRunner().invoke(app, [*args[:6], "grid"])
     assert bad.exit_code != 0
+
+
+def test_cli_evolve_without_a_monitor_is_one_line_naming_evoeye_train(root_copy) -> None:
+    import shutil
+
+    from typer.testing import CliRunner
+
+    import evoeye.cli.evolve  # noqa: F401  (registers the commands)
+    from evoeye.cli.app import app
+    from evoeye.cli.errors import ExitCode
+
+    root = root_copy("no-monitor")
+    shutil.rmtree(root.monitors)
+    res = CliRunner().invoke(app, ["evolve", "--root", str(root.path), "--scenario", SCENARIO,
+                                   "--budget-s", "0"])
+    assert res.exit_code == ExitCode.USER_ERROR, res.output
+    assert "Traceback" not in res.output and len(res.output.strip().splitlines()) == 2
+    assert "no monitor trained on" in res.output and "evoeye train --scenario" in res.output
+    assert "evoeye monitor train" not in res.output
 
 
 def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_copy,

@@ -6,6 +6,7 @@ from typer.testing import CliRunner
 
 import evoeye.cli.monitor  # noqa: F401  (registers the commands)
 from evoeye.cli.app import app
+from evoeye.cli.errors import ExitCode
 from evoeye.monitor.registry import read_card
 
 
@@ -27,7 +28,12 @@ def test_train_command_prints_version_metrics_and_card(tiny) -> None:
 def test_train_command_reports_bad_input_without_a_traceback(tiny) -> None:
     result = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path), "--scenario",
                                       "nowhere"])
-    assert result.exit_code == 1 and "training and validation windows" in result.output
+    assert result.exit_code == ExitCode.USER_ERROR
+    assert "training and validation windows" in result.output
     result = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path), "--scenario",
                                       tiny.scenario, "--init-from", "fusion-000000000000"])
-    assert result.exit_code == 1 and "no monitor version" in result.output
+    assert result.exit_code == ExitCode.USER_ERROR and "no monitor version" in result.output
+    assert "Traceback" not in result.output
+    missing = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path / "nowhere"),
+                                       "--scenario", tiny.scenario])
+    assert missing.exit_code == ExitCode.USER_ERROR and "no data root at" in missing.output

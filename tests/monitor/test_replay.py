@@ -13,6 +13,7 @@ from typer.testing import CliRunner
 
 import evoeye.cli.monitor  # noqa: F401  (registers the commands)
 from evoeye.cli.app import app
+from evoeye.cli.errors import ExitCode
 from evoeye.log import TOPICS, read_run
 from evoeye.log.channels import load_schema
 from evoeye.monitor.registry import load_monitor
@@ -117,4 +118,32 @@ def test_cli_replay_and_export(tiny, trained, tmp_path) -> None:
     assert (tmp_path / "m.onnx").stat().st_size > 10_000
     result = runner.invoke(app, ["replay", str(log), "--monitor", "fusion-missing",
                                  "--root", str(tiny.root.path)])
-    assert result.exit_code == 1 and "no monitor version" in result.output
+    assert result.exit_code == ExitCode.USER_ERROR and "no monitor version" in result.output
+    assert "hint: list the versions" in result.output and "Traceback" not in result.output
+
+
+def test_cli_replay_writes_to_replays_and_warns_on_another_scenario(tiny, trained) -> None:
+    import shutil
+
+    import orjson
+
+    from evoeye.store import ingest
+
+    runner = CliRunner(env={"COLUMNS": "200"})
+    log = tiny.logs[tiny.ids["val"][0]]
+    result = runner.invoke(app, ["replay", str(log), "--monitor", trained,
+                                 "--root", str(tiny.root.path)])
+    assert result.exit_code == 0, result.output
+    copy = tiny.root.replays / f"{log.stem}.{trained}.risk.mcap"
+    assert copy.exists() and not list(tiny.root.runs.rglob("*.risk.mcap"))
+    assert "warning" not in result.output
+    assert not ingest(tiny.root).duplicates  # the replay is not a run log
+    other = tiny.root.monitors / "fusion-elsewhere0"
+    shutil.copytree(tiny.root.monitors / trained, other)
+    card = orjson.loads((other / "card.json").read_bytes())
+    card["logical_scenario"] = "unprotected-intersection"
+    (other / "card.json").write_bytes(orjson.dumps(card))
+    result = runner.invoke(app, ["replay", str(log), "--monitor", other.name,
+                                 "--root", str(tiny.root.path)])
+    assert result.exit_code == 0, result.output
+    assert "warning:" in result.output and "trained on unprotected-intersection" in result.output

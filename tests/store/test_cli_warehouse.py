@@ -11,6 +11,7 @@ from typer.testing import CliRunner
 
 import evoeye.cli.warehouse  # noqa: F401  (registers the commands)
 from evoeye.cli.app import app
+from evoeye.cli.errors import ExitCode
 from evoeye.paths import DataRoot
 from evoeye.store import WriterLock
 
@@ -24,14 +25,18 @@ def ingested(root: DataRoot, add_run) -> DataRoot:
     bad = add_run("cli-bad", n_frames=5, seed=3)
     bad.write_bytes(bad.read_bytes()[:200])
     result = runner.invoke(app, ["ingest", "--root", str(root.path)])
-    assert result.exit_code == 0, result.output
+    assert result.exit_code == ExitCode.PARTIAL, result.output  # one log quarantined
     assert "quarantined" in result.output and "cli-bad.mcap" in result.output
+    assert "creating a new warehouse" in result.output
+    assert "ingest: 100%" in result.stderr and "3/3 [" in result.stderr  # the progress bar
+    assert "log/s]" in result.stderr or "s/log]" in result.stderr
     return root
 
 
 def test_ingest_twice_reports_nothing_new(ingested: DataRoot) -> None:
     result = runner.invoke(app, ["ingest", "--root", str(ingested.path)])
-    assert result.exit_code == 0
+    assert result.exit_code == ExitCode.OK  # nothing new quarantined
+    assert "creating a new warehouse" not in result.output
     assert "runs ingested" in result.output and "already in the warehouse" in result.output
     lines = {line.split("│")[1].strip(): line.split("│")[2].strip()
              for line in result.output.splitlines() if line.count("│") == 3}
@@ -54,7 +59,8 @@ def test_sql_formats(ingested: DataRoot) -> None:
 def test_sql_error_is_reported(ingested: DataRoot) -> None:
     result = runner.invoke(app, ["sql", "SELECT nope FROM scenarios", "--root",
                                  str(ingested.path)])
-    assert result.exit_code == 1 and "nope" in result.output
+    assert result.exit_code == ExitCode.USER_ERROR and "nope" in result.output
+    assert "Traceback" not in result.output
 
 
 def test_stats_prints_the_dataset_table(ingested: DataRoot) -> None:
@@ -71,4 +77,60 @@ def test_stats_prints_the_dataset_table(ingested: DataRoot) -> None:
 def test_ingest_refused_while_another_writer_holds_the_lock(root: DataRoot) -> None:
     with WriterLock(root.writer_lock):
         result = runner.invoke(app, ["ingest", "--root", str(root.path)])
-    assert result.exit_code == 1 and "another process" in result.output
+    assert result.exit_code == ExitCode.USER_ERROR and "another process" in result.output
+    assert "hint:" in result.output
+
+
+@pytest.mark.parametrize("query", [
+    "ATTACH '{duckdb}' AS w; CREATE TABLE w.evil AS SELECT 1 AS x",
+    "ATTACH '{duckdb}' AS w; DROP VIEW w.frames",
+    "COPY (SELECT * FROM scenarios) TO '{root}/leak.csv'",
+    "COPY (SELECT * FROM scenarios) TO '{root}/warehouse/leak.csv'",
+    "SELECT * FROM read_csv('/etc/passwd')",
+    "SELECT * FROM read_parquet('{root}/warehouse/../leak/*.parquet')",
+    "INSTALL httpfs",
+    "SET enable_external_access = true; SELECT * FROM read_csv('/etc/passwd')",
+    "CREATE TABLE t AS SELECT 1 AS x",
+])
+def test_sql_is_read_only(ingested: DataRoot, query: str) -> None:
+    catalog = ingested.duckdb_file.read_bytes()
+    text = query.format(duckdb=ingested.duckdb_file, root=ingested.path)
+    result = runner.invoke(app, ["sql", text, "--root", str(ingested.path)])
+    assert result.exit_code == ExitCode.USER_ERROR, result.output
+    assert "error:" in result.output and "Traceback" not in result.output
+    assert ingested.duckdb_file.read_bytes() == catalog
+    assert not list(ingested.path.rglob("leak*"))
+    # the views still work, for this and any other client
+    ok = runner.invoke(app, ["sql", "SELECT count(*) AS n FROM frames", "--root",
+                             str(ingested.path), "--format", "csv"])
+    assert ok.exit_code == 0 and ok.output.splitlines() == ["n", "60"]
+
+
+def test_sql_allow_files_reads_files_but_still_cannot_write(ingested: DataRoot) -> None:
+    other = ingested.path.parent / "other.csv"
+    other.write_text("a,b\n1,2\n")
+    query = f"SELECT * FROM read_csv('{other}')"
+    refused = runner.invoke(app, ["sql", query, "--root", str(ingested.path)])
+    assert refused.exit_code == ExitCode.USER_ERROR and "--allow-files" in refused.output
+    allowed = runner.invoke(app, ["sql", query, "--root", str(ingested.path), "--allow-files",
+                                  "--format", "csv"])
+    assert allowed.exit_code == 0 and allowed.output.splitlines() == ["a,b", "1,2"]
+    copy = runner.invoke(app, ["sql", f"COPY (SELECT 1) TO '{other}.out'", "--allow-files",
+                               "--root", str(ingested.path)])
+    assert copy.exit_code == ExitCode.USER_ERROR and not other.with_suffix(".csv.out").exists()
+
+
+@pytest.mark.parametrize("command", [["sql", "SELECT 1"], ["warehouse", "stats"]])
+def test_read_commands_name_a_missing_root(tmp_path, command: list[str]) -> None:
+    missing = tmp_path / "nowhere"
+    result = runner.invoke(app, [*command, "--root", str(missing)])
+    assert result.exit_code == ExitCode.USER_ERROR
+    assert f"no data root at {missing}" in result.output.replace("\n", "")
+    assert not missing.exists()
+
+
+def test_tables_keep_identifiers_whole_in_a_pipe(ingested: DataRoot) -> None:
+    result = CliRunner(env={"COLUMNS": "40"}).invoke(
+        app, ["warehouse", "stats", "--root", str(ingested.path)])
+    assert result.exit_code == 0
+    assert "highway-cut-in" in result.output and "…" not in result.output

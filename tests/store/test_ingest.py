@@ -168,3 +168,47 @@ def test_log_layer_reads_what_ingest_skips_without_reading(root: DataRoot, add_r
     assert report.skipped == 1 and not report.quarantined
     with pytest.raises(Exception, match="skip.mcap"):
         read_run(log)
+
+
+def _edited(episode, **changes):
+    from dataclasses import replace
+
+    episode.spec = replace(episode.spec, **changes)
+    return episode
+
+
+def test_metadata_that_does_not_fit_its_logical_scenario_is_quarantined(
+        root: DataRoot, episode_factory, log_writer) -> None:
+    from evoeye.scenarios import get_scenario
+
+    space = get_scenario("highway-cut-in")
+    genuine = episode_factory("x", seed=5)
+    genuine_id = space.scenario_id(np.asarray(genuine.spec.params), genuine.spec.seed)
+    genuine = _edited(genuine, scenario_id=genuine_id)
+    speed = space.index(space.names[0])
+    fast = list(genuine.spec.params)
+    fast[speed] = space.high[speed] + 69.5
+    bad = {
+        "out-of-range": _edited(episode_factory("out-of-range", seed=6), params=tuple(fast)),
+        "unknown": _edited(episode_factory("unknown", seed=7), scenario="no-such-scenario"),
+        # a forged id: the genuine run's id on another vector, written first
+        genuine_id: _edited(episode_factory("forged", seed=8), batch="a-first",
+                            scenario_id=genuine_id),
+        # an id of the simulator's form, of another scenario: it could shadow that one's run
+        "unprotected-intersection-0123456789ab": _edited(
+            episode_factory("other", seed=9), scenario_id="unprotected-intersection-0123456789ab"),
+    }
+    for episode in bad.values():
+        log_writer(root, episode)
+    forged = root.run_log("highway-cut-in", "a-first", genuine_id)
+    assert forged.exists()
+    log_writer(root, genuine)
+    report = ingest(root)
+    reasons = dict(report.quarantined)
+    assert report.ingested == [genuine_id] and len(reasons) == 4
+    assert "outside" in reasons["runs/highway-cut-in/b000/out-of-range.mcap"]
+    assert "unknown logical scenario" in reasons["runs/no-such-scenario/b000/unknown.mcap"]
+    assert "does not match" in reasons[f"runs/highway-cut-in/a-first/{genuine_id}.mcap"]
+    other = "runs/highway-cut-in/b000/unprotected-intersection-0123456789ab.mcap"
+    assert "does not match" in reasons[other]
+    assert (root.quarantine / "highway-cut-in" / "a-first" / f"{genuine_id}.mcap").exists()

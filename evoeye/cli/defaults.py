@@ -1,0 +1,14 @@
+"""Defaults shown in `--help`, kept here so that help never imports the heavy modules they come
+from; tests/cli/test_defaults.py checks each against its source."""
+
+SCENARIO_NAMES = ("highway-cut-in", "unprotected-intersection")  # evoeye.scenarios.SCENARIOS
+SPLIT_SEED, TRAIN_FRAC, VAL_FRAC = 0, 0.5, 0.125  # evoeye.store.SplitSpec()
+CONTEXT_LEN = 5  # evoeye.store.windows.DEFAULT_CONTEXT_LEN
+HORIZON_S = 3.0  # evoeye.store.windows.DEFAULT_HORIZON_S
+TARGET_FPRS = (0.05, 0.01)  # evoeye.monitor.protocol.TARGET_FPRS
+RUNS_PER_PART = 32  # evoeye.store.ingest.DEFAULT_RUNS_PER_PART
+BASELINE_NAMES = ("ttc", "rss", "aem")  # evoeye.evaluation.monitors.BASELINES
+UPDATE_MODES = ("finetune", "retrain")  # evoeye.evolve.config.UPDATE_MODES
+MODULE_NAMES = ("perception", "prediction", "planning", "control")  # evoeye.monitor.inputs.MODULES
+ABLATION_NAMES = ("perception", "perception+prediction", "perception+prediction+planning",
+                  "all")  # evoeye.monitor.inputs.ABLATIONS

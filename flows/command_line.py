@@ -1,0 +1,90 @@
+"""`python -m flows.<name> [--field value …]`: run a flow from the shell, with `--help`.
+
+The options are the fields of the flow's pydantic parameters (`--budget-s 600` sets `budget_s`);
+what is not given keeps its default, and the model validates the whole before anything runs.
+The flow's result is printed as JSON.
+"""
+
+from __future__ import annotations
+
+import argparse
+import dataclasses
+import json
+import os
+import sys
+import types
+import typing
+from collections.abc import Callable, Sequence
+from pathlib import Path
+from typing import Any
+
+from pydantic import BaseModel, ValidationError
+
+API_NOTE = (
+    "Prefect: with no PREFECT_API_URL a flow run first starts a temporary API server (≈ 15-20 s, "
+    "longer on a busy machine; timeout PREFECT_SERVER_EPHEMERAL_STARTUP_TIMEOUT_SECONDS). To skip "
+    "that, run `prefect server start` once and set PREFECT_API_URL=http://127.0.0.1:4200/api."
+)
+
+
+def _inner(annotation: Any) -> Any:
+    """`X | None` → X."""
+    if typing.get_origin(annotation) in (typing.Union, types.UnionType):
+        args = [a for a in typing.get_args(annotation) if a is not type(None)]
+        return args[0] if len(args) == 1 else str
+    return annotation
+
+
+def _help(field: Any) -> str:
+    extra = field.json_schema_extra if isinstance(field.json_schema_extra, dict) else {}
+    choices = f"one of {', '.join(map(str, extra['enum']))}; " if "enum" in extra else ""
+    default = field.get_default(call_default_factory=True)
+    return f"{choices}default: {default}"
+
+
+def say_what_we_wait_for() -> None:
+    """Tell the user, before a flow runs, that a temporary Prefect server starts first."""
+    if not os.environ.get("PREFECT_API_URL"):
+        timeout = os.environ.get("PREFECT_SERVER_EPHEMERAL_STARTUP_TIMEOUT_SECONDS", "20")
+        print(f"starting Prefect's temporary API server first (≈ 15-20 s, up to {timeout} s on a "
+              "busy machine); set PREFECT_API_URL to use a running `prefect server start` "
+              "instead", file=sys.stderr, flush=True)
+
+
+def _plain(value: Any) -> Any:
+    return dataclasses.asdict(value) if dataclasses.is_dataclass(value) else str(value)
+
+
+def parser_for(params: type[BaseModel], description: str | None) -> argparse.ArgumentParser:
+    """An argparse parser with one option per field of `params` (absent ones stay absent)."""
+    ap = argparse.ArgumentParser(prog=f"python -m flows.{Path(sys.argv[0]).stem}",
+                                 description=description, epilog=API_NOTE,
+                                 argument_default=argparse.SUPPRESS,
+                                 formatter_class=argparse.RawDescriptionHelpFormatter)
+    for name, field in params.model_fields.items():
+        flag = "--" + name.replace("_", "-")
+        kind = _inner(field.annotation)
+        if kind is bool:
+            ap.add_argument(flag, dest=name, action=argparse.BooleanOptionalAction,
+                            help=_help(field))
+        elif typing.get_origin(kind) is list:
+            ap.add_argument(flag, dest=name, nargs="+", metavar="VALUE", help=_help(field))
+        else:
+            ap.add_argument(flag, dest=name, metavar=getattr(kind, "__name__", "VALUE").upper(),
+                            help=_help(field))
+    return ap
+
+
+def run_from_command_line(params: type[BaseModel], run: Callable[[Any], Any],
+                          description: str | None, argv: Sequence[str] | None = None) -> Any:
+    """Parse argv into `params`, run the flow with them, print its result as JSON."""
+    ap = parser_for(params, description)
+    given = vars(ap.parse_args(argv))
+    try:
+        chosen = params(**given)
+    except (ValidationError, ValueError) as exc:
+        ap.error(str(exc))
+    say_what_we_wait_for()
+    result = run(chosen)
+    print(json.dumps(result, default=_plain, indent=2))
+    return result

@@ -1,0 +1,69 @@
+"""`evoeye simulate`: exit codes, plain batch names, and a root that cannot be written."""
+
+from __future__ import annotations
+
+import os
+import stat
+
+import pytest
+from typer.testing import CliRunner
+
+import evoeye.batch
+from evoeye.batch import plan_uniform
+from evoeye.cli import app
+from evoeye.cli.errors import ExitCode
+from evoeye.paths import BadNameError, DataRoot
+
+runner = CliRunner()
+SIM = ["simulate", "--scenario", "highway-cut-in", "--n", "2"]
+
+
+def test_failed_runs_give_exit_code_3_and_say_how_many(tmp_path, monkeypatch) -> None:
+    def broken(spec):
+        raise OSError("disk on fire")
+
+    monkeypatch.setattr(evoeye.batch, "run_episode", broken)
+    result = runner.invoke(app, [*SIM, "--root", str(tmp_path)])
+    assert result.exit_code == ExitCode.PARTIAL, result.output
+    assert "2 of 2 runs failed" in result.output and "disk on fire" in result.output
+
+
+@pytest.mark.parametrize("kind", ["file", "read-only"])
+def test_a_root_that_cannot_be_written_is_one_line_and_exit_2(tmp_path, kind) -> None:
+    root = tmp_path / "root"
+    if kind == "file":
+        root.write_text("not a folder")
+    else:
+        root.mkdir()
+        root.chmod(stat.S_IRUSR | stat.S_IXUSR)
+        if os.access(root, os.W_OK):  # running as root: permissions do not apply
+            pytest.skip("permissions are not enforced for this user")
+    result = runner.invoke(app, [*SIM, "--root", str(root)])
+    assert result.exit_code == ExitCode.USER_ERROR, result.output
+    assert "Traceback" not in result.output and "hint: check --root" in result.output
+    assert len(result.output.strip().splitlines()) == 2  # the error and its hint
+
+
+@pytest.mark.parametrize("batch", ["../../../x", "/abs/path", "x/y", "..", ".hidden", "a..b"])
+def test_batch_must_be_a_plain_name_before_anything_runs(tmp_path, batch) -> None:
+    root = tmp_path / "root"
+    result = runner.invoke(app, [*SIM, "--root", str(root), "--batch", batch])
+    assert result.exit_code == ExitCode.USER_ERROR and "plain name" in result.output
+    assert not root.exists() and not list(tmp_path.rglob("*.mcap*"))
+    with pytest.raises(BadNameError):
+        plan_uniform("highway-cut-in", 2, 0, batch=batch)
+    with pytest.raises(BadNameError):
+        DataRoot.resolve(root).run_log("highway-cut-in", batch, "x")
+
+
+def test_debug_shows_the_traceback(tmp_path) -> None:
+    (tmp_path / "root").write_text("not a folder")
+    result = runner.invoke(app, ["--debug", *SIM, "--root", str(tmp_path / "root")])
+    assert result.exit_code != 0 and isinstance(result.exception, OSError)
+
+
+def test_the_summary_keeps_the_scenario_name_whole_in_a_pipe(tmp_path) -> None:
+    result = CliRunner(env={"COLUMNS": "40"}).invoke(app, [*SIM, "--root", str(tmp_path)])
+    assert result.exit_code == ExitCode.OK, result.output
+    row = next(line for line in result.stdout.splitlines() if "highway-cut" in line)
+    assert "highway-cut-in" in row and "…" not in result.stdout
