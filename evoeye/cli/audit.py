@@ -3,33 +3,33 @@
 from __future__ import annotations
 
 import sys
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
-import orjson
 import typer
-from rich.console import Console
-from rich.table import Table
 
-from evoeye.cli.app import app
+from evoeye.cli.app import app, exit_with
+from evoeye.cli.errors import ExitCode
+from evoeye.cli.output import out, table
 from evoeye.cli.simulate import RootOpt
-from evoeye.evaluation.audit import ScenarioAudit, audit_root, write_report
-from evoeye.evaluation.audit.report import report_dict
 from evoeye.paths import DataRoot
+
+if TYPE_CHECKING:
+    from rich.table import Table
+
+    from evoeye.evaluation.audit import ScenarioAudit
 
 
 def summary_table(audits: list[ScenarioAudit]) -> Table:
     """One column per logical scenario, one row per criterion: value and verdict."""
-    table = Table(title="realism audit")
-    table.add_column("criterion")
-    table.add_column("bound")
-    for s in audits:
-        table.add_column(f"{s.logical_scenario} ({len(s.runs)} runs)")
+    t = table("realism audit", ["criterion", "bound",
+                                *(f"{s.logical_scenario} ({len(s.runs)} runs)" for s in audits)],
+              left=("criterion", "bound"))
     colour = {True: "green", False: "red", None: "yellow"}
     for i, first in enumerate(audits[0].verdicts if audits else []):
         cells = [f"[{colour[s.verdicts[i].passed]}]{s.verdicts[i].mark}[/] {s.verdicts[i].value}"
                  for s in audits]
-        table.add_row(first.criterion, first.bound, *cells)
-    return table
+        t.add_row(first.criterion, first.bound, *cells)
+    return t
 
 
 @app.command("audit")
@@ -39,21 +39,26 @@ def audit_command(
     batch: Annotated[str | None, typer.Option(help="Only this batch.")] = None,
     workers: Annotated[int, typer.Option(min=1, help="Processes reading logs.")] = 1,
     as_json: Annotated[bool, typer.Option("--json", help="Print the report as JSON.")] = False,
-    strict: Annotated[bool, typer.Option(help="Exit 1 when a criterion fails.")] = False,
+    strict: Annotated[bool, typer.Option(
+        help=f"Exit {int(ExitCode.CHECK_FAILED)} when a criterion fails.")] = False,
 ) -> None:
     """Check a batch's realism from its logs and the warehouse; write reports/audit-<S>-<B>/."""
-    data = DataRoot.resolve(root)
+    import orjson
+
+    from evoeye.evaluation.audit import audit_root, write_report
+    from evoeye.evaluation.audit.report import report_dict
+
+    data = DataRoot.existing(root)
     audits = audit_root(data, scenario, batch, workers=workers)
-    out = write_report(data, audits, scenario, batch)
+    folder = write_report(data, audits, scenario, batch)
     if as_json:
         sys.stdout.write(orjson.dumps(report_dict(audits, scenario, batch),
                                       option=orjson.OPT_SERIALIZE_NUMPY).decode() + "\n")
     else:
-        console = Console()
         if not audits:
-            console.print(f"no run logs under {data.runs}")
+            out().print(f"no run logs under {data.runs}")
         else:
-            console.print(summary_table(audits))
-        console.print(f"report: {out / 'audit.md'}")
+            out().print(summary_table(audits))
+        out().print(f"report: {folder / 'audit.md'}")
     if strict and any(s.failed for s in audits):
-        raise typer.Exit(1)
+        exit_with(ExitCode.CHECK_FAILED)

@@ -18,12 +18,13 @@ class ExitCode(IntEnum):
     INTERNAL = 1  # an unexpected error (a bug): the traceback is shown
     USER_ERROR = 2  # bad option or input, missing root, unknown monitor, …; nothing was done
     PARTIAL = 3  # the command finished, but some runs failed or some logs were quarantined
+    CHECK_FAILED = 4  # `evoeye audit --strict`: a realism bound is not met
 
 
 EXIT_CODES_HELP = (
     "Exit codes: 0 ok · 2 user error (bad option or input; one line and a hint, "
     "--debug for the traceback) · 3 partly done (some runs failed or some logs were "
-    "quarantined) · 1 internal error."
+    "quarantined) · 4 a checked bound failed (audit --strict) · 1 internal error."
 )
 
 

@@ -36,7 +36,7 @@ def evaluate_command(
         "--monitor", help="Trained monitor version to evaluate (repeatable).")] = None,
     baselines: Annotated[str, typer.Option(
         help="Comma-separated baselines: ttc, rss, aem, context-only ('none' for none).")
-    ] = ",".join(BASELINES),
+    ] = ",".join(BASELINE_NAMES),
     fusion: Annotated[bool, typer.Option(
         "--train-fusion/--no-train-fusion",
         help="Also train a FusionMonitor per scenario (seed 0, L = 5) and evaluate it.")] = False,

@@ -5,23 +5,20 @@ from __future__ import annotations
 import time
 from collections import Counter
 from pathlib import Path
-from typing import Annotated
+from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.table import Table
 
 from evoeye.cli.app import app
-from evoeye.cli.warehouse import RootOpt, _err, _out, attribution_table
-from evoeye.evaluation.explain import (
-    Explained,
-    attribution_shares,
-    explain_one,
-    explain_runs,
-    pending_runs,
-    spec_of,
-)
-from evoeye.log import LogError, read_run
-from evoeye.store import WarehouseLockedError
+from evoeye.cli.errors import UserError
+from evoeye.cli.output import out, table
+from evoeye.cli.warehouse import RootOpt, attribution_table
+from evoeye.paths import DataRoot
+
+if TYPE_CHECKING:
+    from rich.table import Table
+
+    from evoeye.evaluation.explain import Explained
 
 ORACLES = ("oracle_perception", "oracle_prediction", "oracle_planning", "oracle_control")
 
@@ -33,14 +30,13 @@ def _verdict(collided: bool) -> str:
 
 def runs_table(done: list[Explained]) -> Table:
     """One row per run: each oracle's verdict, the careful driver's, and the cause shares."""
-    table = Table(title="explain (✓ avoids the collision, ✗ still collides)")
-    for col in ("run", "t_col s", *(o.removeprefix("oracle_") for o in ORACLES),
-                "careful (brakes at)", "cause share"):
-        table.add_column(col, justify="left" if col in ("run", "cause share") else "right")
+    t = table("explain (✓ avoids the collision, ✗ still collides)",
+              ["run", "t_col s", *(o.removeprefix("oracle_") for o in ORACLES),
+               "careful (brakes at)", "cause share"], left=("run", "cause share"))
     for e in done:
         if e.explanation is None:
-            table.add_row(e.spec.scenario_id, "", *[""] * len(ORACLES), "",
-                          f"[yellow]not explained[/]: {e.error}")
+            t.add_row(e.spec.scenario_id, "", *[""] * len(ORACLES), "",
+                      f"[yellow]not explained[/]: {e.error}")
             continue
         ex = e.explanation
         by = {v.variant: v for v in ex.variants}
@@ -50,10 +46,10 @@ def runs_table(done: list[Explained]) -> Table:
         behind = " (struck from behind)" if careful.struck_from_behind else ""
         causes = (" ".join(f"{c} {1 / len(avoiding):.2f}" for c in avoiding)
                   if avoiding else "compound 1.00")
-        table.add_row(ex.spec.scenario_id, f"{ex.collision_time_s:.2f}",
-                      *(_verdict(by[o].collided) for o in ORACLES),
-                      _verdict(careful.collided) + react + behind, causes)
-    return table
+        t.add_row(ex.spec.scenario_id, f"{ex.collision_time_s:.2f}",
+                  *(_verdict(by[o].collided) for o in ORACLES),
+                  _verdict(careful.collided) + react + behind, causes)
+    return t
 
 
 @app.command()
@@ -69,40 +65,45 @@ def explain(
 ) -> None:
     """Re-simulate collision runs with one module at a time replaced by an oracle, and with a
     careful reference driver; store the outcomes in the warehouse table `attribution`."""
+    from evoeye.evaluation.explain import (
+        attribution_shares,
+        explain_one,
+        explain_runs,
+        pending_runs,
+        spec_of,
+    )
+    from evoeye.log import LogError, read_run
+
     t0 = time.perf_counter()
     if log is not None:
         try:
             meta = read_run(log, topics=()).metadata
-        except LogError as exc:
-            _err().print(f"[red]error:[/] {exc}")
-            raise typer.Exit(2) from exc
+        except (LogError, OSError) as exc:
+            raise UserError(str(exc), "give the path of a run's .mcap log") from exc
         if not meta["collided"]:
-            _out().print(f"{meta['scenario_id']}: no collision in this run, nothing to explain")
+            out().print(f"{meta['scenario_id']}: no collision in this run, nothing to explain")
             return
-        spec = spec_of(meta)
-        _out().print(runs_table([explain_one(spec)]))
+        out().print(runs_table([explain_one(spec_of(meta))]))
         return
-    specs = pending_runs(root, scenario, batch, limit)
+    data = DataRoot.existing(root)
+    specs = pending_runs(data, scenario, batch, limit)
     if not specs:
-        _out().print("nothing to explain: every ingested collision run is explained "
-                     "(or none is ingested: run `evoeye ingest`)")
+        out().print("nothing to explain: every ingested collision run is explained "
+                    "(or none is ingested: run `evoeye ingest`)")
         return
-    _out().print(f"explaining {len(specs)} collision runs with {workers} workers …")
-    try:
-        done = explain_runs(root, specs, workers=workers)
-    except WarehouseLockedError as exc:
-        _err().print(f"[red]error:[/] {exc}")
-        raise typer.Exit(1) from exc
-    _out().print(runs_table(done))
-    shares = attribution_shares(root, scenario)
+    out().print(f"explaining {len(specs)} collision runs with {workers} workers …")
+    done = explain_runs(data, specs, workers=workers)  # a locked warehouse: a known user error
+    out().print(runs_table(done))
+    shares = attribution_shares(data, scenario)
     if shares:
-        _out().print(attribution_table(shares))
+        out().print(attribution_table(shares))
     sims = Counter((v.simulations, v.converged) for e in done if e.explanation
                    for v in e.explanation.variants if v.variant == "oracle_prediction")
     if sims:
-        _out().print("oracle prediction, re-simulations until the outcome repeated: " + ", ".join(
+        out().print("oracle prediction, re-simulations until the outcome repeated: " + ", ".join(
             f"{n}{'' if ok else ' (not repeated, cap)'}: {sims[n, ok]} runs"
             for n, ok in sorted(sims)))
     failed = sum(e.explanation is None for e in done)
-    _out().print(f"{len(done) - failed} runs explained, {failed} not, "
-                 f"in {time.perf_counter() - t0:.1f} s")
+    out().print(f"{len(done) - failed} runs explained, {failed} not, "
+                f"in {time.perf_counter() - t0:.1f} s")
+

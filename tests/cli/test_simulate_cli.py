@@ -2,8 +2,8 @@
 
 from __future__ import annotations
 
-import os
 import stat
+from pathlib import Path
 
 import pytest
 from typer.testing import CliRunner
@@ -29,15 +29,22 @@ def test_failed_runs_give_exit_code_3_and_say_how_many(tmp_path, monkeypatch) ->
 
 
 @pytest.mark.parametrize("kind", ["file", "read-only"])
-def test_a_root_that_cannot_be_written_is_one_line_and_exit_2(tmp_path, kind) -> None:
+def test_a_root_that_cannot_be_written_is_one_line_and_exit_2(tmp_path, kind,
+                                                              monkeypatch) -> None:
     root = tmp_path / "root"
     if kind == "file":
         root.write_text("not a folder")
     else:
         root.mkdir()
         root.chmod(stat.S_IRUSR | stat.S_IXUSR)
-        if os.access(root, os.W_OK):  # running as root: permissions do not apply
-            pytest.skip("permissions are not enforced for this user")
+        real_mkdir = Path.mkdir
+
+        def read_only(self, *args, **kwargs):  # as root, permissions would not apply: the
+            if root in (self, *self.parents):  # file system's answer is what is tested
+                raise PermissionError(13, "Permission denied", str(self))
+            return real_mkdir(self, *args, **kwargs)
+
+        monkeypatch.setattr(Path, "mkdir", read_only)
     result = runner.invoke(app, [*SIM, "--root", str(root)])
     assert result.exit_code == ExitCode.USER_ERROR, result.output
     assert "Traceback" not in result.output and "hint: check --root" in result.output

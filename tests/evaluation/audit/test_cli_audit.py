@@ -69,7 +69,7 @@ def test_strict_fails_exactly_when_a_criterion_fails(batch_root: DataRoot) -> No
     code, report = _audit(batch_root, "--strict")
     failed = any(v["passed"] is False for s in report["logical_scenarios"] for v in s["verdicts"])
     assert report["failed"] is failed
-    assert code == (1 if failed else 0)
+    assert code == (4 if failed else 0)  # ExitCode.CHECK_FAILED
 
 
 def test_an_unreadable_log_is_reported_not_fatal(batch_root: DataRoot, tmp_path: Path) -> None:
