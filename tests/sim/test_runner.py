@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from evoeye.scenarios import get_scenario
+from evoeye.scenarios import SCENARIOS, get_scenario
 from evoeye.sim import runner
 from evoeye.sim.runner import SimConfig, run_episode, run_spec
 
@@ -91,3 +91,19 @@ def test_run_spec_rejects_an_out_of_range_vector():
     x[0] = -5.0
     with pytest.raises(ValueError, match="ego_speed_mps"):
         run_spec("highway-cut-in", x, 0)
+
+
+@pytest.mark.parametrize("scenario", sorted(SCENARIOS))
+def test_every_logical_scenario_has_a_world_whose_actors_all_exist_from_the_start(scenario):
+    assert scenario in runner.WORLD_BUILDERS, f"{scenario} has no world builder"
+    space = get_scenario(scenario)
+    for draw in range(3):
+        params = space.as_dict(space.sample(np.random.default_rng(draw)))
+        world, cruise = runner.WORLD_BUILDERS[scenario](params, np.random.default_rng(draw))
+        first = world.scene()
+        assert cruise > 0.0 and first.n >= 2
+        for _ in range(20):  # 1 s with the ego holding its speed
+            world.step(0.0, 0.0, 0.05)
+        later = world.scene()
+        np.testing.assert_array_equal(later.actor_id, first.actor_id)  # nobody pops in
+        assert runner.scene_finite(later)
