@@ -98,6 +98,12 @@ class PredictionConfig:
     turn_heading_sigma_rad: float = 0.2
     successor_join_m: float = 1.5  # a lane starting this close to another's end continues it
     min_mode_prob: float = 0.05  # less probable modes are dropped (the best one always stays)
+    # give way: a car on a lane that yields to the route (the map's rule of the road) is expected
+    # to stop at the lane's end; the belief fades as the braking it would need to stop grows
+    yield_prior: float = 0.9  # P(it stops) while it could still stop comfortably
+    yield_decel_mps2: float = 3.0  # the braking a driver who means to stop would not exceed …
+    yield_decel_scale_mps2: float = 0.5  # … logistic width of the fade around it
+    yield_range_m: float = 60.0  # within this of the lane's end the hypothesis is made
     lane_resample_m: float = 1.0  # lane polylines are resampled to this spacing at start-up
     grid_cell_m: float = 1.0  # cell of the lookup grid used to project onto lanes
 
@@ -134,6 +140,7 @@ class PlanningConfig:
     emergency_ttc_s: float = 0.8  # time to collision below which the ego brakes hard (AEB)
     emergency_decel_mps2: float = 8.5  # AEB deceleration …
     emergency_jerk_mps3: float = 30.0  # … reached at this jerk
+    aeb_on_predicted_crossings: bool = True  # AEB for a crossing car predicted to enter the path
     stitch_tolerance_mps: float = 1.0  # replan from the measured speed if the plan drifts more
     route_resample_m: float = 1.0
     grid_cell_m: float = 1.0
