@@ -15,12 +15,12 @@ from pathlib import Path
 
 import numpy as np
 
-from evoeye.evaluation.calibration import calibrate_on_validation
 from evoeye.evaluation.dataset import SplitWindows, load_split, narrow
 from evoeye.evaluation.latency import Latency, measure_latency
 from evoeye.evaluation.metrics import Curves, FrameMetrics, frame_metrics
 from evoeye.evaluation.monitors import check_scores, monitor_context_len
 from evoeye.evaluation.scenario import Runs, ScenarioMetrics, scenario_metrics
+from evoeye.monitor.calibration import calibrate_on_validation
 from evoeye.monitor.protocol import TARGET_FPRS, Monitor
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec

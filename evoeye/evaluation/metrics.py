@@ -13,7 +13,7 @@ from sklearn.metrics import (
     roc_curve,
 )
 
-from evoeye.evaluation.calibration import alarms
+from evoeye.monitor.calibration import alarms
 from evoeye.monitor.protocol import Thresholds
 
 CURVE_POINTS = 200  # points kept per curve for reports

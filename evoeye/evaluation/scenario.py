@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from evoeye.evaluation.calibration import alarms
 from evoeye.evaluation.metrics import PRF, auprc, auroc, prf
+from evoeye.monitor.calibration import alarms
 from evoeye.monitor.protocol import Thresholds
 
 

@@ -93,9 +93,9 @@ def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_ru
     version with the same training key (selection, seed, recipe, parent) is reused.
     `splits` and other FusionMonitor options (patience, …) do not apply and are ignored."""
     from evoeye.baselines.aem import AEMConfig, train_aem
-    from evoeye.evaluation.calibration import calibrate_on_validation
     from evoeye.evaluation.dataset import load_runs
     from evoeye.evaluation.monitors import AEM_DIR, find_aem, training_key
+    from evoeye.monitor.calibration import calibrate_on_validation
     from evoeye.monitor.card import describe_selection, thresholds_to_json
 
     parent = load_aem_version(root, init_from) if init_from else None

@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 from sklearn.metrics import average_precision_score, roc_auc_score
 
-from evoeye.evaluation.calibration import alarms
+from evoeye.monitor.calibration import alarms
 from evoeye.monitor.protocol import Thresholds
 from evoeye.store.selection import RunFilter, Runs
 from evoeye.store.windows import Windows

@@ -33,7 +33,7 @@ import torch
 from torch import nn
 
 from evoeye import __version__
-from evoeye.evaluation.calibration import calibrate_on_validation
+from evoeye.monitor.calibration import calibrate_on_validation
 from evoeye.monitor.card import (
     data_summary,
     describe_selection,

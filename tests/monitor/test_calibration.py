@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from evoeye.evaluation import alarms, calibrate
+from evoeye.monitor.calibration import alarms, calibrate
 
 
 def test_thresholds_meet_each_target_fpr_on_their_split():
