@@ -19,7 +19,7 @@ from pathlib import Path
 
 from evoeye.evaluation.harness import evaluate
 from evoeye.evaluation.monitors import fit_context_only, train_fusion
-from evoeye.evaluation.report import DASH, Table, pct
+from evoeye.evaluation.report import DASH, UNREACHABLE, UNREACHABLE_NOTE, Table, pct, rate
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 
@@ -82,7 +82,7 @@ class AblationReport:
             cells = [row.label]
             for s in self.scenarios:
                 r = row.results.get(s)
-                cells += [pct(r["f1"]), pct(r["auroc"]), pct(r["auprc"])] if r else [DASH] * 3
+                cells += [rate(r, "f1"), pct(r["auroc"]), pct(r["auprc"])] if r else [DASH] * 3
             body.append(cells)
         return Table(header, body)
 
@@ -97,12 +97,14 @@ class AblationReport:
         return folder
 
     def markdown(self) -> str:
+        table = self.table()
+        unreachable = any(UNREACHABLE in row for row in table.rows)
         return ("# Monitor ablation (test frames)\n\n"
                 f"Rates in %; F1 at the threshold calibrated on validation for FPR {self.fpr}; "
                 f"seed {self.seed}. L rows use every module input; input rows use L = 5; "
                 f"{CONTROL} is the control that sees only the clock, the ego's speed and its "
                 "position.\n\n"
-                + self.table().markdown() + "\n")
+                + table.markdown() + "\n" + (f"\n{UNREACHABLE_NOTE}\n" if unreachable else ""))
 
 
 def run_ablation(
@@ -133,8 +135,9 @@ def run_ablation(
             rep = evaluate(root, [monitor], scenario, splits, ks=(), store_scores=store_scores)
             fprs = rep.fprs
             m = rep.monitors[0]
+            at = m.frame.at_fpr[rep.fprs[0]]
             row.results[scenario] = {
-                "f1": m.frame.at_fpr[rep.fprs[0]].f1, "auroc": m.frame.auroc,
+                "f1": at.f1, "reachable": at.reachable, "auroc": m.frame.auroc,
                 "auprc": m.frame.auprc, "version": m.version,
             }
     return AblationReport(list(scenarios), (fprs or (0.05,))[0], seed, rows)

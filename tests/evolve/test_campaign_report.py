@@ -65,6 +65,24 @@ def test_a_single_seed_shows_no_spread() -> None:
     assert rows["uniform"][1] == "30.0"
 
 
+def test_seeds_with_an_unreachable_fpr_are_counted_not_averaged_as_zero() -> None:
+    def unreachable(run: dict) -> dict:  # the last round missed FPR 0.01 on both sets
+        last = run["rounds"][-1]
+        for split in ("test", "hard"):
+            last[split] = {**last[split], "f1@0.01": None, "reachable@0.01": False}
+        return run
+
+    res = {**RESULTS["highway-cut-in"],
+           "uniform": [unreachable(_run([0.2, 0.3])), _run([0.2, 0.5])],
+           "evoeye": [unreachable(_run([0.2, 0.6])), unreachable(_run([0.2, 0.6]))]}
+    rows = {r[0]: r for r in table_rows(res, ("uniform", "evoeye"))}
+    assert rows["uniform"][2] == "25.0 (1/2 n/r)"  # F1@0.01 of the one reachable seed
+    assert rows["evoeye"][2] == "n/r" and rows["evoeye"][6] == "n/r"
+    assert rows["evoeye"][1] == "60.0 ± 0.0"  # FPR 0.05 was reached
+    assert "n/r: the target FPR is unreachable" in markdown({"highway-cut-in": res})
+    assert "n/r: the target FPR" not in markdown(RESULTS)
+
+
 def test_report_files_hold_tables_curves_and_map(tmp_path) -> None:
     md = markdown(RESULTS)
     assert "## highway-cut-in — RQ2" in md and "Evolution ablation" in md
