@@ -1,4 +1,4 @@
-"""The RQ2 report: tables (mean ± std over seeds), per-round curves and the blind-spot map.
+"""The RQ2 report: tables (mean ± sample SD over seeds), per-round curves and the blind-spot map.
 
 Input is `collect_results`' dict ({scenario: {"initial", "aem-initial", method: [runs]}}); output
 Markdown, self-contained HTML (SVG charts) and the JSON under `<root>/reports/<name>/`.
@@ -16,6 +16,7 @@ import numpy as np
 
 from evoeye.evaluation.plots import line_chart
 from evoeye.evaluation.report import UNREACHABLE, UNREACHABLE_NOTE
+from evoeye.evaluation.stats import sample_sd
 from evoeye.evolve.experiment import ABLATION, MAIN
 from evoeye.paths import DataRoot
 
@@ -33,8 +34,8 @@ def _value(v: float | None) -> float:
 
 
 def _mean_std(values: list[float], reachable: Sequence[bool] | None = None) -> str:
-    """Mean ± std (in %) of one figure over seeds; seeds whose target FPR was unreachable are
-    left out and counted ('n/r' if every seed's was)."""
+    """Mean ± sample SD (in %) of one figure over seeds; seeds whose target FPR was unreachable
+    are left out and counted ('n/r' if every seed's was)."""
     a = np.asarray(values, float)
     if not len(a):
         return "–"
@@ -42,15 +43,15 @@ def _mean_std(values: list[float], reachable: Sequence[bool] | None = None) -> s
     if not ok.any():
         return UNREACHABLE
     a = a[ok]
-    mean = f"{100 * np.nanmean(a):.1f}"
+    mean, sd = f"{100 * np.nanmean(a):.1f}", sample_sd(a)
     # one seed has no spread to report: "± 0.0" would read as zero variance
-    cell = f"{mean} ± {100 * np.nanstd(a):.1f}" if np.isfinite(a).sum() > 1 else mean
+    cell = mean if sd is None else f"{mean} ± {100 * sd:.1f}"
     return cell if ok.all() else f"{cell} ({int((~ok).sum())}/{len(ok)} {UNREACHABLE})"
 
 
 def _cells(per_seed: Sequence[dict]) -> list[str]:
-    """Mean ± std over seeds of every column on the Test Set and the Hard Set, from each seed's
-    {"test": metrics, "hard": metrics} (`Assessor`'s)."""
+    """Mean ± sample SD over seeds of every column on the Test Set and the Hard Set, from each
+    seed's {"test": metrics, "hard": metrics} (`Assessor`'s)."""
     cells = []
     for split in ("test", "hard"):
         for col in COLUMNS:
@@ -62,8 +63,8 @@ def _cells(per_seed: Sequence[dict]) -> list[str]:
 
 
 def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
-    """Rows: method (those that ran), then mean ± std (in %) of each column on the Test Set and
-    the Hard Set."""
+    """Rows: method (those that ran), then mean ± sample SD (in %) of each column on the Test
+    Set and the Hard Set."""
     rows = [["initial (G_0)", *_cells([res["initial"]])]] if res.get("initial") else []
     if res.get("reseeded"):
         rows.append([f"G_0 re-seeded ×{len(res['reseeded'])} (no new data)",
@@ -80,14 +81,15 @@ def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
 
 
 def acquisition_rows(res: dict) -> list[list[str]]:
-    """Per strategy: acquired runs, collision, near-miss and near-record shares (mean ± std
-    over seeds)."""
+    """Per strategy: acquired runs, collision, near-miss and near-record shares (mean ± sample
+    SD over seeds)."""
     rows = []
     for strategy in MAIN + ABLATION:
         acq = [r["acquisition"] for r in res.get(strategy, []) if r.get("acquisition")]
         if acq:
             runs = np.array([a["runs"] for a in acq], float)
-            runs_s = f"{runs.mean():.0f} ± {runs.std():.0f}" if len(runs) > 1 else f"{runs[0]:.0f}"
+            sd = sample_sd(runs)
+            runs_s = f"{runs.mean():.0f}" + ("" if sd is None else f" ± {sd:.0f}")
             rows.append([strategy, runs_s,
                          _mean_std([a["collision_share"] for a in acq]),
                          _mean_std([a.get("near_miss_share", np.nan) for a in acq]),
@@ -107,11 +109,12 @@ def markdown(results: dict) -> str:
         out += [UNREACHABLE_NOTE, ""]
     for scenario, res in results.items():
         for title, strategies in TABLES:
-            out += [f"## {scenario} — {title} (mean ± std over seeds, %)", "",
+            out += [f"## {scenario} — {title} (mean ± sample SD over seeds, %)", "",
                     "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
             out += ["| " + " | ".join(r) + " |" for r in table_rows(res, strategies)]
             out.append("")
-        out += [f"## {scenario} — what each strategy acquired (mean ± std over seeds)", "",
+        out += [f"## {scenario} — what each strategy acquired (mean ± sample SD over seeds)",
+                "",
                 "| " + " | ".join(ACQUISITION_HEAD) + " |", "|---" * len(ACQUISITION_HEAD) + "|"]
         out += ["| " + " | ".join(r) + " |" for r in acquisition_rows(res)]
         out.append("")
