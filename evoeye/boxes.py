@@ -1,7 +1,9 @@
-"""Oriented rectangles (vehicle footprints): corners and the gap between two.
+"""Oriented rectangles (vehicle footprints): corners, the gap between two, and when two moving
+ones first touch.
 
 Pure numpy, shared by every layer that needs footprints: the simulator's contacts and distances
-(`evoeye.sim.footprint`) and the realism audit. A rectangle is its (4, 2) corners, counter-clockwise; two rectangles overlap or
+(`evoeye.sim.footprint`), the realism audit, and the TTC-2D baseline, which sees only the ADS's
+perceived boxes. A rectangle is its (4, 2) corners, counter-clockwise; two rectangles overlap or
 touch exactly when no edge direction of either separates them (the separating-axis test).
 """
 
@@ -49,3 +51,27 @@ def box_gaps(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     b_lo, b_hi = _extent(b, axes)
     separated = ((a_hi < b_lo) | (b_hi < a_lo)).any(axis=1)
     return np.where(separated, np.minimum(dist[:n], dist[n:]), 0.0)
+
+
+def first_contact_s(a: np.ndarray, b: np.ndarray, velocity_mps: np.ndarray) -> np.ndarray:
+    """(...) the earliest time t ≥ 0 (s) at which rectangle b, translating at `velocity_mps`
+    (..., 2) relative to rectangle a, overlaps or touches it, both keeping their headings; 0 if
+    they overlap now, +inf if never. a, b: (..., 4, 2) corners.
+
+    Exact, with no time steps: on each separating axis the projections overlap during one
+    interval of t (all t, or none, when b does not move along the axis); the rectangles overlap
+    while every axis does, so contact begins at the latest interval start, if that comes before
+    the earliest interval end.
+    """
+    axes = _axes(a, b)
+    a_lo, a_hi = _extent(a, axes)
+    b_lo, b_hi = _extent(b, axes)
+    speed = np.einsum("...d,...md->...m", velocity_mps, axes)  # (..., 4) along each axis
+    moving = speed != 0.0
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t1, t2 = (a_lo - b_hi) / speed, (a_hi - b_lo) / speed  # b's span meets a's ends
+    overlap_now = (b_lo <= a_hi) & (b_hi >= a_lo)
+    start = np.where(moving, np.minimum(t1, t2), np.where(overlap_now, -np.inf, np.inf))
+    end = np.where(moving, np.maximum(t1, t2), np.where(overlap_now, np.inf, -np.inf))
+    t = np.maximum(start.max(axis=-1), 0.0)
+    return np.where(t <= end.min(axis=-1), t, np.inf)
