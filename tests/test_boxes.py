@@ -29,13 +29,16 @@ def _random_states(rng: np.random.Generator, n: int) -> dict[str, np.ndarray]:
             "vy": np.where(aimed, -y / arrive_s + rng.normal(0, 2, n), vy)}
 
 
-def test_first_contact_agrees_with_a_stepped_brute_force_within_one_step() -> None:
-    rng = np.random.default_rng(0)
-    n = 3000
-    s = _random_states(rng, n)
-    ego = np.broadcast_to(_box(0.0, 0.0), (n, 4, 2))
+def _random_scene(seed: int, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(ego, other) corners (n, 4, 2) and the other's relative velocity (n, 2)."""
+    s = _random_states(np.random.default_rng(seed), n)
     other = box_corners(s["x"], s["y"], s["h"], s["length"], s["width"])
-    v = np.stack([s["vx"], s["vy"]], axis=-1)
+    return np.broadcast_to(_box(0.0, 0.0), (n, 4, 2)), other, np.stack([s["vx"], s["vy"]], -1)
+
+
+def test_first_contact_agrees_with_a_stepped_brute_force_within_one_step() -> None:
+    n = 3000
+    ego, other, v = _random_scene(0, n)
     exact = first_contact_s(ego, other, v)
     times = np.arange(0.0, HORIZON_S + 1e-9, DT_S)
     hit = np.stack([box_gaps(ego, other + (v * t)[:, None, :]) <= 0.0 for t in times])  # (T, n)
@@ -54,12 +57,7 @@ def test_first_contact_agrees_with_a_stepped_brute_force_within_one_step() -> No
 
 
 def test_first_contact_is_the_instant_the_boxes_touch() -> None:
-    rng = np.random.default_rng(1)
-    n = 2000
-    s = _random_states(rng, n)
-    ego = np.broadcast_to(_box(0.0, 0.0), (n, 4, 2))
-    other = box_corners(s["x"], s["y"], s["h"], s["length"], s["width"])
-    v = np.stack([s["vx"], s["vy"]], axis=-1)
+    ego, other, v = _random_scene(1, 2000)
     t = first_contact_s(ego, other, v)
     later = np.isfinite(t) & (t > 0)
     at = other[later] + (v[later] * t[later, None])[:, None, :]
