@@ -43,7 +43,7 @@ class Thresholds:
 class Monitor(Protocol):
     """A runtime monitor G: a context c_t ↦ risk that the ego collides within H seconds."""
 
-    name: str  # e.g. "fusion", "ttc", "rss", "aem", "context-only"
+    name: str  # e.g. "fusion", "ttc", "ttc-2d", "rss", "aem", "context-only"
     version: str  # identifies the trained artefact (a content hash, or "rule" for TTC/RSS)
 
     def score(self, windows: Windows) -> np.ndarray:
