@@ -25,7 +25,8 @@ by pair (seed by seed). The choices, and why:
   standardised effect d / SD(a − b) with SD(a − b)² = SD_a² + SD_b² − 2ρ·SD_a·SD_b for the
   measured pair correlation ρ. The Wilcoxon test's power uses its asymptotic relative efficiency
   to the t-test, 3/π for normal differences (Lehmann; G*Power's A.R.E. method): n pairs for the
-  Wilcoxon count as 3n/π for the t-test.
+  Wilcoxon count as 3n/π for the t-test. That is asymptotic; below it, the floor on p rules: with
+  2 / 2^n > α the test can never reject, and its power is 0.
 """
 
 from __future__ import annotations
@@ -194,6 +195,8 @@ def paired_power(n_pairs: int, diff: float, sd_diff: float, *, alpha: float = 0.
     if not 0.0 < alpha < 1.0 or sd_diff <= 0 or n_pairs < 2:
         raise ValueError(f"need 0 < alpha < 1, sd_diff > 0 and ≥ 2 pairs, got {alpha}, "
                          f"{sd_diff}, {n_pairs}")
+    if test == "wilcoxon" and 2.0 / 2.0**n_pairs > alpha:
+        return 0.0  # no outcome of so few pairs reaches p ≤ alpha
     n = n_pairs * (WILCOXON_ARE if test == "wilcoxon" else 1.0)
     df = max(n - 1.0, 1e-9)
     ncp = abs(diff) / sd_diff * math.sqrt(n)

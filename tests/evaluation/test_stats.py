@@ -154,6 +154,14 @@ def test_the_wilcoxon_design_has_the_power_it_promises() -> None:
     assert 0.73 <= np.mean(found) <= 0.9  # target 0.8, SE 0.016
 
 
+def test_too_few_pairs_have_no_wilcoxon_power() -> None:
+    sd = sd_of_differences(0.085, 0.085, 0.5)
+    assert paired_power(5, 0.05, sd) == 0.0  # p ≥ 2/2⁵ = 0.0625 whatever the data
+    assert paired_power(5, 0.05, sd, alpha=0.1) > 0.0
+    assert 0.0 < paired_power(6, 0.05, sd) < paired_power(7, 0.05, sd)
+    assert 0.0 < paired_power(3, 0.05, sd, test="t") < 0.11  # the t-test: 10 %
+
+
 def test_power_inputs_are_checked() -> None:
     with pytest.raises(ValueError, match="non-zero difference"):
         pairs_needed(0.0, 1.0, 1.0, 0.5)
