@@ -1,9 +1,9 @@
 """The main job, small, as one Prefect flow: `python -m flows.demo` (what `make demo` runs).
 
 simulate both logical scenarios → ingest → train the FusionMonitor and evaluate it against the
-TTC / RSS / AEM baselines and the context-only control (RQ1 report) → one evolution round of
-BlindSpotEvolver. With no Prefect API configured, Prefect starts a temporary local server for
-the run; simulation fans out over local processes.
+TTC / TTC-2D / RSS / AEM baselines and the context-only control (RQ1 report) → one evolution
+round of BlindSpotEvolver. With no Prefect API configured, Prefect starts a temporary local
+server for the run; simulation fans out over local processes.
 """
 
 from __future__ import annotations

@@ -35,7 +35,7 @@ def evaluate_command(
     monitor: Annotated[list[str] | None, typer.Option(
         "--monitor", help="Trained monitor version to evaluate (repeatable).")] = None,
     baselines: Annotated[str, typer.Option(
-        help="Comma-separated baselines: ttc, rss, aem, context-only ('none' for none).")
+        help=f"Comma-separated baselines: {', '.join(BASELINE_NAMES)} ('none' for none).")
     ] = ",".join(BASELINE_NAMES),
     fusion: Annotated[bool, typer.Option(
         "--train-fusion/--no-train-fusion",

@@ -38,9 +38,11 @@ def metrics_table(card: dict[str, Any]) -> Table:
               ["AUROC", "AUPRC", "target FPR", "threshold", "Prec.", "Rec.", "F1", "FPR"])
     for i, fpr in enumerate(sorted((float(f) for f in card["thresholds"]), reverse=True)):
         m = val[f"fpr_{fpr:g}"]
+        # n/r: no threshold meets this target with any alarm (evoeye.monitor.calibration)
+        rates = ([_pct(m[k]) for k in ("precision", "recall", "f1")]
+                 if m.get("reachable", True) else ["n/r"] * 3)
         t.add_row(_pct(val["auroc"]) if i == 0 else "", _pct(val["auprc"]) if i == 0 else "",
-                  f"{fpr:g}", f"{m['threshold']:.4f}", _pct(m["precision"]),
-                  _pct(m["recall"]), _pct(m["f1"]), _pct(m["fpr"]))
+                  f"{fpr:g}", f"{m['threshold']:.4f}", *rates, _pct(m["fpr"]))
     return t
 
 

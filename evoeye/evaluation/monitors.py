@@ -1,6 +1,7 @@
 """Which monitors to evaluate: the baselines by name, FusionMonitors by version (a registry).
 
-TTC and RSS are rules and need no data. AEM and the context-only control are trained on the
+TTC, TTC-2D and RSS (also `rss-2s`: CARLA's 2 s response time for the other vehicles) are rules
+and need no data. AEM and the context-only control are trained on the
 train split of the logical scenario and kept under `<root>/baselines/<aem|context-only>/<version>/`;
 a later call with the same training set, split and config loads one instead of training again.
 FusionMonitors come from `evoeye.monitor` (`load_monitor`, `train_monitor`), imported only when
@@ -18,8 +19,8 @@ from typing import TYPE_CHECKING
 
 import numpy as np
 
-from evoeye.baselines.rss import RSSMonitor
-from evoeye.baselines.ttc import TTCMonitor
+from evoeye.baselines.rss import CARLA_OTHER_VEHICLES, RSSMonitor
+from evoeye.baselines.ttc import TTC2DMonitor, TTCMonitor
 from evoeye.evaluation.dataset import load_split
 from evoeye.monitor.protocol import Monitor
 from evoeye.paths import DataRoot
@@ -145,7 +146,9 @@ def load_context_only(root: DataRoot | str | Path | None, version: str) -> Conte
 BaselineBuilder = Callable[[DataRoot, str, SplitSpec], Monitor]
 BASELINES: dict[str, BaselineBuilder] = {
     "ttc": lambda root, scenario, splits: TTCMonitor(),
+    "ttc-2d": lambda root, scenario, splits: TTC2DMonitor(),
     "rss": lambda root, scenario, splits: RSSMonitor(),
+    "rss-2s": lambda root, scenario, splits: RSSMonitor(other=CARLA_OTHER_VEHICLES, name="rss-2s"),
     "aem": lambda root, scenario, splits: fit_aem(root, scenario, splits),
     "context-only": lambda root, scenario, splits: fit_context_only(root, scenario, splits),
 }

@@ -43,12 +43,14 @@ def hard_set(warehouse: Warehouse, scores: pa.Table, *, monitor_version: str, th
 
 
 def metrics_dict(scores: np.ndarray, labels: np.ndarray, thresholds) -> dict:
-    """F1 / precision / recall at each target FPR, AUROC and AUPRC, as plain numbers."""
+    """F1 / precision / recall at each target FPR, AUROC and AUPRC, as plain numbers; at a
+    target FPR the thresholds could not reach (`reachable@…` False) the three rates are None."""
     m = frame_metrics(scores, labels, thresholds, FPRS)
     out = {"auroc": m.auroc, "auprc": m.auprc, "frames": m.frames, "unsafe": m.unsafe_frames}
     for fpr, c in m.at_fpr.items():
         out[f"f1@{fpr}"], out[f"recall@{fpr}"], out[f"precision@{fpr}"] = (
             c.f1, c.recall, c.precision)
+        out[f"reachable@{fpr}"] = c.reachable
     return out
 
 

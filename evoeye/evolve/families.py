@@ -75,13 +75,13 @@ class AEMVersion:
 
 def load_aem_version(root: DataRoot, version: str) -> AEMVersion:
     from evoeye.evaluation.monitors import AEM_DIR, load_aem
-    from evoeye.monitor.card import thresholds_from_json
+    from evoeye.monitor.card import thresholds_from_card
 
     meta = json.loads((root.path / AEM_DIR / version / "meta.json").read_text())
     if "thresholds" not in meta:
         raise KeyError(f"AEM {version} has no calibrated thresholds: it was not trained by a "
                        "campaign (train_aem_version)")
-    return AEMVersion(load_aem(root, version), thresholds_from_json(meta["thresholds"]), meta)
+    return AEMVersion(load_aem(root, version), thresholds_from_card(meta), meta)
 
 
 def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_runs: Runs,
@@ -93,10 +93,10 @@ def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_ru
     version with the same training key (selection, seed, recipe, parent) is reused.
     `splits` and other FusionMonitor options (patience, …) do not apply and are ignored."""
     from evoeye.baselines.aem import AEMConfig, train_aem
-    from evoeye.evaluation.calibration import calibrate_on_validation
     from evoeye.evaluation.dataset import load_runs
     from evoeye.evaluation.monitors import AEM_DIR, find_aem, training_key
-    from evoeye.monitor.card import describe_selection, thresholds_to_json
+    from evoeye.monitor.calibration import calibrate_on_validation
+    from evoeye.monitor.card import describe_selection, thresholds_to_card
 
     parent = load_aem_version(root, init_from) if init_from else None
     config = parent.aem.config if parent else AEMConfig(
@@ -117,7 +117,7 @@ def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_ru
         "training_key": key, "logical_scenario": scenario, "parent": init_from,
         "horizon_s": horizon_s, "selection": selection,
         "train_windows": int(normal.sum()),
-        "thresholds": thresholds_to_json(thresholds),
+        **thresholds_to_card(thresholds),
     })
     return aem.version
 

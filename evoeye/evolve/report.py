@@ -1,4 +1,4 @@
-"""The RQ2 report: tables (mean ± std over seeds), per-round curves and the blind-spot map.
+"""The RQ2 report: tables (mean ± sample SD over seeds), per-round curves and the blind-spot map.
 
 Input is `collect_results`' dict ({scenario: {"initial", "aem-initial", method: [runs]}}); output
 Markdown, self-contained HTML (SVG charts) and the JSON under `<root>/reports/<name>/`.
@@ -15,6 +15,8 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.evaluation.plots import line_chart
+from evoeye.evaluation.report import UNREACHABLE, UNREACHABLE_NOTE
+from evoeye.evaluation.stats import sample_sd
 from evoeye.evolve.experiment import ABLATION, MAIN
 from evoeye.paths import DataRoot
 
@@ -31,51 +33,63 @@ def _value(v: float | None) -> float:
     return np.nan if v is None else float(v)
 
 
-def _final(run: dict, split: str, col: str) -> float:
-    return _value(run["rounds"][-1][split][col])
-
-
-def _mean_std(values: list[float]) -> str:
+def _mean_std(values: list[float], reachable: Sequence[bool] | None = None) -> str:
+    """Mean ± sample SD (in %) of one figure over seeds; seeds whose target FPR was unreachable
+    are left out and counted ('n/r' if every seed's was)."""
     a = np.asarray(values, float)
     if not len(a):
         return "–"
-    mean = f"{100 * np.nanmean(a):.1f}"
+    ok = np.ones(len(a), bool) if reachable is None else np.asarray(reachable, bool)
+    if not ok.any():
+        return UNREACHABLE
+    a = a[ok]
+    mean, sd = f"{100 * np.nanmean(a):.1f}", sample_sd(a)
     # one seed has no spread to report: "± 0.0" would read as zero variance
-    return f"{mean} ± {100 * np.nanstd(a):.1f}" if np.isfinite(a).sum() > 1 else mean
+    cell = mean if sd is None else f"{mean} ± {100 * sd:.1f}"
+    return cell if ok.all() else f"{cell} ({int((~ok).sum())}/{len(ok)} {UNREACHABLE})"
+
+
+def _cells(per_seed: Sequence[dict]) -> list[str]:
+    """Mean ± sample SD over seeds of every column on the Test Set and the Hard Set, from each
+    seed's {"test": metrics, "hard": metrics} (`Assessor`'s)."""
+    cells = []
+    for split in ("test", "hard"):
+        for col in COLUMNS:
+            ms = [m[split] for m in per_seed]
+            fpr = col.partition("@")[2]
+            ok = [m.get(f"reachable@{fpr}", True) for m in ms] if fpr else None
+            cells.append(_mean_std([_value(m[col]) for m in ms], ok))
+    return cells
 
 
 def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
-    """Rows: method (those that ran), then mean ± std (in %) of each column on the Test Set and
-    the Hard Set."""
-    rows = [["initial (G_0)"] + [_mean_std([_value(res["initial"][s][c])])
-                                 for s in ("test", "hard") for c in COLUMNS]
-            ] if res.get("initial") else []
+    """Rows: method (those that ran), then mean ± sample SD (in %) of each column on the Test
+    Set and the Hard Set."""
+    rows = [["initial (G_0)", *_cells([res["initial"]])]] if res.get("initial") else []
     if res.get("reseeded"):
-        rows.append([f"G_0 re-seeded ×{len(res['reseeded'])} (no new data)"]
-                    + [_mean_std([_value(m[s][c]) for m in res["reseeded"]])
-                       for s in ("test", "hard") for c in COLUMNS])
+        rows.append([f"G_0 re-seeded ×{len(res['reseeded'])} (no new data)",
+                     *_cells(res["reseeded"])])
     for strategy in strategies:
         if strategy in OWN_INITIAL and res.get(OWN_INITIAL[strategy][1]):
             label, key = OWN_INITIAL[strategy]
-            rows.append([label] + [_mean_std([_value(res[key][s][c])])
-                                   for s in ("test", "hard") for c in COLUMNS])
+            rows.append([label, *_cells([res[key]])])
         runs = res.get(strategy, [])
         if not runs:  # not part of this experiment
             continue
-        rows.append([strategy] + [_mean_std([_final(r, s, c) for r in runs])
-                                  for s in ("test", "hard") for c in COLUMNS])
+        rows.append([strategy, *_cells([r["rounds"][-1] for r in runs])])
     return rows
 
 
 def acquisition_rows(res: dict) -> list[list[str]]:
-    """Per strategy: acquired runs, collision, near-miss and near-record shares (mean ± std
-    over seeds)."""
+    """Per strategy: acquired runs, collision, near-miss and near-record shares (mean ± sample
+    SD over seeds)."""
     rows = []
     for strategy in MAIN + ABLATION:
         acq = [r["acquisition"] for r in res.get(strategy, []) if r.get("acquisition")]
         if acq:
             runs = np.array([a["runs"] for a in acq], float)
-            runs_s = f"{runs.mean():.0f} ± {runs.std():.0f}" if len(runs) > 1 else f"{runs[0]:.0f}"
+            sd = sample_sd(runs)
+            runs_s = f"{runs.mean():.0f}" + ("" if sd is None else f" ± {sd:.0f}")
             rows.append([strategy, runs_s,
                          _mean_std([a["collision_share"] for a in acq]),
                          _mean_std([a.get("near_miss_share", np.nan) for a in acq]),
@@ -83,16 +97,24 @@ def acquisition_rows(res: dict) -> list[list[str]]:
     return rows
 
 
+def _has_unreachable(results: dict) -> bool:
+    return any(UNREACHABLE in cell for res in results.values() for _, strategies in TABLES
+               for row in table_rows(res, strategies) for cell in row)
+
+
 def markdown(results: dict) -> str:
     head = ["method"] + [f"{s} {c}" for s in ("Test", "Hard") for c in COLUMNS]
     out = ["# evoeye RQ2: self-evolution under the same budget", ""]
+    if _has_unreachable(results):
+        out += [UNREACHABLE_NOTE, ""]
     for scenario, res in results.items():
         for title, strategies in TABLES:
-            out += [f"## {scenario} — {title} (mean ± std over seeds, %)", "",
+            out += [f"## {scenario} — {title} (mean ± sample SD over seeds, %)", "",
                     "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
             out += ["| " + " | ".join(r) + " |" for r in table_rows(res, strategies)]
             out.append("")
-        out += [f"## {scenario} — what each strategy acquired (mean ± std over seeds)", "",
+        out += [f"## {scenario} — what each strategy acquired (mean ± sample SD over seeds)",
+                "",
                 "| " + " | ".join(ACQUISITION_HEAD) + " |", "|---" * len(ACQUISITION_HEAD) + "|"]
         out += ["| " + " | ".join(r) + " |" for r in acquisition_rows(res)]
         out.append("")
@@ -133,7 +155,7 @@ def _html_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
 
 
 def html(results: dict) -> str:
-    body = []
+    body = [f"<p>{escape(UNREACHABLE_NOTE)}</p>"] if _has_unreachable(results) else []
     for scenario, res in results.items():
         body.append(f"<h2>{escape(scenario)}</h2>")
         for title, strategies in TABLES:

@@ -1,6 +1,7 @@
 """Runtime monitors: the FusionMonitor and the protocol every monitor implements.
 
     train_monitor(root, scenario=…, context_len=…, modules=…, seed=…) -> version
+    calibrate_on_validation(scores, val) -> Thresholds    (one calibration for every monitor)
     load_monitor(root, version) -> FusionMonitor    (score(windows) -> (B,) risks)
     RuntimeMonitor(monitor).step(frame_messages) -> RiskState
     replay(log, monitor, out) / export_onnx(monitor, out)
@@ -20,6 +21,9 @@ _LAZY = {
     "FusionConfig": "evoeye.monitor.model",
     "FusionNet": "evoeye.monitor.model",
     "FusionMonitor": "evoeye.monitor.fusion",
+    "alarms": "evoeye.monitor.calibration",
+    "calibrate": "evoeye.monitor.calibration",
+    "calibrate_on_validation": "evoeye.monitor.calibration",
     "MonitorLoadError": "evoeye.monitor.registry",
     "list_versions": "evoeye.monitor.registry",
     "load_monitor": "evoeye.monitor.registry",

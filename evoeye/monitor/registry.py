@@ -22,7 +22,7 @@ from typing import Any
 import orjson
 import torch
 
-from evoeye.monitor.card import thresholds_from_json
+from evoeye.monitor.card import thresholds_from_card
 from evoeye.monitor.fusion import FusionMonitor
 from evoeye.monitor.model import FusionNet, config_from_dict
 from evoeye.paths import DataRoot
@@ -147,4 +147,4 @@ def load_monitor(root: DataRoot | str | os.PathLike | None, version: str) -> Fus
     """The FusionMonitor of a saved version, ready to score (eval mode, thresholds loaded)."""
     card = read_card(root, version)
     net = load_net(version_dir(root, version) / MODEL_FILE, card.get("model_sha256"))
-    return FusionMonitor(net, version, thresholds_from_json(card.get("thresholds", {})), card)
+    return FusionMonitor(net, version, thresholds_from_card(card), card)

@@ -33,13 +33,13 @@ import torch
 from torch import nn
 
 from evoeye import __version__
-from evoeye.evaluation.calibration import calibrate_on_validation
+from evoeye.monitor.calibration import calibrate_on_validation
 from evoeye.monitor.card import (
     data_summary,
     describe_selection,
     ranking_metrics,
     split_metrics,
-    thresholds_to_json,
+    thresholds_to_card,
 )
 from evoeye.monitor.fusion import FusionMonitor, net_inputs
 from evoeye.monitor.model import MODULES, FusionConfig, FusionNet
@@ -239,7 +239,7 @@ def train_monitor(
                             "early_stopping": "val AUPRC"},
         "training": {"best_epoch": result.best_epoch, "epochs_run": len(result.history),
                      "time_s": round(result.time_s, 2), "history": result.history},
-        "thresholds": thresholds_to_json(thresholds),
+        **thresholds_to_card(thresholds),
         "metrics": {"val": split_metrics(scores, val.label, thresholds)},
     }
     return save_version(root, result.net, card)

@@ -83,7 +83,7 @@ def test_fusion_training_windows_pos_weight_and_calibration(eval_root, splits, c
 def test_aem_training_and_calibration(eval_root, splits, collided, layout,
                                       monkeypatch) -> None:
     import evoeye.baselines.aem as aem_mod
-    import evoeye.evaluation.calibration as cal_mod
+    import evoeye.monitor.calibration as cal_mod
     from evoeye.evolve.families import train_aem_version
 
     seen: dict[str, object] = {}

@@ -1,4 +1,4 @@
-"""The RQ2 report: mean ± std per strategy, per-round curves and the blind-spot map."""
+"""The RQ2 report: mean ± sample SD per strategy, per-round curves and the blind-spot map."""
 
 from __future__ import annotations
 
@@ -31,9 +31,9 @@ RESULTS = {"highway-cut-in": {
 }}
 
 
-def test_table_reports_mean_and_std_of_the_last_round() -> None:
+def test_table_reports_mean_and_sample_sd_of_the_last_round() -> None:
     rows = {r[0]: r for r in table_rows(RESULTS["highway-cut-in"], ("uniform", "evoeye"))}
-    assert rows["uniform"][1] == "40.0 ± 10.0"  # test F1@0.05 of 0.3 and 0.5
+    assert rows["uniform"][1] == "40.0 ± 14.1"  # test F1@0.05 of 0.3 and 0.5: SD 0.1·√2
     assert rows["evoeye"][1] == "60.0 ± 0.0"
     assert rows["evoeye"][5] == "30.0 ± 0.0"  # hard F1@0.05
     assert rows["initial (G_0)"][5] == "0.0"  # one value: no spread to report
@@ -44,7 +44,7 @@ def test_the_reseeded_control_is_a_row_of_its_own() -> None:
            "reseeded": [{"test": _m(0.2), "hard": _m(0.2)}, {"test": _m(0.4), "hard": _m(0.3)}]}
     rows = {r[0]: r for r in table_rows(res, ("uniform",))}
     row = rows["G_0 re-seeded ×2 (no new data)"]
-    assert row[1] == "30.0 ± 10.0" and row[5] == "25.0 ± 5.0"
+    assert row[1] == "30.0 ± 14.1" and row[5] == "25.0 ± 7.1"
     assert html({"highway-cut-in": res}).count("<svg") == 5  # controls add no curve
 
 
@@ -54,7 +54,7 @@ def test_aem_evo_is_shown_after_its_own_initial_aem() -> None:
     rows = table_rows(res, ("evoeye", "aem-evo"))
     assert [r[0] for r in rows] == ["initial (G_0)", "evoeye", "AEM (AEM-Evo's G_0)", "aem-evo"]
     assert rows[2][1] == "10.0" and rows[2][5] == "30.0"  # the AEM G_0's own figures
-    assert rows[3][1] == "14.0 ± 2.0"
+    assert rows[3][1] == "14.0 ± 2.8"
     assert [r[0] for r in table_rows(RESULTS["highway-cut-in"], ("aem-evo",))] == [
         "initial (G_0)"]  # no AEM campaign ran: no AEM rows
 
@@ -63,6 +63,24 @@ def test_a_single_seed_shows_no_spread() -> None:
     one = {**RESULTS["highway-cut-in"], "uniform": [_run([0.2, 0.3])]}
     rows = {r[0]: r for r in table_rows(one, ("uniform",))}
     assert rows["uniform"][1] == "30.0"
+
+
+def test_seeds_with_an_unreachable_fpr_are_counted_not_averaged_as_zero() -> None:
+    def unreachable(run: dict) -> dict:  # the last round missed FPR 0.01 on both sets
+        last = run["rounds"][-1]
+        for split in ("test", "hard"):
+            last[split] = {**last[split], "f1@0.01": None, "reachable@0.01": False}
+        return run
+
+    res = {**RESULTS["highway-cut-in"],
+           "uniform": [unreachable(_run([0.2, 0.3])), _run([0.2, 0.5])],
+           "evoeye": [unreachable(_run([0.2, 0.6])), unreachable(_run([0.2, 0.6]))]}
+    rows = {r[0]: r for r in table_rows(res, ("uniform", "evoeye"))}
+    assert rows["uniform"][2] == "25.0 (1/2 n/r)"  # F1@0.01 of the one reachable seed
+    assert rows["evoeye"][2] == "n/r" and rows["evoeye"][6] == "n/r"
+    assert rows["evoeye"][1] == "60.0 ± 0.0"  # FPR 0.05 was reached
+    assert "n/r: the target FPR is unreachable" in markdown({"highway-cut-in": res})
+    assert "n/r: the target FPR" not in markdown(RESULTS)
 
 
 def test_report_files_hold_tables_curves_and_map(tmp_path) -> None:
@@ -78,8 +96,8 @@ def test_report_files_hold_tables_curves_and_map(tmp_path) -> None:
 def test_acquisition_table_averages_over_seeds() -> None:
     rows = {r[0]: r for r in acquisition_rows(RESULTS["highway-cut-in"])}
     assert set(rows) == {"uniform", "evoeye"}  # strategies that did not run are left out
-    assert rows["uniform"] == ["uniform", "40 ± 0", "30.0 ± 10.0", "10.0 ± 0.0", "25.0 ± 0.0"]
-    assert "| uniform | 40 ± 0 | 30.0 ± 10.0 |" in markdown(RESULTS)
+    assert rows["uniform"] == ["uniform", "40 ± 0", "30.0 ± 14.1", "10.0 ± 0.0", "25.0 ± 0.0"]
+    assert "| uniform | 40 ± 0 | 30.0 ± 14.1 |" in markdown(RESULTS)
 
 
 def test_acquisition_counts_runs_within_delta_of_an_earlier_record() -> None:
