@@ -20,7 +20,7 @@ from evoeye.evolve.experiment import METHODS
 from evoeye.evolve.families import FAMILIES
 from evoeye.evolve.scoring import FEEDBACK_MODES
 from evoeye.evolve.strategies import STRATEGIES
-from evoeye.paths import resolve_root
+from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
 from evoeye.store import SplitSpec
 
@@ -90,7 +90,7 @@ class EvolveParams(BaseModel):
 
 def make_campaign(params: EvolveParams) -> Campaign:
     cfg = params.config()
-    root = resolve_root(params.root)
+    root = DataRoot.resolve(params.root)
     assess = None
     if params.assess:
         from evoeye.evolve.assess import Assessor

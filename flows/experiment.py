@@ -25,7 +25,7 @@ from evoeye.evolve.experiment import (
 )
 from evoeye.evolve.report import markdown, write_experiment_report
 from evoeye.evolve.scoring import FEEDBACK_MODES
-from evoeye.paths import resolve_root
+from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
 from evoeye.store import SplitSpec
 from flows.evolve import EvolveParams, check_known, evolution_flow
@@ -68,12 +68,13 @@ class ExperimentParams(BaseModel):
 def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
     """Run (or resume) every campaign, then write and publish the RQ2 report."""
     params = params or ExperimentParams()
-    root = str(resolve_root(params.root))
+    root = DataRoot.resolve(params.root)
     plan = plan_experiment(root, params.scenarios, params.base(), strategies=params.strategies,
                            seeds=range(params.repetitions), budget_s=params.budget_s)
     for cfg in plan:
         name = f"{cfg.scenario}-{method_of(cfg)}-s{cfg.seed}"
-        evolution_flow.with_options(flow_run_name=name)(EvolveParams.of(cfg, root, assess=True))
+        evolution_flow.with_options(flow_run_name=name)(
+            EvolveParams.of(cfg, str(root.path), assess=True))
     results = add_controls(root, plan, collect_results(root, plan), params.controls)
     folder = write_experiment_report(root, results, params.report_name)
     create_markdown_artifact(markdown=markdown(results), key="evoeye-rq2",

@@ -127,7 +127,7 @@ def experiment_command(
     from evoeye.evolve.experiment import ABLATION, MAIN, METHODS, run_experiment
     from evoeye.evolve.report import write_experiment_report
 
-    root = DataRoot.existing(root).path
+    data = DataRoot.existing(root)
     scenarios = scenario or ["highway-cut-in", "unprotected-intersection"]
     unknown = sorted(set(strategy or ()) - set(METHODS))
     if unknown:
@@ -137,10 +137,10 @@ def experiment_command(
     base = _config(scenarios[0], "evoeye", budget_s or 0.0, 0, monitor, n_round, update, epochs,
                    0, feedback)
     with StepBar("experiment") as bar:  # a step: a campaign started or a round done
-        results = run_experiment(root, scenarios, base,
+        results = run_experiment(data, scenarios, base,
                                  strategies=strategy or MAIN + (ABLATION if ablation else ()),
                                  seeds=range(repetitions), budget_s=budget_s, controls=controls,
                                  progress=bar)
-    folder = write_experiment_report(root, results, name)
+    folder = write_experiment_report(data, results, name)
     typer.echo((folder / "rq2.md").read_text(encoding="utf-8"))
     typer.echo(f"report: {folder / 'rq2.html'}")

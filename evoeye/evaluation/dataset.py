@@ -8,7 +8,6 @@ setup ends at the collision — so it enters no calibration and no metric.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -69,7 +68,7 @@ def narrow(windows: Windows, context_len: int) -> Windows:
     )
 
 
-def collision_times(root: Warehouse | DataRoot | str | Path | None,
+def collision_times(root: Warehouse | DataRoot,
                     logical_scenario: str) -> dict[str, float]:
     """scenario_id → tau_col in s (+inf for runs without a collision)."""
     wh = root if isinstance(root, Warehouse) else Warehouse(root)
@@ -82,7 +81,7 @@ def collision_times(root: Warehouse | DataRoot | str | Path | None,
 
 
 def load_split(
-    root: Warehouse | DataRoot | str | Path | None,
+    root: Warehouse | DataRoot,
     logical_scenario: str,
     split: str,
     splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
@@ -97,7 +96,7 @@ def load_split(
 
 
 def load_runs(
-    root: Warehouse | DataRoot | str | Path | None,
+    root: Warehouse | DataRoot,
     logical_scenario: str,
     runs: Runs,
     name: str,

@@ -34,9 +34,6 @@ AEM_DIR = Path("baselines") / "aem"
 CONTEXT_DIR = Path("baselines") / "context-only"
 
 
-def _root(root: DataRoot | str | Path | None) -> DataRoot:
-    return root if isinstance(root, DataRoot) else DataRoot.resolve(root)
-
 
 def _train_ids(root: DataRoot, scenario: str, splits: SplitSpec) -> list[str]:
     con = Warehouse(root).connect()
@@ -67,7 +64,7 @@ def find_aem(root: DataRoot, key: str) -> str | None:
     return find_saved(root, AEM_DIR, key)
 
 
-def fit_aem(root: DataRoot | str | Path | None, scenario: str,
+def fit_aem(root: DataRoot, scenario: str,
             splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
             config: AEMConfig | None = None, *,
             horizon_s: float = DEFAULT_HORIZON_S) -> AEMMonitor:
@@ -78,7 +75,6 @@ def fit_aem(root: DataRoot | str | Path | None, scenario: str,
     from evoeye.baselines.aem import AEMConfig, train_aem
 
     config = config or AEMConfig()
-    root = _root(root)
     ids = _train_ids(root, scenario, splits)
     key = training_key(scenario, asdict(splits), asdict(config), horizon_s, ids)
     if (version := find_aem(root, key)) is not None:
@@ -99,22 +95,22 @@ def _training_meta(key: str, scenario: str, splits: SplitSpec, horizon_s: float,
             "horizon_s": horizon_s, "train_scenarios": len(ids), "train_windows": n_windows}
 
 
-def _version_dir(root: DataRoot | str | Path | None, folder: Path, version: str) -> Path:
+def _version_dir(root: DataRoot, folder: Path, version: str) -> Path:
     """`<root>/<folder>/<version>/`, or a KeyError if no version is saved there."""
-    path = _root(root).path / folder / version
+    path = root.path / folder / version
     if not (path / "meta.json").is_file():
         raise KeyError(f"no version {version!r} under {path.parent}")
     return path
 
 
-def load_aem(root: DataRoot | str | Path | None, version: str) -> AEMMonitor:
+def load_aem(root: DataRoot, version: str) -> AEMMonitor:
     """A saved AEM by version."""
     from evoeye.baselines.aem import AEMMonitor
 
     return AEMMonitor.load(_version_dir(root, AEM_DIR, version))
 
 
-def fit_context_only(root: DataRoot | str | Path | None, scenario: str,
+def fit_context_only(root: DataRoot, scenario: str,
                      splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
                      config: ContextConfig | None = None, *,
                      horizon_s: float = DEFAULT_HORIZON_S) -> ContextOnlyMonitor:
@@ -123,7 +119,6 @@ def fit_context_only(root: DataRoot | str | Path | None, scenario: str,
     from evoeye.baselines.context import ContextConfig, train_context_only
 
     config = config or ContextConfig()
-    root = _root(root)
     ids = _train_ids(root, scenario, splits)
     key = training_key("context-only", scenario, asdict(splits), asdict(config), horizon_s, ids)
     if (version := find_saved(root, CONTEXT_DIR, key)) is not None:
@@ -135,7 +130,7 @@ def fit_context_only(root: DataRoot | str | Path | None, scenario: str,
     return monitor
 
 
-def load_context_only(root: DataRoot | str | Path | None, version: str) -> ContextOnlyMonitor:
+def load_context_only(root: DataRoot, version: str) -> ContextOnlyMonitor:
     """A saved context-only control by version."""
     from evoeye.baselines.context import ContextOnlyMonitor
 
@@ -155,7 +150,7 @@ SAVED_BASELINES: dict[str, Callable[[DataRoot, str], Monitor]] = {  # version pr
 }
 
 
-def baseline_monitors(root: DataRoot | str | Path | None, scenario: str,
+def baseline_monitors(root: DataRoot, scenario: str,
                       splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
                       names: Iterable[str] = tuple(BASELINES)) -> list[Monitor]:
     """The named baselines, ready to score windows of `scenario`."""
@@ -163,7 +158,7 @@ def baseline_monitors(root: DataRoot | str | Path | None, scenario: str,
     unknown = [n for n in names if n not in BASELINES]
     if unknown:
         raise KeyError(f"unknown baseline(s) {unknown}; known: {sorted(BASELINES)}")
-    return [BASELINES[n](_root(root), scenario, splits) for n in names]
+    return [BASELINES[n](root, scenario, splits) for n in names]
 
 
 def fusion_api() -> tuple[Callable, Callable] | None:
@@ -180,23 +175,23 @@ def fusion_api() -> tuple[Callable, Callable] | None:
     return train_monitor, load_monitor
 
 
-def load_monitors(root: DataRoot | str | Path | None, versions: Iterable[str]) -> list[Monitor]:
+def load_monitors(root: DataRoot, versions: Iterable[str]) -> list[Monitor]:
     """Trained monitors by version: saved baselines (AEM, context-only) from here, every other
     from evoeye.monitor."""
     out: list[Monitor] = []
     for v in versions:
         loader = next((f for p, f in SAVED_BASELINES.items() if v.startswith(p)), None)
         if loader is not None:
-            out.append(loader(_root(root), v))
+            out.append(loader(root, v))
             continue
         api = fusion_api()
         if api is None:
             raise RuntimeError(f"cannot load monitor {v!r}: evoeye.monitor has no load_monitor")
-        out.append(api[1](_root(root).path, v))
+        out.append(api[1](root, v))
     return out
 
 
-def train_fusion(root: DataRoot | str | Path | None, scenario: str, *, context_len: int = 5,
+def train_fusion(root: DataRoot, scenario: str, *, context_len: int = 5,
                  modules: tuple[str, ...] | None = None, seed: int = 0,
                  splits: SplitSpec | None = None, **overrides) -> Monitor:
     """Train (or let the registry reuse) a FusionMonitor for `scenario` and load it;
@@ -211,8 +206,8 @@ def train_fusion(root: DataRoot | str | Path | None, scenario: str, *, context_l
         kwargs["modules"] = modules
     if splits is not None:
         kwargs["splits"] = splits
-    version = train_monitor(_root(root).path, **kwargs)
-    return load_monitor(_root(root).path, version)
+    version = train_monitor(root, **kwargs)
+    return load_monitor(root, version)
 
 
 def monitor_context_len(monitor: Monitor, default: int = 5) -> int:

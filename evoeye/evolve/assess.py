@@ -9,8 +9,6 @@ fixed validation split when it was trained).
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pyarrow as pa
 
@@ -55,12 +53,12 @@ def metrics_dict(scores: np.ndarray, labels: np.ndarray, thresholds) -> dict:
 class Assessor:
     """Scores monitor versions on the Test Set and the Hard Set of G_0 of one scenario."""
 
-    def __init__(self, root: DataRoot | str | Path | None, scenario: str, g0: str, *,
+    def __init__(self, root: DataRoot, scenario: str, g0: str, *,
                  splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen)
                  horizon_s: float = DEFAULT_HORIZON_S) -> None:
         from evoeye.evolve.families import load_version
 
-        self.root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+        self.root = root
         self._load = load_version
         monitor = self._load(self.root, g0)
         self.test: SplitWindows = load_split(self.root, scenario, "test", splits,

@@ -102,9 +102,9 @@ def run_seed(campaign_seed: int, k: int) -> int:
 class Campaign:
     """One campaign over a data root: `start()` (or resume), then `run_round` until `done`."""
 
-    def __init__(self, root: DataRoot | str | Path | None, config: CampaignConfig, *,
+    def __init__(self, root: DataRoot, config: CampaignConfig, *,
                  train: Trainer | None = None, assess: Assessor | None = None) -> None:
-        self.root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+        self.root = root
         self.config = config
         self.space = get_scenario(config.scenario)
         self._train = train or trainer_of(config.family)
@@ -233,7 +233,7 @@ class Campaign:
             prop = state.strategy.propose(state.records)
             spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
                             batch=self.campaign_id, source=cfg.strategy, round=state.round + 1)
-            result = simulate_and_log(spec, self.root.path)
+            result = simulate_and_log(spec, self.root)
             if result.status == "error":
                 raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
                                    f"{result.reason}")

@@ -13,7 +13,6 @@ from __future__ import annotations
 import json
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 from scipy.stats import spearmanr
@@ -41,7 +40,7 @@ def initial_budget_s(root: DataRoot, scenario: str, base: CampaignConfig) -> flo
     return float(Campaign(root, replace(base, scenario=scenario)).initial["duration_s"].sum())
 
 
-def plan_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str],
+def plan_experiment(root: DataRoot, scenarios: Sequence[str],
                     base: CampaignConfig, *, strategies: Sequence[str] = MAIN + ABLATION,
                     seeds: Sequence[int] = (0, 1, 2),
                     budget_s: float | None = None) -> list[CampaignConfig]:
@@ -51,7 +50,6 @@ def plan_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str]
     None gives each scenario the simulated time of its initial training data. An `aem-evo`
     campaign starts from the AEM trained on D_init and is judged on G_0's Hard Set.
     """
-    root = _root(root)
     unknown = sorted(set(strategies) - set(METHODS))
     if unknown:
         raise ValueError(f"unknown method(s) {unknown}; known: {sorted(METHODS)}")
@@ -70,18 +68,16 @@ def plan_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str]
     return plan
 
 
-def assessors(root: DataRoot | str | Path | None,
+def assessors(root: DataRoot,
               plan: Sequence[CampaignConfig]) -> dict[str, Assessor]:
     """One Test/Hard Set assessor per scenario of the plan, against that scenario's G_0."""
-    root = _root(root)
     first = {c.scenario: c for c in reversed(plan)}  # one each: an Assessor loads the Test Set
     return {scenario: Assessor.of(Campaign(root, c)) for scenario, c in first.items()}
 
 
-def collect_results(root: DataRoot | str | Path | None, plan: Sequence[CampaignConfig]) -> dict:
+def collect_results(root: DataRoot, plan: Sequence[CampaignConfig]) -> dict:
     """{scenario: {"initial": G_0's metrics, "g0", strategy: [per-seed runs]}} from the stored
     rounds of the plan's campaigns (round 0 holds G_0's assessment)."""
-    root = _root(root)
     out: dict = {}
     for cfg in plan:
         c = Campaign(root, cfg)
@@ -103,13 +99,12 @@ def collect_results(root: DataRoot | str | Path | None, plan: Sequence[CampaignC
     return out
 
 
-def run_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str],
+def run_experiment(root: DataRoot, scenarios: Sequence[str],
                    base: CampaignConfig, *, strategies: Sequence[str] = MAIN + ABLATION,
                    seeds: Sequence[int] = (0, 1, 2), budget_s: float | None = None,
                    controls: int = 3, progress: Callable[[str], None] = print) -> dict:
     """Run (or resume) every campaign of the plan, then `collect_results`, with `controls`
     re-seeded G_0 per scenario."""
-    root = _root(root)
     plan = plan_experiment(root, scenarios, base, strategies=strategies, seeds=seeds,
                            budget_s=budget_s)
     assess = assessors(root, plan)
@@ -123,7 +118,7 @@ def run_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str],
     return add_controls(root, plan, collect_results(root, plan), controls, assess, progress)
 
 
-def add_controls(root: DataRoot | str | Path | None, plan: Sequence[CampaignConfig],
+def add_controls(root: DataRoot, plan: Sequence[CampaignConfig],
                  results: dict, k: int, assess: dict[str, Assessor] | None = None,
                  progress: Callable[[str], None] | None = None) -> dict:
     """`results` with k re-seeded G_0 controls per scenario under "reseeded"."""
@@ -141,7 +136,7 @@ def add_controls(root: DataRoot | str | Path | None, plan: Sequence[CampaignConf
 CONTROL_SEED = 1000  # training seeds of the re-seeded G_0 controls: 1000, 1001, …
 
 
-def reseeded_controls(root: DataRoot | str | Path | None, cfg: CampaignConfig, k: int,
+def reseeded_controls(root: DataRoot, cfg: CampaignConfig, k: int,
                       assess: Assessor) -> list[dict]:
     """The control without new data: G_0's recipe retrained on D_init with k other seeds.
 
@@ -152,7 +147,6 @@ def reseeded_controls(root: DataRoot | str | Path | None, cfg: CampaignConfig, k
     from evoeye.monitor import list_versions, read_card, train_monitor
     from evoeye.monitor.card import describe_selection
 
-    root = _root(root)
     campaign = Campaign(root, cfg)
     ids = [str(s) for s in campaign.initial["scenario_id"]]
     selection = describe_selection(ids)
@@ -170,9 +164,6 @@ def reseeded_controls(root: DataRoot | str | Path | None, cfg: CampaignConfig, k
         out.append(assess(version))
     return out
 
-
-def _root(root: DataRoot | str | Path | None) -> DataRoot:
-    return root if isinstance(root, DataRoot) else DataRoot.resolve(root)
 
 
 def _brief(metrics: str) -> str:

@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import json
 from dataclasses import asdict, dataclass, replace
-from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -122,7 +121,7 @@ def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_ru
     return aem.version
 
 
-def initial_monitor(root: DataRoot | str | Path | None, scenario: str) -> str:
+def initial_monitor(root: DataRoot, scenario: str) -> str:
     """The newest full FusionMonitor (all modules, L = 5) trained from scratch on `scenario`'s
     train split by filter — not on a hand-picked run list (e.g. the experiment's controls)."""
     from evoeye.monitor import list_versions, read_card

@@ -151,10 +151,9 @@ def html(results: dict) -> str:
             "<body style='font-family:sans-serif'>" + "".join(body) + "</body>")
 
 
-def write_experiment_report(root: DataRoot | str | Path | None, results: dict,
+def write_experiment_report(root: DataRoot, results: dict,
                             name: str | None = None) -> Path:
     """rq2.md, rq2.html and rq2.json under `<root>/reports/<name>/`; the folder."""
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
     folder = root.reports / (name or f"rq2-{datetime.now(UTC):%Y%m%dT%H%M%SZ}")
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "rq2.md").write_text(markdown(results), encoding="utf-8")

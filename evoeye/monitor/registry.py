@@ -59,14 +59,11 @@ def version_of(net: FusionNet, card: dict[str, Any]) -> str:
     return VERSION_PREFIX + h.hexdigest()[:12]
 
 
-def version_dir(root: DataRoot | str | os.PathLike | None, version: str) -> Path:
+def version_dir(root: DataRoot, version: str) -> Path:
     if not version or "/" in version or version.startswith("."):
         raise MonitorLoadError(f"not a monitor version id: {version!r}")
-    return _root(root).monitors / version
+    return root.monitors / version
 
-
-def _root(root: DataRoot | str | os.PathLike | None) -> DataRoot:
-    return root if isinstance(root, DataRoot) else DataRoot.resolve(root)
 
 
 def _write(path: Path, data: bytes) -> None:
@@ -76,7 +73,7 @@ def _write(path: Path, data: bytes) -> None:
         os.fsync(f.fileno())
 
 
-def save_version(root: DataRoot | str | os.PathLike | None, net: FusionNet,
+def save_version(root: DataRoot, net: FusionNet,
                  card: dict[str, Any]) -> str:
     """Write a new version (model.pt + card.json) atomically; its id. An identical version
     already on disk is kept as it is (same id = same weights and provenance)."""
@@ -102,16 +99,16 @@ def save_version(root: DataRoot | str | os.PathLike | None, net: FusionNet,
     return version
 
 
-def list_versions(root: DataRoot | str | os.PathLike | None = None) -> list[str]:
+def list_versions(root: DataRoot) -> list[str]:
     """Every complete version under the root, oldest card first."""
-    folder = _root(root).monitors
+    folder = root.monitors
     if not folder.is_dir():
         return []
     done = [p for p in folder.iterdir() if not p.name.startswith(".") and (p / CARD_FILE).exists()]
     return [p.name for p in sorted(done, key=lambda p: (p / CARD_FILE).stat().st_mtime)]
 
 
-def read_card(root: DataRoot | str | os.PathLike | None, version: str) -> dict[str, Any]:
+def read_card(root: DataRoot, version: str) -> dict[str, Any]:
     """The card of a version (MonitorLoadError if it is missing or not JSON)."""
     path = version_dir(root, version) / CARD_FILE
     try:
@@ -143,7 +140,7 @@ def load_net(path: Path, expected_sha256: str | None = None) -> FusionNet:
     return net.eval()
 
 
-def load_monitor(root: DataRoot | str | os.PathLike | None, version: str) -> FusionMonitor:
+def load_monitor(root: DataRoot, version: str) -> FusionMonitor:
     """The FusionMonitor of a saved version, ready to score (eval mode, thresholds loaded)."""
     card = read_card(root, version)
     net = load_net(version_dir(root, version) / MODEL_FILE, card.get("model_sha256"))

@@ -13,7 +13,6 @@ import uuid
 from collections.abc import Sequence
 from dataclasses import dataclass
 from datetime import UTC, datetime
-from pathlib import Path
 
 import duckdb
 import numpy as np
@@ -27,9 +26,6 @@ from evoeye.store.scores import PART_SUFFIX, _write_part
 FEEDBACK_TABLE = "feedback"
 ROUNDS_TABLE = "campaign_rounds"
 
-
-def _root(root: DataRoot | str | Path | None) -> DataRoot:
-    return root if isinstance(root, DataRoot) else DataRoot.resolve(root)
 
 
 def _read(root: DataRoot, table: str, where: str, params: dict, order: str) -> pa.Table:
@@ -78,24 +74,23 @@ class FeedbackRows:
 
 
 def read_feedback(
-    root: DataRoot | str | Path | None, monitor_version: str | None = None
+    root: DataRoot, monitor_version: str | None = None
 ) -> pa.Table:
     """Rows of feedback (all, or one monitor version), ordered by version and run."""
-    return _read(_root(root), FEEDBACK_TABLE,
+    return _read(root, FEEDBACK_TABLE,
                  "$version IS NULL OR monitor_version = $version",
                  {"version": monitor_version}, "monitor_version, scenario_id")
 
 
-def feedback_of(root: DataRoot | str | Path | None, monitor_version: str) -> dict[str, float]:
+def feedback_of(root: DataRoot, monitor_version: str) -> dict[str, float]:
     """scenario_id → stored f_r under `monitor_version`."""
     t = read_feedback(root, monitor_version)
     return dict(zip(t.column("scenario_id").to_pylist(), t.column("feedback").to_pylist(),
                     strict=True))
 
 
-def write_feedback(root: DataRoot | str | Path | None, rows: FeedbackRows) -> int:
+def write_feedback(root: DataRoot, rows: FeedbackRows) -> int:
     """Append the feedback of every run not yet stored for this monitor version; rows written."""
-    root = _root(root)
     ids = np.asarray(rows.scenario_id, dtype=object)
     with WriterLock(root.writer_lock):
         done = set(feedback_of(root, rows.monitor_version))
@@ -137,17 +132,16 @@ class RoundRow:
         return cls(**{k: d[k] for k in cls.__dataclass_fields__})
 
 
-def read_rounds(root: DataRoot | str | Path | None, campaign_id: str | None = None
+def read_rounds(root: DataRoot, campaign_id: str | None = None
                 ) -> list[RoundRow]:
     """The finished rounds of one campaign (or all), in campaign and round order."""
-    t = _read(_root(root), ROUNDS_TABLE, "$cid IS NULL OR campaign_id = $cid",
+    t = _read(root, ROUNDS_TABLE, "$cid IS NULL OR campaign_id = $cid",
               {"cid": campaign_id}, "campaign_id, round")
     return [RoundRow.from_dict(d) for d in t.to_pylist()]
 
 
-def write_round(root: DataRoot | str | Path | None, row: RoundRow) -> bool:
+def write_round(root: DataRoot, row: RoundRow) -> bool:
     """Store a finished round unless (campaign_id, round) is stored already; True if written."""
-    root = _root(root)
     with WriterLock(root.writer_lock):
         if any(r.round == row.round for r in read_rounds(root, row.campaign_id)):
             return False

@@ -73,20 +73,19 @@ class ScoresWritten:
     part: str | None  # None when there was nothing new
 
 
-def scored_scenarios(root: DataRoot | str | Path | None, monitor_version: str) -> set[str]:
+def scored_scenarios(root: DataRoot, monitor_version: str) -> set[str]:
     """The scenario ids that monitor_scores already holds for `monitor_version`."""
     table = read_scores(root, monitor_version=monitor_version, columns=("scenario_id",))
     return set(table.column("scenario_id").to_pylist())
 
 
 def read_scores(
-    root: DataRoot | str | Path | None = None,
+    root: DataRoot,
     *,
     monitor_version: str | None = None,
     columns: Sequence[str] | None = None,
 ) -> pa.Table:
     """Rows of monitor_scores (all, or one monitor version), ordered by version, run, frame."""
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
     names = list(columns) if columns is not None else scores_schema().names
     unknown = set(names) - set(scores_schema().names)
     if unknown:
@@ -117,9 +116,8 @@ def _write_part(folder: Path, name: str, table: pa.Table) -> Path:
     return final
 
 
-def write_scores(root: DataRoot | str | Path | None, rows: ScoreRows) -> ScoresWritten:
+def write_scores(root: DataRoot, rows: ScoreRows) -> ScoresWritten:
     """Append the scores of every run not yet stored for this monitor version, as one part."""
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
     ids = np.asarray(rows.scenario_id, dtype=object)
     with WriterLock(root.writer_lock):
         done = scored_scenarios(root, rows.monitor_version)

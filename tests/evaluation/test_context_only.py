@@ -8,6 +8,7 @@ import shutil
 
 from evoeye.baselines.context import ContextOnlyMonitor
 from evoeye.evaluation.monitors import CONTEXT_DIR
+from evoeye.paths import DataRoot
 
 
 def test_trained_on_train_runs_scored_on_val_and_test_and_in_every_rq1_table(
@@ -41,7 +42,7 @@ def test_trained_on_train_runs_scored_on_val_and_test_and_in_every_rq1_table(
     again = fit_context_only(eval_root, "highway-cut-in", splits)
     assert len(trained_on) == 1 and again.version == m.version
     assert load_monitors(eval_root, [m.version])[0].version == m.version
-    files = write_report(tmp_path, [report.to_dict()], "ctx")
+    files = write_report(DataRoot.resolve(tmp_path), [report.to_dict()], "ctx")
     for path in (files.markdown, files.html):
         assert "context-only" in path.read_text()
     names = [x["name"] for x in json.loads(files.json.read_text())[0]["monitors"]]

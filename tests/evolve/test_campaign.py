@@ -25,15 +25,14 @@ def seed_root(root: Path, n_runs: int = 16, seed: int = 3) -> tuple[DataRoot, st
     from evoeye.monitor import train_monitor
 
     data = DataRoot.resolve(root)
-    run_batch(plan_uniform(SCENARIO, n_runs, seed), data.path)
+    run_batch(plan_uniform(SCENARIO, n_runs, seed), data)
     ingest(data)
     return data, train_monitor(data, SCENARIO, seed=0, splits=SPLITS, epochs=1)
 
 
 @pytest.fixture(scope="module")
-def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
-    data, g0 = seed_root(tmp_path_factory.mktemp("seeded") / "data")
-    return data.path, g0
+def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[DataRoot, str]:
+    return seed_root(tmp_path_factory.mktemp("seeded") / "data")
 
 
 @pytest.fixture
@@ -41,7 +40,7 @@ def root_copy(seeded, tmp_path: Path):
     """A private copy of the seeded root, so each test's campaign starts from the same data."""
     def make(name: str) -> DataRoot:
         dst = tmp_path / name
-        shutil.copytree(seeded[0], dst)
+        shutil.copytree(seeded[0].path, dst)
         return DataRoot.resolve(dst)
     return make
 
@@ -71,7 +70,7 @@ def test_log_windows_equal_the_warehouse_windows(seeded) -> None:
     root, _ = seeded
     sid = Warehouse(root).sql("SELECT scenario_id FROM scenarios WHERE collided LIMIT 1"
                               ).column(0)[0].as_py()
-    log = next(Path(root, "runs").rglob(f"{sid}.mcap"))
+    log = next(root.runs.rglob(f"{sid}.mcap"))
     mine = read_logged_run(log, context_len=5, horizon_s=3.0).windows
     ref = load_windows(root, [sid], context_len=5, horizon_s=3.0)
     assert mine.label.sum() > 0
@@ -173,7 +172,7 @@ def clean_runs(seeded, tmp_path_factory: pytest.TempPathFactory):
     def get(strategy: str, family: str = "fusion") -> dict:
         if (strategy, family) not in cache:
             root = DataRoot.resolve(tmp_path_factory.mktemp(f"clean-{strategy}") / "data")
-            shutil.copytree(seeded[0], root.path)
+            shutil.copytree(seeded[0].path, root.path)
             c = Campaign(root, family_config(seeded[1], family, strategy=strategy))
             c.run(max_rounds=2)
             cache[strategy, family] = snapshot(root, c)

@@ -9,6 +9,7 @@ from evoeye.evolve.report import (
     table_rows,
     write_experiment_report,
 )
+from evoeye.paths import DataRoot
 
 
 def _m(f1: float) -> dict:
@@ -71,7 +72,7 @@ def test_report_files_hold_tables_curves_and_map(tmp_path) -> None:
     page = html(RESULTS)
     assert page.count("<svg") == 5  # 4 curves + the blind-spot map
     assert 'data-series="evoeye"' in page
-    folder = write_experiment_report(tmp_path, RESULTS, "t")
+    folder = write_experiment_report(DataRoot.resolve(tmp_path), RESULTS, "t")
     assert {p.name for p in folder.iterdir()} == {"rq2.md", "rq2.html", "rq2.json"}
 
 

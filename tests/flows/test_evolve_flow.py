@@ -40,7 +40,7 @@ def test_evolution_flow_runs_each_round_as_a_flow_run(prefect_server, seeded) ->
     from prefect.client.schemas.filters import FlowRunFilter, FlowRunFilterName
 
     root, g0 = seeded
-    params = EvolveParams(root=str(root), scenario=SCENARIO, strategy="evoeye", budget_s=1000,
+    params = EvolveParams(root=str(root.path), scenario=SCENARIO, strategy="evoeye", budget_s=1000,
                           monitor=g0, n_round=3, epochs=1, max_rounds=2, train_frac=0.5,
                           val_frac=0.25, assess=True)
     out = evolution_flow(params)
