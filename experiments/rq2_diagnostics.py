@@ -21,8 +21,8 @@ import numpy as np
 
 from evoeye.evolve.assess import Assessor
 from evoeye.evolve.campaign import Campaign, CampaignConfig
-from evoeye.evolve.families import load_version
 from evoeye.evolve.feedback import prior_corrected
+from evoeye.monitor.families import load_version
 from evoeye.paths import DataRoot
 from evoeye.store import RunFilter
 from evoeye.store.windows import load_windows

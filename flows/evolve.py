@@ -16,24 +16,25 @@ from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
 from evoeye.evolve.campaign import Campaign, CampaignState
 from evoeye.evolve.config import UPDATE_MODES, CampaignConfig
-from evoeye.evolve.experiment import METHODS
-from evoeye.evolve.families import FAMILIES
+from evoeye.evolve.experiment import methods
 from evoeye.evolve.scoring import FEEDBACK_MODES
 from evoeye.evolve.strategies import STRATEGIES
+from evoeye.monitor.families import evolvable_families
 from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
 from evoeye.store import SplitSpec
 
-KNOWN = {"scenario": SCENARIOS, "strategy": STRATEGIES, "update": UPDATE_MODES,
-         "feedback": FEEDBACK_MODES, "family": FAMILIES,
-         "method": METHODS}  # the names a flow parameter of that kind may take
+KNOWN = {"scenario": lambda: SCENARIOS, "strategy": lambda: STRATEGIES,
+         "update": lambda: UPDATE_MODES, "feedback": lambda: FEEDBACK_MODES,
+         "family": evolvable_families, "method": methods}  # the names a parameter may take
 
 
 def check_known(kind: str, values: list[str]) -> None:
     """ValueError naming the values of `kind` (a KNOWN key) that are unknown, or no value."""
-    unknown = [v for v in values if v not in KNOWN[kind]]
+    known = KNOWN[kind]()
+    unknown = [v for v in values if v not in known]
     if unknown or not values:
-        raise ValueError(f"unknown {kind} {unknown}; known: {sorted(KNOWN[kind])}")
+        raise ValueError(f"unknown {kind} {unknown}; known: {sorted(known)}")
 
 
 class EvolveParams(BaseModel):
@@ -48,7 +49,7 @@ class EvolveParams(BaseModel):
     n_round: int = Field(20, ge=1)
     update: str = Field("finetune", json_schema_extra={"enum": list(UPDATE_MODES)})
     feedback: str = Field("raw", json_schema_extra={"enum": list(FEEDBACK_MODES)})
-    family: str = Field("fusion", json_schema_extra={"enum": list(FAMILIES)})  # aem: AEM-Evo
+    family: str = Field("fusion", json_schema_extra={"enum": evolvable_families()})
     reference: str | None = None  # aem: the FusionMonitor G_0 whose Hard Set judges
     epochs: int | None = Field(None, ge=1)
     max_rounds: int | None = Field(None, ge=1)  # rounds in this flow run (None: to the budget)

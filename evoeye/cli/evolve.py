@@ -124,14 +124,14 @@ def experiment_command(
     name: Annotated[str | None, typer.Option("--name", help="Report folder name.")] = None,
 ) -> None:
     """The RQ2 table (+ evolution ablation): G_0 vs uniform / avfuzzer / evoeye, R seeds."""
-    from evoeye.evolve.experiment import ABLATION, MAIN, METHODS, run_experiment
+    from evoeye.evolve.experiment import ABLATION, MAIN, methods, run_experiment
     from evoeye.evolve.report import write_experiment_report
 
     data = DataRoot.existing(root)
     scenarios = scenario or ["highway-cut-in", "unprotected-intersection"]
-    unknown = sorted(set(strategy or ()) - set(METHODS))
+    unknown = sorted(set(strategy or ()) - set(methods()))
     if unknown:
-        raise typer.BadParameter(f"unknown method {unknown}; known: {sorted(METHODS)}")
+        raise typer.BadParameter(f"unknown method {unknown}; known: {sorted(methods())}")
     if budget_s is not None and budget_s < 0:
         raise typer.BadParameter(f"--budget-s must be >= 0, got {budget_s}")
     base = _config(scenarios[0], "evoeye", budget_s or 0.0, 0, monitor, n_round, update, epochs,

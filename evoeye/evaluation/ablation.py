@@ -17,8 +17,9 @@ from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
+from evoeye.baselines.families import fit_context_only
 from evoeye.evaluation.harness import evaluate
-from evoeye.evaluation.monitors import fit_context_only, train_fusion
+from evoeye.evaluation.monitors import train_fusion
 from evoeye.evaluation.report import DASH, Table, pct
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec

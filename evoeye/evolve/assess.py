@@ -14,6 +14,7 @@ import pyarrow as pa
 
 from evoeye.evaluation.dataset import SplitWindows, load_split
 from evoeye.evaluation.metrics import frame_metrics
+from evoeye.monitor.families import load_calibrated
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse
 from evoeye.store.scores import ScoreRows, read_scores, scored_scenarios, write_scores
@@ -56,11 +57,8 @@ class Assessor:
     def __init__(self, root: DataRoot, scenario: str, g0: str, *,
                  splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen)
                  horizon_s: float = DEFAULT_HORIZON_S) -> None:
-        from evoeye.evolve.families import load_version
-
         self.root = root
-        self._load = load_version
-        monitor = self._load(self.root, g0)
+        monitor = load_calibrated(self.root, g0)
         self.test: SplitWindows = load_split(self.root, scenario, "test", splits,
                                              context_len=monitor.context_len,
                                              horizon_s=horizon_s)
@@ -86,7 +84,7 @@ class Assessor:
 
     def __call__(self, version: str) -> dict:
         """{"test": metrics, "hard": metrics} of `version` at its own thresholds."""
-        monitor = self._load(self.root, version)
+        monitor = load_calibrated(self.root, version)
         scores = monitor.score(self.test.windows)
         labels = self.test.windows.label
         return {

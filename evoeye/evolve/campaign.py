@@ -40,18 +40,18 @@ import numpy as np
 from evoeye.batch import simulate_and_log
 from evoeye.evolve.avfuzzer import criticality
 from evoeye.evolve.config import CampaignConfig
-from evoeye.evolve.families import (
-    NoInitialDataError,
-    initial_aem,
-    initial_monitor,
-    load_version,
-    trainer_of,
-)
 from evoeye.evolve.protocol import Strategy
 from evoeye.evolve.records import Records
 from evoeye.evolve.scoring import read_logged_run, warehouse_feedback, windows_feedback
 from evoeye.evolve.strategies import FEEDBACK_BLIND, make_strategy
 from evoeye.log import read_run
+from evoeye.monitor.families import (
+    DEFAULT_FAMILY,
+    FAMILIES,
+    SavedMonitor,
+    initial_monitor,
+    load_calibrated,
+)
 from evoeye.paths import DataRoot
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
 from evoeye.sim.runner import run_spec
@@ -66,6 +66,10 @@ JOIN scenario_splits($seed, $train_frac, $val_frac) AS p USING (scenario_id)
 WHERE s.logical_scenario = $scenario AND s.round = 0 AND p.split = 'train' AND s.status = 'ok'
 ORDER BY s.scenario_id
 """
+
+
+class NoInitialDataError(LookupError):
+    """A campaign needs the scenario's initial (round 0) runs in the warehouse."""
 
 
 @dataclass
@@ -107,7 +111,8 @@ class Campaign:
         self.root = root
         self.config = config
         self.space = get_scenario(config.scenario)
-        self._train = train or trainer_of(config.family)
+        self.family = FAMILIES[config.family]
+        self._train = train or self.family.train
         self._assess = assess
         self._monitors: dict[str, object] = {}
 
@@ -129,16 +134,16 @@ class Campaign:
         cfg = self.config
         if cfg.monitor:
             return cfg.monitor
-        if cfg.family == "aem":
-            return initial_aem(self.root, cfg.scenario, list(self.initial["scenario_id"]),
-                               self.val_runs, cfg.horizon_s)
-        return initial_monitor(self.root, cfg.scenario)
+        return self.family.initial(self.root, cfg.scenario,
+                                   train_runs=list(self.initial["scenario_id"]),
+                                   val_runs=self.val_runs, horizon_s=cfg.horizon_s)
 
     @cached_property
     def reference(self) -> str:
-        """The FusionMonitor G_0 whose Hard Set judges this campaign (G_0 itself, or for AEM-Evo
-        the configured / newest from-scratch FusionMonitor of the scenario)."""
-        if self.config.family == "fusion":
+        """The FusionMonitor G_0 whose Hard Set judges this campaign (G_0 itself, or for another
+        family, e.g. AEM-Evo, the configured / newest from-scratch FusionMonitor of the scenario).
+        """
+        if self.config.family == DEFAULT_FAMILY:
             return self.g0
         return self.config.reference or initial_monitor(self.root, self.config.scenario)
 
@@ -159,12 +164,12 @@ class Campaign:
         # acquires the same runs and trains the same monitors under either mode
         if cfg["feedback"] == "raw" or cfg["strategy"] in FEEDBACK_BLIND:
             cfg.pop("feedback")
-        if cfg["family"] == "fusion":  # likewise
+        if cfg["family"] == DEFAULT_FAMILY:  # likewise
             cfg.pop("family")
         cfg["monitor"] = self.g0
         cfg["initial"] = hashlib.sha256("\n".join(self.initial["scenario_id"]).encode()).hexdigest()
         digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]
-        family = "" if self.config.family == "fusion" else f"{self.config.family}-"
+        family = "" if self.config.family == DEFAULT_FAMILY else f"{self.config.family}-"
         return f"evo-{family}{self.config.strategy}-s{self.config.seed}-{digest}"
 
     def feedback_key(self, version: str) -> str:
@@ -175,9 +180,10 @@ class Campaign:
     def log_path(self, scenario_id: str) -> Path:
         return self.root.run_log(self.config.scenario, self.campaign_id, scenario_id)
 
-    def monitor(self, version: str):
+    def monitor(self, version: str) -> SavedMonitor:
+        """A version of the campaign's family, with thresholds (loaded once)."""
         if version not in self._monitors:
-            self._monitors[version] = load_version(self.root, version)
+            self._monitors[version] = load_calibrated(self.root, version)
         return self._monitors[version]
 
     # -- state -----------------------------------------------------------------------------------

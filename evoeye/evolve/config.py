@@ -8,9 +8,10 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
-from evoeye.evolve.families import FAMILIES, family_of
+import evoeye.baselines  # noqa: F401  (registers the baseline monitor families: aem, …)
 from evoeye.evolve.scoring import FEEDBACK_MODES
 from evoeye.evolve.strategies import STRATEGIES
+from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES, evolvable_families, family_of
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
 from evoeye.sim.runner import SimConfig
 from evoeye.store import SplitSpec
@@ -36,7 +37,7 @@ class CampaignConfig:
     patience: int | None = None
     delta: float = DEFAULT_DELTA
     feedback: str = "raw"  # ŷ of f_r: "raw" scores or "prior-corrected" (see evolve.feedback)
-    family: str = "fusion"  # the monitor evolved: "fusion", or "aem" (AEM-Evo, evolve.families)
+    family: str = DEFAULT_FAMILY  # the monitor family evolved: "fusion", "aem" (AEM-Evo), …
     reference: str | None = None  # aem: the FusionMonitor G_0 whose Hard Set judges; None: newest
     horizon_s: float = DEFAULT_HORIZON_S
     splits: SplitSpec = field(default_factory=SplitSpec)
@@ -48,11 +49,12 @@ class CampaignConfig:
             raise ValueError(f"unknown strategy {self.strategy!r}; known: {sorted(STRATEGIES)}")
         if self.feedback not in FEEDBACK_MODES:
             raise ValueError(f"feedback must be one of {FEEDBACK_MODES}, got {self.feedback!r}")
-        if self.family not in FAMILIES:
-            raise ValueError(f"family must be one of {FAMILIES}, got {self.family!r}")
-        if self.monitor and family_of(self.monitor) != self.family:
-            raise ValueError(f"G_0 {self.monitor} is a {family_of(self.monitor)} monitor, but "
-                             f"the campaign evolves the {self.family} family")
+        if self.family not in FAMILIES or not FAMILIES[self.family].evolvable:
+            raise ValueError(f"family must be one of {evolvable_families()}, got "
+                             f"{self.family!r}")
+        if self.monitor and (of := family_of(self.monitor).name) != self.family:
+            raise ValueError(f"G_0 {self.monitor} is a {of} monitor, but the campaign evolves "
+                             f"the {self.family} family")
         if self.update not in UPDATE_MODES:
             raise ValueError(f"update must be one of {UPDATE_MODES}, got {self.update!r}")
         if self.n_round < 1 or self.budget_s < 0 or self.seed < 0 or self.max_run_s <= 0:

@@ -1,7 +1,8 @@
 """The RQ2 experiment: G_0 vs every strategy at the same budget, R seeds, Test Set and Hard Set.
 
-A method is a strategy evolving the FusionMonitor, or `aem-evo`: the `evoeye` strategy evolving
-the AEM baseline (paper RQ3), judged on the same Test Set and the FusionMonitor G_0's Hard Set.
+A method is a strategy evolving the FusionMonitor, or `<family>-evo`: the `evoeye` strategy
+evolving another evolvable monitor family, e.g. `aem-evo` for the AEM baseline (paper RQ3),
+judged on the same Test Set and the FusionMonitor G_0's Hard Set.
 Each (scenario, method, seed) is one campaign (resumable, so a killed experiment re-run picks
 up where it stopped); every round's G_r is assessed and stored with the round, so the per-round
 curves come from the campaign_rounds table. The report (Markdown + self-contained HTML with SVG
@@ -19,20 +20,26 @@ from scipy.stats import spearmanr
 
 from evoeye.evolve.assess import Assessor
 from evoeye.evolve.avfuzzer import CRITICALITY_SCALE_M
-from evoeye.evolve.campaign import Campaign, CampaignConfig, CampaignState, initial_monitor
+from evoeye.evolve.campaign import Campaign, CampaignConfig, CampaignState
 from evoeye.evolve.strategies import STRATEGIES
+from evoeye.monitor.families import DEFAULT_FAMILY, evolvable_families, initial_monitor
 from evoeye.paths import DataRoot
 from evoeye.store.feedback import read_rounds
 
 MAIN = ("uniform", "avfuzzer", "evoeye")
 ABLATION = ("no-feedback", "no-density", "aem-evo")
-# method → (strategy, monitor family)
-METHODS: dict[str, tuple[str, str]] = {**{s: (s, "fusion") for s in STRATEGIES},
-                                       "aem-evo": ("evoeye", "aem")}
+EVOLVE_OTHER = "evoeye"  # the strategy a `<family>-evo` method runs on another family
+
+
+def methods() -> dict[str, tuple[str, str]]:
+    """Method → (strategy, monitor family): every registered strategy on the FusionMonitor,
+    and `<family>-evo` for every other evolvable family."""
+    return {**{s: (s, DEFAULT_FAMILY) for s in STRATEGIES},
+            **{f"{f}-evo": (EVOLVE_OTHER, f) for f in evolvable_families() if f != DEFAULT_FAMILY}}
 
 
 def method_of(cfg: CampaignConfig) -> str:
-    return "aem-evo" if cfg.family == "aem" else cfg.strategy
+    return cfg.strategy if cfg.family == DEFAULT_FAMILY else f"{cfg.family}-evo"
 
 
 def initial_budget_s(root: DataRoot, scenario: str, base: CampaignConfig) -> float:
@@ -50,9 +57,10 @@ def plan_experiment(root: DataRoot, scenarios: Sequence[str],
     None gives each scenario the simulated time of its initial training data. An `aem-evo`
     campaign starts from the AEM trained on D_init and is judged on G_0's Hard Set.
     """
-    unknown = sorted(set(strategies) - set(METHODS))
+    known = methods()
+    unknown = sorted(set(strategies) - set(known))
     if unknown:
-        raise ValueError(f"unknown method(s) {unknown}; known: {sorted(METHODS)}")
+        raise ValueError(f"unknown method(s) {unknown}; known: {sorted(known)}")
     plan = []
     for scenario in scenarios:
         g0 = (base.monitor if base.scenario == scenario and base.monitor
@@ -60,8 +68,8 @@ def plan_experiment(root: DataRoot, scenarios: Sequence[str],
         budget = initial_budget_s(root, scenario, base) if budget_s is None else budget_s
         for seed in seeds:
             for method in strategies:
-                strategy, family = METHODS[method]
-                own = family == "fusion"
+                strategy, family = known[method]
+                own = family == DEFAULT_FAMILY
                 plan.append(replace(base, scenario=scenario, strategy=strategy, seed=seed,
                                     budget_s=budget, family=family, monitor=g0 if own else None,
                                     reference=None if own else g0))
@@ -86,7 +94,7 @@ def collect_results(root: DataRoot, plan: Sequence[CampaignConfig]) -> dict:
             continue  # not started yet
         rounds = [json.loads(r.metrics) if r.metrics else None for r in rows]
         res = out.setdefault(cfg.scenario, {"g0": c.reference})
-        res.setdefault("initial" if cfg.family == "fusion" else f"{cfg.family}-initial",
+        res.setdefault("initial" if cfg.family == DEFAULT_FAMILY else f"{cfg.family}-initial",
                        rounds[0])
         state = c.start()
         method = method_of(cfg)

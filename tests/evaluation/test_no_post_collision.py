@@ -84,7 +84,7 @@ def test_aem_training_and_calibration(eval_root, splits, collided, layout,
                                       monkeypatch) -> None:
     import evoeye.baselines.aem as aem_mod
     import evoeye.evaluation.calibration as cal_mod
-    from evoeye.evolve.families import train_aem_version
+    from evoeye.baselines.families import train_aem_version
 
     seen: dict[str, object] = {}
     real_train, real_cal = aem_mod.train_aem, cal_mod.calibrate_on_validation

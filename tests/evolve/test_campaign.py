@@ -215,7 +215,7 @@ def test_killed_mid_round_resumes_to_the_same_records(root_copy, seeded, clean_r
 @pytest.mark.parametrize("family", ["fusion", "aem"])
 def test_killed_during_training_resumes_to_the_same_records(root_copy, seeded, clean_runs,
                                                             family: str) -> None:
-    from evoeye.evolve.families import trainer_of
+    from evoeye.monitor.families import FAMILIES
 
     cfg = family_config(seeded[1], family, strategy="evoeye")
     calls = {"n": 0}
@@ -224,7 +224,7 @@ def test_killed_during_training_resumes_to_the_same_records(root_copy, seeded, c
         calls["n"] += 1
         if calls["n"] == 2:
             raise RuntimeError("killed mid-training")
-        return trainer_of(family)(*args, **kwargs)
+        return FAMILIES[family].train(*args, **kwargs)
 
     root = root_copy("killed")
     with pytest.raises(RuntimeError, match="mid-training"):
@@ -326,7 +326,7 @@ def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_cop
 
     from evoeye.evaluation.dataset import load_runs
     from evoeye.evolve.assess import Assessor
-    from evoeye.evolve.families import load_version
+    from evoeye.monitor.families import load_version
 
     with pytest.raises(ValueError, match="is a fusion monitor, but the campaign evolves the aem"):
         config(seeded[1], family="aem")
@@ -342,7 +342,7 @@ def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_cop
     assert [r.round for r in rows] == [0, 1] and rows[0].monitor_version == g0
     g1 = load_version(root, rows[1].monitor_version)
     assert g1.version != g0 and g1.card["parent"] == g0
-    np.testing.assert_array_equal(g1.aem.mean, load_version(root, g0).aem.mean)  # parent's
+    np.testing.assert_array_equal(g1.mean, load_version(root, g0).mean)  # parent's
     # thresholds calibrated on the (eligible: pre-collision) safe frames of the validation split
     val = load_runs(root, SCENARIO, c.val_runs, "val", horizon_s=3.0)
     safe = val.windows.label == 0
