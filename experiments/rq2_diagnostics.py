@@ -19,9 +19,9 @@ import argparse
 
 import numpy as np
 
-from evoeye.evolve.assess import Assessor
-from evoeye.evolve.campaign import Campaign, CampaignConfig
-from evoeye.evolve.feedback import prior_corrected
+from evoeye.evolve.campaign.assess import Assessor
+from evoeye.evolve.campaign.loop import Campaign, CampaignConfig
+from evoeye.evolve.search.feedback import prior_corrected
 from evoeye.monitor.families import load_version
 from evoeye.paths import DataRoot
 from evoeye.store import RunFilter

@@ -14,11 +14,11 @@ from prefect import flow, get_run_logger, task
 from prefect.cache_policies import NONE
 from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
-from evoeye.evolve.campaign import Campaign, CampaignState
-from evoeye.evolve.config import UPDATE_MODES, CampaignConfig
-from evoeye.evolve.experiment import methods
-from evoeye.evolve.scoring import FEEDBACK_MODES
-from evoeye.evolve.strategies import STRATEGIES
+from evoeye.evolve.campaign.config import UPDATE_MODES, CampaignConfig
+from evoeye.evolve.campaign.experiment import methods
+from evoeye.evolve.campaign.loop import Campaign, CampaignState
+from evoeye.evolve.campaign.scoring import FEEDBACK_MODES
+from evoeye.evolve.search.strategies import STRATEGIES
 from evoeye.monitor.families import evolvable_families
 from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
@@ -94,7 +94,7 @@ def make_campaign(params: EvolveParams) -> Campaign:
     root = DataRoot.resolve(params.root)
     assess = None
     if params.assess:
-        from evoeye.evolve.assess import Assessor
+        from evoeye.evolve.campaign.assess import Assessor
 
         assess = Assessor.of(Campaign(root, cfg))
     return Campaign(root, cfg, assess=assess)

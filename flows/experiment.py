@@ -14,8 +14,8 @@ from prefect import flow, get_run_logger
 from prefect.artifacts import create_markdown_artifact
 from pydantic import BaseModel, Field, ValidationInfo, field_validator
 
-from evoeye.evolve.config import UPDATE_MODES, CampaignConfig
-from evoeye.evolve.experiment import (
+from evoeye.evolve.campaign.config import UPDATE_MODES, CampaignConfig
+from evoeye.evolve.campaign.experiment import (
     ABLATION,
     MAIN,
     add_controls,
@@ -23,8 +23,8 @@ from evoeye.evolve.experiment import (
     method_of,
     plan_experiment,
 )
-from evoeye.evolve.report import markdown, write_experiment_report
-from evoeye.evolve.scoring import FEEDBACK_MODES
+from evoeye.evolve.campaign.report import markdown, write_experiment_report
+from evoeye.evolve.campaign.scoring import FEEDBACK_MODES
 from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
 from evoeye.store import SplitSpec

@@ -52,7 +52,7 @@ KNOWN_ERRORS: dict[str, str] = {
                                                 "trains it again",
     "evoeye.monitor.families.NoMonitorError": "train one first: `evoeye train --scenario NAME`, "
                                               "or name it with --monitor",
-    "evoeye.evolve.campaign.NoInitialDataError": "simulate and ingest the scenario's initial "
+    "evoeye.evolve.campaign.loop.NoInitialDataError": "simulate and ingest the scenario's initial "
                                                  "runs: `evoeye simulate …`, `evoeye ingest`",
     "evoeye.store.lock.WarehouseLockedError": "wait for the other writer to finish, then run "
                                               "again",

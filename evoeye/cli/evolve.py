@@ -14,7 +14,7 @@ from evoeye.cli.output import StepBar
 from evoeye.paths import DataRoot
 
 if TYPE_CHECKING:
-    from evoeye.evolve.config import CampaignConfig
+    from evoeye.evolve.campaign.config import CampaignConfig
 
 FEEDBACK_HELP = ("ŷ in f_r = mean |ŷ − y|: raw monitor scores, or prior-corrected "
                  "(undo the training pos_weight).")
@@ -25,7 +25,7 @@ Root = Annotated[Path | None, typer.Option(
 def _config(scenario: str, strategy: str, budget_s: float, seed: int, monitor: str | None,
             n_round: int, update: str, epochs: int | None, split_seed: int,
             feedback: str = "raw", family: str = "fusion") -> CampaignConfig:
-    from evoeye.evolve.config import CampaignConfig
+    from evoeye.evolve.campaign.config import CampaignConfig
     from evoeye.store import SplitSpec
 
     if update not in UPDATE_MODES:
@@ -60,8 +60,8 @@ def evolve_command(
     """Run (or resume) an evolution campaign; per round, G_r's F1 / AUPRC on the test set."""
     from tqdm import tqdm
 
-    from evoeye.evolve.assess import Assessor
-    from evoeye.evolve.campaign import Campaign
+    from evoeye.evolve.campaign.assess import Assessor
+    from evoeye.evolve.campaign.loop import Campaign
 
     cfg = _config(scenario, strategy, budget_s, seed, monitor, n_round, update, epochs,
                   split_seed, feedback, family)
@@ -124,8 +124,8 @@ def experiment_command(
     name: Annotated[str | None, typer.Option("--name", help="Report folder name.")] = None,
 ) -> None:
     """The RQ2 table (+ evolution ablation): G_0 vs uniform / avfuzzer / evoeye, R seeds."""
-    from evoeye.evolve.experiment import ABLATION, MAIN, methods, run_experiment
-    from evoeye.evolve.report import write_experiment_report
+    from evoeye.evolve.campaign.experiment import ABLATION, MAIN, methods, run_experiment
+    from evoeye.evolve.campaign.report import write_experiment_report
 
     data = DataRoot.existing(root)
     scenarios = scenario or ["highway-cut-in", "unprotected-intersection"]

@@ -7,7 +7,7 @@ from evoeye.cli import defaults
 
 def test_help_defaults_equal_their_sources() -> None:
     from evoeye.evaluation.monitors import BASELINES
-    from evoeye.evolve.config import UPDATE_MODES
+    from evoeye.evolve.campaign.config import UPDATE_MODES
     from evoeye.monitor.inputs import ABLATIONS, MODULES
     from evoeye.monitor.protocol import TARGET_FPRS
     from evoeye.scenarios import SCENARIOS

@@ -8,8 +8,8 @@ from dataclasses import replace
 import pytest
 from pydantic import ValidationError
 
-from evoeye.evolve.campaign import Campaign, CampaignConfig, initial_monitor
-from evoeye.evolve.experiment import plan_experiment
+from evoeye.evolve.campaign.experiment import plan_experiment
+from evoeye.evolve.campaign.loop import Campaign, CampaignConfig, initial_monitor
 from evoeye.monitor import list_versions
 from evoeye.store import SplitSpec
 from evoeye.store.feedback import read_rounds

@@ -9,12 +9,12 @@ import numpy as np
 import pytest
 
 from evoeye.batch import plan_uniform, run_batch
-from evoeye.evolve import campaign as campaign_mod
-from evoeye.evolve.campaign import Campaign, CampaignConfig
-from evoeye.evolve.scoring import frame_labels, read_logged_run, run_contexts
+from evoeye.evolve.campaign import loop as campaign_mod
+from evoeye.evolve.campaign.loop import Campaign, CampaignConfig
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse, ingest, load_windows
 from evoeye.store.feedback import read_feedback, read_rounds
+from evoeye.store.log_windows import read_logged_run
 
 SCENARIO = "unprotected-intersection"  # ~half its runs collide: both classes in tiny splits
 SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
@@ -80,17 +80,6 @@ def test_log_windows_equal_the_warehouse_windows(seeded) -> None:
         np.testing.assert_array_equal(a, ref.arrays()[name], err_msg=name)
 
 
-def test_frame_labels_and_contexts_follow_the_definitions() -> None:
-    t = np.arange(10) * 0.5
-    hit = np.zeros(10, bool)
-    hit[6:] = True  # tau_col = 3.0 s
-    assert frame_labels(t, hit, 1.0).tolist() == [0, 0, 0, 0, 1, 1, 0, 0, 0, 0]
-    assert frame_labels(t, np.zeros(10, bool), 1.0).sum() == 0
-    ctx, mask = run_contexts(3, 2)
-    assert ctx.tolist() == [[0, 0], [0, 1], [1, 2]]
-    assert mask.tolist() == [[False, True], [True, True], [True, True]]
-
-
 def test_config_rejects_unknown_strategy_and_update() -> None:
     with pytest.raises(ValueError, match="strategy"):
         CampaignConfig(SCENARIO, strategy="random-walk")
@@ -116,7 +105,7 @@ def test_campaign_id_is_stable_and_ignores_the_budget(seeded) -> None:
 
 
 def test_prior_corrected_feedback_is_stored_apart_and_undoes_pos_weight(root_copy) -> None:
-    from evoeye.evolve.feedback import prior_corrected
+    from evoeye.evolve.search.feedback import prior_corrected
 
     root = root_copy("prior")
     g0 = Campaign(root, config(None)).g0
@@ -236,7 +225,7 @@ def test_killed_during_training_resumes_to_the_same_records(root_copy, seeded, c
 def test_hard_set_is_the_missed_unsafe_frames_and_the_safe_frames_of_their_runs(seeded) -> None:
     import pyarrow as pa
 
-    from evoeye.evolve.assess import hard_set
+    from evoeye.evolve.campaign.assess import hard_set
 
     root, _ = seeded
     wh = Warehouse(root)
@@ -275,7 +264,7 @@ def test_hard_set_is_the_missed_unsafe_frames_and_the_safe_frames_of_their_runs(
 
 
 def test_assessor_g0_misses_its_whole_hard_set(seeded) -> None:
-    from evoeye.evolve.assess import Assessor
+    from evoeye.evolve.campaign.assess import Assessor
 
     root, g0 = seeded
     m = Assessor(root, SCENARIO, g0, splits=SPLITS)(g0)
@@ -325,7 +314,7 @@ def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_cop
     import json
 
     from evoeye.evaluation.dataset import load_runs
-    from evoeye.evolve.assess import Assessor
+    from evoeye.evolve.campaign.assess import Assessor
     from evoeye.monitor.families import load_version
 
     with pytest.raises(ValueError, match="is a fusion monitor, but the campaign evolves the aem"):

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from evoeye.evolve.report import (
+from evoeye.evolve.campaign.report import (
     acquisition_rows,
     html,
     markdown,
@@ -88,8 +88,8 @@ def test_acquisition_counts_runs_within_delta_of_an_earlier_record() -> None:
 
     import numpy as np
 
-    from evoeye.evolve.experiment import acquisition
-    from evoeye.evolve.records import Records
+    from evoeye.evolve.campaign.experiment import acquisition
+    from evoeye.evolve.search.records import Records
     from evoeye.scenarios import get_scenario
 
     space = get_scenario("unprotected-intersection")
@@ -112,7 +112,7 @@ def test_acquisition_counts_runs_within_delta_of_an_earlier_record() -> None:
 def test_map_axes_are_the_parameters_feedback_depends_on_most() -> None:
     import numpy as np
 
-    from evoeye.evolve.experiment import map_axes
+    from evoeye.evolve.campaign.experiment import map_axes
 
     rng = np.random.default_rng(0)
     u = rng.random((200, 6))

@@ -38,12 +38,12 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.batch import simulate_and_log
-from evoeye.evolve.avfuzzer import criticality
-from evoeye.evolve.config import CampaignConfig
-from evoeye.evolve.protocol import Strategy
-from evoeye.evolve.records import Records
-from evoeye.evolve.scoring import read_logged_run, warehouse_feedback, windows_feedback
-from evoeye.evolve.strategies import FEEDBACK_BLIND, make_strategy
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
+from evoeye.evolve.search.fitness import criticality
+from evoeye.evolve.search.protocol import Strategy
+from evoeye.evolve.search.records import Records
+from evoeye.evolve.search.strategies import FEEDBACK_BLIND, make_strategy
 from evoeye.log import read_run
 from evoeye.monitor.families import (
     DEFAULT_FAMILY,
@@ -58,6 +58,7 @@ from evoeye.sim.runner import run_spec
 from evoeye.store import RunFilter, Warehouse, ingest
 from evoeye.store.feedback import FeedbackRows, RoundRow, feedback_of, read_rounds, write_feedback
 from evoeye.store.feedback import write_round as store_round
+from evoeye.store.log_windows import read_logged_run
 
 INITIAL_RECORDS_SQL = """
 SELECT s.scenario_id, s.params, s.collided, s.min_distance_m, s.duration_s

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.evaluation.plots import line_chart
-from evoeye.evolve.experiment import ABLATION, MAIN, methods
+from evoeye.evolve.campaign.experiment import ABLATION, MAIN, methods
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.paths import DataRoot
 

@@ -6,7 +6,7 @@ judged on the same Test Set and the FusionMonitor G_0's Hard Set.
 Each (scenario, method, seed) is one campaign (resumable, so a killed experiment re-run picks
 up where it stopped); every round's G_r is assessed and stored with the round, so the per-round
 curves come from the campaign_rounds table. The report (Markdown + self-contained HTML with SVG
-charts, `evolve.report`) goes to `<root>/reports/<name>/`.
+charts, `report.py`) goes to `<root>/reports/<name>/`.
 """
 
 from __future__ import annotations
@@ -18,10 +18,10 @@ from dataclasses import replace
 import numpy as np
 from scipy.stats import spearmanr
 
-from evoeye.evolve.assess import Assessor
-from evoeye.evolve.avfuzzer import CRITICALITY_SCALE_M
-from evoeye.evolve.campaign import Campaign, CampaignConfig, CampaignState
-from evoeye.evolve.strategies import STRATEGIES
+from evoeye.evolve.campaign.assess import Assessor
+from evoeye.evolve.campaign.loop import Campaign, CampaignConfig, CampaignState
+from evoeye.evolve.search.fitness import CRITICALITY_SCALE_M
+from evoeye.evolve.search.strategies import STRATEGIES
 from evoeye.monitor.families import DEFAULT_FAMILY, evolvable_families, initial_monitor
 from evoeye.paths import DataRoot
 from evoeye.store.feedback import read_rounds

@@ -9,8 +9,8 @@ from __future__ import annotations
 from dataclasses import dataclass, field
 
 import evoeye.baselines  # noqa: F401  (registers the baseline monitor families: aem, …)
-from evoeye.evolve.scoring import FEEDBACK_MODES
-from evoeye.evolve.strategies import STRATEGIES
+from evoeye.evolve.campaign.scoring import FEEDBACK_MODES
+from evoeye.evolve.search.strategies import STRATEGIES
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES, evolvable_families, family_of
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
 from evoeye.sim.runner import SimConfig
@@ -36,7 +36,7 @@ class CampaignConfig:
     epochs: int | None = None  # per update; None: 10 when fine-tuning, TrainParams' when not
     patience: int | None = None
     delta: float = DEFAULT_DELTA
-    feedback: str = "raw"  # ŷ of f_r: "raw" scores or "prior-corrected" (see evolve.feedback)
+    feedback: str = "raw"  # ŷ of f_r: "raw" scores or "prior-corrected" (see evolve.search.feedback)
     family: str = DEFAULT_FAMILY  # the monitor family evolved: "fusion", "aem" (AEM-Evo), …
     reference: str | None = None  # aem: the FusionMonitor G_0 whose Hard Set judges; None: newest
     horizon_s: float = DEFAULT_HORIZON_S
