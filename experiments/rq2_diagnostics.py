@@ -20,7 +20,8 @@ import argparse
 import numpy as np
 
 from evoeye.evolve.campaign.assess import Assessor
-from evoeye.evolve.campaign.loop import Campaign, CampaignConfig
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.search.feedback import prior_corrected
 from evoeye.monitor.families import load_version
 from evoeye.paths import DataRoot

@@ -23,6 +23,25 @@ def test_params_reject_unknown_strategy() -> None:
         EvolveParams(update="warm")
 
 
+def test_round_tasks_pass_parameters_and_run_ids_not_state() -> None:
+    import inspect
+
+    from flows import evolve
+
+    for task in (evolve.acquire, evolve.ingest_round, evolve.train, evolve.score):
+        kinds = {p.annotation for p in inspect.signature(task.fn).parameters.values()}
+        assert kinds <= {"CampaignRun", "list[str]", "str", "float"}, (task.name, kinds)
+
+
+def test_params_are_the_campaign_options_and_give_back_the_config() -> None:
+    from evoeye.evolve.campaign.config import CampaignConfig, campaign_options
+
+    assert {o.name for o in campaign_options()} <= set(EvolveParams.model_fields)
+    cfg = CampaignConfig(SCENARIO, strategy="avfuzzer", seed=2, n_round=3, patience=2)
+    params = EvolveParams.of(cfg, "/r", max_rounds=1)
+    assert params.config() == cfg and params.root == "/r" and params.max_rounds == 1
+
+
 def test_nightly_deployment_has_cron_and_parameter_schema() -> None:
     d = nightly_deployment(EvolveParams(scenario=SCENARIO, strategy="uniform", budget_s=60))
     assert d.name == "nightly-evolution"

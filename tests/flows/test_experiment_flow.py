@@ -8,9 +8,11 @@ from dataclasses import replace
 import pytest
 from pydantic import ValidationError
 
+from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.experiment import plan_experiment
-from evoeye.evolve.campaign.loop import Campaign, CampaignConfig, initial_monitor
+from evoeye.evolve.campaign.loop import Campaign
 from evoeye.monitor import list_versions
+from evoeye.monitor.families import initial_monitor
 from evoeye.store import SplitSpec
 from evoeye.store.feedback import read_rounds
 from flows.experiment import ExperimentParams, experiment_flow

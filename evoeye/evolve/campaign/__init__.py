@@ -9,8 +9,7 @@ Imported on first use, so the command line can read `CampaignConfig`'s options (
 no numpy) without loading the loop.
 """
 
-from importlib import import_module
-from typing import Any
+from evoeye.lazy import lazy_attributes
 
 _LAZY = {
     "CampaignConfig": "evoeye.evolve.campaign.config",
@@ -23,10 +22,7 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        return getattr(import_module(_LAZY[name]), name)
-    raise AttributeError(f"module 'evoeye.evolve.campaign' has no attribute {name!r}")
+__getattr__ = lazy_attributes(__name__, _LAZY)
 
 
 __all__ = list(_LAZY)

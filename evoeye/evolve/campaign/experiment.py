@@ -19,7 +19,8 @@ import numpy as np
 from scipy.stats import spearmanr
 
 from evoeye.evolve.campaign.assess import Assessor
-from evoeye.evolve.campaign.loop import Campaign, CampaignConfig, CampaignState
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.loop import Campaign, CampaignState
 from evoeye.evolve.search.fitness import CRITICALITY_SCALE_M
 from evoeye.evolve.search.strategies import STRATEGIES
 from evoeye.monitor.families import DEFAULT_FAMILY, evolvable_families, initial_monitor

@@ -30,7 +30,7 @@ from __future__ import annotations
 import hashlib
 import json
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from functools import cached_property
 from pathlib import Path
@@ -188,8 +188,10 @@ class Campaign:
         return self._monitors[version]
 
     # -- state -----------------------------------------------------------------------------------
-    def start(self) -> CampaignState:
-        """The state after the last stored round; round 0 (G_0, D_init scored) is stored first."""
+    def start(self, new_ids: Sequence[str] = ()) -> CampaignState:
+        """The state after the last stored round; round 0 (G_0, D_init scored) is stored first.
+        `new_ids`: runs `acquire` added since, by id (the flow's round tasks pass them on), read
+        back from their logs with their feedback under G_r."""
         rounds = read_rounds(self.root, self.campaign_id)
         if not rounds:
             self._store_feedback(self.g0, self.initial["scenario_id"])
@@ -209,7 +211,7 @@ class Campaign:
             scenario_id=init["scenario_id"],
         )
         ok = [True] * records.n
-        for sid in (s for r in rounds for s in r.scenario_ids):
+        for sid in [*(s for r in rounds for s in r.scenario_ids), *new_ids]:
             meta = read_run(self.log_path(sid), topics=()).metadata
             records = records.append(np.asarray(meta["params"], float), **_outcome(meta))
             ok.append(meta["status"] == "ok")
@@ -233,7 +235,8 @@ class Campaign:
 
     # -- one round, in the steps a flow runs as tasks ----------------------------------------------
     def acquire(self, state: CampaignState) -> list[str]:
-        """Lines 5–10, up to N_round times: propose, simulate, score with G_r, add. New ids."""
+        """Lines 5–10, up to N_round times: propose, simulate, score with G_r, add; then store the
+        new runs' f_r. Their ids."""
         cfg, monitor = self.config, self.monitor(state.monitor)
         new: list[str] = []
         while len(new) < cfg.n_round and not self.done(state):
@@ -253,6 +256,9 @@ class Campaign:
                 np.asarray(run.metadata["params"], float), feedback=float(fb), **outcome)
             state.ok = np.append(state.ok, run.ok)
             new.append(spec.scenario_id)
+        if new:  # f_r of the new runs, stored now so that a later step can read them by id
+            added = state.records.tail(state.records.n - len(new))
+            self._write_feedback(state.monitor, added.scenario_id, added.feedback)
         return new
 
     def ingest(self):
@@ -276,9 +282,7 @@ class Campaign:
 
     def finish_round(self, state: CampaignState, new_ids: list[str], version: str,
                      train_s: float) -> RoundRow:
-        """Line 13 and the commit: store f_r of the new runs and f_{r+1} of all, then the round."""
-        new = state.records.tail(state.records.n - len(new_ids))
-        self._write_feedback(state.monitor, new.scenario_id, new.feedback)
+        """Line 13 and the commit: store f_{r+1} of every record, then the round."""
         ok_ids = state.records.scenario_id[state.ok]
         self._store_feedback(version, ok_ids)
         row = RoundRow(self.campaign_id, self.config.scenario, self.config.strategy,

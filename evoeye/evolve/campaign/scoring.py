@@ -8,11 +8,10 @@ after a monitor update) are scored from the warehouse.
 
 from __future__ import annotations
 
+from evoeye.evolve.campaign.config import FEEDBACK_MODES
 from evoeye.evolve.search.feedback import ScenarioFeedback, prior_corrected, scenario_feedback
 from evoeye.paths import DataRoot
 from evoeye.store.windows import Windows, load_windows
-
-FEEDBACK_MODES = ("raw", "prior-corrected")  # ŷ as the monitor scores it, or σ(logit − log w)
 
 
 def windows_feedback(monitor, windows: Windows, mode: str = "raw") -> ScenarioFeedback:

@@ -10,7 +10,8 @@ import pytest
 
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.evolve.campaign import loop as campaign_mod
-from evoeye.evolve.campaign.loop import Campaign, CampaignConfig
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.loop import Campaign
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse, ingest, load_windows
 from evoeye.store.feedback import read_feedback, read_rounds
