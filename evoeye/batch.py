@@ -115,7 +115,8 @@ class BatchSummary:
         return sum(r.sim_time_s for r in self.results if not r.skipped)
 
 
-def _context() -> mp.context.BaseContext:
+def pool_context() -> mp.context.BaseContext:
+    """The multiprocessing context worker pools start in."""
     # fork starts workers in milliseconds with highway-env already imported; spawn elsewhere.
     return mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
 
@@ -134,7 +135,7 @@ def run_batch(
         for spec in wrap(specs):
             summary.results.append(_guarded(spec, root))
     else:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=_context(),
+        with ProcessPoolExecutor(max_workers=workers, mp_context=pool_context(),
                                  initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
             futures: dict[Future, RunSpec] = {
                 pool.submit(simulate_and_log, s, root): s for s in specs

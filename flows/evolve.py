@@ -82,7 +82,8 @@ def score(params: CampaignRun, new_ids: list[str], version: str,
     campaign = make_campaign(params)
     row = campaign.finish_round(campaign.start(new_ids), new_ids, version, train_s)
     return {"round": row.round, "monitor": row.monitor_version, "records": row.n_records,
-            "simulated_s": row.simulated_s, "metrics": row.metrics}
+            "simulated_s": row.simulated_s,
+            "metrics": row.metrics.as_dict() if row.metrics else None}
 
 
 @flow(name="evoeye-evolve-round", log_prints=True)

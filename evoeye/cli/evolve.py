@@ -8,7 +8,6 @@ adds one typer option per field to a command, so an option is declared once, in
 from __future__ import annotations
 
 import inspect
-import json
 from collections.abc import Callable, Collection
 from functools import wraps
 from pathlib import Path
@@ -78,6 +77,7 @@ def evolve_command(
     from tqdm import tqdm
 
     from evoeye.evolve.campaign.assess import Assessor
+    from evoeye.evolve.campaign.experiment import brief
     from evoeye.evolve.campaign.loop import Campaign
 
     cfg = _config(options)
@@ -93,12 +93,8 @@ def evolve_command(
     bar = tqdm(total=round(cfg.budget_s), desc="evolve", unit="sim s")
 
     def show(row, state) -> None:
-        m = json.loads(row.metrics) if row.metrics else {}
-        t, h = m.get("test", {}), m.get("hard", {})
         bar.write(f"round {row.round}: {len(row.scenario_ids)} runs, {row.simulated_s:.0f}/"
-                  f"{cfg.budget_s:.0f} s, monitor {row.monitor_version} | test F1@0.05 "
-                  f"{t.get('f1@0.05', 0):.3f} AUPRC {t.get('auprc') or 0:.3f} | hard F1@0.05 "
-                  f"{h.get('f1@0.05', 0):.3f}")
+                  f"{cfg.budget_s:.0f} s, monitor {row.monitor_version} | {brief(row.metrics)}")
         bar.update(max(0, min(round(state.spent_s), bar.total) - bar.n))
         bar.set_postfix_str(f"round {row.round}")
 

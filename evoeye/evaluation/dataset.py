@@ -16,12 +16,6 @@ from evoeye.store import RunFilter, SplitSpec, Warehouse, load_windows
 from evoeye.store.selection import Runs
 from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S, Windows
 
-OUTCOMES_SQL = """
-SELECT scenario_id, collided, collision_time_s
-FROM scenarios
-WHERE logical_scenario = $logical_scenario
-"""
-
 
 @dataclass
 class SplitWindows:
@@ -72,7 +66,7 @@ def collision_times(root: Warehouse | DataRoot,
                     logical_scenario: str) -> dict[str, float]:
     """scenario_id → tau_col in s (+inf for runs without a collision)."""
     wh = root if isinstance(root, Warehouse) else Warehouse(root)
-    rows = wh.sql(OUTCOMES_SQL, {"logical_scenario": logical_scenario}).to_pylist()
+    rows = wh.query("run_outcomes", logical_scenario=logical_scenario).to_pylist()
     return {
         r["scenario_id"]: float(r["collision_time_s"])
         if r["collided"] and r["collision_time_s"] is not None else np.inf

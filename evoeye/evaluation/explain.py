@@ -15,7 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from evoeye import __version__
-from evoeye.batch import _context
+from evoeye.batch import pool_context
 from evoeye.paths import DataRoot
 from evoeye.sim.counterfactual import VARIANTS, Explanation, explain_run
 from evoeye.sim.episode import RunSpec
@@ -75,7 +75,7 @@ def _explained(specs: Sequence[RunSpec], workers: int) -> Iterator[Explained]:
     if workers == 1:
         yield from map(explain_one, specs)
         return
-    with ProcessPoolExecutor(max_workers=workers, mp_context=_context()) as pool:
+    with ProcessPoolExecutor(max_workers=workers, mp_context=pool_context()) as pool:
         futures = {pool.submit(explain_one, s): s for s in specs}
         for fut in as_completed(futures):
             try:

@@ -16,12 +16,10 @@ from evoeye.monitor.protocol import Monitor
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse
 
-SCENARIOS_SQL = "SELECT DISTINCT logical_scenario FROM scenarios ORDER BY logical_scenario"
-
 
 def warehouse_scenarios(root: DataRoot) -> list[str]:
     """The logical scenarios that have runs in the warehouse."""
-    return Warehouse(root).sql(SCENARIOS_SQL).column("logical_scenario").to_pylist()
+    return Warehouse(root).query("logical_scenarios").column("logical_scenario").to_pylist()
 
 
 def trained_on(monitor: Monitor) -> str | None:

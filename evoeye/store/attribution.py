@@ -1,7 +1,7 @@
 """Table attribution: counterfactual outcomes of collision runs (`evoeye explain`), append-only.
 
 Layout: `<root>/warehouse/attribution/part-<utc stamp>-<id>.parquet`, columns as declared in
-`schemas/warehouse/attribution.sql`. Like feedback (whose part writer this reuses), a write
+`schemas/warehouse/attribution.sql` (a derived table: `evoeye.store.derived`). A write
 takes the warehouse writer lock, skips every (scenario_id, variant, software_version) already
 stored and writes the rest as one new part, so re-running `explain` adds nothing and a killed
 one resumes with the runs it had not written. Every connection sees the table as the view
@@ -17,7 +17,7 @@ import pyarrow as pa
 
 from evoeye.paths import DataRoot
 from evoeye.store.catalog import write_catalog
-from evoeye.store.feedback import _append, _read
+from evoeye.store.derived import append_part, read_parts
 from evoeye.store.lock import WriterLock
 from evoeye.store.schema import declared_schema
 
@@ -45,9 +45,7 @@ class AttributionRow:
 def read_attribution(root: DataRoot,
                      software_version: str | None = None) -> pa.Table:
     """Rows of attribution (all, or one software version), ordered by run and variant."""
-    return _read(root, ATTRIBUTION_TABLE,
-                 "$version IS NULL OR software_version = $version",
-                 {"version": software_version}, "software_version, scenario_id, variant")
+    return read_parts(root, ATTRIBUTION_TABLE, "attribution_rows", version=software_version)
 
 
 def explained_keys(root: DataRoot,
@@ -72,7 +70,7 @@ def write_attribution(root: DataRoot, rows: Sequence[AttributionRow],
             schema = declared_schema(ATTRIBUTION_TABLE)
             names = [f.name for f in fields(AttributionRow)]
             values = list(zip(*(astuple(r) for r in new.values()), strict=True))
-            _append(root, ATTRIBUTION_TABLE, {
+            append_part(root, ATTRIBUTION_TABLE, {
                 n: pa.array(v, schema.field(n).type) for n, v in zip(names, values, strict=True)
             })
         if refresh_catalog and root.duckdb_file.exists():

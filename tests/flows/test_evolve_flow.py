@@ -67,7 +67,7 @@ def test_evolution_flow_runs_each_round_as_a_flow_run(prefect_server, seeded) ->
     rows = read_rounds(root, out["campaign_id"])
     assert [r.round for r in rows] == [0, 1, 2]
     assert [len(r.scenario_ids) for r in rows] == [0, 3, 3]
-    assert all('"hard"' in r.metrics for r in rows)  # every G_r assessed
+    assert all(r.metrics.hard["frames"] >= 0 for r in rows)  # every G_r assessed
     with get_client(sync_client=True) as client:
         runs = client.read_flow_runs(flow_run_filter=FlowRunFilter(
             name=FlowRunFilterName(any_=["round-1", "round-2"])))

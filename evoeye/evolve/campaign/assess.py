@@ -17,6 +17,7 @@ from evoeye.evaluation.metrics import frame_metrics
 from evoeye.monitor.families import load_calibrated
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse
+from evoeye.store.feedback import RoundMetrics
 from evoeye.store.scores import ScoreRows, read_scores, scored_scenarios, write_scores
 from evoeye.store.sqlfiles import query
 from evoeye.store.windows import DEFAULT_HORIZON_S
@@ -82,13 +83,13 @@ class Assessor:
         return cls(campaign.root, cfg.scenario, campaign.reference, splits=cfg.splits,
                    horizon_s=cfg.horizon_s)
 
-    def __call__(self, version: str) -> dict:
-        """{"test": metrics, "hard": metrics} of `version` at its own thresholds."""
+    def __call__(self, version: str) -> RoundMetrics:
+        """`version` on the Test Set and the Hard Set, at its own thresholds."""
         monitor = load_calibrated(self.root, version)
         scores = monitor.score(self.test.windows)
         labels = self.test.windows.label
-        return {
-            "version": version,
-            "test": metrics_dict(scores, labels, monitor.thresholds),
-            "hard": metrics_dict(scores[self.hard], labels[self.hard], monitor.thresholds),
-        }
+        return RoundMetrics(
+            version,
+            test=metrics_dict(scores, labels, monitor.thresholds),
+            hard=metrics_dict(scores[self.hard], labels[self.hard], monitor.thresholds),
+        )

@@ -11,7 +11,6 @@ charts, `report.py`) goes to `<root>/reports/<name>/`.
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from dataclasses import replace
 
@@ -25,7 +24,7 @@ from evoeye.evolve.search.fitness import CRITICALITY_SCALE_M
 from evoeye.evolve.search.strategies import STRATEGIES
 from evoeye.monitor.families import DEFAULT_FAMILY, evolvable_families, initial_monitor
 from evoeye.paths import DataRoot
-from evoeye.store.feedback import read_rounds
+from evoeye.store.feedback import RoundMetrics, read_rounds
 
 MAIN = ("uniform", "avfuzzer", "evoeye")
 ABLATION = ("no-feedback", "no-density", "aem-evo")
@@ -93,7 +92,7 @@ def collect_results(root: DataRoot, plan: Sequence[CampaignConfig]) -> dict:
         rows = read_rounds(root, c.campaign_id)
         if not rows:
             continue  # not started yet
-        rounds = [json.loads(r.metrics) if r.metrics else None for r in rows]
+        rounds = [r.metrics.as_dict() if r.metrics else None for r in rows]
         res = out.setdefault(cfg.scenario, {"g0": c.reference})
         res.setdefault("initial" if cfg.family == DEFAULT_FAMILY else f"{cfg.family}-initial",
                        rounds[0])
@@ -123,7 +122,7 @@ def run_experiment(root: DataRoot, scenarios: Sequence[str],
         progress(f"{cfg.scenario} {method} seed {cfg.seed}: campaign {c.campaign_id}, "
                  f"budget {cfg.budget_s:.0f} s")
         c.run(on_round=lambda row, st, s=method: progress(
-            f"  {s} round {row.round}: {_brief(row.metrics)}"))
+            f"  {s} round {row.round}: {brief(row.metrics)}"))
     return add_controls(root, plan, collect_results(root, plan), controls, assess, progress)
 
 
@@ -170,17 +169,18 @@ def reseeded_controls(root: DataRoot, cfg: CampaignConfig, k: int,
         version = have.get(seed) or train_monitor(
             root, cfg.scenario, train_runs=ids, val_runs=campaign.val_runs, seed=seed,
             splits=cfg.splits, horizon_s=cfg.horizon_s)
-        out.append(assess(version))
+        out.append(assess(version).as_dict())
     return out
 
 
 
-def _brief(metrics: str) -> str:
-    if not metrics:
+def brief(metrics: RoundMetrics | None) -> str:
+    """A round's metrics in one line ('' if it was not assessed)."""
+    if metrics is None:
         return ""
-    m = json.loads(metrics)
-    return (f"test F1@0.05 {m['test']['f1@0.05']:.3f} AUPRC {m['test']['auprc'] or 0:.3f} | "
-            f"hard F1@0.05 {m['hard']['f1@0.05']:.3f}")
+    t, h = metrics.test, metrics.hard
+    return (f"test F1@0.05 {t['f1@0.05']:.3f} AUPRC {t['auprc'] or 0:.3f} | "
+            f"hard F1@0.05 {h['f1@0.05']:.3f}")
 
 
 NEAR_MISS_M = 1.0  # a collision-free run whose footprints came this close is a near miss

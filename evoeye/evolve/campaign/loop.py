@@ -56,17 +56,16 @@ from evoeye.paths import DataRoot
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
 from evoeye.sim.runner import run_spec
 from evoeye.store import RunFilter, Warehouse, ingest
-from evoeye.store.feedback import FeedbackRows, RoundRow, feedback_of, read_rounds, write_feedback
+from evoeye.store.feedback import (
+    FeedbackRows,
+    RoundMetrics,
+    RoundRow,
+    feedback_of,
+    read_rounds,
+    write_feedback,
+)
 from evoeye.store.feedback import write_round as store_round
 from evoeye.store.log_windows import read_logged_run
-
-INITIAL_RECORDS_SQL = """
-SELECT s.scenario_id, s.params, s.collided, s.min_distance_m, s.duration_s
-FROM scenarios AS s
-JOIN scenario_splits($seed, $train_frac, $val_frac) AS p USING (scenario_id)
-WHERE s.logical_scenario = $scenario AND s.round = 0 AND p.split = 'train' AND s.status = 'ok'
-ORDER BY s.scenario_id
-"""
 
 
 class NoInitialDataError(LookupError):
@@ -96,7 +95,7 @@ class CampaignState:
 
 
 Trainer = Callable[..., str]  # train_monitor's signature
-Assessor = Callable[[str], dict]  # monitor version → metrics (stored with the round, as JSON)
+Assessor = Callable[[str], RoundMetrics]  # monitor version → metrics, stored with the round
 
 
 def run_seed(campaign_seed: int, k: int) -> int:
@@ -122,8 +121,8 @@ class Campaign:
     def initial(self) -> dict[str, np.ndarray]:
         """D_init: the train split of the scenario's round-0 runs, by scenario id."""
         cfg = self.config
-        t = Warehouse(self.root).sql(INITIAL_RECORDS_SQL, {
-            "scenario": cfg.scenario, **asdict(cfg.splits)}).to_pydict()
+        t = Warehouse(self.root).query("initial_records", scenario=cfg.scenario,
+                                       **asdict(cfg.splits)).to_pydict()
         if not t["scenario_id"]:
             raise NoInitialDataError(f"no initial (round 0) training runs of {cfg.scenario!r} in "
                               f"{self.root.warehouse}: simulate and ingest them first")
@@ -173,10 +172,10 @@ class Campaign:
         family = "" if self.config.family == DEFAULT_FAMILY else f"{self.config.family}-"
         return f"evo-{family}{self.config.strategy}-s{self.config.seed}-{digest}"
 
-    def feedback_key(self, version: str) -> str:
-        """The feedback table's monitor_version of f under `version`: the version itself for
-        raw scores, `<version>+prior` for prior-corrected ones (G_0 is shared by campaigns)."""
-        return version if self.config.feedback == "raw" else f"{version}+prior"
+    def stored_feedback(self, version: str) -> dict[str, float]:
+        """scenario_id → f stored under `version` in this campaign's feedback mode (G_0's is
+        shared by every campaign of the mode)."""
+        return feedback_of(self.root, version, self.config.feedback)
 
     def log_path(self, scenario_id: str) -> Path:
         return self.root.run_log(self.config.scenario, self.campaign_id, scenario_id)
@@ -216,7 +215,7 @@ class Campaign:
             records = records.append(np.asarray(meta["params"], float), **_outcome(meta))
             ok.append(meta["status"] == "ok")
         n_init = len(init["scenario_id"])
-        stored = feedback_of(self.root, self.feedback_key(last.monitor_version))
+        stored = self.stored_feedback(last.monitor_version)
         records = records.with_feedback(np.array(
             [stored.get(s, np.nan) for s in records.scenario_id], dtype=float))
         options = {"delta": self.config.delta} if self.config.delta != DEFAULT_DELTA else {}
@@ -289,7 +288,7 @@ class Campaign:
                        self.config.seed, state.round + 1, version, list(new_ids),
                        state.acquired, state.spent_s, train_s, self._metrics(version))
         store_round(self.root, row)
-        stored = feedback_of(self.root, self.feedback_key(version))
+        stored = self.stored_feedback(version)
         state.records = state.records.with_feedback(np.array(
             [stored.get(s, np.nan) for s in state.records.scenario_id], dtype=float))
         state.round, state.monitor = row.round, version
@@ -322,7 +321,7 @@ class Campaign:
     # -- helpers ---------------------------------------------------------------------------------
     def _store_feedback(self, version: str, scenario_ids) -> None:
         """Score ingested runs with `version` and store f (runs already stored are skipped)."""
-        have = feedback_of(self.root, self.feedback_key(version))
+        have = self.stored_feedback(version)
         todo = [str(s) for s in scenario_ids if s not in have]
         if not todo:
             return
@@ -334,12 +333,12 @@ class Campaign:
         ids, feedback = np.asarray(ids, dtype=object), np.asarray(feedback, float)
         keep = np.isfinite(feedback)
         n = np.zeros(len(ids), int) if n_contexts is None else np.asarray(n_contexts)
-        write_feedback(self.root, FeedbackRows(self.config.scenario, self.feedback_key(version),
-                                               ids[keep],
-                                               feedback[keep], n[keep]))
+        write_feedback(self.root, FeedbackRows(self.config.scenario, version,
+                                               self.config.feedback, ids[keep], feedback[keep],
+                                               n[keep]))
 
-    def _metrics(self, version: str) -> str:
-        return json.dumps(self._assess(version)) if self._assess else ""
+    def _metrics(self, version: str) -> RoundMetrics | None:
+        return self._assess(version) if self._assess else None
 
 
 def _outcome(meta: dict) -> dict:

@@ -62,6 +62,7 @@ def snapshot(root: DataRoot, c: Campaign) -> dict:
                     r.simulated_s) for r in rounds],
         "logs": logs,
         "feedback": sorted(zip(fb.column("monitor_version").to_pylist(),
+                               fb.column("feedback_mode").to_pylist(),
                                fb.column("scenario_id").to_pylist(),
                                fb.column("feedback").to_pylist(), strict=True)),
     }
@@ -112,16 +113,17 @@ def test_prior_corrected_feedback_is_stored_apart_and_undoes_pos_weight(root_cop
     g0 = Campaign(root, config(None)).g0
     raw = Campaign(root, config(g0))
     cor = Campaign(root, config(g0, feedback="prior-corrected"))
-    raw.start(), cor.start()  # each scores D_init with G_0 and stores it under its own key
+    raw.start(), cor.start()  # each scores D_init with G_0 and stores it under its own mode
     fb = read_feedback(root)
-    by_key: dict[str, dict] = {}
-    for v, sid, f in zip(fb.column("monitor_version").to_pylist(),
-                         fb.column("scenario_id").to_pylist(),
-                         fb.column("feedback").to_pylist(), strict=True):
-        by_key.setdefault(v, {})[sid] = f
-    assert set(by_key) == {g0, f"{g0}+prior"}
-    ids = sorted(by_key[g0])
-    assert ids == sorted(by_key[f"{g0}+prior"]) and len(ids) > 0
+    by_key: dict[tuple[str, str], dict] = {}
+    for v, mode, sid, f in zip(fb.column("monitor_version").to_pylist(),
+                               fb.column("feedback_mode").to_pylist(),
+                               fb.column("scenario_id").to_pylist(),
+                               fb.column("feedback").to_pylist(), strict=True):
+        by_key.setdefault((v, mode), {})[sid] = f
+    assert set(by_key) == {(g0, "raw"), (g0, "prior-corrected")}
+    ids = sorted(by_key[g0, "raw"])
+    assert ids == sorted(by_key[g0, "prior-corrected"]) and len(ids) > 0
     monitor = raw.monitor(g0)
     w = load_windows(root, ids, context_len=monitor.context_len, horizon_s=3.0)
     pos_weight = monitor.card["hyperparameters"]["pos_weight"]
@@ -130,8 +132,10 @@ def test_prior_corrected_feedback_is_stored_apart_and_undoes_pos_weight(root_cop
     sid = w.scenario_id
     for one in ids[:3]:
         k = sid == one
-        assert by_key[f"{g0}+prior"][one] == pytest.approx(np.abs(p[k] - w.label[k]).mean())
-        assert by_key[g0][one] == pytest.approx(np.abs(monitor.score(w)[k] - w.label[k]).mean())
+        assert by_key[g0, "prior-corrected"][one] == pytest.approx(
+            np.abs(p[k] - w.label[k]).mean())
+        assert by_key[g0, "raw"][one] == pytest.approx(
+            np.abs(monitor.score(w)[k] - w.label[k]).mean())
 
 
 def test_budget_is_never_overspent_and_every_round_is_recorded(root_copy) -> None:
@@ -146,7 +150,8 @@ def test_budget_is_never_overspent_and_every_round_is_recorded(root_copy) -> Non
     assert rows[0].monitor_version == g0 and rows[0].scenario_ids == []
     assert rows[-1].n_records == state.acquired == sum(len(r.scenario_ids) for r in rows)
     # every record carries its feedback under the last monitor
-    last = {s: f for v, s, f in snapshot(root, c)["feedback"] if v == rows[-1].monitor_version}
+    last = {s: f for v, mode, s, f in snapshot(root, c)["feedback"]
+            if (v, mode) == (rows[-1].monitor_version, "raw")}
     assert set(state.records.scenario_id) <= set(last)
     # re-running a finished campaign does nothing
     before = snapshot(root, c)
@@ -269,8 +274,8 @@ def test_assessor_g0_misses_its_whole_hard_set(seeded) -> None:
 
     root, g0 = seeded
     m = Assessor(root, SCENARIO, g0, splits=SPLITS)(g0)
-    assert m["hard"]["recall@0.05"] == 0.0 and m["hard"]["unsafe"] > 0
-    assert m["test"]["frames"] > m["hard"]["frames"]
+    assert m.version == g0 and m.hard["recall@0.05"] == 0.0 and m.hard["unsafe"] > 0
+    assert m.test["frames"] > m.hard["frames"]
 
 
 def test_cli_evolve_prints_the_state_and_round_metrics(root_copy, seeded) -> None:
@@ -312,8 +317,6 @@ def test_cli_evolve_without_a_monitor_is_one_line_naming_evoeye_train(root_copy)
 
 def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_copy,
                                                                          seeded) -> None:
-    import json
-
     from evoeye.evaluation.dataset import load_runs
     from evoeye.evolve.campaign.assess import Assessor
     from evoeye.monitor.families import load_version
@@ -338,12 +341,13 @@ def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_cop
     safe = val.windows.label == 0
     assert (g1.score(val.windows)[safe] > g1.thresholds.at(0.05)).mean() <= 0.05
     # every record's feedback under G_1 is the mean |AEM risk − y| of its frames
-    fb = {s: f for v, s, f in snapshot(root, c)["feedback"] if v == g1.version}
+    fb = {s: f for v, mode, s, f in snapshot(root, c)["feedback"]
+          if (v, mode) == (g1.version, "raw")}
     ids = sorted(fb)[:3]
     w = load_windows(root, ids, context_len=5, horizon_s=3.0)
     risk = g1.score(w)
     for one in ids:
         k = w.scenario_id == one
         assert fb[one] == pytest.approx(np.abs(risk[k] - w.label[k]).mean())
-    hard = json.loads(rows[1].metrics)["hard"]
-    assert hard["frames"] == assess(seeded[1])["hard"]["frames"] > 0
+    hard = rows[1].metrics.hard
+    assert hard["frames"] == assess(seeded[1]).hard["frames"] > 0

@@ -26,9 +26,10 @@ def test_literal_defaults_equal_their_sources() -> None:
     from evoeye.sim.runner import SimConfig
     from evoeye.store.windows import DEFAULT_HORIZON_S
 
-    assert (config.DEFAULT_DELTA, config.DEFAULT_HORIZON_S, config.MAX_RUN_S,
-            config.DEFAULT_FAMILY) == (DEFAULT_DELTA, DEFAULT_HORIZON_S, SimConfig().duration_s,
-                                       DEFAULT_FAMILY)
+    literal = {"delta": config.DEFAULT_DELTA, "horizon_s": config.DEFAULT_HORIZON_S,
+               "max_run_s": config.MAX_RUN_S, "family": config.DEFAULT_FAMILY}
+    assert literal == {"delta": DEFAULT_DELTA, "horizon_s": DEFAULT_HORIZON_S,
+                       "max_run_s": SimConfig().duration_s, "family": DEFAULT_FAMILY}
 
 
 def test_the_config_module_imports_nothing_heavy() -> None:
