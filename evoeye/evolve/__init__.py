@@ -8,6 +8,6 @@
   configuration, the Test / Hard Set assessment, and the RQ2 experiment and report. The flows
   (`flows/evolve.py`, `flows/experiment.py`) run its steps as Prefect tasks.
 
-`.importlinter` checks the split: the search imports nothing of the campaign, the warehouse,
-the logs, the simulator or the monitors.
+`lint-imports` checks the split (the "pure-search" contract in pyproject.toml): the search
+imports nothing of the campaign, the warehouse, the logs, the simulator or the monitors.
 """

@@ -3,47 +3,20 @@
 from __future__ import annotations
 
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from evoeye.batch import plan_uniform, run_batch
 from evoeye.evolve.campaign import loop as campaign_mod
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.loop import Campaign
 from evoeye.paths import DataRoot
-from evoeye.store import SplitSpec, Warehouse, ingest, load_windows
+from evoeye.store import SplitSpec, Warehouse, load_windows
 from evoeye.store.feedback import read_feedback, read_rounds
 from evoeye.store.log_windows import read_logged_run
 
-SCENARIO = "unprotected-intersection"  # ~half its runs collide: both classes in tiny splits
+SCENARIO = "unprotected-intersection"  # of the `seeded` data root (conftest.py)
 SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
-
-
-def seed_root(root: Path, n_runs: int = 16, seed: int = 3) -> tuple[DataRoot, str]:
-    """A data root with n uniform runs ingested and an initial monitor G_0 (1 epoch)."""
-    from evoeye.monitor import train_monitor
-
-    data = DataRoot.resolve(root)
-    run_batch(plan_uniform(SCENARIO, n_runs, seed), data)
-    ingest(data)
-    return data, train_monitor(data, SCENARIO, seed=0, splits=SPLITS, epochs=1)
-
-
-@pytest.fixture(scope="module")
-def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[DataRoot, str]:
-    return seed_root(tmp_path_factory.mktemp("seeded") / "data")
-
-
-@pytest.fixture
-def root_copy(seeded, tmp_path: Path):
-    """A private copy of the seeded root, so each test's campaign starts from the same data."""
-    def make(name: str) -> DataRoot:
-        dst = tmp_path / name
-        shutil.copytree(seeded[0].path, dst)
-        return DataRoot.resolve(dst)
-    return make
 
 
 def config(g0: str, **kw) -> CampaignConfig:
