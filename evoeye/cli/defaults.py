@@ -9,7 +9,6 @@ TARGET_FPRS = (0.05, 0.01)  # evoeye.monitor.protocol.TARGET_FPRS
 RUNS_PER_PART = 32  # evoeye.store.ingest.DEFAULT_RUNS_PER_PART
 BASELINE_NAMES = ("ttc", "ttc-2d", "rss", "rss-2s", "aem",
                   "context-only")  # evoeye.evaluation.monitors.BASELINES
-UPDATE_MODES = ("finetune", "retrain")  # evoeye.evolve.config.UPDATE_MODES
 MODULE_NAMES = ("perception", "prediction", "planning", "control")  # evoeye.monitor.inputs.MODULES
 ABLATION_NAMES = ("perception", "perception+prediction", "perception+prediction+planning",
                   "all")  # evoeye.monitor.inputs.ABLATIONS

@@ -80,7 +80,7 @@ def train_command(
     from evoeye.monitor.train import train_monitor
     from evoeye.store import SplitSpec
 
-    root = DataRoot.existing(root).path
+    data = DataRoot.existing(root)
     console = out()
 
     def progress(row: dict[str, Any]) -> None:
@@ -92,18 +92,18 @@ def train_command(
     extra = {} if weight_decay is None else {"weight_decay": weight_decay}
     try:
         version = train_monitor(
-            root, scenario, context_len=context_len, horizon_s=horizon_s,
+            data, scenario, context_len=context_len, horizon_s=horizon_s,
             modules=parse_modules(modules), dropout=dropout, seed=seed,
             splits=SplitSpec(seed=split_seed), init_from=init_from, epochs=epochs,
             patience=patience, batch_size=batch_size, lr=lr, progress=progress, **extra)
     except ValueError as exc:
         raise UserError(str(exc), "check --scenario, and that `evoeye ingest` has run") from exc
-    card = read_card(root, version)
+    card = read_card(data, version)
     console.print(metrics_table(card))
     t = card["training"]
     console.print(f"best epoch {t['best_epoch']} of {t['epochs_run']}, {t['time_s']:.1f} s, "
                   f"{card['n_parameters']:,} parameters, L = {card['context_len']}")
-    console.print(f"card: {version_dir(root, version) / CARD_FILE}")
+    console.print(f"card: {version_dir(data, version) / CARD_FILE}")
     console.print(f"version: [bold]{version}[/]")
 
 

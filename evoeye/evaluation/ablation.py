@@ -87,9 +87,8 @@ class AblationReport:
             body.append(cells)
         return Table(header, body)
 
-    def write(self, root: DataRoot | str | Path | None, name: str = "ablation") -> Path:
+    def write(self, root: DataRoot, name: str = "ablation") -> Path:
         """Write ablation.md and ablation.json under `<root>/reports/<name>/`; the folder."""
-        root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
         folder = root.path / "reports" / name
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "ablation.md").write_text(self.markdown(), encoding="utf-8")
@@ -109,7 +108,7 @@ class AblationReport:
 
 
 def run_ablation(
-    root: DataRoot | str | Path | None,
+    root: DataRoot,
     scenarios: Sequence[str],
     splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
     *,

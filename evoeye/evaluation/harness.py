@@ -13,7 +13,6 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 
 import numpy as np
 
@@ -114,7 +113,7 @@ def evaluate_monitor(monitor: Monitor, val: SplitWindows, test: SplitWindows, ru
 
 
 def evaluate(
-    root: DataRoot | str | Path | None,
+    root: DataRoot,
     monitors: Iterable[Monitor],
     scenario: str,
     splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
@@ -126,7 +125,6 @@ def evaluate(
     latency: bool = False,
 ) -> EvaluationReport:
     """Calibrate every monitor on val, measure it on test, store its scores (module doc)."""
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
     monitors = list(monitors)
     if not monitors:
         raise ValueError("evaluate needs at least one monitor")

@@ -250,10 +250,9 @@ class ReportFiles:
     json: Path
 
 
-def write_report(root: DataRoot | str | Path | None, reports: list[dict],
+def write_report(root: DataRoot, reports: list[dict],
                  name: str | None = None) -> ReportFiles:
     """Write rq1.md, report.html and report.json under `<root>/reports/<name>/`."""
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
     name = name or f"rq1-{datetime.now(UTC):%Y%m%dT%H%M%SZ}"
     if not name or "/" in name or name.startswith("."):
         raise ValueError(f"report name must be a plain folder name, got {name!r}")

@@ -20,7 +20,6 @@ scratch, with normalisers fitted on the training frames.
 from __future__ import annotations
 
 import copy
-import os
 import time
 from collections.abc import Callable, Sequence
 from contextlib import contextmanager
@@ -169,7 +168,7 @@ def _selections(scenario: str | None, splits: SplitSpec, train_runs: Runs, val_r
 
 
 def train_monitor(
-    root: DataRoot | str | os.PathLike | None = None,
+    root: DataRoot,
     scenario: str | None = None,
     *,
     context_len: int | None = None,
@@ -193,7 +192,6 @@ def train_monitor(
     FusionConfig's) come from the parent when fine-tuning. `overrides` set TrainParams fields
     (epochs=…, lr=…); a full `params` replaces both them and `seed`.
     """
-    root = DataRoot.resolve(root) if not isinstance(root, DataRoot) else root
     params = params or TrainParams(seed=seed, **overrides)
     train_runs, val_runs = _selections(scenario, splits, train_runs, val_runs)
     parent = load_monitor(root, init_from) if init_from else None

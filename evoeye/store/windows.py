@@ -10,7 +10,6 @@ asked for (all at once, or per training batch), so N frames cost N feature rows,
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
-from pathlib import Path
 from typing import TYPE_CHECKING
 
 import numpy as np
@@ -151,7 +150,7 @@ class _WindowsBuilder:
 
 
 def load_windows(
-    root: Warehouse | DataRoot | str | Path | None = None,
+    root: Warehouse | DataRoot,
     runs: Runs = None,
     *,
     context_len: int = DEFAULT_CONTEXT_LEN,

@@ -11,9 +11,10 @@ import pytest
 
 from evoeye.baselines import RSSMonitor, TTCMonitor
 from evoeye.baselines.aem import AEMConfig
+from evoeye.baselines.families import AEM, fit_aem
 from evoeye.evaluation import evaluate
 from evoeye.evaluation.dataset import load_split
-from evoeye.evaluation.monitors import AEM_DIR, baseline_monitors, fit_aem
+from evoeye.evaluation.monitors import baseline_monitors
 from evoeye.evaluation.report import html_report, markdown_report, write_report
 from evoeye.evaluation.rq1 import rq1_report
 from evoeye.store.attribution import AttributionRow, write_attribution
@@ -115,8 +116,8 @@ def test_aem_is_trained_once_and_evaluated(eval_root, splits) -> None:
     first = fit_aem(eval_root, SCENARIO, splits, small)
     again = fit_aem(eval_root, SCENARIO, splits, small)
     assert again.version == first.version
-    assert (eval_root.path / AEM_DIR / first.version / "model.pt").is_file()
-    assert len(list((eval_root.path / AEM_DIR).iterdir())) == 1
+    assert (AEM.version_dir(eval_root, first.version) / "model.pt").is_file()
+    assert len(list(AEM.versions_dir(eval_root).iterdir())) == 1
     rep = evaluate(eval_root, [first], SCENARIO, splits, store_scores=False)
     assert rep.monitors[0].context_len == 5 and rep.monitors[0].scores_written == 0
     assert rep.monitors[0].frame.auroc is not None

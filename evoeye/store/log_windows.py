@@ -1,12 +1,13 @@
-"""Feedback f_r(x) of runs under a monitor: from a fresh run log, or from the warehouse.
+"""A run log's labelled windows straight from its MCAP file: the numpy twin of the warehouse's SQL.
 
-A new record is scored straight from its MCAP log, through the warehouse's own conversion
-(`frames_table` → `frame_features`, eligible frames, contexts and labels as `eligible_frames`,
-`windows.sql` and `frame_labels_h` build them), so it needs no ingest and gives the scores its
-warehouse windows would get: no frame at or after the run's collision enters its feedback.
-Reading the log (not the in-memory Episode) makes a freshly simulated run and one found on disk
-by a resumed campaign go through exactly the same code, so their feedback is bit-identical.
-Runs already ingested (the refresh after a monitor update) are scored from the warehouse.
+The same conversion the warehouse makes, without ingesting: the log's frames as ingest writes
+them (`frames_table` → `frame_features`), then eligible frames, labels and contexts as the
+SQL builds them — `eligible_frames` and `frame_labels_h` (warehouse/views/05_frame_labels.sql)
+and warehouse/queries/windows.sql — so a run's windows are bit-identical to those
+`load_windows` returns once it is ingested (tests/store/test_log_windows.py checks it). The
+evolution campaign scores each freshly simulated run this way: reading the log (not the
+in-memory Episode) makes a new run and one found on disk by a resumed campaign go through the
+same code.
 """
 
 from __future__ import annotations
@@ -18,11 +19,10 @@ from typing import Any
 import numpy as np
 import pyarrow as pa
 
-from evoeye.evolve.feedback import ScenarioFeedback, prior_corrected, scenario_feedback
 from evoeye.log import read_run
 from evoeye.store.features import FEATURES, frame_features
 from evoeye.store.records import frames_table
-from evoeye.store.windows import Windows, load_windows
+from evoeye.store.windows import Windows
 
 LABEL_EPS_S = 1e-6  # as eligible_frames / frame_labels_h: frame times sit on a float 20 Hz grid
 
@@ -91,26 +91,3 @@ def read_logged_run(path: str | Path, context_len: int, horizon_s: float) -> Log
         frames.column("frame").to_numpy().astype(np.int32), t_s, horizon_s, FEATURES, xy,
     )
     return LoggedRun(Path(path), meta, windows)
-
-
-FEEDBACK_MODES = ("raw", "prior-corrected")  # ŷ as the monitor scores it, or σ(logit − log w)
-
-
-def windows_feedback(monitor, windows: Windows, mode: str = "raw") -> ScenarioFeedback:
-    """f_r per run of `windows` under `monitor` (anything with `.score(windows)`); with
-    "prior-corrected", ŷ first undoes the monitor's training pos_weight (card, default 1)."""
-    if mode not in FEEDBACK_MODES:
-        raise ValueError(f"feedback mode must be one of {FEEDBACK_MODES}, got {mode!r}")
-    scores = monitor.score(windows)
-    if mode == "prior-corrected":
-        card = getattr(monitor, "card", None) or {}
-        scores = prior_corrected(scores, card.get("hyperparameters", {}).get("pos_weight") or 1.0)
-    return scenario_feedback(scores, windows.label, windows.scenario_id)
-
-
-def warehouse_feedback(root, monitor, scenario_ids, horizon_s: float,
-                       mode: str = "raw") -> ScenarioFeedback:
-    """f_r of ingested runs, scored from their warehouse windows (the refresh of line 13)."""
-    windows = load_windows(root, list(scenario_ids), context_len=monitor.context_len,
-                           horizon_s=horizon_s)
-    return windows_feedback(monitor, windows, mode)

@@ -9,15 +9,15 @@ fixed validation split when it was trained).
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pyarrow as pa
 
 from evoeye.evaluation.dataset import SplitWindows, load_split
 from evoeye.evaluation.metrics import frame_metrics
+from evoeye.monitor.families import load_calibrated
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse
+from evoeye.store.feedback import RoundMetrics
 from evoeye.store.scores import ScoreRows, read_scores, scored_scenarios, write_scores
 from evoeye.store.sqlfiles import query
 from evoeye.store.windows import DEFAULT_HORIZON_S
@@ -57,14 +57,11 @@ def metrics_dict(scores: np.ndarray, labels: np.ndarray, thresholds) -> dict:
 class Assessor:
     """Scores monitor versions on the Test Set and the Hard Set of G_0 of one scenario."""
 
-    def __init__(self, root: DataRoot | str | Path | None, scenario: str, g0: str, *,
+    def __init__(self, root: DataRoot, scenario: str, g0: str, *,
                  splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen)
                  horizon_s: float = DEFAULT_HORIZON_S) -> None:
-        from evoeye.evolve.families import load_version
-
-        self.root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
-        self._load = load_version
-        monitor = self._load(self.root, g0)
+        self.root = root
+        monitor = load_calibrated(self.root, g0)
         self.test: SplitWindows = load_split(self.root, scenario, "test", splits,
                                              context_len=monitor.context_len,
                                              horizon_s=horizon_s)
@@ -88,13 +85,13 @@ class Assessor:
         return cls(campaign.root, cfg.scenario, campaign.reference, splits=cfg.splits,
                    horizon_s=cfg.horizon_s)
 
-    def __call__(self, version: str) -> dict:
-        """{"test": metrics, "hard": metrics} of `version` at its own thresholds."""
-        monitor = self._load(self.root, version)
+    def __call__(self, version: str) -> RoundMetrics:
+        """`version` on the Test Set and the Hard Set, at its own thresholds."""
+        monitor = load_calibrated(self.root, version)
         scores = monitor.score(self.test.windows)
         labels = self.test.windows.label
-        return {
-            "version": version,
-            "test": metrics_dict(scores, labels, monitor.thresholds),
-            "hard": metrics_dict(scores[self.hard], labels[self.hard], monitor.thresholds),
-        }
+        return RoundMetrics(
+            version,
+            test=metrics_dict(scores, labels, monitor.thresholds),
+            hard=metrics_dict(scores[self.hard], labels[self.hard], monitor.thresholds),
+        )

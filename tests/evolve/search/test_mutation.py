@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from evoeye.evolve import DensityIndex, Records, make_strategy, regional_potential
-from evoeye.evolve.mutation import EPSILON, density_aware_mutation, exploit_probability
+from evoeye.evolve.search import DensityIndex, Records, make_strategy, regional_potential
+from evoeye.evolve.search.mutation import EPSILON, density_aware_mutation, exploit_probability
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
 
 CROSSING = get_scenario("unprotected-intersection")  # 10 parameters

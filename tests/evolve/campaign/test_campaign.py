@@ -3,47 +3,20 @@
 from __future__ import annotations
 
 import shutil
-from pathlib import Path
 
 import numpy as np
 import pytest
 
-from evoeye.batch import plan_uniform, run_batch
-from evoeye.evolve import campaign as campaign_mod
-from evoeye.evolve.campaign import Campaign, CampaignConfig
-from evoeye.evolve.scoring import frame_labels, read_logged_run, run_contexts
+from evoeye.evolve.campaign import loop as campaign_mod
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.loop import Campaign
 from evoeye.paths import DataRoot
-from evoeye.store import SplitSpec, Warehouse, ingest, load_windows
+from evoeye.store import SplitSpec, Warehouse, load_windows
 from evoeye.store.feedback import read_feedback, read_rounds
+from evoeye.store.log_windows import read_logged_run
 
-SCENARIO = "unprotected-intersection"  # ~half its runs collide: both classes in tiny splits
+SCENARIO = "unprotected-intersection"  # of the `seeded` data root (conftest.py)
 SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
-
-
-def seed_root(root: Path, n_runs: int = 16, seed: int = 3) -> tuple[DataRoot, str]:
-    """A data root with n uniform runs ingested and an initial monitor G_0 (1 epoch)."""
-    from evoeye.monitor import train_monitor
-
-    data = DataRoot.resolve(root)
-    run_batch(plan_uniform(SCENARIO, n_runs, seed), data.path)
-    ingest(data)
-    return data, train_monitor(data, SCENARIO, seed=0, splits=SPLITS, epochs=1)
-
-
-@pytest.fixture(scope="module")
-def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
-    data, g0 = seed_root(tmp_path_factory.mktemp("seeded") / "data")
-    return data.path, g0
-
-
-@pytest.fixture
-def root_copy(seeded, tmp_path: Path):
-    """A private copy of the seeded root, so each test's campaign starts from the same data."""
-    def make(name: str) -> DataRoot:
-        dst = tmp_path / name
-        shutil.copytree(seeded[0], dst)
-        return DataRoot.resolve(dst)
-    return make
 
 
 def config(g0: str, **kw) -> CampaignConfig:
@@ -62,6 +35,7 @@ def snapshot(root: DataRoot, c: Campaign) -> dict:
                     r.simulated_s) for r in rounds],
         "logs": logs,
         "feedback": sorted(zip(fb.column("monitor_version").to_pylist(),
+                               fb.column("feedback_mode").to_pylist(),
                                fb.column("scenario_id").to_pylist(),
                                fb.column("feedback").to_pylist(), strict=True)),
     }
@@ -71,7 +45,7 @@ def test_log_windows_equal_the_warehouse_windows(seeded) -> None:
     root, _ = seeded
     sid = Warehouse(root).sql("SELECT scenario_id FROM scenarios WHERE collided LIMIT 1"
                               ).column(0)[0].as_py()
-    log = next(Path(root, "runs").rglob(f"{sid}.mcap"))
+    log = next(root.runs.rglob(f"{sid}.mcap"))
     mine = read_logged_run(log, context_len=5, horizon_s=3.0).windows
     ref = load_windows(root, [sid], context_len=5, horizon_s=3.0)
     assert mine.label.sum() > 0
@@ -79,17 +53,6 @@ def test_log_windows_equal_the_warehouse_windows(seeded) -> None:
     np.testing.assert_array_equal(mine.context_mask, ref.context_mask)
     for name, a in mine.arrays().items():
         np.testing.assert_array_equal(a, ref.arrays()[name], err_msg=name)
-
-
-def test_frame_labels_and_contexts_follow_the_definitions() -> None:
-    t = np.arange(10) * 0.5
-    hit = np.zeros(10, bool)
-    hit[6:] = True  # tau_col = 3.0 s
-    assert frame_labels(t, hit, 1.0).tolist() == [0, 0, 0, 0, 1, 1, 0, 0, 0, 0]
-    assert frame_labels(t, np.zeros(10, bool), 1.0).sum() == 0
-    ctx, mask = run_contexts(3, 2)
-    assert ctx.tolist() == [[0, 0], [0, 1], [1, 2]]
-    assert mask.tolist() == [[False, True], [True, True], [True, True]]
 
 
 def test_config_rejects_unknown_strategy_and_update() -> None:
@@ -117,22 +80,23 @@ def test_campaign_id_is_stable_and_ignores_the_budget(seeded) -> None:
 
 
 def test_prior_corrected_feedback_is_stored_apart_and_undoes_pos_weight(root_copy) -> None:
-    from evoeye.evolve.feedback import prior_corrected
+    from evoeye.evolve.search.feedback import prior_corrected
 
     root = root_copy("prior")
     g0 = Campaign(root, config(None)).g0
     raw = Campaign(root, config(g0))
     cor = Campaign(root, config(g0, feedback="prior-corrected"))
-    raw.start(), cor.start()  # each scores D_init with G_0 and stores it under its own key
+    raw.start(), cor.start()  # each scores D_init with G_0 and stores it under its own mode
     fb = read_feedback(root)
-    by_key: dict[str, dict] = {}
-    for v, sid, f in zip(fb.column("monitor_version").to_pylist(),
-                         fb.column("scenario_id").to_pylist(),
-                         fb.column("feedback").to_pylist(), strict=True):
-        by_key.setdefault(v, {})[sid] = f
-    assert set(by_key) == {g0, f"{g0}+prior"}
-    ids = sorted(by_key[g0])
-    assert ids == sorted(by_key[f"{g0}+prior"]) and len(ids) > 0
+    by_key: dict[tuple[str, str], dict] = {}
+    for v, mode, sid, f in zip(fb.column("monitor_version").to_pylist(),
+                               fb.column("feedback_mode").to_pylist(),
+                               fb.column("scenario_id").to_pylist(),
+                               fb.column("feedback").to_pylist(), strict=True):
+        by_key.setdefault((v, mode), {})[sid] = f
+    assert set(by_key) == {(g0, "raw"), (g0, "prior-corrected")}
+    ids = sorted(by_key[g0, "raw"])
+    assert ids == sorted(by_key[g0, "prior-corrected"]) and len(ids) > 0
     monitor = raw.monitor(g0)
     w = load_windows(root, ids, context_len=monitor.context_len, horizon_s=3.0)
     pos_weight = monitor.card["hyperparameters"]["pos_weight"]
@@ -141,8 +105,10 @@ def test_prior_corrected_feedback_is_stored_apart_and_undoes_pos_weight(root_cop
     sid = w.scenario_id
     for one in ids[:3]:
         k = sid == one
-        assert by_key[f"{g0}+prior"][one] == pytest.approx(np.abs(p[k] - w.label[k]).mean())
-        assert by_key[g0][one] == pytest.approx(np.abs(monitor.score(w)[k] - w.label[k]).mean())
+        assert by_key[g0, "prior-corrected"][one] == pytest.approx(
+            np.abs(p[k] - w.label[k]).mean())
+        assert by_key[g0, "raw"][one] == pytest.approx(
+            np.abs(monitor.score(w)[k] - w.label[k]).mean())
 
 
 def test_budget_is_never_overspent_and_every_round_is_recorded(root_copy) -> None:
@@ -157,7 +123,8 @@ def test_budget_is_never_overspent_and_every_round_is_recorded(root_copy) -> Non
     assert rows[0].monitor_version == g0 and rows[0].scenario_ids == []
     assert rows[-1].n_records == state.acquired == sum(len(r.scenario_ids) for r in rows)
     # every record carries its feedback under the last monitor
-    last = {s: f for v, s, f in snapshot(root, c)["feedback"] if v == rows[-1].monitor_version}
+    last = {s: f for v, mode, s, f in snapshot(root, c)["feedback"]
+            if (v, mode) == (rows[-1].monitor_version, "raw")}
     assert set(state.records.scenario_id) <= set(last)
     # re-running a finished campaign does nothing
     before = snapshot(root, c)
@@ -173,7 +140,7 @@ def clean_runs(seeded, tmp_path_factory: pytest.TempPathFactory):
     def get(strategy: str, family: str = "fusion") -> dict:
         if (strategy, family) not in cache:
             root = DataRoot.resolve(tmp_path_factory.mktemp(f"clean-{strategy}") / "data")
-            shutil.copytree(seeded[0], root.path)
+            shutil.copytree(seeded[0].path, root.path)
             c = Campaign(root, family_config(seeded[1], family, strategy=strategy))
             c.run(max_rounds=2)
             cache[strategy, family] = snapshot(root, c)
@@ -216,7 +183,7 @@ def test_killed_mid_round_resumes_to_the_same_records(root_copy, seeded, clean_r
 @pytest.mark.parametrize("family", ["fusion", "aem"])
 def test_killed_during_training_resumes_to_the_same_records(root_copy, seeded, clean_runs,
                                                             family: str) -> None:
-    from evoeye.evolve.families import trainer_of
+    from evoeye.monitor.families import FAMILIES
 
     cfg = family_config(seeded[1], family, strategy="evoeye")
     calls = {"n": 0}
@@ -225,7 +192,7 @@ def test_killed_during_training_resumes_to_the_same_records(root_copy, seeded, c
         calls["n"] += 1
         if calls["n"] == 2:
             raise RuntimeError("killed mid-training")
-        return trainer_of(family)(*args, **kwargs)
+        return FAMILIES[family].train(*args, **kwargs)
 
     root = root_copy("killed")
     with pytest.raises(RuntimeError, match="mid-training"):
@@ -237,7 +204,7 @@ def test_killed_during_training_resumes_to_the_same_records(root_copy, seeded, c
 def test_hard_set_is_the_missed_unsafe_frames_and_the_safe_frames_of_their_runs(seeded) -> None:
     import pyarrow as pa
 
-    from evoeye.evolve.assess import hard_set
+    from evoeye.evolve.campaign.assess import hard_set
 
     root, _ = seeded
     wh = Warehouse(root)
@@ -276,12 +243,12 @@ def test_hard_set_is_the_missed_unsafe_frames_and_the_safe_frames_of_their_runs(
 
 
 def test_assessor_g0_misses_its_whole_hard_set(seeded) -> None:
-    from evoeye.evolve.assess import Assessor
+    from evoeye.evolve.campaign.assess import Assessor
 
     root, g0 = seeded
     m = Assessor(root, SCENARIO, g0, splits=SPLITS)(g0)
-    assert m["hard"]["recall@0.05"] == 0.0 and m["hard"]["unsafe"] > 0
-    assert m["test"]["frames"] > m["hard"]["frames"]
+    assert m.version == g0 and m.hard["recall@0.05"] == 0.0 and m.hard["unsafe"] > 0
+    assert m.test["frames"] > m.hard["frames"]
 
 
 def test_cli_evolve_prints_the_state_and_round_metrics(root_copy, seeded) -> None:
@@ -323,11 +290,9 @@ def test_cli_evolve_without_a_monitor_is_one_line_naming_evoeye_train(root_copy)
 
 def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_copy,
                                                                          seeded) -> None:
-    import json
-
     from evoeye.evaluation.dataset import load_runs
-    from evoeye.evolve.assess import Assessor
-    from evoeye.evolve.families import load_version
+    from evoeye.evolve.campaign.assess import Assessor
+    from evoeye.monitor.families import load_version
 
     with pytest.raises(ValueError, match="is a fusion monitor, but the campaign evolves the aem"):
         config(seeded[1], family="aem")
@@ -343,18 +308,19 @@ def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_cop
     assert [r.round for r in rows] == [0, 1] and rows[0].monitor_version == g0
     g1 = load_version(root, rows[1].monitor_version)
     assert g1.version != g0 and g1.card["parent"] == g0
-    np.testing.assert_array_equal(g1.aem.mean, load_version(root, g0).aem.mean)  # parent's
+    np.testing.assert_array_equal(g1.mean, load_version(root, g0).mean)  # parent's
     # thresholds calibrated on the (eligible: pre-collision) safe frames of the validation split
     val = load_runs(root, SCENARIO, c.val_runs, "val", horizon_s=3.0)
     safe = val.windows.label == 0
     assert (g1.score(val.windows)[safe] > g1.thresholds.at(0.05)).mean() <= 0.05
     # every record's feedback under G_1 is the mean |AEM risk − y| of its frames
-    fb = {s: f for v, s, f in snapshot(root, c)["feedback"] if v == g1.version}
+    fb = {s: f for v, mode, s, f in snapshot(root, c)["feedback"]
+          if (v, mode) == (g1.version, "raw")}
     ids = sorted(fb)[:3]
     w = load_windows(root, ids, context_len=5, horizon_s=3.0)
     risk = g1.score(w)
     for one in ids:
         k = w.scenario_id == one
         assert fb[one] == pytest.approx(np.abs(risk[k] - w.label[k]).mean())
-    hard = json.loads(rows[1].metrics)["hard"]
-    assert hard["frames"] == assess(seeded[1])["hard"]["frames"] > 0
+    hard = rows[1].metrics.hard
+    assert hard["frames"] == assess(seeded[1]).hard["frames"] > 0

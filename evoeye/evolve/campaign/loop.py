@@ -30,7 +30,7 @@ from __future__ import annotations
 import hashlib
 import json
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass
 from functools import cached_property
 from pathlib import Path
@@ -38,34 +38,38 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.batch import simulate_and_log
-from evoeye.evolve.avfuzzer import criticality
-from evoeye.evolve.config import CampaignConfig
-from evoeye.evolve.families import (
-    NoInitialDataError,
-    initial_aem,
-    initial_monitor,
-    load_version,
-    trainer_of,
-)
-from evoeye.evolve.protocol import Strategy
-from evoeye.evolve.records import Records
-from evoeye.evolve.scoring import read_logged_run, warehouse_feedback, windows_feedback
-from evoeye.evolve.strategies import FEEDBACK_BLIND, make_strategy
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
+from evoeye.evolve.search.fitness import criticality
+from evoeye.evolve.search.protocol import Strategy
+from evoeye.evolve.search.records import Records
+from evoeye.evolve.search.strategies import FEEDBACK_BLIND, make_strategy
 from evoeye.log import read_run
+from evoeye.monitor.families import (
+    DEFAULT_FAMILY,
+    FAMILIES,
+    SavedMonitor,
+    initial_monitor,
+    load_calibrated,
+)
 from evoeye.paths import DataRoot
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
 from evoeye.sim.runner import run_spec
 from evoeye.store import RunFilter, Warehouse, ingest
-from evoeye.store.feedback import FeedbackRows, RoundRow, feedback_of, read_rounds, write_feedback
+from evoeye.store.feedback import (
+    FeedbackRows,
+    RoundMetrics,
+    RoundRow,
+    feedback_of,
+    read_rounds,
+    write_feedback,
+)
 from evoeye.store.feedback import write_round as store_round
+from evoeye.store.log_windows import read_logged_run
 
-INITIAL_RECORDS_SQL = """
-SELECT s.scenario_id, s.params, s.collided, s.min_distance_m, s.duration_s
-FROM scenarios AS s
-JOIN scenario_splits($seed, $train_frac, $val_frac) AS p USING (scenario_id)
-WHERE s.logical_scenario = $scenario AND s.round = 0 AND p.split = 'train' AND s.status = 'ok'
-ORDER BY s.scenario_id
-"""
+
+class NoInitialDataError(LookupError):
+    """A campaign needs the scenario's initial (round 0) runs in the warehouse."""
 
 
 @dataclass
@@ -91,7 +95,7 @@ class CampaignState:
 
 
 Trainer = Callable[..., str]  # train_monitor's signature
-Assessor = Callable[[str], dict]  # monitor version → metrics (stored with the round, as JSON)
+Assessor = Callable[[str], RoundMetrics]  # monitor version → metrics, stored with the round
 
 
 def run_seed(campaign_seed: int, k: int) -> int:
@@ -102,12 +106,13 @@ def run_seed(campaign_seed: int, k: int) -> int:
 class Campaign:
     """One campaign over a data root: `start()` (or resume), then `run_round` until `done`."""
 
-    def __init__(self, root: DataRoot | str | Path | None, config: CampaignConfig, *,
+    def __init__(self, root: DataRoot, config: CampaignConfig, *,
                  train: Trainer | None = None, assess: Assessor | None = None) -> None:
-        self.root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+        self.root = root
         self.config = config
         self.space = get_scenario(config.scenario)
-        self._train = train or trainer_of(config.family)
+        self.family = FAMILIES[config.family]
+        self._train = train or self.family.train
         self._assess = assess
         self._monitors: dict[str, object] = {}
 
@@ -116,8 +121,8 @@ class Campaign:
     def initial(self) -> dict[str, np.ndarray]:
         """D_init: the train split of the scenario's round-0 runs, by scenario id."""
         cfg = self.config
-        t = Warehouse(self.root).sql(INITIAL_RECORDS_SQL, {
-            "scenario": cfg.scenario, **asdict(cfg.splits)}).to_pydict()
+        t = Warehouse(self.root).query("initial_records", scenario=cfg.scenario,
+                                       **asdict(cfg.splits)).to_pydict()
         if not t["scenario_id"]:
             raise NoInitialDataError(f"no initial (round 0) training runs of {cfg.scenario!r} in "
                               f"{self.root.warehouse}: simulate and ingest them first")
@@ -129,16 +134,16 @@ class Campaign:
         cfg = self.config
         if cfg.monitor:
             return cfg.monitor
-        if cfg.family == "aem":
-            return initial_aem(self.root, cfg.scenario, list(self.initial["scenario_id"]),
-                               self.val_runs, cfg.horizon_s)
-        return initial_monitor(self.root, cfg.scenario)
+        return self.family.initial(self.root, cfg.scenario,
+                                   train_runs=list(self.initial["scenario_id"]),
+                                   val_runs=self.val_runs, horizon_s=cfg.horizon_s)
 
     @cached_property
     def reference(self) -> str:
-        """The FusionMonitor G_0 whose Hard Set judges this campaign (G_0 itself, or for AEM-Evo
-        the configured / newest from-scratch FusionMonitor of the scenario)."""
-        if self.config.family == "fusion":
+        """The FusionMonitor G_0 whose Hard Set judges this campaign (G_0 itself, or for another
+        family, e.g. AEM-Evo, the configured / newest from-scratch FusionMonitor of the scenario).
+        """
+        if self.config.family == DEFAULT_FAMILY:
             return self.g0
         return self.config.reference or initial_monitor(self.root, self.config.scenario)
 
@@ -159,30 +164,33 @@ class Campaign:
         # acquires the same runs and trains the same monitors under either mode
         if cfg["feedback"] == "raw" or cfg["strategy"] in FEEDBACK_BLIND:
             cfg.pop("feedback")
-        if cfg["family"] == "fusion":  # likewise
+        if cfg["family"] == DEFAULT_FAMILY:  # likewise
             cfg.pop("family")
         cfg["monitor"] = self.g0
         cfg["initial"] = hashlib.sha256("\n".join(self.initial["scenario_id"]).encode()).hexdigest()
         digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]
-        family = "" if self.config.family == "fusion" else f"{self.config.family}-"
+        family = "" if self.config.family == DEFAULT_FAMILY else f"{self.config.family}-"
         return f"evo-{family}{self.config.strategy}-s{self.config.seed}-{digest}"
 
-    def feedback_key(self, version: str) -> str:
-        """The feedback table's monitor_version of f under `version`: the version itself for
-        raw scores, `<version>+prior` for prior-corrected ones (G_0 is shared by campaigns)."""
-        return version if self.config.feedback == "raw" else f"{version}+prior"
+    def stored_feedback(self, version: str) -> dict[str, float]:
+        """scenario_id → f stored under `version` in this campaign's feedback mode (G_0's is
+        shared by every campaign of the mode)."""
+        return feedback_of(self.root, version, self.config.feedback)
 
     def log_path(self, scenario_id: str) -> Path:
         return self.root.run_log(self.config.scenario, self.campaign_id, scenario_id)
 
-    def monitor(self, version: str):
+    def monitor(self, version: str) -> SavedMonitor:
+        """A version of the campaign's family, with thresholds (loaded once)."""
         if version not in self._monitors:
-            self._monitors[version] = load_version(self.root, version)
+            self._monitors[version] = load_calibrated(self.root, version)
         return self._monitors[version]
 
     # -- state -----------------------------------------------------------------------------------
-    def start(self) -> CampaignState:
-        """The state after the last stored round; round 0 (G_0, D_init scored) is stored first."""
+    def start(self, new_ids: Sequence[str] = ()) -> CampaignState:
+        """The state after the last stored round; round 0 (G_0, D_init scored) is stored first.
+        `new_ids`: runs `acquire` added since, by id (the flow's round tasks pass them on), read
+        back from their logs with their feedback under G_r."""
         rounds = read_rounds(self.root, self.campaign_id)
         if not rounds:
             self._store_feedback(self.g0, self.initial["scenario_id"])
@@ -202,12 +210,12 @@ class Campaign:
             scenario_id=init["scenario_id"],
         )
         ok = [True] * records.n
-        for sid in (s for r in rounds for s in r.scenario_ids):
+        for sid in [*(s for r in rounds for s in r.scenario_ids), *new_ids]:
             meta = read_run(self.log_path(sid), topics=()).metadata
             records = records.append(np.asarray(meta["params"], float), **_outcome(meta))
             ok.append(meta["status"] == "ok")
         n_init = len(init["scenario_id"])
-        stored = feedback_of(self.root, self.feedback_key(last.monitor_version))
+        stored = self.stored_feedback(last.monitor_version)
         records = records.with_feedback(np.array(
             [stored.get(s, np.nan) for s in records.scenario_id], dtype=float))
         options = {"delta": self.config.delta} if self.config.delta != DEFAULT_DELTA else {}
@@ -226,14 +234,15 @@ class Campaign:
 
     # -- one round, in the steps a flow runs as tasks ----------------------------------------------
     def acquire(self, state: CampaignState) -> list[str]:
-        """Lines 5–10, up to N_round times: propose, simulate, score with G_r, add. New ids."""
+        """Lines 5–10, up to N_round times: propose, simulate, score with G_r, add; then store the
+        new runs' f_r. Their ids."""
         cfg, monitor = self.config, self.monitor(state.monitor)
         new: list[str] = []
         while len(new) < cfg.n_round and not self.done(state):
             prop = state.strategy.propose(state.records)
             spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
                             batch=self.campaign_id, source=cfg.strategy, round=state.round + 1)
-            result = simulate_and_log(spec, self.root.path)
+            result = simulate_and_log(spec, self.root)
             if result.status == "error":
                 raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
                                    f"{result.reason}")
@@ -246,6 +255,9 @@ class Campaign:
                 np.asarray(run.metadata["params"], float), feedback=float(fb), **outcome)
             state.ok = np.append(state.ok, run.ok)
             new.append(spec.scenario_id)
+        if new:  # f_r of the new runs, stored now so that a later step can read them by id
+            added = state.records.tail(state.records.n - len(new))
+            self._write_feedback(state.monitor, added.scenario_id, added.feedback)
         return new
 
     def ingest(self):
@@ -269,16 +281,14 @@ class Campaign:
 
     def finish_round(self, state: CampaignState, new_ids: list[str], version: str,
                      train_s: float) -> RoundRow:
-        """Line 13 and the commit: store f_r of the new runs and f_{r+1} of all, then the round."""
-        new = state.records.tail(state.records.n - len(new_ids))
-        self._write_feedback(state.monitor, new.scenario_id, new.feedback)
+        """Line 13 and the commit: store f_{r+1} of every record, then the round."""
         ok_ids = state.records.scenario_id[state.ok]
         self._store_feedback(version, ok_ids)
         row = RoundRow(self.campaign_id, self.config.scenario, self.config.strategy,
                        self.config.seed, state.round + 1, version, list(new_ids),
                        state.acquired, state.spent_s, train_s, self._metrics(version))
         store_round(self.root, row)
-        stored = feedback_of(self.root, self.feedback_key(version))
+        stored = self.stored_feedback(version)
         state.records = state.records.with_feedback(np.array(
             [stored.get(s, np.nan) for s in state.records.scenario_id], dtype=float))
         state.round, state.monitor = row.round, version
@@ -311,7 +321,7 @@ class Campaign:
     # -- helpers ---------------------------------------------------------------------------------
     def _store_feedback(self, version: str, scenario_ids) -> None:
         """Score ingested runs with `version` and store f (runs already stored are skipped)."""
-        have = feedback_of(self.root, self.feedback_key(version))
+        have = self.stored_feedback(version)
         todo = [str(s) for s in scenario_ids if s not in have]
         if not todo:
             return
@@ -323,12 +333,12 @@ class Campaign:
         ids, feedback = np.asarray(ids, dtype=object), np.asarray(feedback, float)
         keep = np.isfinite(feedback)
         n = np.zeros(len(ids), int) if n_contexts is None else np.asarray(n_contexts)
-        write_feedback(self.root, FeedbackRows(self.config.scenario, self.feedback_key(version),
-                                               ids[keep],
-                                               feedback[keep], n[keep]))
+        write_feedback(self.root, FeedbackRows(self.config.scenario, version,
+                                               self.config.feedback, ids[keep], feedback[keep],
+                                               n[keep]))
 
-    def _metrics(self, version: str) -> str:
-        return json.dumps(self._assess(version)) if self._assess else ""
+    def _metrics(self, version: str) -> RoundMetrics | None:
+        return self._assess(version) if self._assess else None
 
 
 def _outcome(meta: dict) -> dict:

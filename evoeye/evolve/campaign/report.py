@@ -17,15 +17,35 @@ import numpy as np
 from evoeye.evaluation.plots import line_chart
 from evoeye.evaluation.report import UNREACHABLE, UNREACHABLE_NOTE
 from evoeye.evaluation.stats import sample_sd
-from evoeye.evolve.experiment import ABLATION, MAIN
+from evoeye.evolve.campaign.experiment import ABLATION, MAIN, methods
+from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.paths import DataRoot
 
 COLUMNS = ("f1@0.05", "f1@0.01", "auroc", "auprc")
 ACQUISITION_HEAD = ("method", "runs", "collisions %", "near misses (< 1 m, no collision) %",
                     "within δ of an earlier record %")
-# a method's starting monitor, when it is not the FusionMonitor G_0: (row label, results key)
-OWN_INITIAL = {"aem-evo": ("AEM (AEM-Evo's G_0)", "aem-initial")}
-TABLES = (("RQ2", MAIN), ("Evolution ablation", ("evoeye",) + ABLATION))
+
+
+def ran(res: dict) -> tuple[str, ...]:
+    """The methods with runs in `res`: the RQ2 ones, the ablations, then any other."""
+    return tuple(m for m in dict.fromkeys(MAIN + ABLATION + tuple(methods())) if res.get(m))
+
+
+def tables(res: dict) -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """(title, methods) of each table: RQ2 (with methods that are neither RQ2 nor ablation),
+    and the evolution ablation."""
+    other = tuple(m for m in ran(res) if m not in MAIN + ABLATION)
+    return ("RQ2", MAIN + other), ("Evolution ablation", ("evoeye",) + ABLATION)
+
+
+def own_initial(method: str) -> tuple[str, str] | None:
+    """(row label, results key) of a method's starting monitor when it is not the FusionMonitor
+    G_0 (a `<family>-evo` method starts from its family's G_0)."""
+    family = methods().get(method, ("", DEFAULT_FAMILY))[1]
+    if family == DEFAULT_FAMILY:
+        return None
+    label = FAMILIES[family].label
+    return f"{label} ({label}-Evo's G_0)", f"{family}-initial"
 
 
 def _value(v: float | None) -> float:
@@ -70,8 +90,8 @@ def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
         rows.append([f"G_0 re-seeded ×{len(res['reseeded'])} (no new data)",
                      *_cells(res["reseeded"])])
     for strategy in strategies:
-        if strategy in OWN_INITIAL and res.get(OWN_INITIAL[strategy][1]):
-            label, key = OWN_INITIAL[strategy]
+        if (own := own_initial(strategy)) and res.get(own[1]):
+            label, key = own
             rows.append([label, *_cells([res[key]])])
         runs = res.get(strategy, [])
         if not runs:  # not part of this experiment
@@ -84,7 +104,7 @@ def acquisition_rows(res: dict) -> list[list[str]]:
     """Per strategy: acquired runs, collision, near-miss and near-record shares (mean ± sample
     SD over seeds)."""
     rows = []
-    for strategy in MAIN + ABLATION:
+    for strategy in ran(res):
         acq = [r["acquisition"] for r in res.get(strategy, []) if r.get("acquisition")]
         if acq:
             runs = np.array([a["runs"] for a in acq], float)
@@ -98,7 +118,7 @@ def acquisition_rows(res: dict) -> list[list[str]]:
 
 
 def _has_unreachable(results: dict) -> bool:
-    return any(UNREACHABLE in cell for res in results.values() for _, strategies in TABLES
+    return any(UNREACHABLE in cell for res in results.values() for _, strategies in tables(res)
                for row in table_rows(res, strategies) for cell in row)
 
 
@@ -108,7 +128,7 @@ def markdown(results: dict) -> str:
     if _has_unreachable(results):
         out += [UNREACHABLE_NOTE, ""]
     for scenario, res in results.items():
-        for title, strategies in TABLES:
+        for title, strategies in tables(res):
             out += [f"## {scenario} — {title} (mean ± sample SD over seeds, %)", "",
                     "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
             out += ["| " + " | ".join(r) + " |" for r in table_rows(res, strategies)]
@@ -123,9 +143,9 @@ def markdown(results: dict) -> str:
 
 def _curves(res: dict, split: str, col: str) -> str:
     series = []
-    ran = {s: res[s] for s in MAIN + ABLATION if res.get(s)}
-    n_max = max((len(r["rounds"]) for runs in ran.values() for r in runs), default=1)
-    for strategy, runs in ran.items():
+    by_method = {s: res[s] for s in ran(res)}
+    n_max = max((len(r["rounds"]) for runs in by_method.values() for r in runs), default=1)
+    for strategy, runs in by_method.items():
         n = min(len(r["rounds"]) for r in runs)
         ys = [float(np.nanmean([_value(r["rounds"][i][split][col]) for r in runs]))
               for i in range(n)]
@@ -158,7 +178,7 @@ def html(results: dict) -> str:
     body = [f"<p>{escape(UNREACHABLE_NOTE)}</p>"] if _has_unreachable(results) else []
     for scenario, res in results.items():
         body.append(f"<h2>{escape(scenario)}</h2>")
-        for title, strategies in TABLES:
+        for title, strategies in tables(res):
             head = ["method"] + [f"{s} {c}" for s in ("Test", "Hard") for c in COLUMNS]
             body.append(f"<h3>{title}</h3>" + _html_table(head, table_rows(res, strategies)))
         body.append("<h3>What each strategy acquired</h3>" + _html_table(
@@ -173,10 +193,9 @@ def html(results: dict) -> str:
             "<body style='font-family:sans-serif'>" + "".join(body) + "</body>")
 
 
-def write_experiment_report(root: DataRoot | str | Path | None, results: dict,
+def write_experiment_report(root: DataRoot, results: dict,
                             name: str | None = None) -> Path:
     """rq2.md, rq2.html and rq2.json under `<root>/reports/<name>/`; the folder."""
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
     folder = root.reports / (name or f"rq2-{datetime.now(UTC):%Y%m%dT%H%M%SZ}")
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "rq2.md").write_text(markdown(results), encoding="utf-8")

@@ -29,27 +29,14 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from evoeye.evolve.protocol import Proposal, StrategyError
-from evoeye.evolve.records import Records
+from evoeye.evolve.search.protocol import Proposal, StrategyError
+from evoeye.evolve.search.records import Records
 from evoeye.scenarios import LogicalScenario
 
-CRITICALITY_SCALE_M = 10.0  # a min ego–actor gap of 10 m or more counts as not critical at all
 MIN_ROULETTE_WEIGHT = 0.001
 
 Batch = tuple[np.ndarray, str]  # (k, dim) scenarios to simulate, and their proposal kind
 Search = Generator[Batch, np.ndarray, None]
-
-
-def criticality(
-    collided: np.ndarray | bool,
-    min_distance_m: np.ndarray | float | None,
-    scale_m: float = CRITICALITY_SCALE_M,
-) -> np.ndarray:
-    """AV-Fuzzer fitness in [0, 1]: min gap / 10 m clipped, 0 for a collision, 1 if unknown."""
-    hit = np.asarray(collided, dtype=bool)
-    gap_m = np.asarray(min_distance_m, dtype=float)  # None (a failed run) becomes NaN
-    fit = np.where(np.isnan(gap_m), 1.0, np.clip(gap_m / scale_m, 0.0, 1.0))
-    return np.where(hit, 0.0, fit)
 
 
 def actor_groups(space: LogicalScenario, exclude: tuple[str, ...] = ()) -> tuple[np.ndarray, ...]:

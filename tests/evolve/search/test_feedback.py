@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from evoeye.evolve import normalise_feedback, scenario_feedback
+from evoeye.evolve.search import normalise_feedback, scenario_feedback
 
 
 def test_feedback_on_a_hand_built_example():
@@ -62,7 +62,7 @@ def test_equal_feedback_normalises_to_zero_instead_of_dividing_by_zero():
 
 
 def test_prior_corrected_undoes_the_weighted_bce_odds_shift() -> None:
-    from evoeye.evolve.feedback import prior_corrected
+    from evoeye.evolve.search.feedback import prior_corrected
 
     p = np.array([0.01, 0.2, 0.5, 0.9])  # true probabilities
     w = 24.0

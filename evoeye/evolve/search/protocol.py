@@ -27,7 +27,7 @@ from typing import Protocol, runtime_checkable
 
 import numpy as np
 
-from evoeye.evolve.records import Records
+from evoeye.evolve.search.records import Records
 
 
 class StrategyError(RuntimeError):

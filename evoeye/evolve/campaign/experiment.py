@@ -1,39 +1,45 @@
 """The RQ2 experiment: G_0 vs every strategy at the same budget, R seeds, Test Set and Hard Set.
 
-A method is a strategy evolving the FusionMonitor, or `aem-evo`: the `evoeye` strategy evolving
-the AEM baseline (paper RQ3), judged on the same Test Set and the FusionMonitor G_0's Hard Set.
+A method is a strategy evolving the FusionMonitor, or `<family>-evo`: the `evoeye` strategy
+evolving another evolvable monitor family, e.g. `aem-evo` for the AEM baseline (paper RQ3),
+judged on the same Test Set and the FusionMonitor G_0's Hard Set.
 Each (scenario, method, seed) is one campaign (resumable, so a killed experiment re-run picks
 up where it stopped); every round's G_r is assessed and stored with the round, so the per-round
 curves come from the campaign_rounds table. The report (Markdown + self-contained HTML with SVG
-charts, `evolve.report`) goes to `<root>/reports/<name>/`.
+charts, `report.py`) goes to `<root>/reports/<name>/`.
 """
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable, Sequence
 from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 from scipy.stats import spearmanr
 
-from evoeye.evolve.assess import Assessor
-from evoeye.evolve.avfuzzer import CRITICALITY_SCALE_M
-from evoeye.evolve.campaign import Campaign, CampaignConfig, CampaignState, initial_monitor
-from evoeye.evolve.strategies import STRATEGIES
+from evoeye.evolve.campaign.assess import Assessor
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.loop import Campaign, CampaignState
+from evoeye.evolve.search.fitness import CRITICALITY_SCALE_M
+from evoeye.evolve.search.strategies import STRATEGIES
+from evoeye.monitor.families import DEFAULT_FAMILY, evolvable_families, initial_monitor
 from evoeye.paths import DataRoot
-from evoeye.store.feedback import read_rounds
+from evoeye.store.feedback import RoundMetrics, read_rounds
 
 MAIN = ("uniform", "avfuzzer", "evoeye")
 ABLATION = ("no-feedback", "no-density", "aem-evo")
-# method → (strategy, monitor family)
-METHODS: dict[str, tuple[str, str]] = {**{s: (s, "fusion") for s in STRATEGIES},
-                                       "aem-evo": ("evoeye", "aem")}
+EVOLVE_OTHER = "evoeye"  # the strategy a `<family>-evo` method runs on another family
+
+
+def methods() -> dict[str, tuple[str, str]]:
+    """Method → (strategy, monitor family): every registered strategy on the FusionMonitor,
+    and `<family>-evo` for every other evolvable family."""
+    return {**{s: (s, DEFAULT_FAMILY) for s in STRATEGIES},
+            **{f"{f}-evo": (EVOLVE_OTHER, f) for f in evolvable_families() if f != DEFAULT_FAMILY}}
 
 
 def method_of(cfg: CampaignConfig) -> str:
-    return "aem-evo" if cfg.family == "aem" else cfg.strategy
+    return cfg.strategy if cfg.family == DEFAULT_FAMILY else f"{cfg.family}-evo"
 
 
 def initial_budget_s(root: DataRoot, scenario: str, base: CampaignConfig) -> float:
@@ -41,7 +47,7 @@ def initial_budget_s(root: DataRoot, scenario: str, base: CampaignConfig) -> flo
     return float(Campaign(root, replace(base, scenario=scenario)).initial["duration_s"].sum())
 
 
-def plan_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str],
+def plan_experiment(root: DataRoot, scenarios: Sequence[str],
                     base: CampaignConfig, *, strategies: Sequence[str] = MAIN + ABLATION,
                     seeds: Sequence[int] = (0, 1, 2),
                     budget_s: float | None = None) -> list[CampaignConfig]:
@@ -51,10 +57,10 @@ def plan_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str]
     None gives each scenario the simulated time of its initial training data. An `aem-evo`
     campaign starts from the AEM trained on D_init and is judged on G_0's Hard Set.
     """
-    root = _root(root)
-    unknown = sorted(set(strategies) - set(METHODS))
+    known = methods()
+    unknown = sorted(set(strategies) - set(known))
     if unknown:
-        raise ValueError(f"unknown method(s) {unknown}; known: {sorted(METHODS)}")
+        raise ValueError(f"unknown method(s) {unknown}; known: {sorted(known)}")
     plan = []
     for scenario in scenarios:
         g0 = (base.monitor if base.scenario == scenario and base.monitor
@@ -62,35 +68,33 @@ def plan_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str]
         budget = initial_budget_s(root, scenario, base) if budget_s is None else budget_s
         for seed in seeds:
             for method in strategies:
-                strategy, family = METHODS[method]
-                own = family == "fusion"
+                strategy, family = known[method]
+                own = family == DEFAULT_FAMILY
                 plan.append(replace(base, scenario=scenario, strategy=strategy, seed=seed,
                                     budget_s=budget, family=family, monitor=g0 if own else None,
                                     reference=None if own else g0))
     return plan
 
 
-def assessors(root: DataRoot | str | Path | None,
+def assessors(root: DataRoot,
               plan: Sequence[CampaignConfig]) -> dict[str, Assessor]:
     """One Test/Hard Set assessor per scenario of the plan, against that scenario's G_0."""
-    root = _root(root)
     first = {c.scenario: c for c in reversed(plan)}  # one each: an Assessor loads the Test Set
     return {scenario: Assessor.of(Campaign(root, c)) for scenario, c in first.items()}
 
 
-def collect_results(root: DataRoot | str | Path | None, plan: Sequence[CampaignConfig]) -> dict:
+def collect_results(root: DataRoot, plan: Sequence[CampaignConfig]) -> dict:
     """{scenario: {"initial": G_0's metrics, "g0", strategy: [per-seed runs]}} from the stored
     rounds of the plan's campaigns (round 0 holds G_0's assessment)."""
-    root = _root(root)
     out: dict = {}
     for cfg in plan:
         c = Campaign(root, cfg)
         rows = read_rounds(root, c.campaign_id)
         if not rows:
             continue  # not started yet
-        rounds = [json.loads(r.metrics) if r.metrics else None for r in rows]
+        rounds = [r.metrics.as_dict() if r.metrics else None for r in rows]
         res = out.setdefault(cfg.scenario, {"g0": c.reference})
-        res.setdefault("initial" if cfg.family == "fusion" else f"{cfg.family}-initial",
+        res.setdefault("initial" if cfg.family == DEFAULT_FAMILY else f"{cfg.family}-initial",
                        rounds[0])
         state = c.start()
         method = method_of(cfg)
@@ -103,13 +107,12 @@ def collect_results(root: DataRoot | str | Path | None, plan: Sequence[CampaignC
     return out
 
 
-def run_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str],
+def run_experiment(root: DataRoot, scenarios: Sequence[str],
                    base: CampaignConfig, *, strategies: Sequence[str] = MAIN + ABLATION,
                    seeds: Sequence[int] = (0, 1, 2), budget_s: float | None = None,
                    controls: int = 3, progress: Callable[[str], None] = print) -> dict:
     """Run (or resume) every campaign of the plan, then `collect_results`, with `controls`
     re-seeded G_0 per scenario."""
-    root = _root(root)
     plan = plan_experiment(root, scenarios, base, strategies=strategies, seeds=seeds,
                            budget_s=budget_s)
     assess = assessors(root, plan)
@@ -119,11 +122,11 @@ def run_experiment(root: DataRoot | str | Path | None, scenarios: Sequence[str],
         progress(f"{cfg.scenario} {method} seed {cfg.seed}: campaign {c.campaign_id}, "
                  f"budget {cfg.budget_s:.0f} s")
         c.run(on_round=lambda row, st, s=method: progress(
-            f"  {s} round {row.round}: {_brief(row.metrics)}"))
+            f"  {s} round {row.round}: {brief(row.metrics)}"))
     return add_controls(root, plan, collect_results(root, plan), controls, assess, progress)
 
 
-def add_controls(root: DataRoot | str | Path | None, plan: Sequence[CampaignConfig],
+def add_controls(root: DataRoot, plan: Sequence[CampaignConfig],
                  results: dict, k: int, assess: dict[str, Assessor] | None = None,
                  progress: Callable[[str], None] | None = None) -> dict:
     """`results` with k re-seeded G_0 controls per scenario under "reseeded"."""
@@ -141,7 +144,7 @@ def add_controls(root: DataRoot | str | Path | None, plan: Sequence[CampaignConf
 CONTROL_SEED = 1000  # training seeds of the re-seeded G_0 controls: 1000, 1001, …
 
 
-def reseeded_controls(root: DataRoot | str | Path | None, cfg: CampaignConfig, k: int,
+def reseeded_controls(root: DataRoot, cfg: CampaignConfig, k: int,
                       assess: Assessor) -> list[dict]:
     """The control without new data: G_0's recipe retrained on D_init with k other seeds.
 
@@ -152,7 +155,6 @@ def reseeded_controls(root: DataRoot | str | Path | None, cfg: CampaignConfig, k
     from evoeye.monitor import list_versions, read_card, train_monitor
     from evoeye.monitor.card import describe_selection
 
-    root = _root(root)
     campaign = Campaign(root, cfg)
     ids = [str(s) for s in campaign.initial["scenario_id"]]
     selection = describe_selection(ids)
@@ -167,20 +169,18 @@ def reseeded_controls(root: DataRoot | str | Path | None, cfg: CampaignConfig, k
         version = have.get(seed) or train_monitor(
             root, cfg.scenario, train_runs=ids, val_runs=campaign.val_runs, seed=seed,
             splits=cfg.splits, horizon_s=cfg.horizon_s)
-        out.append(assess(version))
+        out.append(assess(version).as_dict())
     return out
 
 
-def _root(root: DataRoot | str | Path | None) -> DataRoot:
-    return root if isinstance(root, DataRoot) else DataRoot.resolve(root)
 
-
-def _brief(metrics: str) -> str:
-    if not metrics:
+def brief(metrics: RoundMetrics | None) -> str:
+    """A round's metrics in one line ('' if it was not assessed)."""
+    if metrics is None:
         return ""
-    m = json.loads(metrics)
-    return (f"test F1@0.05 {m['test']['f1@0.05']:.3f} AUPRC {m['test']['auprc'] or 0:.3f} | "
-            f"hard F1@0.05 {m['hard']['f1@0.05']:.3f}")
+    t, h = metrics.test, metrics.hard
+    return (f"test F1@0.05 {t['f1@0.05']:.3f} AUPRC {t['auprc'] or 0:.3f} | "
+            f"hard F1@0.05 {h['f1@0.05']:.3f}")
 
 
 NEAR_MISS_M = 1.0  # a collision-free run whose footprints came this close is a near miss

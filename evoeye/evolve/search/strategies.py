@@ -9,7 +9,7 @@
   removed: the potential of a seed is its own normalised feedback (S_δ(x) shrinks to {x}), so
   p(x) = (f̄(x) + ε) / (max_D f̄ + ε), regardless of how its neighbourhood was explored.
 * `uniform` — uniform samples of X (the paper's Uniform baseline).
-* `avfuzzer` — the GA of DESIGN.md §4, see `evoeye.evolve.avfuzzer`.
+* `avfuzzer` — the GA of DESIGN.md §4, see `evoeye.evolve.search.avfuzzer`.
 
 Proposal k of a density-aware or uniform strategy draws from `default_rng([seed, k])` only, so
 the same seed, counter and records give the same proposal; `replay` just restores the counter.
@@ -22,9 +22,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from evoeye.evolve.avfuzzer import AVFuzzer
-from evoeye.evolve.feedback import normalise_feedback
-from evoeye.evolve.mutation import (
+from evoeye.evolve.search.avfuzzer import AVFuzzer
+from evoeye.evolve.search.feedback import normalise_feedback
+from evoeye.evolve.search.mutation import (
     EPSILON,
     ConstantPotential,
     NeighbourhoodPotential,
@@ -33,8 +33,8 @@ from evoeye.evolve.mutation import (
     density_aware_mutation,
     exploit_probability,
 )
-from evoeye.evolve.protocol import Proposal, Strategy, StrategyError
-from evoeye.evolve.records import Records
+from evoeye.evolve.search.protocol import Proposal, Strategy, StrategyError
+from evoeye.evolve.search.records import Records
 from evoeye.scenarios import DEFAULT_DELTA, LogicalScenario
 
 

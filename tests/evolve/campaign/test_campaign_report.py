@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
-from evoeye.evolve.report import (
+from evoeye.evolve.campaign.report import (
     acquisition_rows,
     html,
     markdown,
     table_rows,
     write_experiment_report,
 )
+from evoeye.paths import DataRoot
 
 
 def _m(f1: float) -> dict:
@@ -89,7 +90,7 @@ def test_report_files_hold_tables_curves_and_map(tmp_path) -> None:
     page = html(RESULTS)
     assert page.count("<svg") == 5  # 4 curves + the blind-spot map
     assert 'data-series="evoeye"' in page
-    folder = write_experiment_report(tmp_path, RESULTS, "t")
+    folder = write_experiment_report(DataRoot.resolve(tmp_path), RESULTS, "t")
     assert {p.name for p in folder.iterdir()} == {"rq2.md", "rq2.html", "rq2.json"}
 
 
@@ -105,8 +106,8 @@ def test_acquisition_counts_runs_within_delta_of_an_earlier_record() -> None:
 
     import numpy as np
 
-    from evoeye.evolve.experiment import acquisition
-    from evoeye.evolve.records import Records
+    from evoeye.evolve.campaign.experiment import acquisition
+    from evoeye.evolve.search.records import Records
     from evoeye.scenarios import get_scenario
 
     space = get_scenario("unprotected-intersection")
@@ -129,7 +130,7 @@ def test_acquisition_counts_runs_within_delta_of_an_earlier_record() -> None:
 def test_map_axes_are_the_parameters_feedback_depends_on_most() -> None:
     import numpy as np
 
-    from evoeye.evolve.experiment import map_axes
+    from evoeye.evolve.campaign.experiment import map_axes
 
     rng = np.random.default_rng(0)
     u = rng.random((200, 6))

@@ -5,8 +5,8 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
-from evoeye.evolve import AVFuzzer, StrategyError, criticality
-from evoeye.evolve.avfuzzer import (
+from evoeye.evolve.search import AVFuzzer, StrategyError, criticality
+from evoeye.evolve.search.avfuzzer import (
     actor_groups,
     crossover,
     mutate,

@@ -3,7 +3,7 @@
 import numpy as np
 import pytest
 
-from evoeye.evolve import (
+from evoeye.evolve.search import (
     STRATEGIES,
     Records,
     Strategy,
@@ -11,7 +11,7 @@ from evoeye.evolve import (
     make_strategy,
     scenario_feedback,
 )
-from evoeye.evolve.mutation import EPSILON
+from evoeye.evolve.search.mutation import EPSILON
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
 
 HIGHWAY = get_scenario("highway-cut-in")
