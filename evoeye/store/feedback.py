@@ -87,7 +87,8 @@ def write_feedback(root: DataRoot, rows: FeedbackRows) -> int:
 class RoundMetrics:
     """G_r on the fixed Test Set and on G_0's Hard Set (`evoeye.evolve.campaign.assess`), stored
     with its round as JSON. Per set: auroc, auprc (None with one class), frames, unsafe, and
-    f1 / recall / precision at each target FPR, keyed `f1@0.05`, …"""
+    f1 / recall / precision at each target FPR, keyed `f1@0.05`, … (None where `reachable@0.05`,
+    … is False: the thresholds could not reach that target)."""
 
     version: str
     test: dict[str, Any]

@@ -17,6 +17,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.stats import spearmanr
 
+from evoeye.evaluation.report import UNREACHABLE
 from evoeye.evolve.campaign.assess import Assessor
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.loop import Campaign, CampaignState
@@ -179,8 +180,13 @@ def brief(metrics: RoundMetrics | None) -> str:
     if metrics is None:
         return ""
     t, h = metrics.test, metrics.hard
-    return (f"test F1@0.05 {t['f1@0.05']:.3f} AUPRC {t['auprc'] or 0:.3f} | "
-            f"hard F1@0.05 {h['f1@0.05']:.3f}")
+    return (f"test F1@0.05 {_f1(t)} AUPRC {t['auprc'] or 0:.3f} | "
+            f"hard F1@0.05 {_f1(h)}")
+
+
+def _f1(split: dict) -> str:
+    """F1 at the first target FPR, or n/r where that target was unreachable (its F1 is None)."""
+    return UNREACHABLE if split["f1@0.05"] is None else f"{split['f1@0.05']:.3f}"
 
 
 NEAR_MISS_M = 1.0  # a collision-free run whose footprints came this close is a near miss

@@ -138,3 +138,14 @@ def test_map_axes_are_the_parameters_feedback_depends_on_most() -> None:
     feedback[:5] = np.nan  # unscored records are ignored
     assert map_axes(u, feedback) == (4, 1)
     assert map_axes(u, np.zeros(200)) == (0, 1)  # no signal: the first two
+
+
+def test_a_round_in_one_line_shows_an_unreachable_f1_as_nr() -> None:
+    from evoeye.evolve.campaign.experiment import brief
+    from evoeye.store.feedback import RoundMetrics
+
+    m = RoundMetrics("fusion-b",
+                     test={"f1@0.05": None, "reachable@0.05": False, "auprc": 0.5},
+                     hard={"f1@0.05": 0.25, "reachable@0.05": True, "auprc": None})
+    assert brief(m) == "test F1@0.05 n/r AUPRC 0.500 | hard F1@0.05 0.250"
+    assert brief(None) == ""
