@@ -153,8 +153,8 @@ def frame_features_table(frames: pa.Table, spec: FeatureSpec = FEATURES) -> pa.T
     columns = pack(frame_features(frames, spec))
     for name in ("scenario_id", "frame", "ingest_id"):
         columns[name] = frames.column(name)
-    schema = file_schema("frame_features")
-    return pa.table([columns[f.name] for f in schema], schema=schema)
+    names = file_schema("frame_features").names  # the DDL's columns, with pack's list types
+    return pa.table([columns[name] for name in names], names=names)
 
 
 TOPIC_ATTRIBUTE = dict(zip(TOPICS, TOPICS._fields, strict=True))  # topic → FrameMessages field
