@@ -114,6 +114,8 @@ class FrameFeatures:
         Runs of consecutive rows in `index` are copied as slices (4× faster than a gather)."""
         if index is None:
             index = np.arange(len(part))
+        if len(index) == 0:
+            return
         breaks = np.flatnonzero(np.diff(index) != 1) + 1
         if len(breaks) > len(index) // MIN_SLICE_ROWS:  # scattered rows: one gather
             for name, arr in part.arrays().items():

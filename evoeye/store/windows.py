@@ -148,8 +148,9 @@ def _gather_features(paths: list[Path], source: np.ndarray, spec: FeatureSpec
             start = int(lo)
             for batch in part.to_batches():
                 take = rows[(rows >= 0) & (rows < batch.num_rows)]
-                features.fill(start, unpack(batch, spec), take)
-                start += len(take)
+                if len(take):
+                    features.fill(start, unpack(batch, spec), take)
+                    start += len(take)
                 rows = rows - batch.num_rows
         offset += part.num_rows
     position = np.empty(len(source), np.int64)

@@ -115,6 +115,15 @@ def test_parts_written_with_nullable_list_items_read_the_same(varied: DataRoot) 
                                   before.context)
 
 
+def test_parts_of_many_row_groups_read_the_same(varied: DataRoot) -> None:
+    """A part read back as several record batches, some holding no selected row."""
+    for path in varied.table_dir("frame_features").rglob("*.parquet"):
+        pq.write_table(pq.read_table(path, partitioning=None), path, row_group_size=2)
+    assert pq.ParquetFile(path).num_row_groups > 2
+    ids = ["r-hit-late", "r-long", "r-one"]
+    assert_same(load_windows(varied, ids, context_len=3), reference(varied, ids, 3, 3.0))
+
+
 def test_a_missing_feature_part_is_named(varied: DataRoot) -> None:
     part = next(varied.table_dir("frame_features").rglob("*.parquet"))
     part.unlink()
