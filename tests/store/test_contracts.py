@@ -27,7 +27,6 @@ from evoeye.store.sqlfiles import query, query_names
 # Sample parameters for every file in warehouse/queries (a new query must be added here).
 QUERY_PARAMS = {
     "committed_runs": {},
-    "count_frames": {},
     "dataset_stats": {"horizon_s": 3.0, "seed": 0, "train_frac": 0.5, "val_frac": 0.125},
     "run_frames": {"scenario_id": "c-0"},
     "select_runs": {
@@ -35,7 +34,8 @@ QUERY_PARAMS = {
         "max_round": None, "collided": None, "status": "ok", "seed": 0, "train_frac": 0.5,
         "val_frac": 0.125,
     },
-    "windows": {"context_len": 5, "horizon_s": 3.0},
+    "windows": {"horizon_s": 3.0},
+    "window_parts": {},
     "collision_runs": {"logical_scenario": None, "batch": None, "software_version": "other",
                        "variants": 5},
     "attribution_shares": {"logical_scenario": "highway-cut-in"},
@@ -144,6 +144,9 @@ def test_every_query_runs(name: str, filled: DataRoot) -> None:
     con = Warehouse(filled).connect()
     try:
         con.register("selected_runs", con.sql("SELECT scenario_id FROM scenarios"))
+        con.register("feature_rows", con.sql(
+            "SELECT scenario_id, frame, ingest_id, row_number() OVER () AS feature_row "
+            "FROM frame_features"))
         con.register("monitor_scores", con.sql(
             "SELECT scenario_id, frame, 'm' AS monitor_version, 0.0 AS score FROM frames"))
         params = dict(QUERY_PARAMS[name])
