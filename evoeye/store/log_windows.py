@@ -1,9 +1,9 @@
 """A run log's labelled windows straight from its MCAP file: the numpy twin of the warehouse's SQL.
 
 The same conversion the warehouse makes, without ingesting: the log's frames as ingest writes
-them (`frames_table` → `frame_features`), then eligible frames, labels and contexts as the
-SQL builds them — `eligible_frames` and `frame_labels_h` (warehouse/views/05_frame_labels.sql)
-and warehouse/queries/windows.sql — so a run's windows are bit-identical to those
+them (`frames_table` → `frame_features`), then eligible frames and labels as the SQL builds them
+(`eligible_frames` and `frame_labels_h`, warehouse/views/05_frame_labels.sql) and the contexts
+by `load_windows`' own `context_rows`, so a run's windows are bit-identical to those
 `load_windows` returns once it is ingested (tests/store/test_log_windows.py checks it). The
 evolution campaign scores each freshly simulated run this way: reading the log (not the
 in-memory Episode) makes a new run and one found on disk by a resumed campaign go through the
@@ -22,7 +22,7 @@ import pyarrow as pa
 from evoeye.log import read_run
 from evoeye.store.features import FEATURES, frame_features
 from evoeye.store.records import frames_table
-from evoeye.store.windows import Windows
+from evoeye.store.windows import Windows, context_rows
 
 LABEL_EPS_S = 1e-6  # as eligible_frames / frame_labels_h: frame times sit on a float 20 Hz grid
 
@@ -62,12 +62,6 @@ def frame_labels(t_s: np.ndarray, collided: np.ndarray, horizon_s: float) -> np.
     return ((lead > LABEL_EPS_S) & (lead <= horizon_s + LABEL_EPS_S)).astype(np.int8)
 
 
-def run_contexts(n_frames: int, context_len: int) -> tuple[np.ndarray, np.ndarray]:
-    """(ctx_row, ctx_mask), both (N, L): frame t−L+1+k clamped to 0, masked where clamped."""
-    k = np.arange(n_frames)[:, None] - context_len + 1 + np.arange(context_len)[None, :]
-    return np.maximum(k, 0).astype(np.int64), k >= 0
-
-
 def read_logged_run(path: str | Path, context_len: int, horizon_s: float) -> LoggedRun:
     """A run log's metadata and its labelled windows, as the warehouse would build them (one per
     eligible frame; None if the run has none)."""
@@ -83,7 +77,7 @@ def read_logged_run(path: str | Path, context_len: int, horizon_s: float) -> Log
     n = frames.num_rows
     if n == 0:
         return LoggedRun(Path(path), meta, None)
-    ctx, mask = run_contexts(n, context_len)
+    ctx, mask = context_rows(np.zeros(n, np.int64), context_len)  # one run, from row 0
     xy = np.stack([frames.column(c).to_numpy(zero_copy_only=False).astype(np.float64)
                    for c in ("loc_x_m", "loc_y_m")], axis=1)  # (N, 2)
     windows = Windows(

@@ -7,7 +7,8 @@ import pytest
 
 from evoeye.paths import DataRoot
 from evoeye.store import ingest, load_windows
-from evoeye.store.log_windows import frame_labels, read_logged_run, run_contexts
+from evoeye.store.log_windows import frame_labels, read_logged_run
+from evoeye.store.windows import context_rows
 
 
 def test_frame_labels_and_contexts_follow_the_definitions() -> None:
@@ -16,7 +17,7 @@ def test_frame_labels_and_contexts_follow_the_definitions() -> None:
     hit[6:] = True  # tau_col = 3.0 s
     assert frame_labels(t, hit, 1.0).tolist() == [0, 0, 0, 0, 1, 1, 0, 0, 0, 0]
     assert frame_labels(t, np.zeros(10, bool), 1.0).sum() == 0
-    ctx, mask = run_contexts(3, 2)
+    ctx, mask = context_rows(np.zeros(3, np.int64), 2)  # one run of 3 frames, L = 2
     assert ctx.tolist() == [[0, 0], [0, 1], [1, 2]]
     assert mask.tolist() == [[False, True], [True, True], [True, True]]
 
