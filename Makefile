@@ -26,7 +26,9 @@ demo: $(STAMP)
 	@echo "make demo: simulate $(N) runs per scenario, ingest, train + evaluate, one evolution round"
 	$(BIN)/python -m flows.demo --root $(ROOT) --n $(N) --workers $(WORKERS)
 
+# the import contracts in pyproject.toml (layers, a pure search, Prefect only in flows/) first
 test: $(STAMP)
+	$(BIN)/lint-imports --no-logo
 	$(BIN)/python -m pytest -q -n 2 --dist loadgroup
 
 bench: $(STAMP)

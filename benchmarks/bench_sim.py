@@ -27,6 +27,7 @@ from highway_env.vehicle.kinematics import Vehicle
 from benchmarks.machine import describe
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.log import write_episode
+from evoeye.paths import DataRoot
 from evoeye.sim.runner import WORLD_BUILDERS, build_world, run_episode
 
 DT_S = 0.05
@@ -89,7 +90,7 @@ def bench_workers(scenario: str, n: int, workers: int) -> float:
     otherwise idle machine to mean anything)."""
     specs = plan_uniform(scenario, n, seed=123, batch=f"w{workers}")
     with tempfile.TemporaryDirectory() as root:
-        return run_batch(specs, root, workers=workers).wall_s
+        return run_batch(specs, DataRoot.resolve(root), workers=workers).wall_s
 
 
 def main() -> None:

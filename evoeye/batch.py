@@ -59,9 +59,9 @@ class RunResult:
     sim_time_s: float = 0.0
 
 
-def simulate_and_log(spec: RunSpec, root: str | Path) -> RunResult:
+def simulate_and_log(spec: RunSpec, root: DataRoot) -> RunResult:
     """Simulate one run and write its log, unless its log already exists. Picklable."""
-    path = DataRoot.at(root).run_log(spec.scenario, spec.batch, spec.scenario_id)
+    path = root.run_log(spec.scenario, spec.batch, spec.scenario_id)
     if path.exists():
         try:
             meta = read_run(path, topics=()).metadata
@@ -79,10 +79,9 @@ def simulate_and_log(spec: RunSpec, root: str | Path) -> RunResult:
                      sim_time_s=o.duration_s)
 
 
-def remove_stale_logs(specs: Sequence[RunSpec], root: str | Path) -> list[Path]:
+def remove_stale_logs(specs: Sequence[RunSpec], root: DataRoot) -> list[Path]:
     """Check every batch name, then remove the `.tmp` logs of dead writers in their folders."""
-    data = DataRoot.at(root)
-    folders = {data.batch_dir(s.scenario, s.batch) for s in specs}
+    folders = {root.batch_dir(s.scenario, s.batch) for s in specs}
     return [p for folder in sorted(folders) for p in remove_stale_temps(folder)]
 
 
@@ -116,13 +115,14 @@ class BatchSummary:
         return sum(r.sim_time_s for r in self.results if not r.skipped)
 
 
-def _context() -> mp.context.BaseContext:
+def pool_context() -> mp.context.BaseContext:
+    """The multiprocessing context worker pools start in."""
     # fork starts workers in milliseconds with highway-env already imported; spawn elsewhere.
     return mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
 
 
 def run_batch(
-    specs: Sequence[RunSpec], root: str | Path, *, workers: int = 1,
+    specs: Sequence[RunSpec], root: DataRoot, *, workers: int = 1,
     progress: Callable[[Iterable], Iterable] | None = None,
 ) -> BatchSummary:
     """Run every spec (in `workers` processes); one broken run never stops the others."""
@@ -135,10 +135,10 @@ def run_batch(
         for spec in wrap(specs):
             summary.results.append(_guarded(spec, root))
     else:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=_context(),
+        with ProcessPoolExecutor(max_workers=workers, mp_context=pool_context(),
                                  initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
             futures: dict[Future, RunSpec] = {
-                pool.submit(simulate_and_log, s, str(root)): s for s in specs
+                pool.submit(simulate_and_log, s, root): s for s in specs
             }
             for fut in wrap(as_completed(futures)):
                 summary.results.append(_result(fut, futures[fut], root))
@@ -147,20 +147,20 @@ def run_batch(
     return summary
 
 
-def _guarded(spec: RunSpec, root: str | Path) -> RunResult:
+def _guarded(spec: RunSpec, root: DataRoot) -> RunResult:
     try:
         return simulate_and_log(spec, root)
     except Exception as exc:  # noqa: BLE001 - reported per run, the batch goes on
         return _error(spec, root, exc)
 
 
-def _result(fut: Future, spec: RunSpec, root: str | Path) -> RunResult:
+def _result(fut: Future, spec: RunSpec, root: DataRoot) -> RunResult:
     try:
         return fut.result()
     except Exception as exc:  # noqa: BLE001 - includes a worker that died
         return _error(spec, root, exc)
 
 
-def _error(spec: RunSpec, root: str | Path, exc: BaseException) -> RunResult:
-    path = DataRoot.at(root).run_log(spec.scenario, spec.batch, spec.scenario_id)
+def _error(spec: RunSpec, root: DataRoot, exc: BaseException) -> RunResult:
+    path = root.run_log(spec.scenario, spec.batch, spec.scenario_id)
     return RunResult(spec.scenario_id, str(path), "error", reason=f"{type(exc).__name__}: {exc}")

@@ -1,5 +1,8 @@
 """Where evoeye keeps its data: one data root, resolved once, with a named folder per stage.
 
+The command line (`evoeye.cli`) and the flows (`flows/`) resolve the root once, from `--root`,
+`$EVOEYE_HOME` or the default; everything inside `evoeye` takes the resolved `DataRoot`.
+
 Layout under the root (default `./evoeye-data`, or `$EVOEYE_HOME`, or `--root`):
 
     runs/<logical_scenario>/<batch>/<scenario_id>.mcap  one MCAP log per run (`*.tmp`: unfinished)
@@ -61,11 +64,6 @@ class DataRoot:
             raise MissingRootError(f"no data root at {data.path}")
         return data
 
-    @classmethod
-    def at(cls, root: str | os.PathLike[str] | None = None) -> DataRoot:
-        """Same as `resolve` (the name the batch runner uses)."""
-        return cls.resolve(root)
-
     @property
     def runs(self) -> Path:
         return self.path / "runs"
@@ -114,8 +112,3 @@ class DataRoot:
     def relative(self, path: Path) -> str:
         """`path` relative to the root, POSIX-style (as stored in the warehouse)."""
         return Path(os.path.abspath(path)).relative_to(self.path).as_posix()
-
-
-def resolve_root(root: str | os.PathLike[str] | None = None) -> Path:
-    """The data root's path (see DataRoot.resolve)."""
-    return DataRoot.resolve(root).path

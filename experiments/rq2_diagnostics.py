@@ -19,10 +19,12 @@ import argparse
 
 import numpy as np
 
-from evoeye.evolve.assess import Assessor
-from evoeye.evolve.campaign import Campaign, CampaignConfig
-from evoeye.evolve.families import load_version
-from evoeye.evolve.feedback import prior_corrected
+from evoeye.evolve.campaign.assess import Assessor
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.experiment import brief
+from evoeye.evolve.campaign.loop import Campaign
+from evoeye.evolve.search.feedback import prior_corrected
+from evoeye.monitor.families import load_version
 from evoeye.paths import DataRoot
 from evoeye.store import RunFilter
 from evoeye.store.windows import load_windows
@@ -83,8 +85,7 @@ def data_value(a: argparse.Namespace) -> None:
         for k in range(a.train_seeds):
             m = assess(train_monitor(a.root, a.scenario, train_runs=ids, val_runs=val,
                                      seed=100 + k))
-            print(f"{strategy} s{seed} train-seed {k}: test F1@0.05 {m['test']['f1@0.05']:.3f} "
-                  f"AUPRC {m['test']['auprc']:.3f} | hard F1@0.05 {m['hard']['f1@0.05']:.3f}",
+            print(f"{strategy} s{seed} train-seed {k}: {brief(m)}",
                   flush=True)
 
 

@@ -39,7 +39,8 @@ def _help(field: Any) -> str:
     extra = field.json_schema_extra if isinstance(field.json_schema_extra, dict) else {}
     choices = f"one of {', '.join(map(str, extra['enum']))}; " if "enum" in extra else ""
     default = field.get_default(call_default_factory=True)
-    return f"{choices}default: {default}"
+    about = f"{field.description} " if field.description else ""
+    return f"{about}({choices}default: {default})"
 
 
 def say_what_we_wait_for() -> None:

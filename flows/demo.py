@@ -1,9 +1,9 @@
 """The main job, small, as one Prefect flow: `python -m flows.demo` (what `make demo` runs).
 
 simulate both logical scenarios → ingest → train the FusionMonitor and evaluate it against the
-TTC / RSS / AEM baselines and the context-only control (RQ1 report) → one evolution round of
-BlindSpotEvolver. With no Prefect API configured, Prefect starts a temporary local server for
-the run; simulation fans out over local processes.
+TTC / TTC-2D / RSS / AEM baselines and the context-only control (RQ1 report) → one evolution
+round of BlindSpotEvolver. With no Prefect API configured, Prefect starts a temporary local
+server for the run; simulation fans out over local processes.
 """
 
 from __future__ import annotations
@@ -38,7 +38,8 @@ class DemoParams(BaseModel):
 @flow(name="evoeye-demo", log_prints=True)
 def demo_flow(params: DemoParams) -> dict[str, Any]:
     """The whole pipeline once, end to end; returns where the results are."""
-    root = str(DataRoot.resolve(params.root).path)
+    data = DataRoot.resolve(params.root)
+    root = str(data.path)  # the sub-flows' parameters: plain, as a user would give them
     for scenario in SCENARIOS:
         simulate_batch_flow(SimulateParams(scenario=scenario, n=params.n, seed=params.seed,
                                            root=root, workers=params.workers, batch="demo"))
@@ -48,9 +49,9 @@ def demo_flow(params: DemoParams) -> dict[str, Any]:
         root=root, scenario=EVOLVE_SCENARIO, strategy="evoeye", n_round=params.evolve_runs,
         budget_s=20.0 * params.evolve_runs, max_rounds=1, epochs=2, assess=True,
     ))
-    data = DataRoot.resolve(root)
     return {"runs": str(data.runs), "warehouse": str(data.warehouse),
-            "monitors": str(data.monitors), "rq1": rq1, "evolution": evolution}
+            "monitors": str(data.monitors), "rq1": rq1, "evolution": evolution,
+            "campaign_rounds": str(data.table_dir("campaign_rounds"))}
 
 
 def main() -> None:
@@ -66,13 +67,12 @@ def main() -> None:
         ap.error(" ".join(str(exc).split()))
     say_what_we_wait_for()
     result = demo_flow(params)
-    data = DataRoot.resolve(args.root)
     print("\nevoeye demo finished. Results:")
     print(f"  MCAP logs (Foxglove / Lichtblick): {result['runs']}")
     print(f"  warehouse (Parquet + DuckDB):      {result['warehouse']}")
     print(f"  trained monitors and cards:        {result['monitors']}")
     print(f"  RQ1 report (Markdown + HTML):      {result['rq1']['report_dir']}")
-    print(f"  evolution round state:             {data.warehouse / 'campaign_rounds'}")
+    print(f"  evolution round state:             {result['campaign_rounds']}")
 
 
 if __name__ == "__main__":

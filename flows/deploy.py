@@ -12,8 +12,6 @@ Each night's flow run resumes the same campaign (its id follows from the paramet
 
 from __future__ import annotations
 
-import argparse
-
 from prefect.client.schemas.objects import ConcurrencyLimitConfig, ConcurrencyLimitStrategy
 from prefect.deployments.runner import RunnerDeployment
 from prefect.schedules import Cron
@@ -23,6 +21,7 @@ from flows.evolve import EvolveParams, evolution_flow
 DEPLOYMENT_NAME = "nightly-evolution"
 NIGHTLY_CRON = "0 2 * * *"  # 02:00 every day
 TIMEZONE = "UTC"
+NIGHTLY_BUDGET_S = 21_600.0  # the whole campaign's simulated seconds, unless --budget-s
 
 
 def nightly_deployment(params: EvolveParams | None = None, *, cron: str = NIGHTLY_CRON,
@@ -45,20 +44,15 @@ def main(argv: list[str] | None = None) -> None:
     """Serve the nightly deployment against the configured Prefect API ($PREFECT_API_URL)."""
     from prefect import serve
 
-    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    ap.add_argument("--root")
-    ap.add_argument("--scenario", default="highway-cut-in")
-    ap.add_argument("--strategy", default="evoeye")
-    ap.add_argument("--budget-s", type=float, default=21_600.0)
-    ap.add_argument("--seed", type=int, default=0)
-    ap.add_argument("--monitor")
-    ap.add_argument("--rounds-per-night", type=int, default=None)
+    from flows.command_line import parser_for
+
+    ap = parser_for(EvolveParams, __doc__.splitlines()[0])
+    ap.add_argument("--rounds-per-night", dest="max_rounds", type=int)
     ap.add_argument("--cron", default=NIGHTLY_CRON)
-    a = ap.parse_args(argv)
-    params = EvolveParams(root=a.root, scenario=a.scenario, strategy=a.strategy,
-                          budget_s=a.budget_s, seed=a.seed, monitor=a.monitor,
-                          max_rounds=a.rounds_per_night, assess=True)
-    serve(nightly_deployment(params, cron=a.cron))
+    given = vars(ap.parse_args(argv))
+    cron = given.pop("cron")
+    params = EvolveParams(**{"budget_s": NIGHTLY_BUDGET_S, "assess": True, **given})
+    serve(nightly_deployment(params, cron=cron))
 
 
 if __name__ == "__main__":

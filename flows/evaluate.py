@@ -15,7 +15,7 @@ from pydantic import BaseModel, Field
 from evoeye.evaluation.monitors import BASELINES
 from evoeye.evaluation.report import markdown_report, write_report
 from evoeye.evaluation.rq1 import rq1, warehouse_scenarios
-from evoeye.paths import resolve_root
+from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 from flows.runners import retry_while_locked
 
@@ -47,7 +47,7 @@ class EvaluateParams(BaseModel):
 
 @task(retries=5, retry_delay_seconds=10, retry_condition_fn=retry_while_locked,
       task_run_name="evaluate-{scenario}")
-def evaluate_scenario(root: str, scenario: str, params: EvaluateParams) -> dict[str, Any]:
+def evaluate_scenario(root: DataRoot, scenario: str, params: EvaluateParams) -> dict[str, Any]:
     """The RQ1 figures of one logical scenario (EvaluationReport as a dict)."""
     (report,) = rq1(root, [scenario], baselines=params.baselines,
                     monitor_versions=params.monitors, fusion=params.train_fusion,
@@ -59,7 +59,7 @@ def evaluate_scenario(root: str, scenario: str, params: EvaluateParams) -> dict[
 def evaluate_flow(params: EvaluateParams | None = None) -> dict[str, Any]:
     """Evaluate every scenario, write the report, publish the RQ1 table as an artifact."""
     params = params or EvaluateParams()
-    root = str(resolve_root(params.root))
+    root = DataRoot.resolve(params.root)
     scenarios = params.scenarios or warehouse_scenarios(root)
     # one after the other: each task writes monitor_scores under the single writer lock
     reports = [evaluate_scenario(root, s, params) for s in scenarios]

@@ -12,10 +12,10 @@ from typing import Any
 
 from prefect import flow, get_run_logger
 from prefect.artifacts import create_markdown_artifact
-from pydantic import BaseModel, Field, ValidationInfo, field_validator
+from pydantic import Field
 
-from evoeye.evolve.config import UPDATE_MODES, CampaignConfig
-from evoeye.evolve.experiment import (
+from evoeye.evolve.campaign.config import CampaignConfig, config_from
+from evoeye.evolve.campaign.experiment import (
     ABLATION,
     MAIN,
     add_controls,
@@ -23,57 +23,50 @@ from evoeye.evolve.experiment import (
     method_of,
     plan_experiment,
 )
-from evoeye.evolve.report import markdown, write_experiment_report
-from evoeye.evolve.scoring import FEEDBACK_MODES
-from evoeye.paths import resolve_root
+from evoeye.evolve.campaign.report import markdown, write_experiment_report
+from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
-from evoeye.store import SplitSpec
-from flows.evolve import EvolveParams, check_known, evolution_flow
+from flows.campaign_params import KnownNames, campaign_model
+from flows.evolve import EvolveParams, evolution_flow
+
+# options the experiment sets per campaign; the others apply to all of its campaigns
+PER_CAMPAIGN = ("scenario", "strategy", "seed", "budget_s", "family", "reference")
 
 
-class ExperimentParams(BaseModel):
+class ExperimentRun(KnownNames):
     """The experiment (defaults: the paper's — both scenarios, 3 seeds, budget = initial data)."""
+
+    names = {"scenarios": "scenario", "strategies": "method"}
 
     root: str | None = None
     scenarios: list[str] = Field(default_factory=lambda: list(SCENARIOS))
-    strategies: list[str] = Field(default_factory=lambda: list(MAIN + ABLATION))
+    strategies: list[str] = Field(default_factory=lambda: list(MAIN + ABLATION))  # methods
     repetitions: int = Field(3, ge=1)
     budget_s: float | None = Field(None, ge=0.0)  # None: simulated time of the initial data
-    n_round: int = Field(20, ge=1)
-    epochs: int | None = Field(None, ge=1)
-    update: str = Field("finetune", json_schema_extra={"enum": list(UPDATE_MODES)})
-    feedback: str = Field("raw", json_schema_extra={"enum": list(FEEDBACK_MODES)})
-    split_seed: int = Field(SplitSpec().seed, ge=0)
-    train_frac: float = Field(SplitSpec().train_frac, ge=0.0, le=1.0)
-    val_frac: float = Field(SplitSpec().val_frac, ge=0.0, le=1.0)
     controls: int = Field(3, ge=0)  # re-seeded G_0 per scenario (no new data)
     report_name: str | None = None
 
-    @field_validator("scenarios", "strategies", "update", "feedback")
-    @classmethod
-    def _known(cls, value: str | list[str], info: ValidationInfo) -> str | list[str]:
-        kind = {"scenarios": "scenario", "strategies": "method"}.get(info.field_name,
-                                                                        info.field_name)
-        check_known(kind, value if isinstance(value, list) else [value])
-        return value
-
     def base(self) -> CampaignConfig:
-        return CampaignConfig(self.scenarios[0], budget_s=self.budget_s or 0.0,
-                              n_round=self.n_round, epochs=self.epochs, update=self.update,
-                              feedback=self.feedback,
-                              splits=SplitSpec(self.split_seed, self.train_frac, self.val_frac))
+        """The options every campaign shares (the first scenario's, whose G_0 `monitor` is)."""
+        return config_from(self.model_dump(exclude={"budget_s"}), scenario=self.scenarios[0],
+                           budget_s=self.budget_s or 0.0)
+
+
+ExperimentParams = campaign_model("ExperimentParams", ExperimentRun, __name__,
+                                  exclude=PER_CAMPAIGN)
 
 
 @flow(name="evoeye-experiment", log_prints=True)
 def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
     """Run (or resume) every campaign, then write and publish the RQ2 report."""
     params = params or ExperimentParams()
-    root = str(resolve_root(params.root))
+    root = DataRoot.resolve(params.root)
     plan = plan_experiment(root, params.scenarios, params.base(), strategies=params.strategies,
                            seeds=range(params.repetitions), budget_s=params.budget_s)
     for cfg in plan:
         name = f"{cfg.scenario}-{method_of(cfg)}-s{cfg.seed}"
-        evolution_flow.with_options(flow_run_name=name)(EvolveParams.of(cfg, root, assess=True))
+        evolution_flow.with_options(flow_run_name=name)(
+            EvolveParams.of(cfg, str(root.path), assess=True))
     results = add_controls(root, plan, collect_results(root, plan), params.controls)
     folder = write_experiment_report(root, results, params.report_name)
     create_markdown_artifact(markdown=markdown(results), key="evoeye-rq2",

@@ -12,7 +12,7 @@ from typing import Any
 from prefect import flow, get_run_logger, task
 from pydantic import BaseModel, Field
 
-from evoeye.paths import resolve_root
+from evoeye.paths import DataRoot
 from evoeye.store import ingest
 from evoeye.store.ingest import DEFAULT_RUNS_PER_PART
 from flows.runners import retry_while_locked
@@ -26,7 +26,7 @@ class IngestParams(BaseModel):
 
 
 @task(retries=5, retry_delay_seconds=10, retry_condition_fn=retry_while_locked)
-def ingest_logs(root: str, runs_per_part: int) -> dict[str, Any]:
+def ingest_logs(root: DataRoot, runs_per_part: int) -> dict[str, Any]:
     """One ingest pass; the IngestReport as a dict."""
     return asdict(ingest(root, runs_per_part=runs_per_part))
 
@@ -35,11 +35,11 @@ def ingest_logs(root: str, runs_per_part: int) -> dict[str, Any]:
 def ingest_flow(params: IngestParams | None = None) -> dict[str, Any]:
     """Ingest the runs of `params.root`; the report names every quarantined log."""
     params = params or IngestParams()
-    root = str(resolve_root(params.root))
+    root = DataRoot.resolve(params.root)
     report = ingest_logs(root, params.runs_per_part)
     logger = get_run_logger()
-    logger.info("%d runs (%d frames) ingested, %d already in, into %s/warehouse",
-                len(report["ingested"]), report["frames"], report["skipped"], root)
+    logger.info("%d runs (%d frames) ingested, %d already in, into %s",
+                len(report["ingested"]), report["frames"], report["skipped"], root.warehouse)
     for log, reason in report["quarantined"]:
         logger.warning("quarantined %s: %s", log, reason)
     if report["catalog_error"]:

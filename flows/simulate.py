@@ -2,13 +2,11 @@
 
 from __future__ import annotations
 
-from pathlib import Path
-
 from prefect import flow, get_run_logger, task
 from pydantic import BaseModel, Field
 
 from evoeye.batch import RunResult, plan_uniform, simulate_and_log
-from evoeye.paths import check_batch_name, resolve_root
+from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import SCENARIOS
 from evoeye.sim.episode import RunSpec
 from flows.runners import task_runner
@@ -34,14 +32,14 @@ class SimulateParams(BaseModel):
 
 
 @task(retries=1, retry_delay_seconds=1, task_run_name="run-{spec.scenario_id}")
-def simulate_run(spec: RunSpec, root: str) -> RunResult:
+def simulate_run(spec: RunSpec, root: DataRoot) -> RunResult:
     """Simulate and log one run (skipped if its log exists): the result names the log file."""
     return simulate_and_log(spec, root)
 
 
 def simulate_batch_flow(params: SimulateParams) -> list[RunResult]:
     """Fan the batch out over the chosen task runner and collect the per-run results."""
-    root = str(resolve_root(params.root))
+    root = DataRoot.resolve(params.root)
     specs = plan_uniform(params.scenario, params.n, params.seed, batch=params.batch)
     runner_flow = simulate_flow.with_options(
         task_runner=task_runner(params.workers, params.dask_address)
@@ -50,7 +48,7 @@ def simulate_batch_flow(params: SimulateParams) -> list[RunResult]:
 
 
 @flow(name="evoeye-simulate", log_prints=True)
-def simulate_flow(specs: list[RunSpec], root: str) -> list[RunResult]:
+def simulate_flow(specs: list[RunSpec], root: DataRoot) -> list[RunResult]:
     """Simulate every spec; the results name each log (`path`) and its outcome."""
     futures = [simulate_run.submit(s, root) for s in specs]
     results = [f.result() for f in futures]
@@ -58,7 +56,7 @@ def simulate_flow(specs: list[RunSpec], root: str) -> list[RunResult]:
     collided = sum(r.collided for r in results)
     failed = [r for r in results if r.status != "ok"]
     logger.info("%d runs, %d collisions, %d failed; logs under %s",
-                len(results), collided, len(failed), Path(root) / "runs")
+                len(results), collided, len(failed), root.runs)
     for r in failed:
         logger.warning("%s %s: %s", r.status, r.scenario_id, r.reason)
     return results

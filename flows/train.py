@@ -11,7 +11,7 @@ from prefect import flow, get_run_logger, task
 from pydantic import BaseModel, Field, field_validator
 
 from evoeye.monitor.inputs import parse_modules
-from evoeye.paths import resolve_root
+from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 
 
@@ -41,7 +41,7 @@ class TrainFlowParams(BaseModel):
 
 
 @task(task_run_name="train-{params.scenario}")
-def train_version(params: TrainFlowParams, root: str) -> str:
+def train_version(params: TrainFlowParams, root: DataRoot) -> str:
     """One training run; the saved version's id."""
     from evoeye.monitor.train import train_monitor
 
@@ -61,7 +61,7 @@ def train_flow(params: TrainFlowParams | None = None) -> dict[str, Any]:
     from evoeye.monitor.registry import CARD_FILE, read_card, version_dir
 
     params = params or TrainFlowParams()
-    root = str(resolve_root(params.root))
+    root = DataRoot.resolve(params.root)
     version = train_version(params, root)
     card = read_card(root, version)
     val = card["metrics"]["val"]

@@ -7,6 +7,7 @@ from typer.testing import CliRunner
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.cli import app
 from evoeye.log import read_run
+from evoeye.paths import DataRoot
 from evoeye.sim import runner
 from evoeye.sim.runner import SimConfig
 
@@ -38,12 +39,12 @@ def test_plan_rejects_bad_sizes():
 
 def test_batch_writes_one_log_per_run_and_rerun_skips_them(tmp_path):
     specs = plan_uniform("highway-cut-in", 3, seed=1)
-    first = run_batch(specs, tmp_path)
+    first = run_batch(specs, DataRoot.resolve(tmp_path))
     assert first.runs == 3 and first.skipped == 0 and first.failures == 0
     logs = sorted((tmp_path / "runs" / "highway-cut-in" / "uniform-seed1").glob("*.mcap"))
     assert [p.stem for p in logs] == sorted(s.scenario_id for s in specs)
     before = {p: p.read_bytes() for p in logs}
-    again = run_batch(specs, tmp_path)
+    again = run_batch(specs, DataRoot.resolve(tmp_path))
     assert again.skipped == 3 and again.simulated_s == 0.0
     assert {p: p.read_bytes() for p in logs} == before
     assert [r.collided for r in again.results] == [r.collided for r in first.results]
@@ -51,11 +52,11 @@ def test_batch_writes_one_log_per_run_and_rerun_skips_them(tmp_path):
 
 def test_killed_batch_resumes_without_duplicates(tmp_path):
     specs = plan_uniform("highway-cut-in", 3, seed=2)
-    run_batch(specs[:1], tmp_path)  # the first run finished before the kill
+    run_batch(specs[:1], DataRoot.resolve(tmp_path))  # the first run finished before the kill
     folder = tmp_path / "runs" / "highway-cut-in" / "uniform-seed2"
     (folder / f"{specs[1].scenario_id}.mcap.tmp").write_bytes(b"half a log")  # killed mid-write
     (folder / f"{specs[2].scenario_id}.mcap").write_bytes(b"\x89MCAP0\r\n garbage")
-    summary = run_batch(specs, tmp_path)
+    summary = run_batch(specs, DataRoot.resolve(tmp_path))
     assert summary.skipped == 1 and summary.failures == 0
     finals = sorted(p.stem for p in folder.glob("*.mcap"))
     assert finals == sorted(s.scenario_id for s in specs)
@@ -65,8 +66,8 @@ def test_killed_batch_resumes_without_duplicates(tmp_path):
 
 def test_the_same_seed_gives_byte_identical_logs(tmp_path):
     specs = plan_uniform("unprotected-intersection", 2, seed=5)
-    run_batch(specs, tmp_path / "a")
-    run_batch(specs, tmp_path / "b", workers=2)
+    run_batch(specs, DataRoot.resolve(tmp_path / "a"))
+    run_batch(specs, DataRoot.resolve(tmp_path / "b"), workers=2)
     for s in specs:
         rel = f"runs/{s.scenario}/{s.batch}/{s.scenario_id}.mcap"
         assert (tmp_path / "a" / rel).read_bytes() == (tmp_path / "b" / rel).read_bytes()
@@ -83,7 +84,7 @@ def test_one_broken_run_does_not_stop_the_batch(tmp_path, monkeypatch):
         return real(params, rng)
 
     monkeypatch.setitem(runner.WORLD_BUILDERS, "highway-cut-in", sometimes_broken)
-    summary = run_batch(specs, tmp_path)
+    summary = run_batch(specs, DataRoot.resolve(tmp_path))
     by_id = {r.scenario_id: r for r in summary.results}
     assert by_id[bad].status == "failed" and "boom" in by_id[bad].reason
     assert summary.failures == 1 and summary.runs == 3

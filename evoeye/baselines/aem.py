@@ -15,13 +15,17 @@ import hashlib
 import io
 import json
 from contextlib import contextmanager
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 import torch
 from torch import nn
 
+from evoeye.monitor.card import thresholds_from_card
+from evoeye.monitor.families import read_version
+from evoeye.monitor.protocol import Thresholds
 from evoeye.store.windows import Windows
 
 INPUT_ARRAYS = (  # (array, mask or None): the FusionMonitor's module inputs
@@ -32,6 +36,7 @@ INPUT_ARRAYS = (  # (array, mask or None): the FusionMonitor's module inputs
     ("control", None),
 )
 CHUNK = 8192  # windows gathered at a time (a window is ~L·350 floats)
+MODEL_FILE, META_FILE = "model.pt", "meta.json"
 
 
 @dataclass(frozen=True)
@@ -91,6 +96,8 @@ class AEMMonitor:
     std: np.ndarray  # (D,)
     error_scale: float  # median reconstruction error on the training windows
     name: str = "aem"
+    thresholds: Thresholds | None = None  # calibrated when a campaign trained it (meta.json)
+    card: dict[str, Any] = field(default_factory=dict)  # meta.json of a saved version
 
     @property
     def context_len(self) -> int:
@@ -122,7 +129,8 @@ class AEMMonitor:
 
     # -- persistence (torch.load(weights_only=True) reads it back) -------------------------------
     def save(self, folder: Path, meta: dict | None = None) -> Path:
-        """Write `<folder>/<version>/model.pt` and `meta.json`; the version folder."""
+        """Write `<folder>/<version>/model.pt` and `meta.json` (with `meta`, and the model's
+        sha256); the version folder."""
         out = Path(folder) / self.version
         out.mkdir(parents=True, exist_ok=True)
         buf = io.BytesIO()
@@ -133,27 +141,16 @@ class AEMMonitor:
             "std": torch.from_numpy(self.std),
             "error_scale": float(self.error_scale),
         }, buf)
-        (out / "model.pt").write_bytes(buf.getvalue())
+        (out / MODEL_FILE).write_bytes(buf.getvalue())
         info = {"version": self.version, "name": self.name, "config": asdict(self.config),
                 "model_sha256": hashlib.sha256(buf.getvalue()).hexdigest()}
-        (out / "meta.json").write_text(json.dumps({**info, **(meta or {})}, indent=2) + "\n")
+        (out / META_FILE).write_text(json.dumps({**info, **(meta or {})}, indent=2) + "\n")
         return out
 
     @classmethod
-    def load(cls, version_dir: Path) -> AEMMonitor:
-        """The AEM saved in `version_dir`, checked against the sha256 in its meta.json (as a
-        FusionMonitor against its card); AEMLoadError if the hash is missing or differs."""
-        model, meta = Path(version_dir) / "model.pt", Path(version_dir) / "meta.json"
-        try:
-            data = model.read_bytes()
-            expected = json.loads(meta.read_text(encoding="utf-8")).get("model_sha256")
-        except (OSError, ValueError) as e:
-            raise AEMLoadError(f"{version_dir}: cannot read the AEM ({e})") from e
-        if not expected:
-            raise AEMLoadError(f"{meta}: no model_sha256, so {model} cannot be checked")
-        if hashlib.sha256(data).hexdigest() != expected:
-            raise AEMLoadError(f"{model}: checkpoint is corrupt or was modified (its sha256 "
-                               "differs from the one in meta.json)")
+    def decode(cls, data: bytes, meta: dict[str, Any]) -> AEMMonitor:
+        """The AEM of checked model.pt bytes (`torch.load(weights_only=True)`) and its meta.json,
+        with the thresholds it records, if any."""
         blob = torch.load(io.BytesIO(data), weights_only=True)
         cfg = dict(blob["config"])
         cfg["hidden"] = tuple(cfg["hidden"])
@@ -161,11 +158,15 @@ class AEMMonitor:
         mean, std = blob["mean"].numpy(), blob["std"].numpy()
         model = AutoEncoder(len(mean), config.hidden, config.latent)
         model.load_state_dict(blob["state_dict"])
-        return cls(config, model, mean, std, float(blob["error_scale"]))
+        thresholds = thresholds_from_card(meta) if "thresholds" in meta else None
+        return cls(config, model, mean, std, float(blob["error_scale"]), thresholds=thresholds,
+                   card=meta)
 
-
-class AEMLoadError(Exception):
-    """A saved AEM that cannot be loaded: unreadable, without a hash, or not matching it."""
+    @classmethod
+    def load(cls, version_dir: Path) -> AEMMonitor:
+        """The AEM saved in `version_dir`, checked against the sha256 in its meta.json (as a
+        FusionMonitor against its card); MonitorLoadError if the hash is missing or differs."""
+        return cls.decode(*read_version(version_dir, MODEL_FILE, META_FILE))
 
 
 @contextmanager

@@ -7,7 +7,7 @@ script. A learned monitor that cannot clearly beat it has learned the script, no
 fails. The classifier is scikit-learn's `HistGradientBoostingClassifier`, without its internal
 validation split (so the same data and config give the same model), run on one OpenMP thread:
 with its default pool on 2 shared cores a 20 K-row fit measured 76 s, on one thread 0.5 s. Saved
-as a pickle whose sha256 is checked against `meta.json` before it is loaded.
+as a pickle whose sha256 is checked against `meta.json` before it is loaded (`read_version`).
 """
 
 from __future__ import annotations
@@ -15,19 +15,22 @@ from __future__ import annotations
 import hashlib
 import json
 import pickle
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
+from typing import Any
 
 import numpy as np
 from sklearn.ensemble import HistGradientBoostingClassifier
 from threadpoolctl import threadpool_limits
 
+from evoeye.monitor.families import read_version
+from evoeye.monitor.protocol import Thresholds
 from evoeye.store.features import CONTROL_FEATURES
 from evoeye.store.windows import Windows
 
 CONTEXT_INPUTS = ("t_s", "ego_speed_mps", "ego_x_m", "ego_y_m")
 SPEED = CONTROL_FEATURES.index("ego_speed_mps")
-MODEL_FILE = "model.pkl"
+MODEL_FILE, META_FILE = "model.pkl", "meta.json"
 THREADS = 1  # OpenMP threads for fit and predict (module doc)
 
 
@@ -60,6 +63,8 @@ class ContextOnlyMonitor:
     data_sha256: str  # of the training inputs and labels: same data and config, same version
     name: str = "context-only"
     context_len: int = 1  # reads only the newest frame of a window
+    thresholds: Thresholds | None = None  # never calibrated when saved: evaluate calibrates
+    card: dict[str, Any] = field(default_factory=dict)  # meta.json of a saved version
 
     @property
     def version(self) -> str:
@@ -82,19 +87,20 @@ class ContextOnlyMonitor:
         info = {"version": self.version, "name": self.name, "inputs": list(CONTEXT_INPUTS),
                 "config": asdict(self.config), "data_sha256": self.data_sha256,
                 "model_sha256": hashlib.sha256(blob).hexdigest()}
-        (out / "meta.json").write_text(json.dumps({**info, **(meta or {})}, indent=2) + "\n")
+        (out / META_FILE).write_text(json.dumps({**info, **(meta or {})}, indent=2) + "\n")
         return out
 
     @classmethod
-    def load(cls, version_dir: Path) -> ContextOnlyMonitor:
-        """The saved monitor; refuses a model file whose sha256 differs from meta.json's."""
-        version_dir = Path(version_dir)
-        meta = json.loads((version_dir / "meta.json").read_text())
-        blob = (version_dir / MODEL_FILE).read_bytes()
-        if hashlib.sha256(blob).hexdigest() != meta["model_sha256"]:
-            raise ValueError(f"{version_dir / MODEL_FILE} does not match its meta.json sha256")
+    def decode(cls, blob: bytes, meta: dict[str, Any]) -> ContextOnlyMonitor:
+        """The monitor of a checked model.pkl and its meta.json."""
         model = pickle.loads(blob)  # noqa: S301 (our own file, checked against its sha256)
-        return cls(ContextConfig(**meta["config"]), model, meta["data_sha256"])
+        return cls(ContextConfig(**meta["config"]), model, meta["data_sha256"], card=meta)
+
+    @classmethod
+    def load(cls, version_dir: Path) -> ContextOnlyMonitor:
+        """The saved monitor; MonitorLoadError for a model file whose sha256 differs from
+        meta.json's."""
+        return cls.decode(*read_version(version_dir, MODEL_FILE, META_FILE))
 
 
 def train_context_only(train: Windows, config: ContextConfig = ContextConfig()  # noqa: B008

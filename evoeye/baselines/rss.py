@@ -12,6 +12,9 @@ speed is v_ego + dvx and its lateral speed dvy. Safe distances come from ad-rss'
 * lateral: `calculateSafeLateralDistance`, the obstacle left or right of the ego (ad-rss counts
   lateral speed positive to the right, so it gets −dvy; the ego's own lateral speed is 0).
 
+Both road users get the same dynamics by default (response time 1 s); CARLA's RSS sensor gives
+the other vehicles 2 s (`CARLA_OTHER_VEHICLES`, the `rss-2s` baseline).
+
 Actual distances are bumper and side gaps; an obstacle within half a lane of the ego's centre
 line is in the ego's lane and overlaps laterally (gap 0), as in a lane-based RSS world model.
 Per axis the criticality is c = s / (s + d) for safe distance s and gap d (0.5 exactly at the
@@ -24,18 +27,25 @@ rounded speeds.
 
 from __future__ import annotations
 
-import hashlib
-import json
 import warnings
 from dataclasses import asdict, dataclass, field, fields
 
 import numpy as np
 
-from evoeye.baselines.ttc import DVX, DX, DY, EGO_LENGTH_M, EGO_WIDTH_M, LENGTH, WIDTH
-from evoeye.store.features import CONTROL_FEATURES, PERCEPTION_FEATURES
+from evoeye.baselines.ttc import (
+    DVX,
+    DVY,
+    DX,
+    DY,
+    EGO_LENGTH_M,
+    EGO_WIDTH_M,
+    LENGTH,
+    WIDTH,
+    rule_version,
+)
+from evoeye.store.features import CONTROL_FEATURES
 from evoeye.store.windows import Windows
 
-DVY = PERCEPTION_FEATURES.index("dvy_mps")
 EGO_SPEED = CONTROL_FEATURES.index("ego_speed_mps")
 LANE_WIDTH_M = 4.0
 
@@ -53,6 +63,9 @@ class RssParams:
     lat_brake_min_mps2: float = 0.8
     lateral_fluctuation_margin_m: float = 0.1
     max_speed_on_acceleration_mps: float = 100.0
+
+
+CARLA_OTHER_VEHICLES = RssParams(response_time_s=2.0)  # CARLA's RssCheck: other vehicles 2 s
 
 
 def _ad_rss():
@@ -164,7 +177,7 @@ class RSSMonitor:
     speed_grid_mps: float = 0.05
     ego_length_m: float = EGO_LENGTH_M
     ego_width_m: float = EGO_WIDTH_M
-    name: str = "rss"
+    name: str = "rss"  # "rss-2s" for the variant with CARLA_OTHER_VEHICLES
     context_len: int = 1
     _cache: dict = field(default_factory=dict, init=False, repr=False, compare=False)
     _lib: AdRss | None = field(default=None, init=False, repr=False, compare=False)
@@ -173,8 +186,7 @@ class RSSMonitor:
     def version(self) -> str:
         cfg = {f.name: getattr(self, f.name) for f in fields(self) if f.init}
         cfg["ego"], cfg["other"] = asdict(self.ego), asdict(self.other)
-        digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()
-        return f"rss-{digest[:10]}"
+        return rule_version("rss", cfg)
 
     def _safe_m(self, kind: int, a_mps: float, b_mps: float) -> float:
         if self._lib is None:

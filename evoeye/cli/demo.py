@@ -11,7 +11,7 @@ from evoeye.cli.defaults import SCENARIO_NAMES
 from evoeye.cli.errors import ExitCode
 from evoeye.cli.output import out
 from evoeye.cli.simulate import RootOpt, failures_code, simulate_batch, summary_table
-from evoeye.cli.warehouse import ingest_command, stats_command
+from evoeye.cli.warehouse import ingest_into, print_stats
 from evoeye.paths import DataRoot
 
 
@@ -32,10 +32,10 @@ def demo(
     out().print(summary_table("evoeye demo: simulate", rows))
     code = failures_code(rows)
     try:
-        ingest_command(root=data.path)
+        ingest_into(data)
     except typer.Exit as partial:
         code = ExitCode(partial.exit_code)
-    stats_command(root=data.path)
+    print_stats(data)
     out().print(f"\nMCAP logs (open in Foxglove or Lichtblick): {data.runs}")
     out().print(f"warehouse (Parquet + DuckDB): {data.warehouse}")
     out().print(f'try: evoeye sql --root {data.path} "SELECT * FROM dataset_stats"')

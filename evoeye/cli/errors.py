@@ -45,13 +45,14 @@ KNOWN_ERRORS: dict[str, str] = {
                                      "`evoeye ingest`, or point --root / EVOEYE_HOME at it",
     "evoeye.paths.BadNameError": "use letters, digits, '.', '_' and '-' only",
     "evoeye.scenarios.space.ScenarioError": "",
-    "evoeye.monitor.registry.MonitorLoadError": "list the versions with `ls <root>/monitors`, "
-                                                "or train one: `evoeye train --scenario NAME`",
-    "evoeye.baselines.aem.AEMLoadError": "remove that AEM folder; the next `evoeye evaluate` "
-                                          "trains it again",
-    "evoeye.evolve.families.NoMonitorError": "train one first: `evoeye train --scenario NAME`, "
-                                             "or name it with --monitor",
-    "evoeye.evolve.families.NoInitialDataError": "simulate and ingest the scenario's initial "
+    "evoeye.monitor.families.MonitorLoadError": "list the versions (`ls <root>/monitors "
+                                                "<root>/baselines/*`), or train one: `evoeye "
+                                                "train --scenario NAME`; a damaged baseline "
+                                                "folder can be removed, `evoeye evaluate` "
+                                                "trains it again",
+    "evoeye.monitor.families.NoMonitorError": "train one first: `evoeye train --scenario NAME`, "
+                                              "or name it with --monitor",
+    "evoeye.evolve.campaign.loop.NoInitialDataError": "simulate and ingest the scenario's initial "
                                                  "runs: `evoeye simulate …`, `evoeye ingest`",
     "evoeye.store.lock.WarehouseLockedError": "wait for the other writer to finish, then run "
                                               "again",

@@ -35,7 +35,7 @@ def evaluate_command(
     monitor: Annotated[list[str] | None, typer.Option(
         "--monitor", help="Trained monitor version to evaluate (repeatable).")] = None,
     baselines: Annotated[str, typer.Option(
-        help="Comma-separated baselines: ttc, rss, aem, context-only ('none' for none).")
+        help=f"Comma-separated baselines: {', '.join(BASELINE_NAMES)} ('none' for none).")
     ] = ",".join(BASELINE_NAMES),
     fusion: Annotated[bool, typer.Option(
         "--train-fusion/--no-train-fusion",
@@ -66,18 +66,18 @@ def evaluate_command(
         splits = SplitSpec(split_seed, train_frac, val_frac)
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from exc
-    root = DataRoot.existing(root).path
+    data = DataRoot.existing(root)
     per_scenario = int(fusion) + int(bool(names)) + 1  # the steps rq1 reports per scenario
     total = per_scenario * len(scenario) if scenario else None
     try:
         with StepBar("evaluate", total=total) as bar:
-            reports = rq1(root, scenario, baselines=names, monitor_versions=monitor or (),
+            reports = rq1(data, scenario, baselines=names, monitor_versions=monitor or (),
                           fusion=fusion, splits=splits, latency=latency, store_scores=store,
                           progress=bar)
     except (ValueError, KeyError, RuntimeError) as exc:
         raise UserError(str(exc).strip("'\""), "check --scenario and --monitor, and that "
                         "`evoeye ingest` has run") from exc
-    files = rq1_report(root, reports, name)
+    files = rq1_report(data, reports, name)
     dicts = [r.to_dict() for r in reports]
     if as_json:
         sys.stdout.write(json.dumps({"reports": dicts, "report_dir": str(files.folder)}) + "\n")

@@ -1,70 +1,86 @@
-"""`evoeye evolve` (one campaign, round by round) and `evoeye experiment` (the RQ2 table)."""
+"""`evoeye evolve` (one campaign, round by round) and `evoeye experiment` (the RQ2 table).
+
+Their campaign options are `CampaignConfig`'s (`campaign_options`): `with_campaign_options`
+adds one typer option per field to a command, so an option is declared once, in
+`evoeye.evolve.campaign.config` (which imports nothing heavy, as `--help` requires).
+"""
 
 from __future__ import annotations
 
-import json
+import inspect
+from collections.abc import Callable, Collection
+from functools import wraps
 from pathlib import Path
-from typing import TYPE_CHECKING, Annotated
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 
 from evoeye.cli.app import app
-from evoeye.cli.defaults import UPDATE_MODES
 from evoeye.cli.output import StepBar
+from evoeye.evolve.campaign.config import campaign_options
 from evoeye.paths import DataRoot
 
 if TYPE_CHECKING:
-    from evoeye.evolve.config import CampaignConfig
+    from evoeye.evolve.campaign.config import CampaignConfig
 
-FEEDBACK_HELP = ("ŷ in f_r = mean |ŷ − y|: raw monitor scores, or prior-corrected "
-                 "(undo the training pos_weight).")
 Root = Annotated[Path | None, typer.Option(
     "--root", help="Data root (default: $EVOEYE_HOME or ./evoeye-data).")]
 
 
-def _config(scenario: str, strategy: str, budget_s: float, seed: int, monitor: str | None,
-            n_round: int, update: str, epochs: int | None, split_seed: int,
-            feedback: str = "raw", family: str = "fusion") -> CampaignConfig:
-    from evoeye.evolve.config import CampaignConfig
-    from evoeye.store import SplitSpec
+def with_campaign_options(exclude: Collection[str] = ()) -> Callable[[Callable], Callable]:
+    """A command taking `options` (the campaign options given, by name) and its own parameters
+    becomes one whose signature has a typer option per campaign option (minus `exclude`)."""
+    def wrap(command: Callable) -> Callable:
+        own = [p for p in inspect.signature(command, eval_str=True).parameters.values()
+               if p.name != "options"]
+        mine = campaign_options(exclude)
+        added = [inspect.Parameter(o.name, inspect.Parameter.KEYWORD_ONLY, default=o.default,
+                                   annotation=Annotated[o.type | None if o.optional else o.type,
+                                                        typer.Option(
+                                                            "--" + o.name.replace("_", "-"),
+                                                            help=o.help, min=o.ge, max=o.le)])
+                 for o in mine]
 
-    if update not in UPDATE_MODES:
-        raise typer.BadParameter(f"--update must be one of {UPDATE_MODES}")
+        @wraps(command)
+        def with_options(**kwargs: Any) -> Any:
+            options = {o.name: kwargs.pop(o.name) for o in mine}
+            return command(options, **kwargs)
+
+        params = [p.replace(kind=inspect.Parameter.KEYWORD_ONLY) for p in own] + added
+        with_options.__signature__ = inspect.Signature(params)  # type: ignore[attr-defined]
+        with_options.__annotations__ = {p.name: p.annotation for p in params}
+        del with_options.__wrapped__  # typer must see the new signature, not the command's
+        return with_options
+    return wrap
+
+
+def _config(options: dict[str, Any], **fixed: Any) -> CampaignConfig:
+    """The CampaignConfig of the options given (typer.BadParameter naming what is wrong)."""
+    from evoeye.evolve.campaign.config import config_from
+
     try:
-        return CampaignConfig(scenario=scenario, strategy=strategy, budget_s=budget_s, seed=seed,
-                              monitor=monitor, n_round=n_round, update=update, epochs=epochs,
-                              splits=SplitSpec(seed=split_seed), feedback=feedback,
-                              family=family)
+        return config_from(options, **fixed)
     except (ValueError, KeyError) as e:
         raise typer.BadParameter(str(e)) from None
 
 
 @app.command("evolve")
+@with_campaign_options()
 def evolve_command(
+    options: dict[str, Any],
     root: Root = None,
-    scenario: Annotated[str, typer.Option("--scenario")] = "highway-cut-in",
-    strategy: Annotated[str, typer.Option("--strategy")] = "evoeye",
-    budget_s: Annotated[float, typer.Option("--budget-s", help="Simulated seconds.")] = 600.0,
-    seed: Annotated[int, typer.Option("--seed")] = 0,
-    monitor: Annotated[str | None, typer.Option("--monitor", help="G_0 version.")] = None,
-    n_round: Annotated[int, typer.Option("--n-round")] = 20,
-    update: Annotated[str, typer.Option("--update", help="finetune | retrain")] = "finetune",
-    epochs: Annotated[int | None, typer.Option("--epochs")] = None,
-    max_rounds: Annotated[int | None, typer.Option("--max-rounds")] = None,
-    split_seed: Annotated[int, typer.Option("--split-seed")] = 0,
-    feedback: Annotated[str, typer.Option("--feedback", help=FEEDBACK_HELP)] = "raw",
-    family: Annotated[str, typer.Option("--family", help="The monitor evolved: fusion, or aem "
-                                        "(AEM-Evo; judged on the FusionMonitor's Hard Set).")
-                      ] = "fusion",
+    max_rounds: Annotated[int | None, typer.Option(
+        "--max-rounds", min=1, help="Rounds in this run (default: until the budget is spent).")
+    ] = None,
 ) -> None:
     """Run (or resume) an evolution campaign; per round, G_r's F1 / AUPRC on the test set."""
     from tqdm import tqdm
 
-    from evoeye.evolve.assess import Assessor
-    from evoeye.evolve.campaign import Campaign
+    from evoeye.evolve.campaign.assess import Assessor
+    from evoeye.evolve.campaign.experiment import brief
+    from evoeye.evolve.campaign.loop import Campaign
 
-    cfg = _config(scenario, strategy, budget_s, seed, monitor, n_round, update, epochs,
-                  split_seed, feedback, family)
+    cfg = _config(options)
     data = DataRoot.existing(root)
     probe = Campaign(data, cfg)
     assess = Assessor.of(probe)
@@ -77,12 +93,8 @@ def evolve_command(
     bar = tqdm(total=round(cfg.budget_s), desc="evolve", unit="sim s")
 
     def show(row, state) -> None:
-        m = json.loads(row.metrics) if row.metrics else {}
-        t, h = m.get("test", {}), m.get("hard", {})
         bar.write(f"round {row.round}: {len(row.scenario_ids)} runs, {row.simulated_s:.0f}/"
-                  f"{cfg.budget_s:.0f} s, monitor {row.monitor_version} | test F1@0.05 "
-                  f"{t.get('f1@0.05', 0):.3f} AUPRC {t.get('auprc') or 0:.3f} | hard F1@0.05 "
-                  f"{h.get('f1@0.05', 0):.3f}")
+                  f"{cfg.budget_s:.0f} s, monitor {row.monitor_version} | {brief(row.metrics)}")
         bar.update(max(0, min(round(state.spent_s), bar.total) - bar.n))
         bar.set_postfix_str(f"round {row.round}")
 
@@ -97,50 +109,49 @@ def evolve_command(
                f"{state.monitor}")
 
 
+# options the experiment sets per campaign (its own --scenario, --strategy, --budget-s, seeds)
+PER_CAMPAIGN = ("scenario", "strategy", "seed", "budget_s", "family", "reference")
+
+
 @app.command("experiment")
+@with_campaign_options(exclude=PER_CAMPAIGN)
 def experiment_command(
+    options: dict[str, Any],
     root: Root = None,
-    scenario: Annotated[list[str] | None, typer.Option("--scenario")] = None,
+    scenario: Annotated[list[str] | None, typer.Option(
+        "--scenario", help="Logical scenarios (repeatable; default: both). The first one's G_0 "
+        "is --monitor.")] = None,
     budget_s: Annotated[float | None, typer.Option(
-        "--budget-s", help="Simulated seconds per campaign (default: the simulated time of the "
-        "scenario's initial training data, as in the paper).")] = None,
-    repetitions: Annotated[int, typer.Option("--repetitions", "-r")] = 3,
-    n_round: Annotated[int, typer.Option("--n-round")] = 20,
-    epochs: Annotated[int | None, typer.Option("--epochs")] = None,
-    update: Annotated[str, typer.Option(
-        "--update", help="Monitor update per round: finetune (from G_r) or retrain.")] = "finetune",
-    monitor: Annotated[str | None, typer.Option(
-        "--monitor", help="G_0 of the first --scenario (default: its newest monitor trained "
-        "from scratch).")] = None,
-    feedback: Annotated[str, typer.Option("--feedback", help=FEEDBACK_HELP)] = "raw",
+        "--budget-s", min=0.0, help="Simulated seconds per campaign (default: the simulated "
+        "time of the scenario's initial training data, as in the paper).")] = None,
+    repetitions: Annotated[int, typer.Option("--repetitions", "-r", min=1)] = 3,
     controls: Annotated[int, typer.Option(
         "--controls", min=0, help="G_0 retrained on the initial data with this many other "
         "seeds: the Hard-Set score a new model gets without new data.")] = 3,
     ablation: Annotated[bool, typer.Option("--ablation/--no-ablation")] = True,
     strategy: Annotated[list[str] | None, typer.Option(
-        "--strategy", help="Run only these methods (repeatable): a strategy, or aem-evo "
-        "(evoeye evolving the AEM baseline); default: the RQ2 ones, plus the ablations "
-        "(no-feedback, no-density, aem-evo) unless --no-ablation.")] = None,
+        "--strategy", help="Run only these methods (repeatable): a strategy, or <family>-evo "
+        "(evoeye evolving another monitor family, e.g. aem-evo); default: the RQ2 ones, plus "
+        "the ablations (no-feedback, no-density, aem-evo) unless --no-ablation.")] = None,
     name: Annotated[str | None, typer.Option("--name", help="Report folder name.")] = None,
 ) -> None:
     """The RQ2 table (+ evolution ablation): G_0 vs uniform / avfuzzer / evoeye, R seeds."""
-    from evoeye.evolve.experiment import ABLATION, MAIN, METHODS, run_experiment
-    from evoeye.evolve.report import write_experiment_report
+    from evoeye.evolve.campaign.config import check_known
+    from evoeye.evolve.campaign.experiment import ABLATION, MAIN, run_experiment
+    from evoeye.evolve.campaign.report import write_experiment_report
 
-    root = DataRoot.existing(root).path
+    data = DataRoot.existing(root)
     scenarios = scenario or ["highway-cut-in", "unprotected-intersection"]
-    unknown = sorted(set(strategy or ()) - set(METHODS))
-    if unknown:
-        raise typer.BadParameter(f"unknown method {unknown}; known: {sorted(METHODS)}")
-    if budget_s is not None and budget_s < 0:
-        raise typer.BadParameter(f"--budget-s must be >= 0, got {budget_s}")
-    base = _config(scenarios[0], "evoeye", budget_s or 0.0, 0, monitor, n_round, update, epochs,
-                   0, feedback)
+    try:
+        check_known("method", strategy or MAIN)
+    except ValueError as e:
+        raise typer.BadParameter(str(e)) from None
+    base = _config(options, scenario=scenarios[0], budget_s=budget_s or 0.0)
     with StepBar("experiment") as bar:  # a step: a campaign started or a round done
-        results = run_experiment(root, scenarios, base,
+        results = run_experiment(data, scenarios, base,
                                  strategies=strategy or MAIN + (ABLATION if ablation else ()),
                                  seeds=range(repetitions), budget_s=budget_s, controls=controls,
                                  progress=bar)
-    folder = write_experiment_report(root, results, name)
+    folder = write_experiment_report(data, results, name)
     typer.echo((folder / "rq2.md").read_text(encoding="utf-8"))
     typer.echo(f"report: {folder / 'rq2.html'}")

@@ -38,9 +38,11 @@ def metrics_table(card: dict[str, Any]) -> Table:
               ["AUROC", "AUPRC", "target FPR", "threshold", "Prec.", "Rec.", "F1", "FPR"])
     for i, fpr in enumerate(sorted((float(f) for f in card["thresholds"]), reverse=True)):
         m = val[f"fpr_{fpr:g}"]
+        # n/r: no threshold meets this target with any alarm (evoeye.monitor.calibration)
+        rates = ([_pct(m[k]) for k in ("precision", "recall", "f1")]
+                 if m.get("reachable", True) else ["n/r"] * 3)
         t.add_row(_pct(val["auroc"]) if i == 0 else "", _pct(val["auprc"]) if i == 0 else "",
-                  f"{fpr:g}", f"{m['threshold']:.4f}", _pct(m["precision"]),
-                  _pct(m["recall"]), _pct(m["f1"]), _pct(m["fpr"]))
+                  f"{fpr:g}", f"{m['threshold']:.4f}", *rates, _pct(m["fpr"]))
     return t
 
 
@@ -78,7 +80,7 @@ def train_command(
     from evoeye.monitor.train import train_monitor
     from evoeye.store import SplitSpec
 
-    root = DataRoot.existing(root).path
+    data = DataRoot.existing(root)
     console = out()
 
     def progress(row: dict[str, Any]) -> None:
@@ -90,18 +92,18 @@ def train_command(
     extra = {} if weight_decay is None else {"weight_decay": weight_decay}
     try:
         version = train_monitor(
-            root, scenario, context_len=context_len, horizon_s=horizon_s,
+            data, scenario, context_len=context_len, horizon_s=horizon_s,
             modules=parse_modules(modules), dropout=dropout, seed=seed,
             splits=SplitSpec(seed=split_seed), init_from=init_from, epochs=epochs,
             patience=patience, batch_size=batch_size, lr=lr, progress=progress, **extra)
     except ValueError as exc:
         raise UserError(str(exc), "check --scenario, and that `evoeye ingest` has run") from exc
-    card = read_card(root, version)
+    card = read_card(data, version)
     console.print(metrics_table(card))
     t = card["training"]
     console.print(f"best epoch {t['best_epoch']} of {t['epochs_run']}, {t['time_s']:.1f} s, "
                   f"{card['n_parameters']:,} parameters, L = {card['context_len']}")
-    console.print(f"card: {version_dir(root, version) / CARD_FILE}")
+    console.print(f"card: {version_dir(data, version) / CARD_FILE}")
     console.print(f"version: [bold]{version}[/]")
 
 

@@ -63,7 +63,7 @@ def simulate_batch(scenario: str, n: int, seed: int, data: DataRoot, workers: in
         raise UserError(str(exc), "see `evoeye simulate --help`") from exc
     data.runs.mkdir(parents=True, exist_ok=True)
     bar = lambda it: tqdm(it, total=len(specs), desc=scenario, unit="run")  # noqa: E731
-    summary = run_batch(specs, data.path, workers=workers, progress=bar)
+    summary = run_batch(specs, data, workers=workers, progress=bar)
     for path in summary.stale_removed:
         out().print(f"[dim]removed the unfinished log of a killed run: {path}[/]")
     for r in summary.results:

@@ -20,6 +20,7 @@ if TYPE_CHECKING:
     import pyarrow as pa
     from rich.table import Table
 
+    from evoeye.store import SplitSpec
     from evoeye.store.ingest import IngestReport
 
 warehouse_app = typer.Typer(no_args_is_help=True, help="Inspect the Parquet/DuckDB warehouse.")
@@ -59,11 +60,15 @@ def ingest_command(
 
     Exits 3 if any log was quarantined (listed with its reason).
     """
+    ingest_into(DataRoot.resolve(root), runs_per_part)
+
+
+def ingest_into(data: DataRoot, runs_per_part: int = RUNS_PER_PART) -> None:
+    """Ingest with a progress bar, print the report; exit 3 if any log was quarantined."""
     from tqdm import tqdm
 
     from evoeye.store import ingest
 
-    data = DataRoot.resolve(root)
     if not data.warehouse.is_dir():
         where = "" if data.path.is_dir() else " (the data root does not exist yet)"
         err().print(f"creating a new warehouse at {data.warehouse}{where}")
@@ -193,13 +198,22 @@ def stats_command(
         VAL_FRAC,
 ) -> None:
     """Per logical scenario and split: scenarios, violations, frames, unsafe frames."""
-    from evoeye.store import SplitSpec, Warehouse
+    from evoeye.store import SplitSpec
 
     data = DataRoot.existing(root)
     try:
         splits = SplitSpec(seed, train_frac, val_frac)
     except ValueError as exc:
         raise UserError(str(exc), "see `evoeye warehouse stats --help`") from exc
+    print_stats(data, horizon_s, splits)
+
+
+def print_stats(data: DataRoot, horizon_s: float = HORIZON_S, splits: SplitSpec | None = None
+                ) -> None:
+    """The dataset statistics table (and the root causes, if explained) of a data root."""
+    from evoeye.store import SplitSpec, Warehouse
+
+    splits = splits or SplitSpec()
     rows = Warehouse(data).query(
         "dataset_stats", horizon_s=horizon_s, seed=splits.seed,
         train_frac=splits.train_frac, val_frac=splits.val_frac,

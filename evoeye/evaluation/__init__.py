@@ -1,6 +1,7 @@
-"""Evaluation: calibration, the paper's metrics, scenario-level detection, lead time, reports."""
+"""Evaluation: the paper's metrics, scenario-level detection, lead time, reports.
 
-from evoeye.evaluation.calibration import alarms, calibrate, calibrate_on_validation
+Thresholds come from `evoeye.monitor.calibration` (one calibration for every monitor)."""
+
 from evoeye.evaluation.harness import EvaluationReport, MonitorResult, evaluate
 from evoeye.evaluation.metrics import PRF, FrameMetrics, frame_metrics, prf
 from evoeye.evaluation.monitors import BASELINES, baseline_monitors, load_monitors, train_fusion
@@ -16,10 +17,7 @@ __all__ = [
     "MonitorResult",
     "Runs",
     "ScenarioMetrics",
-    "alarms",
     "baseline_monitors",
-    "calibrate",
-    "calibrate_on_validation",
     "evaluate",
     "frame_metrics",
     "load_monitors",

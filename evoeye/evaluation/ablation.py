@@ -4,10 +4,10 @@ Variants: L ∈ {1, 3, 5, 7} with every module input, and at L = 5 the inputs pe
 + prediction, + planning (and all four: the full FusionMonitor, which is also the L = 5 row).
 Each variant is a FusionMonitor trained by `evoeye.monitor.train_monitor` (seeded: the same
 seed and data give the same version) and evaluated like RQ1; the table reports F1 at the first
-target FPR, AUROC and AUPRC on the test frames per logical scenario. A last row is the
-context-only control (clock, ego speed and position; `evoeye.baselines.context`), trained,
-calibrated and evaluated the same way: a variant that cannot clearly beat it has learned the
-scenario script.
+target FPR, AUROC and AUPRC on the test frames per logical scenario. The last rows are
+references, calibrated and evaluated the same way: the context-only control (clock, ego speed
+and position; `evoeye.baselines.context`) — a variant that cannot clearly beat it has learned
+the scenario script — and the rule baselines TTC, TTC-2D, RSS and RSS-2s.
 """
 
 from __future__ import annotations
@@ -18,14 +18,15 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from evoeye.evaluation.harness import evaluate
-from evoeye.evaluation.monitors import fit_context_only, train_fusion
-from evoeye.evaluation.report import DASH, Table, pct
+from evoeye.evaluation.monitors import baseline_monitors, monitor_context_len, train_fusion
+from evoeye.evaluation.report import DASH, UNREACHABLE, UNREACHABLE_NOTE, Table, pct, rate
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 
 CONTEXT_LENS = (1, 3, 5, 7)
 FULL_INPUTS = "all"
 CONTROL = "context-only"  # the control row's label and baseline name
+REFERENCES = (CONTROL, "ttc", "ttc-2d", "rss", "rss-2s")  # baseline rows, by baseline name
 
 
 def input_sets() -> dict[str, tuple[str, ...]]:
@@ -82,13 +83,12 @@ class AblationReport:
             cells = [row.label]
             for s in self.scenarios:
                 r = row.results.get(s)
-                cells += [pct(r["f1"]), pct(r["auroc"]), pct(r["auprc"])] if r else [DASH] * 3
+                cells += [rate(r, "f1"), pct(r["auroc"]), pct(r["auprc"])] if r else [DASH] * 3
             body.append(cells)
         return Table(header, body)
 
-    def write(self, root: DataRoot | str | Path | None, name: str = "ablation") -> Path:
+    def write(self, root: DataRoot, name: str = "ablation") -> Path:
         """Write ablation.md and ablation.json under `<root>/reports/<name>/`; the folder."""
-        root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
         folder = root.path / "reports" / name
         folder.mkdir(parents=True, exist_ok=True)
         (folder / "ablation.md").write_text(self.markdown(), encoding="utf-8")
@@ -97,44 +97,52 @@ class AblationReport:
         return folder
 
     def markdown(self) -> str:
+        table = self.table()
+        unreachable = any(UNREACHABLE in row for row in table.rows)
         return ("# Monitor ablation (test frames)\n\n"
                 f"Rates in %; F1 at the threshold calibrated on validation for FPR {self.fpr}; "
                 f"seed {self.seed}. L rows use every module input; input rows use L = 5; "
                 f"{CONTROL} is the control that sees only the clock, the ego's speed and its "
-                "position.\n\n"
-                + self.table().markdown() + "\n")
+                "position; ttc, ttc-2d, rss and rss-2s are the rule baselines.\n\n"
+                + table.markdown() + "\n" + (f"\n{UNREACHABLE_NOTE}\n" if unreachable else ""))
 
 
 def run_ablation(
-    root: DataRoot | str | Path | None,
+    root: DataRoot,
     scenarios: Sequence[str],
     splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
     *,
     context_lens: Sequence[int] = CONTEXT_LENS,
     inputs: Sequence[str] | None = None,
     seed: int = 0,
+    references: Sequence[str] = REFERENCES,
     store_scores: bool = True,
     progress: Callable[[str], None] | None = None,
     **train_overrides,
 ) -> AblationReport:
-    """Train and evaluate every variant on every scenario; the ablation table's figures."""
+    """Train and evaluate every variant, then the `references` (baseline names), on every
+    scenario; the ablation table's figures."""
     sets = input_sets()
     rows = [AblationRow(v.label, v.context_len, v.inputs) for v in variants(context_lens, inputs)]
-    rows.append(AblationRow(CONTROL, 1, CONTROL))
+    rows += [AblationRow(name, 1, name) for name in references]
     fprs = None
     for scenario in scenarios:
         for row in rows:
             if progress is not None:
                 progress(f"{scenario}: {row.label}")
-            monitor = fit_context_only(root, scenario, splits) if row.inputs == CONTROL else (
-                train_fusion(root, scenario, context_len=row.context_len,
-                             modules=sets[row.inputs], seed=seed, splits=splits,
-                             **train_overrides))
+            if row.inputs in sets:
+                monitor = train_fusion(root, scenario, context_len=row.context_len,
+                                       modules=sets[row.inputs], seed=seed, splits=splits,
+                                       **train_overrides)
+            else:
+                monitor = baseline_monitors(root, scenario, splits, [row.inputs])[0]
+                row.context_len = monitor_context_len(monitor)
             rep = evaluate(root, [monitor], scenario, splits, ks=(), store_scores=store_scores)
             fprs = rep.fprs
             m = rep.monitors[0]
+            at = m.frame.at_fpr[rep.fprs[0]]
             row.results[scenario] = {
-                "f1": m.frame.at_fpr[rep.fprs[0]].f1, "auroc": m.frame.auroc,
+                "f1": at.f1, "reachable": at.reachable, "auroc": m.frame.auroc,
                 "auprc": m.frame.auprc, "version": m.version,
             }
     return AblationReport(list(scenarios), (fprs or (0.05,))[0], seed, rows)

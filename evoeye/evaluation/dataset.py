@@ -8,7 +8,6 @@ setup ends at the collision — so it enters no calibration and no metric.
 from __future__ import annotations
 
 from dataclasses import dataclass
-from pathlib import Path
 
 import numpy as np
 
@@ -16,12 +15,6 @@ from evoeye.paths import DataRoot
 from evoeye.store import RunFilter, SplitSpec, Warehouse, load_windows
 from evoeye.store.selection import Runs
 from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S, Windows
-
-OUTCOMES_SQL = """
-SELECT scenario_id, collided, collision_time_s
-FROM scenarios
-WHERE logical_scenario = $logical_scenario
-"""
 
 
 @dataclass
@@ -69,11 +62,11 @@ def narrow(windows: Windows, context_len: int) -> Windows:
     )
 
 
-def collision_times(root: Warehouse | DataRoot | str | Path | None,
+def collision_times(root: Warehouse | DataRoot,
                     logical_scenario: str) -> dict[str, float]:
     """scenario_id → tau_col in s (+inf for runs without a collision)."""
     wh = root if isinstance(root, Warehouse) else Warehouse(root)
-    rows = wh.sql(OUTCOMES_SQL, {"logical_scenario": logical_scenario}).to_pylist()
+    rows = wh.query("run_outcomes", logical_scenario=logical_scenario).to_pylist()
     return {
         r["scenario_id"]: float(r["collision_time_s"])
         if r["collided"] and r["collision_time_s"] is not None else np.inf
@@ -82,7 +75,7 @@ def collision_times(root: Warehouse | DataRoot | str | Path | None,
 
 
 def load_split(
-    root: Warehouse | DataRoot | str | Path | None,
+    root: Warehouse | DataRoot,
     logical_scenario: str,
     split: str,
     splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
@@ -97,7 +90,7 @@ def load_split(
 
 
 def load_runs(
-    root: Warehouse | DataRoot | str | Path | None,
+    root: Warehouse | DataRoot,
     logical_scenario: str,
     runs: Runs,
     name: str,

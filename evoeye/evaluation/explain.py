@@ -12,11 +12,10 @@ import time
 from collections.abc import Callable, Iterator, Sequence
 from concurrent.futures import ProcessPoolExecutor, as_completed
 from dataclasses import dataclass
-from pathlib import Path
 from typing import Any
 
 from evoeye import __version__
-from evoeye.batch import _context
+from evoeye.batch import pool_context
 from evoeye.paths import DataRoot
 from evoeye.sim.counterfactual import VARIANTS, Explanation, explain_run
 from evoeye.sim.episode import RunSpec
@@ -33,7 +32,7 @@ def spec_of(record: dict[str, Any]) -> RunSpec:
     )
 
 
-def pending_runs(root: DataRoot | str | Path | None, scenario: str | None = None,
+def pending_runs(root: DataRoot, scenario: str | None = None,
                  batch: str | None = None, limit: int | None = None) -> list[RunSpec]:
     """The ingested collision runs this software version has not fully explained yet."""
     rows = Warehouse(root).query(
@@ -76,7 +75,7 @@ def _explained(specs: Sequence[RunSpec], workers: int) -> Iterator[Explained]:
     if workers == 1:
         yield from map(explain_one, specs)
         return
-    with ProcessPoolExecutor(max_workers=workers, mp_context=_context()) as pool:
+    with ProcessPoolExecutor(max_workers=workers, mp_context=pool_context()) as pool:
         futures = {pool.submit(explain_one, s): s for s in specs}
         for fut in as_completed(futures):
             try:
@@ -86,13 +85,12 @@ def _explained(specs: Sequence[RunSpec], workers: int) -> Iterator[Explained]:
 
 
 def explain_runs(
-    root: DataRoot | str | Path | None, specs: Sequence[RunSpec], *, workers: int = 2,
+    root: DataRoot, specs: Sequence[RunSpec], *, workers: int = 2,
     on_result: Callable[[Explained], None] | None = None,
 ) -> list[Explained]:
     """Explain `specs` in `workers` processes, storing each run's rows as it finishes."""
     if workers < 1:
         raise ValueError(f"--workers must be at least 1, got {workers}")
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
     done: list[Explained] = []
     for e in _explained(specs, workers):
         if e.explanation is not None:
@@ -105,7 +103,7 @@ def explain_runs(
     return sorted(done, key=lambda e: e.spec.scenario_id)
 
 
-def attribution_shares(root: DataRoot | str | Path | None,
+def attribution_shares(root: DataRoot,
                        scenario: str | None = None) -> list[dict[str, Any]]:
     """Rows of the view attribution_shares (one per logical scenario, version and cause)."""
     return Warehouse(root).query("attribution_shares", logical_scenario=scenario).to_pylist()

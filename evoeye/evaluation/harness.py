@@ -1,7 +1,9 @@
 """`evaluate`: score a logical scenario's val and test splits with monitors and report RQ1.
 
-Per monitor: thresholds for each target FPR are calibrated on the validation frames and applied
-unchanged to the test frames; frame-level P / R / F1, AUROC and AUPRC; scenario-level
+Per monitor: thresholds for each target FPR are calibrated on the validation frames
+(`evoeye.monitor.calibration`: the FPR they realise there is kept next to the target, and a
+target no threshold can meet with any alarm is marked unreachable) and applied unchanged to the
+test frames; frame-level P / R / F1, AUROC and AUPRC; scenario-level
 detection for each K with warning lead times; optionally CPU latency. Every scored frame (val and
 test) goes to the warehouse table monitor_scores. The windows hold no frame at or after a run's
 collision (see `dataset.py`), so none enters calibration or a metric.
@@ -11,16 +13,15 @@ from __future__ import annotations
 
 from collections.abc import Iterable, Sequence
 from dataclasses import asdict, dataclass, field
-from pathlib import Path
 
 import numpy as np
 
-from evoeye.evaluation.calibration import calibrate_on_validation
 from evoeye.evaluation.dataset import SplitWindows, load_split, narrow
 from evoeye.evaluation.latency import Latency, measure_latency
 from evoeye.evaluation.metrics import Curves, FrameMetrics, frame_metrics
 from evoeye.evaluation.monitors import check_scores, monitor_context_len
 from evoeye.evaluation.scenario import Runs, ScenarioMetrics, scenario_metrics
+from evoeye.monitor.calibration import calibrate_on_validation
 from evoeye.monitor.protocol import TARGET_FPRS, Monitor
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
@@ -39,6 +40,7 @@ class MonitorResult:
     context_len: int
     thresholds: dict[float, float]  # target FPR → threshold (from validation)
     val_fpr: dict[float, float]  # FPR the thresholds realise on validation
+    reachable: dict[float, bool]  # False: no threshold meets the target with any alarm on val
     frame: FrameMetrics
     scenario: dict[int, ScenarioMetrics]  # K → results
     curves: Curves
@@ -50,6 +52,7 @@ class MonitorResult:
             "name": self.name, "version": self.version, "context_len": self.context_len,
             "thresholds": {str(k): v for k, v in self.thresholds.items()},
             "val_fpr": {str(k): v for k, v in self.val_fpr.items()},
+            "reachable": {str(k): v for k, v in self.reachable.items()},
             "frame": self.frame.to_dict(),
             "scenario": {str(k): v.to_dict() for k, v in self.scenario.items()},
             "curves": asdict(self.curves),
@@ -96,11 +99,11 @@ def evaluate_monitor(monitor: Monitor, val: SplitWindows, test: SplitWindows, ru
     L = monitor_context_len(monitor)
     s_val = check_scores(monitor, monitor.score(narrow(val.windows, L)), len(val))
     s_test = check_scores(monitor, monitor.score(narrow(test.windows, L)), len(test))
-    y_val, y_test = val.windows.label, test.windows.label
+    y_test = test.windows.label
     thr = calibrate_on_validation(s_val, val.windows, fprs)
-    val_fpr = {f: float((s_val[y_val == 0] > thr.at(f)).mean()) for f in fprs}
     result = MonitorResult(
-        monitor.name, monitor.version, L, dict(thr.by_fpr), val_fpr,
+        monitor.name, monitor.version, L, dict(thr.by_fpr), dict(thr.realised_fpr),
+        {f: thr.reachable(f) for f in fprs},
         frame_metrics(s_test, y_test, thr, fprs),
         {k: scenario_metrics(s_test, runs, thr, k, fprs) for k in ks},
         Curves.of(s_test, y_test),
@@ -110,7 +113,7 @@ def evaluate_monitor(monitor: Monitor, val: SplitWindows, test: SplitWindows, ru
 
 
 def evaluate(
-    root: DataRoot | str | Path | None,
+    root: DataRoot,
     monitors: Iterable[Monitor],
     scenario: str,
     splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
@@ -122,7 +125,6 @@ def evaluate(
     latency: bool = False,
 ) -> EvaluationReport:
     """Calibrate every monitor on val, measure it on test, store its scores (module doc)."""
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
     monitors = list(monitors)
     if not monitors:
         raise ValueError("evaluate needs at least one monitor")

@@ -13,7 +13,7 @@ from sklearn.metrics import (
     roc_curve,
 )
 
-from evoeye.evaluation.calibration import alarms
+from evoeye.monitor.calibration import alarms
 from evoeye.monitor.protocol import Thresholds
 
 CURVE_POINTS = 200  # points kept per curve for reports
@@ -21,39 +21,53 @@ CURVE_POINTS = 200  # points kept per curve for reports
 
 @dataclass(frozen=True)
 class PRF:
-    """Confusion counts and the rates derived from them (0 where a rate is undefined)."""
+    """Confusion counts and the rates derived from them (0 where a rate is undefined).
+
+    At a threshold whose target FPR was unreachable on validation (`reachable` False,
+    `evoeye.monitor.calibration`) precision, recall and F1 are None: no operating point at that
+    FPR exists to measure, and a 0 would read as a monitor that misses everything.
+    """
 
     tp: int
     fp: int
     fn: int
     tn: int
+    reachable: bool = True
 
     @property
-    def precision(self) -> float:
+    def precision(self) -> float | None:
+        if not self.reachable:
+            return None
         return self.tp / (self.tp + self.fp) if self.tp + self.fp else 0.0
 
     @property
-    def recall(self) -> float:
+    def recall(self) -> float | None:
+        if not self.reachable:
+            return None
         return self.tp / (self.tp + self.fn) if self.tp + self.fn else 0.0
 
     @property
-    def f1(self) -> float:
+    def f1(self) -> float | None:
         p, r = self.precision, self.recall
+        if p is None or r is None:
+            return None
         return 2 * p * r / (p + r) if p + r else 0.0
 
     @property
     def fpr(self) -> float:
         return self.fp / (self.fp + self.tn) if self.fp + self.tn else 0.0
 
-    def to_dict(self) -> dict[str, float | int]:
+    def to_dict(self) -> dict[str, float | int | bool | None]:
         return {"precision": self.precision, "recall": self.recall, "f1": self.f1,
-                "fpr": self.fpr, "tp": self.tp, "fp": self.fp, "fn": self.fn, "tn": self.tn}
+                "fpr": self.fpr, "tp": self.tp, "fp": self.fp, "fn": self.fn, "tn": self.tn,
+                "reachable": self.reachable}
 
 
-def prf(predicted: np.ndarray, labels: np.ndarray) -> PRF:
+def prf(predicted: np.ndarray, labels: np.ndarray, reachable: bool = True) -> PRF:
     """Counts of predicted-positive vs true labels (both (N,), truthy = positive)."""
     p, y = np.asarray(predicted, bool), np.asarray(labels, bool)
-    return PRF(int((p & y).sum()), int((p & ~y).sum()), int((~p & y).sum()), int((~p & ~y).sum()))
+    return PRF(int((p & y).sum()), int((p & ~y).sum()), int((~p & y).sum()), int((~p & ~y).sum()),
+               reachable)
 
 
 def auroc(scores: np.ndarray, labels: np.ndarray) -> float | None:
@@ -118,6 +132,6 @@ def frame_metrics(scores: np.ndarray, labels: np.ndarray, thresholds: Thresholds
     scores, labels = np.asarray(scores, float), np.asarray(labels).astype(bool)
     fprs = sorted(thresholds.by_fpr, reverse=True) if fprs is None else list(fprs)
     return FrameMetrics(
-        {f: prf(alarms(scores, thresholds.at(f)), labels) for f in fprs},
+        {f: prf(alarms(scores, thresholds.at(f)), labels, thresholds.reachable(f)) for f in fprs},
         auroc(scores, labels), auprc(scores, labels), len(labels), int(labels.sum()),
     )

@@ -17,11 +17,27 @@ from evoeye.evaluation.plots import line_chart, strip_chart
 from evoeye.paths import DataRoot
 
 DASH = "–"
+UNREACHABLE = "n/r"  # the operating point's target FPR was unreachable on validation
+UNREACHABLE_NOTE = ("n/r: the target FPR is unreachable for this monitor: more than that share "
+                    "of the validation negatives tie at its top score, so no threshold meets "
+                    "the target with any alarm (its rates there are not measured).")
 
 
 def pct(x: float | None) -> str:
     """A rate as a percentage with one decimal ('–' if undefined)."""
     return DASH if x is None else f"{100 * x:.1f}"
+
+
+def rate(point: dict, key: str) -> str:
+    """A rate of one operating point (`PRF.to_dict()`) in %, 'n/r' where its target FPR was
+    unreachable."""
+    return pct(point[key]) if point.get("reachable", True) else UNREACHABLE
+
+
+def any_unreachable(reports: list[dict]) -> bool:
+    """Whether some monitor of these reports has a target FPR it could not reach."""
+    return any(not ok for r in reports for m in r["monitors"]
+               for ok in m.get("reachable", {}).values())
 
 
 def secs(x: float | None) -> str:
@@ -68,8 +84,7 @@ def rq1_table(report: dict) -> Table:
         fr = m["frame"]
         cells = [m["name"]]
         for f in fprs:
-            a = fr["at_fpr"][f]
-            cells += [pct(a["precision"]), pct(a["recall"]), pct(a["f1"])]
+            cells += [rate(fr["at_fpr"][f], k) for k in ("precision", "recall", "f1")]
         rows.append(cells + [pct(fr["auroc"]), pct(fr["auprc"]), DASH, DASH])
     for k in report["ks"]:
         rows.append([f"Scenario-level (K={k})"])
@@ -77,11 +92,11 @@ def rq1_table(report: dict) -> Table:
             sc = m["scenario"][str(k)]
             cells = [m["name"]]
             for f in fprs:
-                a = sc["at_fpr"][f]
-                cells += [pct(a["precision"]), pct(a["recall"]), pct(a["f1"])]
+                cells += [rate(sc["at_fpr"][f], k) for k in ("precision", "recall", "f1")]
             lt = sc["lead_time"][main]
-            cells += [pct(sc["auroc"]), pct(sc["auprc"]),
-                      f"{lt['detected']}/{lt['violations']}", secs(lt["median_s"])]
+            warned = ([f"{lt['detected']}/{lt['violations']}", secs(lt["median_s"])]
+                      if sc["at_fpr"][main].get("reachable", True) else [UNREACHABLE] * 2)
+            cells += [pct(sc["auroc"]), pct(sc["auprc"]), *warned]
             rows.append(cells)
     return Table(header, rows)
 
@@ -99,11 +114,20 @@ def dataset_table(reports: list[dict]) -> Table:
                  rows)
 
 
+def _calibrated(m: dict, fpr: str) -> list[str]:
+    """Threshold and the FPR it realises on validation ('n/r' added if unreachable)."""
+    realised = pct(m["val_fpr"].get(fpr))
+    ok = m.get("reachable", {}).get(fpr, True)
+    return [f"{m['thresholds'][fpr]:.4g}", realised if ok else f"{realised} {UNREACHABLE}"]
+
+
 def monitors_table(reports: list[dict]) -> Table:
-    """Versions, thresholds (with the FPR they realise on validation) and CPU cost."""
+    """Versions, thresholds with the FPR they realise on validation next to the target, and
+    CPU cost."""
     fprs = [str(f) for f in reports[0]["fprs"]] if reports else []
     header = ["Logical scenario", "Method", "Version", "L"]
-    header += [f"thr@{f} (val FPR %)" for f in fprs]
+    for f in fprs:
+        header += [f"thr@{f}", f"val FPR % (target {pct(float(f))})"]
     header += ["Latency b=1 (ms)", "Throughput b=1024 (/s)"]
     rows = []
     for r in reports:
@@ -111,7 +135,7 @@ def monitors_table(reports: list[dict]) -> Table:
             lat = m["latency"]
             rows.append(
                 [r["logical_scenario"], m["name"], m["version"], str(m["context_len"])]
-                + [f"{m['thresholds'][f]:.4g} ({pct(m['val_fpr'][f])})" for f in fprs]
+                + [c for f in fprs for c in _calibrated(m, f)]
                 + ([f"{lat['latency_ms_median']:.3f}", f"{lat['throughput_per_s']:,.0f}"]
                    if lat else [DASH, DASH])
             )
@@ -152,6 +176,8 @@ def markdown_report(reports: list[dict]) -> str:
              "Rates in %, thresholds calibrated on validation for each target FPR and applied "
              "unchanged to test. Warned: violation runs warned before the collision / all; "
              "Lead: median warning lead time of those runs.", ""]
+    if any_unreachable(reports):
+        parts += [UNREACHABLE_NOTE, ""]
     for r in reports:
         parts += [f"## {r['logical_scenario']}", "", rq1_table(r).markdown(), ""]
     parts += ["## Dataset", "", dataset_table(reports).markdown(), "",
@@ -202,6 +228,8 @@ def html_report(reports: list[dict], title: str = "evoeye RQ1 report") -> str:
             f'<p class="note">Generated {stamp}. Rates in %. Thresholds calibrated on '
             "validation frames, applied unchanged to test; frames at or after a collision are "
             "not scored. A run warns at its first K consecutive alarms before the collision.</p>"]
+    if any_unreachable(reports):
+        body.append(f'<p class="note">{escape(UNREACHABLE_NOTE)}</p>')
     body += [_scenario_html(r) for r in reports]
     body += ["<h2>Dataset</h2>", dataset_table(reports).html(),
              "<h2>Monitors</h2>", monitors_table(reports).html()]
@@ -222,10 +250,9 @@ class ReportFiles:
     json: Path
 
 
-def write_report(root: DataRoot | str | Path | None, reports: list[dict],
+def write_report(root: DataRoot, reports: list[dict],
                  name: str | None = None) -> ReportFiles:
     """Write rq1.md, report.html and report.json under `<root>/reports/<name>/`."""
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
     name = name or f"rq1-{datetime.now(UTC):%Y%m%dT%H%M%SZ}"
     if not name or "/" in name or name.startswith("."):
         raise ValueError(f"report name must be a plain folder name, got {name!r}")

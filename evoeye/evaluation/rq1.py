@@ -7,7 +7,6 @@ the logical scenario they were trained on when their card names one, else on eve
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from pathlib import Path
 
 from evoeye.evaluation.explain import attribution_shares
 from evoeye.evaluation.harness import SCENARIO_KS, EvaluationReport, evaluate
@@ -17,12 +16,10 @@ from evoeye.monitor.protocol import Monitor
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse
 
-SCENARIOS_SQL = "SELECT DISTINCT logical_scenario FROM scenarios ORDER BY logical_scenario"
 
-
-def warehouse_scenarios(root: DataRoot | str | Path | None) -> list[str]:
+def warehouse_scenarios(root: DataRoot) -> list[str]:
     """The logical scenarios that have runs in the warehouse."""
-    return Warehouse(root).sql(SCENARIOS_SQL).column("logical_scenario").to_pylist()
+    return Warehouse(root).query("logical_scenarios").column("logical_scenario").to_pylist()
 
 
 def trained_on(monitor: Monitor) -> str | None:
@@ -32,7 +29,7 @@ def trained_on(monitor: Monitor) -> str | None:
 
 
 def rq1(
-    root: DataRoot | str | Path | None,
+    root: DataRoot,
     scenarios: Sequence[str] | None = None,
     *,
     baselines: Sequence[str] = tuple(BASELINES),
@@ -46,7 +43,6 @@ def rq1(
 ) -> list[EvaluationReport]:
     """Evaluate the baselines, the given monitor versions and (with `fusion`) a FusionMonitor
     trained for each scenario; one report per logical scenario."""
-    root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
     scenarios = list(scenarios) if scenarios else warehouse_scenarios(root)
     if not scenarios:
         raise ValueError(f"the warehouse under {root.path} has no runs: ingest some first")
@@ -67,7 +63,7 @@ def rq1(
     return reports
 
 
-def rq1_report(root: DataRoot | str | Path | None, reports: Sequence[EvaluationReport],
+def rq1_report(root: DataRoot, reports: Sequence[EvaluationReport],
                name: str | None = None) -> ReportFiles:
     """Write the Markdown, HTML and JSON report of these evaluations, with each logical
     scenario's root-cause shares (`evoeye explain`) when the warehouse has them."""

@@ -17,8 +17,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from evoeye.evaluation.calibration import alarms
 from evoeye.evaluation.metrics import PRF, auprc, auroc, prf
+from evoeye.monitor.calibration import alarms
 from evoeye.monitor.protocol import Thresholds
 
 
@@ -137,7 +137,7 @@ def scenario_metrics(scores: np.ndarray, runs: Runs, thresholds: Thresholds, k: 
     for f in fprs:
         warn_t = warnings_at(runs, alarms(s, thresholds.at(f)), k)
         warned = ~np.isnan(warn_t)
-        at_fpr[f] = prf(warned, violated)
+        at_fpr[f] = prf(warned, violated, thresholds.reachable(f))
         leads = runs.collision_time_s[warned & violated] - warn_t[warned & violated]
         lead[f] = LeadTimes(int((warned & violated).sum()), int(violated.sum()),
                             np.round(leads, 4).tolist())

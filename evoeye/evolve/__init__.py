@@ -1,41 +1,13 @@
-"""Self-evolution, the pure core: feedback, density-aware mutation, acquisition strategies.
+"""Self-evolution, in two halves that meet only through the `Strategy` protocol and `Records`.
 
-The loop (simulate, retrain every N_round records, refresh feedback, stop on the simulated-time
-budget) lives with the flows; it drives a `Strategy` through `propose` / `tell` and resumes it
-with `replay`.
+* `evoeye.evolve.search` — the pure search: acquisition strategies (BlindSpotEvolver and its
+  ablations, Uniform, AV-Fuzzer), density-aware mutation, the feedback maths and `criticality`.
+  numpy and the logical scenario space only: no I/O, no monitor, no warehouse.
+* `evoeye.evolve.campaign` — the campaign with its I/O: Algorithm 1 as a resumable loop over a
+  data root (simulate, log, ingest, train the monitor, store feedback and rounds), its
+  configuration, the Test / Hard Set assessment, and the RQ2 experiment and report. The flows
+  (`flows/evolve.py`, `flows/experiment.py`) run its steps as Prefect tasks.
+
+`lint-imports` checks the split (the "pure-search" contract in pyproject.toml): the search
+imports nothing of the campaign, the warehouse, the logs, the simulator or the monitors.
 """
-
-from evoeye.evolve.avfuzzer import AVFuzzer, AVFuzzerConfig, criticality
-from evoeye.evolve.feedback import ScenarioFeedback, normalise_feedback, scenario_feedback
-from evoeye.evolve.mutation import (
-    DensityIndex,
-    Mutation,
-    density_aware_mutation,
-    exploit_probability,
-    regional_potential,
-)
-from evoeye.evolve.protocol import Proposal, Strategy, StrategyError
-from evoeye.evolve.records import Records
-from evoeye.evolve.strategies import STRATEGIES, DensityStrategy, UniformStrategy, make_strategy
-
-__all__ = [
-    "STRATEGIES",
-    "AVFuzzer",
-    "AVFuzzerConfig",
-    "DensityIndex",
-    "DensityStrategy",
-    "Mutation",
-    "Proposal",
-    "Records",
-    "ScenarioFeedback",
-    "Strategy",
-    "StrategyError",
-    "UniformStrategy",
-    "criticality",
-    "density_aware_mutation",
-    "exploit_probability",
-    "make_strategy",
-    "normalise_feedback",
-    "regional_potential",
-    "scenario_feedback",
-]

@@ -6,6 +6,8 @@ actor 0, times on the 20 Hz grid) match what `evoeye.sim` produces.
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
 from evoeye.ads.messages import (
@@ -146,3 +148,22 @@ def synthetic_episode(
         round=0,
     )
     return Episode(spec, synthetic_road_map(), outcome, "evoeye-test 0.0", rate_hz, frames)
+
+
+def with_collision(episode: Episode, frame: int | None) -> Episode:
+    """The episode with the ego colliding with actor 1 from `frame` on (never if None), in place.
+
+    Replaces the random crashes of `synthetic_frame`; the outcome follows the frames."""
+    for i, f in enumerate(episode.frames):
+        hit = frame is not None and i >= frame
+        f.scene.crashed[:] = False
+        f.scene.crashed[0] = hit
+        f.scene.ego_collision = hit
+        f.scene.collision_actor = 1 if hit else -1
+    collided = frame is not None and frame < len(episode.frames)
+    episode.outcome = replace(
+        episode.outcome, collided=collided,
+        collision_time_s=episode.frames[frame].scene.t_s if collided else None,
+        other_actor=1 if collided else None,
+    )
+    return episode

@@ -1,17 +1,17 @@
 """Runtime monitors: the FusionMonitor and the protocol every monitor implements.
 
     train_monitor(root, scenario=…, context_len=…, modules=…, seed=…) -> version
+    calibrate_on_validation(scores, val) -> Thresholds    (one calibration for every monitor)
     load_monitor(root, version) -> FusionMonitor    (score(windows) -> (B,) risks)
     RuntimeMonitor(monitor).step(frame_messages) -> RiskState
     replay(log, monitor, out) / export_onnx(monitor, out)
+    load_version(root, version) -> any family's version (FAMILIES: the family registry)
 
 Everything but the protocol is imported on first use, so importing the protocol (as the
 evaluation code and the SQL-only commands do) does not load torch.
 """
 
-from importlib import import_module
-from typing import Any
-
+from evoeye.lazy import lazy_attributes
 from evoeye.monitor.protocol import TARGET_FPRS, Monitor, Thresholds
 
 _LAZY = {
@@ -20,7 +20,14 @@ _LAZY = {
     "FusionConfig": "evoeye.monitor.model",
     "FusionNet": "evoeye.monitor.model",
     "FusionMonitor": "evoeye.monitor.fusion",
-    "MonitorLoadError": "evoeye.monitor.registry",
+    "alarms": "evoeye.monitor.calibration",
+    "calibrate": "evoeye.monitor.calibration",
+    "calibrate_on_validation": "evoeye.monitor.calibration",
+    "FAMILIES": "evoeye.monitor.families",
+    "MonitorFamily": "evoeye.monitor.families",
+    "MonitorLoadError": "evoeye.monitor.families",
+    "load_version": "evoeye.monitor.families",
+    "register_family": "evoeye.monitor.families",
     "list_versions": "evoeye.monitor.registry",
     "load_monitor": "evoeye.monitor.registry",
     "read_card": "evoeye.monitor.registry",
@@ -33,10 +40,7 @@ _LAZY = {
 }
 
 
-def __getattr__(name: str) -> Any:
-    if name in _LAZY:
-        return getattr(import_module(_LAZY[name]), name)
-    raise AttributeError(f"module 'evoeye.monitor' has no attribute {name!r}")
+__getattr__ = lazy_attributes(__name__, _LAZY)
 
 
 __all__ = ["TARGET_FPRS", "Monitor", "Thresholds", *_LAZY]

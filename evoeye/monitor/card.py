@@ -8,7 +8,7 @@ from typing import Any
 import numpy as np
 from sklearn.metrics import average_precision_score, roc_auc_score
 
-from evoeye.evaluation.calibration import alarms
+from evoeye.monitor.calibration import alarms
 from evoeye.monitor.protocol import Thresholds
 from evoeye.store.selection import RunFilter, Runs
 from evoeye.store.windows import Windows
@@ -49,9 +49,10 @@ def ranking_metrics(scores: np.ndarray, labels: np.ndarray) -> dict[str, float |
             "auprc": float(average_precision_score(labels, scores))}
 
 
-def threshold_metrics(scores: np.ndarray, labels: np.ndarray, threshold: float
-                      ) -> dict[str, float]:
-    """Frame-level precision, recall, F1 and realised FPR of alarms at `threshold`."""
+def threshold_metrics(scores: np.ndarray, labels: np.ndarray, threshold: float,
+                      reachable: bool = True) -> dict[str, Any]:
+    """Frame-level precision, recall, F1 and realised FPR of alarms at `threshold`; precision,
+    recall and F1 are None at a threshold whose target FPR was unreachable."""
     labels = np.asarray(labels).astype(bool)
     alarm = alarms(scores, threshold)
     tp, fp = int((alarm & labels).sum()), int((alarm & ~labels).sum())
@@ -59,8 +60,10 @@ def threshold_metrics(scores: np.ndarray, labels: np.ndarray, threshold: float
     precision = tp / (tp + fp) if tp + fp else 0.0
     recall = tp / (tp + fn) if tp + fn else 0.0
     f1 = 2 * precision * recall / (precision + recall) if precision + recall else 0.0
-    return {"threshold": float(threshold), "precision": precision, "recall": recall, "f1": f1,
-            "fpr": fp / (fp + tn) if fp + tn else 0.0}
+    rates = {"precision": precision, "recall": recall, "f1": f1} if reachable else dict.fromkeys(
+        ("precision", "recall", "f1"))
+    return {"threshold": float(threshold), **rates, "fpr": fp / (fp + tn) if fp + tn else 0.0,
+            "reachable": reachable}
 
 
 def split_metrics(scores: np.ndarray, labels: np.ndarray, thresholds: Thresholds
@@ -68,7 +71,7 @@ def split_metrics(scores: np.ndarray, labels: np.ndarray, thresholds: Thresholds
     """Ranking metrics plus, per calibrated FPR (key "fpr_0.05", …), the threshold metrics."""
     out: dict[str, Any] = ranking_metrics(scores, labels)
     for fpr, thr in sorted(thresholds.by_fpr.items(), reverse=True):
-        out[f"fpr_{fpr:g}"] = threshold_metrics(scores, labels, thr)
+        out[f"fpr_{fpr:g}"] = threshold_metrics(scores, labels, thr, thresholds.reachable(fpr))
     return out
 
 
@@ -76,5 +79,26 @@ def thresholds_to_json(thresholds: Thresholds) -> dict[str, float]:
     return {f"{fpr:g}": thr for fpr, thr in sorted(thresholds.by_fpr.items(), reverse=True)}
 
 
-def thresholds_from_json(d: dict[str, float]) -> Thresholds:
-    return Thresholds({float(fpr): float(thr) for fpr, thr in d.items()})
+def thresholds_from_json(d: dict[str, float],
+                         calibration: dict[str, dict] | None = None) -> Thresholds:
+    """Thresholds from a card's "thresholds" and, if it has one, its "calibration"."""
+    calibration = calibration or {}
+    return Thresholds({float(fpr): float(thr) for fpr, thr in d.items()},
+                      {float(f): float(c["realised_fpr"]) for f, c in calibration.items()
+                       if c.get("realised_fpr") is not None},
+                      frozenset(float(f) for f, c in calibration.items() if not c["reachable"]))
+
+
+def thresholds_to_card(thresholds: Thresholds) -> dict[str, dict]:
+    """The card (or meta.json) entries of calibrated thresholds: "thresholds" (target FPR →
+    threshold) and "calibration" (target FPR → the FPR realised on validation, reachable)."""
+    return {"thresholds": thresholds_to_json(thresholds),
+            "calibration": {f"{fpr:g}": {"realised_fpr": thresholds.realised_fpr.get(fpr),
+                                         "reachable": thresholds.reachable(fpr)}
+                            for fpr in sorted(thresholds.by_fpr, reverse=True)}}
+
+
+def thresholds_from_card(card: dict[str, Any]) -> Thresholds:
+    """The thresholds a card (or meta.json) records; cards written before calibration was
+    recorded have no realised FPR and count every target as reachable."""
+    return thresholds_from_json(card.get("thresholds", {}), card.get("calibration"))

@@ -1,4 +1,4 @@
-"""Monitor versions on disk: `<root>/monitors/<version>/` with `model.pt` and `card.json`.
+"""FusionMonitor versions on disk: `<root>/monitors/<version>/` with `model.pt` and `card.json`.
 
 `model.pt` holds only the network config (plain types) and its state_dict (tensors, including
 the input normalisers), loaded with `torch.load(weights_only=True)`: no pickled code runs. The
@@ -6,7 +6,8 @@ card records where the weights came from and how good they are (see `evoeye.moni
 plus the checkpoint's sha256, checked on load. A version id is `fusion-<hash>` of the weights
 and of what produced them (config, hyper-parameters, data selection and fingerprint, parent),
 never of the wall clock: the same seed on the same data gives the same version. Versions are
-written once, atomically (a temporary folder renamed into place), and never modified.
+written once, atomically (a temporary folder renamed into place), and never modified. Reading
+them (folders, cards, the checksum) is the fusion family's (`evoeye.monitor.families`).
 """
 
 from __future__ import annotations
@@ -22,19 +23,22 @@ from typing import Any
 import orjson
 import torch
 
-from evoeye.monitor.card import thresholds_from_json
+from evoeye.monitor.card import thresholds_from_card
+from evoeye.monitor.families import (
+    DEFAULT_FAMILY,
+    FAMILIES,
+    MonitorLoadError,
+    read_model,
+)
 from evoeye.monitor.fusion import FusionMonitor
 from evoeye.monitor.model import FusionNet, config_from_dict
 from evoeye.paths import DataRoot
 
-MODEL_FILE = "model.pt"
-CARD_FILE = "card.json"
-VERSION_PREFIX = "fusion-"
+FUSION = FAMILIES[DEFAULT_FAMILY]
+MODEL_FILE = FUSION.model_file
+CARD_FILE = FUSION.meta_file
+VERSION_PREFIX = FUSION.prefix
 HASHED_CARD_KEYS = ("config", "hyperparameters", "selection", "data", "parent", "horizon_s")
-
-
-class MonitorLoadError(Exception):
-    """A monitor version that cannot be loaded: missing, corrupt, or not matching its card."""
 
 
 def _json(value: Any) -> bytes:
@@ -59,14 +63,8 @@ def version_of(net: FusionNet, card: dict[str, Any]) -> str:
     return VERSION_PREFIX + h.hexdigest()[:12]
 
 
-def version_dir(root: DataRoot | str | os.PathLike | None, version: str) -> Path:
-    if not version or "/" in version or version.startswith("."):
-        raise MonitorLoadError(f"not a monitor version id: {version!r}")
-    return _root(root).monitors / version
-
-
-def _root(root: DataRoot | str | os.PathLike | None) -> DataRoot:
-    return root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+def version_dir(root: DataRoot, version: str) -> Path:
+    return FUSION.version_dir(root, version)
 
 
 def _write(path: Path, data: bytes) -> None:
@@ -76,7 +74,7 @@ def _write(path: Path, data: bytes) -> None:
         os.fsync(f.fileno())
 
 
-def save_version(root: DataRoot | str | os.PathLike | None, net: FusionNet,
+def save_version(root: DataRoot, net: FusionNet,
                  card: dict[str, Any]) -> str:
     """Write a new version (model.pt + card.json) atomically; its id. An identical version
     already on disk is kept as it is (same id = same weights and provenance)."""
@@ -102,37 +100,19 @@ def save_version(root: DataRoot | str | os.PathLike | None, net: FusionNet,
     return version
 
 
-def list_versions(root: DataRoot | str | os.PathLike | None = None) -> list[str]:
+def list_versions(root: DataRoot) -> list[str]:
     """Every complete version under the root, oldest card first."""
-    folder = _root(root).monitors
-    if not folder.is_dir():
-        return []
-    done = [p for p in folder.iterdir() if not p.name.startswith(".") and (p / CARD_FILE).exists()]
-    return [p.name for p in sorted(done, key=lambda p: (p / CARD_FILE).stat().st_mtime)]
+    return FUSION.versions(root)
 
 
-def read_card(root: DataRoot | str | os.PathLike | None, version: str) -> dict[str, Any]:
+def read_card(root: DataRoot, version: str) -> dict[str, Any]:
     """The card of a version (MonitorLoadError if it is missing or not JSON)."""
-    path = version_dir(root, version) / CARD_FILE
-    try:
-        return orjson.loads(path.read_bytes())
-    except FileNotFoundError:
-        known = ", ".join(list_versions(root)[-5:]) or "none"
-        raise MonitorLoadError(f"no monitor version {version!r} under {path.parents[1]} "
-                               f"(latest: {known})") from None
-    except (OSError, orjson.JSONDecodeError) as e:
-        raise MonitorLoadError(f"{path}: unreadable card ({e})") from e
+    return FUSION.read_meta(root, version)
 
 
-def load_net(path: Path, expected_sha256: str | None = None) -> FusionNet:
-    """A FusionNet from a model.pt, weights only; MonitorLoadError on anything wrong."""
-    try:
-        data = path.read_bytes()
-    except OSError as e:
-        raise MonitorLoadError(f"{path}: cannot read checkpoint ({e.strerror or e})") from e
-    if expected_sha256 is not None and hashlib.sha256(data).hexdigest() != expected_sha256:
-        raise MonitorLoadError(f"{path}: checkpoint is corrupt or was modified (its sha256 "
-                               "differs from the one in card.json)")
+def net_from_bytes(data: bytes, path: Path) -> FusionNet:
+    """A FusionNet from model.pt bytes (read from `path`), weights only; MonitorLoadError on
+    anything wrong."""
     try:
         ckpt = torch.load(io.BytesIO(data), map_location="cpu", weights_only=True)
         net = FusionNet(config_from_dict(ckpt["config"]))
@@ -143,8 +123,25 @@ def load_net(path: Path, expected_sha256: str | None = None) -> FusionNet:
     return net.eval()
 
 
-def load_monitor(root: DataRoot | str | os.PathLike | None, version: str) -> FusionMonitor:
+def load_net(path: Path, expected_sha256: str | None = None) -> FusionNet:
+    """A FusionNet from a model.pt, weights only, checked against `expected_sha256` if given;
+    MonitorLoadError on anything wrong."""
+    if expected_sha256 is None:
+        try:
+            data = path.read_bytes()
+        except OSError as e:
+            raise MonitorLoadError(f"{path}: cannot read checkpoint ({e.strerror or e})") from e
+    else:
+        data = read_model(path, path.with_name(CARD_FILE), {"model_sha256": expected_sha256})
+    return net_from_bytes(data, path)
+
+
+def decode_monitor(data: bytes, card: dict[str, Any], version: str) -> FusionMonitor:
+    """The FusionMonitor of checked model.pt bytes and its card (eval mode, thresholds loaded)."""
+    net = net_from_bytes(data, Path(FUSION.folder, version, MODEL_FILE))
+    return FusionMonitor(net, version, thresholds_from_card(card), card)
+
+
+def load_monitor(root: DataRoot, version: str) -> FusionMonitor:
     """The FusionMonitor of a saved version, ready to score (eval mode, thresholds loaded)."""
-    card = read_card(root, version)
-    net = load_net(version_dir(root, version) / MODEL_FILE, card.get("model_sha256"))
-    return FusionMonitor(net, version, thresholds_from_json(card.get("thresholds", {})), card)
+    return FUSION.load(root, version)

@@ -1,15 +1,16 @@
 """RuntimeMonitor: the FusionMonitor inside an ADS loop — one frame of messages in, risk out.
 
-Each frame's messages go through the warehouse's own conversion (`runtime_table` → the
-`frame_features` of `evoeye.store.features`), so at run time the monitor sees exactly the inputs
-it was trained on. The last L frames form the context; until L frames have been seen, the first
-frame fills the missing slots and they are masked, exactly as `warehouse/queries/windows.sql`
-pads the start of a run. Streaming a run therefore gives the scores of its warehouse windows.
+Each frame's messages go through the warehouse's own feature code (`frame_features` of
+`evoeye.store.features`, reading the messages as `MessageSignals`: the values ingest would store),
+so at run time the monitor sees exactly the inputs it was trained on. The last L frames form
+the context, kept in fixed (1, L, …) buffers the network reads in place; until L frames have
+been seen, the first frame fills the missing slots and they are masked, exactly as
+`load_windows` pads the start of a run. Streaming a run therefore gives the scores of its
+warehouse windows.
 """
 
 from __future__ import annotations
 
-from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -19,7 +20,7 @@ import torch
 from evoeye.ads.messages import FrameMessages
 from evoeye.monitor.fusion import FusionMonitor
 from evoeye.store.features import FrameFeatures, frame_features
-from evoeye.store.records import runtime_table
+from evoeye.store.records import MessageSignals
 
 
 @dataclass(frozen=True)
@@ -48,45 +49,56 @@ class RuntimeMonitor:
         self.threshold = float(threshold if threshold is not None
                                else monitor.thresholds.at(fpr))
         self.consecutive = consecutive
-        self._frames: deque[dict[str, np.ndarray]] = deque(maxlen=monitor.context_len)
-        self._first: dict[str, np.ndarray] | None = None
+        self._context: dict[str, np.ndarray] = {}  # (1, L, …) per input, oldest first
+        self._tensors: dict[str, torch.Tensor] = {}  # the same memory, as the network reads it
+        self._seen = 0  # frames of the current run
         self._run = 0
 
     def reset(self) -> None:
         """Forget the context: the next frame starts a new run."""
-        self._frames.clear()
-        self._first = None
+        self._seen = 0
         self._run = 0
 
     def step(self, messages: FrameMessages) -> RiskState:
         """Score the context ending at this frame (its modules' messages, in time order)."""
-        features = frame_features(runtime_table([messages]))
+        features = frame_features(MessageSignals(messages))
         return self.step_features(features, float(messages.localization.t_s))
 
     def step_features(self, features: FrameFeatures, t_s: float) -> RiskState:
         """As `step`, from one frame's already computed features (a FrameFeatures of 1 row)."""
         if len(features) != 1:
             raise ValueError(f"one frame at a time, got {len(features)}")
-        frame = {name: arr[0] for name, arr in features.arrays().items()}
-        if self._first is None:
-            self._first = frame
-        self._frames.append(frame)
-        score = float(self.monitor.score_batch(self._context())[0])
+        self._push(features.arrays())
+        score = float(self.monitor.score_batch(self._tensors)[0])
         above = score > self.threshold
         self._run = self._run + 1 if above else 0
         return RiskState(t_s, score, above, self._run >= self.consecutive, self.threshold)
+
+    def _push(self, frame: dict[str, np.ndarray]) -> None:
+        """Shift the context one slot left and put `frame` (arrays of 1 row) last; the first
+        frame of a run fills every slot, masked but its own."""
+        if not self._context:
+            length = self.monitor.context_len
+            self._context = {name: np.zeros((1, length, *arr.shape[1:]), arr.dtype)
+                             for name, arr in frame.items()}
+            self._context["context_mask"] = np.zeros((1, length), bool)
+            self._tensors = {name: torch.from_numpy(arr) for name, arr in self._context.items()}
+        mask = self._context["context_mask"]
+        for name, arr in frame.items():
+            slots = self._context[name]
+            if self._seen:
+                slots[0, :-1] = slots[0, 1:]
+                slots[0, -1] = arr[0]
+            else:
+                slots[0] = arr[0]
+        if self._seen:
+            mask[0, :-1] = mask[0, 1:]
+        else:
+            mask[0] = False
+        mask[0, -1] = True
+        self._seen += 1
 
     def run(self, frames: Sequence[FrameMessages]) -> list[RiskState]:
         """Reset, then step through a whole run."""
         self.reset()
         return [self.step(m) for m in frames]
-
-    def _context(self) -> dict[str, torch.Tensor]:
-        """(1, L, …) tensors of the last L frames, padded on the left with the first frame."""
-        length = self.monitor.context_len
-        pad = length - len(self._frames)
-        slots = [self._first] * pad + list(self._frames)
-        out = {name: torch.from_numpy(np.stack([s[name] for s in slots])[None])
-               for name in slots[0]}
-        out["context_mask"] = torch.tensor([[False] * pad + [True] * len(self._frames)])
-        return out

@@ -20,7 +20,6 @@ scratch, with normalisers fitted on the training frames.
 from __future__ import annotations
 
 import copy
-import os
 import time
 from collections.abc import Callable, Sequence
 from contextlib import contextmanager
@@ -33,13 +32,13 @@ import torch
 from torch import nn
 
 from evoeye import __version__
-from evoeye.evaluation.calibration import calibrate_on_validation
+from evoeye.monitor.calibration import calibrate_on_validation
 from evoeye.monitor.card import (
     data_summary,
     describe_selection,
     ranking_metrics,
     split_metrics,
-    thresholds_to_json,
+    thresholds_to_card,
 )
 from evoeye.monitor.fusion import FusionMonitor, net_inputs
 from evoeye.monitor.model import MODULES, FusionConfig, FusionNet
@@ -169,7 +168,7 @@ def _selections(scenario: str | None, splits: SplitSpec, train_runs: Runs, val_r
 
 
 def train_monitor(
-    root: DataRoot | str | os.PathLike | None = None,
+    root: DataRoot,
     scenario: str | None = None,
     *,
     context_len: int | None = None,
@@ -193,7 +192,6 @@ def train_monitor(
     FusionConfig's) come from the parent when fine-tuning. `overrides` set TrainParams fields
     (epochs=…, lr=…); a full `params` replaces both them and `seed`.
     """
-    root = DataRoot.resolve(root) if not isinstance(root, DataRoot) else root
     params = params or TrainParams(seed=seed, **overrides)
     train_runs, val_runs = _selections(scenario, splits, train_runs, val_runs)
     parent = load_monitor(root, init_from) if init_from else None
@@ -239,7 +237,7 @@ def train_monitor(
                             "early_stopping": "val AUPRC"},
         "training": {"best_epoch": result.best_epoch, "epochs_run": len(result.history),
                      "time_s": round(result.time_s, 2), "history": result.history},
-        "thresholds": thresholds_to_json(thresholds),
+        **thresholds_to_card(thresholds),
         "metrics": {"val": split_metrics(scores, val.label, thresholds)},
     }
     return save_version(root, result.net, card)

@@ -4,9 +4,9 @@ The outcome's `min_distance_m` (and AV-Fuzzer's fitness, which is built on it) n
 gap between the ego's footprint and another vehicle's: 0 only when the two rectangles touch or
 overlap. Centre distance minus half-lengths is not that gap — two cars side by side in adjacent
 lanes (4 m apart, 5 m long) would be at "distance 0" — so this computes the Euclidean distance
-between the rectangles: 0 if a separating-axis test finds them overlapping, otherwise the
-smallest corner-to-edge distance either way (for convex polygons that do not overlap, the
-closest pair always involves a corner). Vectorised over the other actors.
+between the rectangles (`evoeye.boxes.box_gaps`): 0 if a separating-axis test finds them
+overlapping, otherwise the smallest corner-to-edge distance either way. Vectorised over the
+other actors.
 """
 
 from __future__ import annotations
@@ -15,34 +15,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
+from evoeye.boxes import box_corners, box_gaps
 from evoeye.scene import SceneState
 
-_UNIT = np.array([[0.5, 0.5], [-0.5, 0.5], [-0.5, -0.5], [0.5, -0.5]])  # corners, box frame
-
-
-def box_corners(x: np.ndarray, y: np.ndarray, heading: np.ndarray, length: np.ndarray,
-                width: np.ndarray) -> np.ndarray:
-    """(N, 4, 2) corners of N oriented rectangles, counter-clockwise."""
-    local = _UNIT[None] * np.stack([length, width], axis=-1)[:, None, :]  # (N, 4, 2)
-    c, s = np.cos(heading)[:, None], np.sin(heading)[:, None]
-    return np.stack([x[:, None] + c * local[..., 0] - s * local[..., 1],
-                     y[:, None] + s * local[..., 0] + c * local[..., 1]], axis=-1)
-
-
-def box_gaps(a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """(N,) Euclidean distance between rectangles a[i] and b[i] ((N, 4, 2) corners); 0 if they
-    overlap. Separated: the smallest corner-to-edge distance, both ways in one pass."""
-    n = len(a)
-    p, q = np.concatenate([a, b]), np.concatenate([b, a])  # corners of p to edges of q
-    ab = np.roll(q, -1, axis=1) - q  # edges q_m → q_{m+1}
-    ap = p[:, :, None, :] - q[:, None, :, :]  # (2N, corner, edge, 2)
-    t = np.einsum("nkmd,nmd->nkm", ap, ab) / np.einsum("nmd,nmd->nm", ab, ab)[:, None, :]
-    d = ap - np.clip(t, 0.0, 1.0)[..., None] * ab[:, None]
-    dist = np.sqrt(np.einsum("nkmd,nkmd->nkm", d, d).reshape(2 * n, -1).min(axis=1))
-    axes = np.concatenate([a[:, 1:3] - a[:, 0:2], b[:, 1:3] - b[:, 0:2]], axis=1)  # (N, 4, 2)
-    proj_a, proj_b = a @ axes.transpose(0, 2, 1), b @ axes.transpose(0, 2, 1)  # (N, 4, axis)
-    separated = ((proj_a.max(1) < proj_b.min(1)) | (proj_b.max(1) < proj_a.min(1))).any(axis=1)
-    return np.where(separated, np.minimum(dist[:n], dist[n:]), 0.0)
+__all__ = ["box_corners", "box_gaps", "ego_gaps", "min_ego_gap"]
 
 
 def _bbox_gap(x: np.ndarray, y: np.ndarray, h: np.ndarray, length: np.ndarray,

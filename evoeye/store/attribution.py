@@ -1,7 +1,7 @@
 """Table attribution: counterfactual outcomes of collision runs (`evoeye explain`), append-only.
 
 Layout: `<root>/warehouse/attribution/part-<utc stamp>-<id>.parquet`, columns as declared in
-`schemas/warehouse/attribution.sql`. Like feedback (whose part writer this reuses), a write
+`schemas/warehouse/attribution.sql` (a derived table: `evoeye.store.derived`). A write
 takes the warehouse writer lock, skips every (scenario_id, variant, software_version) already
 stored and writes the rest as one new part, so re-running `explain` adds nothing and a killed
 one resumes with the runs it had not written. Every connection sees the table as the view
@@ -12,13 +12,12 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import astuple, dataclass, fields
-from pathlib import Path
 
 import pyarrow as pa
 
 from evoeye.paths import DataRoot
 from evoeye.store.catalog import write_catalog
-from evoeye.store.feedback import _append, _read, _root
+from evoeye.store.derived import append_part, read_parts
 from evoeye.store.lock import WriterLock
 from evoeye.store.schema import declared_schema
 
@@ -43,15 +42,13 @@ class AttributionRow:
         return self.scenario_id, self.variant, self.software_version
 
 
-def read_attribution(root: DataRoot | str | Path | None,
+def read_attribution(root: DataRoot,
                      software_version: str | None = None) -> pa.Table:
     """Rows of attribution (all, or one software version), ordered by run and variant."""
-    return _read(_root(root), ATTRIBUTION_TABLE,
-                 "$version IS NULL OR software_version = $version",
-                 {"version": software_version}, "software_version, scenario_id, variant")
+    return read_parts(root, ATTRIBUTION_TABLE, "attribution_rows", version=software_version)
 
 
-def explained_keys(root: DataRoot | str | Path | None,
+def explained_keys(root: DataRoot,
                    software_version: str | None = None) -> set[tuple[str, str, str]]:
     """The (scenario_id, variant, software_version) triples already stored."""
     t = read_attribution(root, software_version)
@@ -59,11 +56,10 @@ def explained_keys(root: DataRoot | str | Path | None,
                      ("scenario_id", "variant", "software_version")), strict=True))
 
 
-def write_attribution(root: DataRoot | str | Path | None, rows: Sequence[AttributionRow],
+def write_attribution(root: DataRoot, rows: Sequence[AttributionRow],
                       *, refresh_catalog: bool = False) -> int:
     """Append the rows whose key is not stored yet, as one part; the number written. With
     `refresh_catalog`, rewrite the DuckDB catalog file so its `attribution` view sees them."""
-    root = _root(root)
     with WriterLock(root.writer_lock):
         done = explained_keys(root)
         new: dict[tuple[str, str, str], AttributionRow] = {}
@@ -74,7 +70,7 @@ def write_attribution(root: DataRoot | str | Path | None, rows: Sequence[Attribu
             schema = declared_schema(ATTRIBUTION_TABLE)
             names = [f.name for f in fields(AttributionRow)]
             values = list(zip(*(astuple(r) for r in new.values()), strict=True))
-            _append(root, ATTRIBUTION_TABLE, {
+            append_part(root, ATTRIBUTION_TABLE, {
                 n: pa.array(v, schema.field(n).type) for n, v in zip(names, values, strict=True)
             })
         if refresh_catalog and root.duckdb_file.exists():

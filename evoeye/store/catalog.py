@@ -87,8 +87,8 @@ def _lock_down(con: duckdb.DuckDBPyConnection, readable: Path) -> None:
 class Warehouse:
     """Read access to the warehouse of one data root."""
 
-    def __init__(self, root: DataRoot | str | Path | None = None) -> None:
-        self.root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+    def __init__(self, root: DataRoot) -> None:
+        self.root = root
 
     def connect(self) -> duckdb.DuckDBPyConnection:
         """A fresh in-memory DuckDB with every warehouse view; the caller closes it."""

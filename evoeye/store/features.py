@@ -2,6 +2,8 @@
 
 Everything is expressed in the ego frame of the ADS's own localization (x forward, y left,
 origin at the ego centre), so a monitor learns relative geometry, never absolute map positions.
+The signals come as `Signals` (`evoeye.store.signals`): an Arrow frames table at ingest, one
+frame's live messages at run time — one feature code for both.
 Per frame, with n = `max_obstacles`, K = `pred_points`, P = `plan_points`:
 
     perception       (n, 9)    PERCEPTION_FEATURES of the n nearest obstacles, nearest first
@@ -29,9 +31,9 @@ from dataclasses import dataclass, fields
 
 import numpy as np
 import pyarrow as pa
-import pyarrow.compute as pc
 
 from evoeye.ads.messages import PLANNING_DECISIONS
+from evoeye.store.signals import ArrowSignals, Signals
 
 PERCEPTION_FEATURES = (
     "dx_m", "dy_m", "cos_dheading", "sin_dheading", "dvx_mps", "dvy_mps",
@@ -70,6 +72,7 @@ class FeatureSpec:
 
 
 FEATURES = FeatureSpec()  # the spec the warehouse's frame_features are built with
+MIN_SLICE_ROWS = 64  # `FrameFeatures.fill` copies runs this long or longer as slices
 
 
 @dataclass
@@ -105,33 +108,30 @@ class FrameFeatures:
             np.zeros((n_frames, len(CONTROL_FEATURES)), np.float32),
         )
 
-    def fill(self, start: int, part: FrameFeatures) -> None:
-        """Copy `part` into rows start … start + len(part)."""
-        for name, arr in part.arrays().items():
-            getattr(self, name)[start : start + len(part)] = arr
+    def fill(self, start: int, part: FrameFeatures, index: np.ndarray | None = None) -> None:
+        """Copy `part` (its rows `index`, default all) into rows start, start + 1, …
 
-
-# -- Arrow helpers -------------------------------------------------------------------------------
-def _scalar(table: pa.Table, name: str) -> np.ndarray:
-    return table.column(name).to_numpy(zero_copy_only=False).astype(np.float64)
-
-
-def _list(table: pa.Table, name: str) -> tuple[np.ndarray, pa.Array]:
-    """(offsets (N+1,) int64 from 0, child values) of a list column."""
-    arr = table.column(name).combine_chunks()
-    offsets = arr.offsets.to_numpy().astype(np.int64)
-    values = arr.values.slice(offsets[0], offsets[-1] - offsets[0])
-    return offsets - offsets[0], values
-
-
-def _values(table: pa.Table, name: str) -> tuple[np.ndarray, np.ndarray]:
-    offsets, values = _list(table, name)
-    return offsets, values.to_numpy(zero_copy_only=False).astype(np.float64)
+        Runs of consecutive rows in `index` are copied as slices (4× faster than a gather)."""
+        if index is None:
+            index = np.arange(len(part))
+        if len(index) == 0:
+            return
+        breaks = np.flatnonzero(np.diff(index) != 1) + 1
+        if len(breaks) > len(index) // MIN_SLICE_ROWS:  # scattered rows: one gather
+            for name, arr in part.arrays().items():
+                np.take(arr, index, axis=0, out=getattr(self, name)[start : start + len(index)])
+            return
+        for lo, hi in zip(np.r_[0, breaks], np.r_[breaks, len(index)], strict=True):
+            src, dst = int(index[lo]), start + int(lo)
+            for name, arr in part.arrays().items():
+                getattr(self, name)[dst : dst + hi - lo] = arr[src : src + hi - lo]
 
 
 # -- geometry -----------------------------------------------------------------------------------
 @dataclass(frozen=True)
 class _EgoPose:
+    """The ego's pose and velocity (map frame), one entry per frame — or per item (`expand`)."""
+
     x_m: np.ndarray
     y_m: np.ndarray
     cos: np.ndarray
@@ -141,27 +141,48 @@ class _EgoPose:
     vy_mps: np.ndarray
 
     @classmethod
-    def of(cls, table: pa.Table) -> _EgoPose:
-        h = _scalar(table, "loc_heading_rad")
-        v = _scalar(table, "loc_speed_mps")
+    def of(cls, signals: Signals) -> _EgoPose:
+        h = signals.scalar("loc_heading_rad")
+        v = signals.scalar("loc_speed_mps")
         c, s = np.cos(h), np.sin(h)
-        return cls(_scalar(table, "loc_x_m"), _scalar(table, "loc_y_m"), c, s, h, v * c, v * s)
+        return cls(signals.scalar("loc_x_m"), signals.scalar("loc_y_m"), c, s, h, v * c, v * s)
 
-    def rotate(self, wx: np.ndarray, wy: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, ...]:
-        """World vectors (wx, wy) of frames `rows` → ego-frame (forward, left)."""
-        c, s = self.cos[rows], self.sin[rows]
-        return c * wx + s * wy, -s * wx + c * wy
+    def expand(self, offsets: np.ndarray | None, trailing: int = 0) -> _EgoPose:
+        """The pose of each item of a list column with these offsets (None: of each frame),
+        with `trailing` axes of length 1 to broadcast against per-item values. One frame's pose
+        is a pose of floats (numpy multiplies by a float at half the cost of broadcasting)."""
+        arrays = [self.x_m, self.y_m, self.cos, self.sin, self.heading_rad, self.vx_mps,
+                  self.vy_mps]
+        if len(arrays[0]) == 1:
+            return _EgoPose(*(float(a[0]) for a in arrays))
+        if offsets is not None:
+            rows = np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
+            arrays = [a[rows] for a in arrays]
+        if trailing:
+            arrays = [a.reshape(-1, *(1,) * trailing) for a in arrays]
+        return _EgoPose(*arrays)
 
-    def to_ego(self, x: np.ndarray, y: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, ...]:
-        """World points of frames `rows` → ego-frame points."""
-        return self.rotate(x - self.x_m[rows], y - self.y_m[rows], rows)
+    def rotate(self, wx: np.ndarray, wy: np.ndarray) -> tuple[np.ndarray, ...]:
+        """World vectors (wx, wy) → ego-frame (forward, left)."""
+        return self.cos * wx + self.sin * wy, -self.sin * wx + self.cos * wy
+
+    def to_ego(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, ...]:
+        """World points → ego-frame points."""
+        return self.rotate(x - self.x_m, y - self.y_m)
+
+
+def _frame_of_items(offsets: np.ndarray) -> np.ndarray:
+    """(M,) the frame of each item of a list column with these offsets."""
+    if len(offsets) == 2:  # one frame (run time): no repeat needed
+        return np.zeros(offsets[1], np.int64)
+    return np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
 
 
 def _nearest_slots(
     offsets: np.ndarray, dist: np.ndarray, n_max: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """For items grouped by frame: (item, frame, slot) of the n_max nearest per frame."""
-    frame = np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
+    frame = _frame_of_items(offsets)
     order = np.lexsort((dist, frame))  # by frame, then distance
     slot = np.arange(len(order)) - offsets[frame[order]]
     keep = slot < n_max
@@ -180,99 +201,101 @@ def _points_index(
 
 
 def _finite32(a: np.ndarray) -> np.ndarray:
-    return np.nan_to_num(a, nan=0.0, posinf=0.0, neginf=0.0).astype(np.float32)
+    """float32 of `a` with every non-finite value 0 (np.nan_to_num's result, without its cost)."""
+    return np.where(np.isfinite(a), a, 0.0).astype(np.float32)
 
 
 # -- per module ---------------------------------------------------------------------------------
-def _perception(t: pa.Table, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
-    offsets, x = _values(t, "obs_x_m")
-    rows = np.repeat(np.arange(len(t)), np.diff(offsets))
-    dx, dy = ego.to_ego(x, _values(t, "obs_y_m")[1], rows)
-    dh = _values(t, "obs_heading_rad")[1] - ego.heading_rad[rows]
-    dvx, dvy = ego.rotate(
-        _values(t, "obs_vx_mps")[1] - ego.vx_mps[rows],
-        _values(t, "obs_vy_mps")[1] - ego.vy_mps[rows],
-        rows,
-    )
-    feats = np.stack(
-        [dx, dy, np.cos(dh), np.sin(dh), dvx, dvy, _values(t, "obs_length_m")[1],
-         _values(t, "obs_width_m")[1], _values(t, "obs_confidence")[1]],
-        axis=-1,
-    )
-    item, frame, slot = _nearest_slots(offsets, np.hypot(dx, dy), spec.max_obstacles)
+PERCEPTION_COLUMNS = ("obs_x_m", "obs_y_m", "obs_heading_rad", "obs_vx_mps", "obs_vy_mps",
+                      "obs_length_m", "obs_width_m", "obs_confidence")
+PLAN_COLUMNS = ("plan_x_m", "plan_y_m", "plan_heading_rad", "plan_t_rel_s", "plan_speed_mps",
+                "plan_accel_mps2")
+
+
+def _perception(t: Signals, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
+    offsets, (x, y, h, vx, vy, length, width, confidence) = t.columns(PERCEPTION_COLUMNS)
+    pose = ego.expand(offsets)
+    feats = np.empty((len(x), len(PERCEPTION_FEATURES)))
+    feats[:, 0], feats[:, 1] = pose.to_ego(x, y)
+    dh = h - pose.heading_rad
+    feats[:, 2], feats[:, 3] = np.cos(dh), np.sin(dh)
+    feats[:, 4], feats[:, 5] = pose.rotate(vx - pose.vx_mps, vy - pose.vy_mps)
+    feats[:, 6], feats[:, 7], feats[:, 8] = length, width, confidence
+    dist = np.hypot(feats[:, 0], feats[:, 1])
+    item, frame, slot = _nearest_slots(offsets, dist, spec.max_obstacles)
     out.perception[frame, slot] = _finite32(feats[item])
     out.perception_mask[frame, slot] = True
 
 
-def _prediction(t: pa.Table, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
-    outer, inner_x = _list(t, "pred_x_m")
-    _, inner_y = _list(t, "pred_y_m")
-    inner = inner_x.offsets.to_numpy().astype(np.int64)  # absolute into inner_x.values
-    x = inner_x.values.to_numpy(zero_copy_only=False).astype(np.float64)
-    y = inner_y.values.to_numpy(zero_copy_only=False).astype(np.float64)
+def _prediction(t: Signals, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
+    outer, inner, x = t.points("pred_x_m")  # inner: absolute into x
+    y = t.points("pred_y_m")[2]
     if len(inner) <= 1 or len(x) == 0:
         return
     idx, _ = _points_index(inner, spec.pred_raw_index, len(x))  # (M, K) into x / y
     has_points = np.diff(inner) > 0
-    rows = np.repeat(np.arange(len(t)), np.diff(outer))
-    dx, dy = ego.to_ego(x[idx], y[idx], rows[:, None])
+    dx, dy = ego.expand(outer, trailing=1).to_ego(x[idx], y[idx])
     # one slot per obstacle, its most probable mode: the first of its contiguous rows
-    track = _values(t, "pred_track_id")[1]
+    track = t.items("pred_track_id")[1]
     first = np.ones(len(track), dtype=bool)
-    first[1:] = (track[1:] != track[:-1]) | (rows[1:] != rows[:-1])
+    first[1:] = track[1:] != track[:-1]
+    if len(outer) > 2:  # a new frame starts a new obstacle too
+        rows = _frame_of_items(outer)
+        first[1:] |= rows[1:] != rows[:-1]
     dist = np.where(has_points & first, np.hypot(dx[:, 0], dy[:, 0]), np.inf)
     item, frame, slot = _nearest_slots(outer, dist, spec.max_obstacles)
     primary = first[item]
     item, frame, slot = item[primary], frame[primary], slot[primary]
-    item_ok = has_points[item]
-    out.prediction[frame, slot] = _finite32(np.stack([dx[item], dy[item]], axis=-1))
-    out.prediction_mask[frame, slot] = item_ok
+    out.prediction[frame, slot, :, 0] = _finite32(dx[item])
+    out.prediction[frame, slot, :, 1] = _finite32(dy[item])
+    out.prediction_mask[frame, slot] = has_points[item]
 
 
-def _plan(t: pa.Table, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
-    offsets, x = _values(t, "plan_x_m")
+def _plan(t: Signals, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
+    offsets, (x, y, h, t_rel, speed, accel) = t.columns(PLAN_COLUMNS)
     if len(x) == 0:
         return
     idx, mask = _points_index(offsets, spec.plan_raw_index, len(x))  # (N, P)
-    rows = np.arange(len(t))[:, None]
-    dx, dy = ego.to_ego(x[idx], _values(t, "plan_y_m")[1][idx], rows)
-    dh = _values(t, "plan_heading_rad")[1][idx] - ego.heading_rad[rows]
-    feats = np.stack(
-        [_values(t, "plan_t_rel_s")[1][idx], dx, dy, np.cos(dh), np.sin(dh),
-         _values(t, "plan_speed_mps")[1][idx], _values(t, "plan_accel_mps2")[1][idx]],
-        axis=-1,
-    )
+    pose = ego.expand(None, trailing=1)
+    feats = np.empty((*idx.shape, len(PLAN_FEATURES)))
+    feats[..., 1], feats[..., 2] = pose.to_ego(x[idx], y[idx])
+    dh = h[idx] - pose.heading_rad
+    feats[..., 3], feats[..., 4] = np.cos(dh), np.sin(dh)
+    feats[..., 0], feats[..., 5], feats[..., 6] = t_rel[idx], speed[idx], accel[idx]
     has_plan = np.diff(offsets) > 0
     out.plan[has_plan] = _finite32(feats[has_plan])
     out.plan_mask[:] = mask
 
 
-def _plan_info_and_control(t: pa.Table, out: FrameFeatures) -> None:
-    decision = pc.index_in(t.column("plan_decision"), value_set=pa.array(PLANNING_DECISIONS))
-    code = decision.to_numpy(zero_copy_only=False)  # float with NaN where unknown
-    known = np.isfinite(code)
-    one_hot = np.zeros((len(t), len(PLANNING_DECISIONS)))
-    one_hot[np.flatnonzero(known), code[known].astype(np.int64)] = 1.0
-    out.plan_info[:] = _finite32(
-        np.column_stack([_scalar(t, "plan_target_speed_mps"), one_hot])
-    )
-    out.control[:] = _finite32(np.column_stack([
-        _scalar(t, "ctrl_throttle"), _scalar(t, "ctrl_brake"), _scalar(t, "ctrl_steering_rad"),
-        _scalar(t, "ctrl_accel_cmd_mps2"), _scalar(t, "loc_speed_mps"),
-        _scalar(t, "loc_accel_mps2"),
-    ]))
+CONTROL_COLUMNS = ("ctrl_throttle", "ctrl_brake", "ctrl_steering_rad", "ctrl_accel_cmd_mps2",
+                   "loc_speed_mps", "loc_accel_mps2")  # the sources of CONTROL_FEATURES
 
 
-def frame_features(table: pa.Table, spec: FeatureSpec = FEATURES) -> FrameFeatures:
-    """The monitor inputs of every row of `table` (runtime_frames columns), in row order."""
-    out = FrameFeatures.empty(len(table), spec)
-    if len(table) == 0:
+def _plan_info_and_control(t: Signals, out: FrameFeatures) -> None:
+    code = t.codes("plan_decision", PLANNING_DECISIONS)
+    info = np.zeros((len(t), len(PLAN_INFO_FEATURES)))
+    info[:, 0] = t.scalar("plan_target_speed_mps")
+    known = np.flatnonzero(code >= 0)
+    info[known, 1 + code[known]] = 1.0
+    out.plan_info[:] = _finite32(info)
+    control = np.empty((len(t), len(CONTROL_FEATURES)))
+    for col, name in enumerate(CONTROL_COLUMNS):
+        control[:, col] = t.scalar(name)
+    out.control[:] = _finite32(control)
+
+
+def frame_features(source: pa.Table | Signals, spec: FeatureSpec = FEATURES) -> FrameFeatures:
+    """The monitor inputs of every frame of `source`, in order: an Arrow table with
+    runtime_frames columns, or any `Signals` (one frame's live messages at run time)."""
+    signals = ArrowSignals(source) if isinstance(source, pa.Table | pa.RecordBatch) else source
+    out = FrameFeatures.empty(len(signals), spec)
+    if len(signals) == 0:
         return out
-    ego = _EgoPose.of(table)
-    _perception(table, ego, spec, out)
-    _prediction(table, ego, spec, out)
-    _plan(table, ego, spec, out)
-    _plan_info_and_control(table, out)
+    ego = _EgoPose.of(signals)
+    _perception(signals, ego, spec, out)
+    _prediction(signals, ego, spec, out)
+    _plan(signals, ego, spec, out)
+    _plan_info_and_control(signals, out)
     return out
 
 
@@ -285,13 +308,20 @@ STORED = (
     ("plan_info", None, None),
     ("control", None, None),
 )
+STORED_COLUMNS = tuple(c for stored in STORED for c in (stored[0], stored[2]) if c is not None)
+
+
+# Items are never null: declaring so spares Parquet a definition level per float, which makes
+# reading the lists back (load_windows) a third faster. DuckDB sees FLOAT[] either way.
+STORED_LIST = pa.list_(pa.field("element", pa.float32(), nullable=False))
 
 
 def _flat_list(arr: np.ndarray) -> pa.ListArray:
     """(N, …) → a list column of N rows of prod(…) float32 values each."""
     width = int(np.prod(arr.shape[1:]))
     offsets = pa.array(np.arange(arr.shape[0] + 1, dtype=np.int32) * width, pa.int32())
-    return pa.ListArray.from_arrays(offsets, pa.array(arr.reshape(-1), pa.float32()))
+    values = pa.array(arr.reshape(-1), pa.float32())
+    return pa.ListArray.from_arrays(offsets, values, type=STORED_LIST)
 
 
 def pack(features: FrameFeatures) -> dict[str, pa.Array]:

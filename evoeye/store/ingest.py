@@ -96,7 +96,7 @@ class Ingester:
 
     def __init__(
         self,
-        root: DataRoot | str | Path | None = None,
+        root: DataRoot,
         *,
         runs_per_part: int = DEFAULT_RUNS_PER_PART,
         on_log: Callable[[Path], None] | None = None,
@@ -104,7 +104,7 @@ class Ingester:
     ) -> None:
         if runs_per_part < 1:
             raise ValueError(f"runs_per_part must be at least 1, got {runs_per_part}")
-        self.root = root if isinstance(root, DataRoot) else DataRoot.resolve(root)
+        self.root = root
         self.runs_per_part = runs_per_part
         self.on_log = on_log  # progress callback, called before each log is read
         self.on_start = on_start  # called once with the number of logs to read
@@ -188,7 +188,7 @@ class Ingester:
 
 
 def ingest(
-    root: DataRoot | str | Path | None = None,
+    root: DataRoot,
     *,
     runs_per_part: int = DEFAULT_RUNS_PER_PART,
     on_log: Callable[[Path], None] | None = None,

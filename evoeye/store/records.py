@@ -12,6 +12,7 @@ import math
 import re
 from collections.abc import Sequence
 from datetime import datetime
+from functools import cache
 from typing import Any, Protocol
 
 import numpy as np
@@ -153,8 +154,8 @@ def frame_features_table(frames: pa.Table, spec: FeatureSpec = FEATURES) -> pa.T
     columns = pack(frame_features(frames, spec))
     for name in ("scenario_id", "frame", "ingest_id"):
         columns[name] = frames.column(name)
-    schema = file_schema("frame_features")
-    return pa.table([columns[f.name] for f in schema], schema=schema)
+    names = file_schema("frame_features").names  # the DDL's columns, with pack's list types
+    return pa.table([columns[name] for name in names], names=names)
 
 
 TOPIC_ATTRIBUTE = dict(zip(TOPICS, TOPICS._fields, strict=True))  # topic → FrameMessages field
@@ -181,6 +182,83 @@ def runtime_table(frames: Sequence[FrameMessages]) -> pa.Table:
             columns[name] = pa.array([_plain(getattr(m, field)) for m in messages],
                                      type=schema.field(name).type)
     return pa.table(columns)
+
+
+def _stored_dtype(typ: pa.DataType) -> np.dtype:
+    """The numpy type of a frames column's numbers (of its innermost items for a list)."""
+    while pa.types.is_list(typ):
+        typ = typ.value_type
+    return np.dtype(typ.to_pandas_dtype()) if pa.types.is_floating(typ) else np.dtype(np.float64)
+
+
+@cache
+def _message_fields() -> dict[str, tuple[str, str, np.dtype]]:
+    """Every runtime frames column → (FrameMessages attribute, message field, numpy type its
+    numbers are stored as: a FLOAT column rounds to float32 in the warehouse, so here too)."""
+    schema = file_schema("frames")
+    return {name: (TOPIC_ATTRIBUTE[topic], field, _stored_dtype(schema.field(name).type))
+            for name, (topic, field) in frame_column_sources().items() if topic != FRAME_CLOCK}
+
+
+class MessageSignals:
+    """One frame's live ADS messages as feature `Signals` (evoeye.store.features): the values
+    `runtime_table` would store, read straight from the messages (no Arrow on the way), so the
+    monitor at run time computes its inputs with the warehouse's own feature code."""
+
+    def __init__(self, messages: FrameMessages):
+        self.messages = messages
+
+    def __len__(self) -> int:
+        return 1
+
+    def _value(self, name: str) -> Any:
+        attribute, field, _ = _message_fields()[name]
+        return getattr(getattr(self.messages, attribute), field)
+
+    def _numbers(self, name: str, value: Any) -> np.ndarray:
+        """`value` as stored in column `name` (float32 for FLOAT), then as float64."""
+        stored = np.asarray(value, _message_fields()[name][2])
+        return stored if stored.dtype == np.float64 else stored.astype(np.float64)
+
+    def scalar(self, name: str) -> np.ndarray:
+        return self._numbers(name, (self._value(name),))
+
+    def items(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        values = self._numbers(name, self._value(name)).reshape(-1)
+        return np.array((0, len(values))), values
+
+    def columns(self, names: tuple[str, ...]) -> tuple[np.ndarray, list[np.ndarray]]:
+        fields = _message_fields()
+        dtypes = {fields[name][2] for name in names}
+        values = [self._value(name) for name in names]
+        try:  # one conversion for the whole message when the columns share a type
+            grid = np.array(values, dtypes.pop()) if len(dtypes) == 1 else None
+        except ValueError:  # fields of unequal lengths
+            grid = None
+        if grid is None or grid.ndim != 2:
+            return self.items(names[0])[0], [self.items(name)[1] for name in names]
+        grid = grid.astype(np.float64, copy=False)
+        return np.array((0, grid.shape[1])), list(grid)
+
+    def points(self, name: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        rows = self._value(name)
+        try:  # (items, points): an array as the ADS sends it, or equal lists from a log
+            grid = self._numbers(name, rows)
+        except ValueError:  # lists of unequal lengths
+            grid = None
+        if grid is not None and grid.ndim == 2:
+            counts = np.full(grid.shape[0], grid.shape[1])
+            values = grid.reshape(-1)
+        else:
+            counts = np.array([len(r) for r in rows], np.int64)
+            values = self._numbers(name, [v for r in rows for v in r])
+        inner = np.zeros(len(counts) + 1, np.int64)
+        np.cumsum(counts, out=inner[1:])
+        return np.array((0, len(counts))), inner, values
+
+    def codes(self, name: str, vocabulary: tuple[str, ...]) -> np.ndarray:
+        value = self._value(name)
+        return np.array((vocabulary.index(value) if value in vocabulary else -1,), np.int64)
 
 
 def _check_partition(meta: dict[str, Any]) -> None:

@@ -8,27 +8,8 @@ from dataclasses import asdict, dataclass, field
 import duckdb
 import pyarrow as pa
 
+from evoeye.splits import SPLITS, SplitSpec
 from evoeye.store.sqlfiles import query
-
-SPLITS = ("train", "val", "test")
-
-
-@dataclass(frozen=True)
-class SplitSpec:
-    """A scenario-level split (macro `scenario_splits`): seed and the train / val shares.
-
-    The defaults follow the paper's datasets: half the initial data trains, the other half is
-    held out and split val : test = 1 : 3. Runs of rounds >= 1 always train.
-    """
-
-    seed: int = 0
-    train_frac: float = 0.5
-    val_frac: float = 0.125
-
-    def __post_init__(self) -> None:
-        fracs_ok = min(self.train_frac, self.val_frac) >= 0.0
-        if not (fracs_ok and self.train_frac + self.val_frac <= 1.0):
-            raise ValueError(f"need 0 <= train_frac, val_frac and a sum <= 1: {self}")
 
 
 @dataclass(frozen=True)

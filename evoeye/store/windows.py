@@ -1,10 +1,12 @@
-"""Training windows: runtime contexts c_t (Definition 2) with labels y_t (Definition 1), from SQL.
+"""Training windows: runtime contexts c_t (Definition 2) with labels y_t (Definition 1).
 
-`warehouse/queries/windows.sql` returns every eligible frame of the selected runs (none at or
-after a run's collision: view eligible_frames) with its label, its monitor inputs (table
-frame_features), the ego's localization estimate and the rows of its L context frames (`ctx_row`,
-`ctx_mask`). The frames' inputs are kept once; a window is `features[ctx_row]`, gathered when
-asked for (all at once, or per training batch), so N frames cost N feature rows, not N·L.
+`warehouse/queries/windows.sql` lists every eligible frame of the selected runs (none at or
+after a run's collision: view eligible_frames) in (scenario_id, frame) order, with its label, the
+ego's localization estimate and the row of its monitor inputs in the runs' frame_features parts;
+the L context frames follow from that order (`context_rows`). The inputs are decoded by Arrow
+straight from those Parquet parts into numpy (DuckDB never turns their float lists into rows of
+its own) and kept once per frame: a window is `features[context]`, gathered when asked for (all
+at once, or per training batch), so N frames cost N feature rows, not N·L.
 """
 
 from __future__ import annotations
@@ -13,12 +15,15 @@ from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import TYPE_CHECKING
 
+import duckdb
 import numpy as np
 import pyarrow as pa
+import pyarrow.parquet as pq
 
 from evoeye.paths import DataRoot
 from evoeye.store.catalog import Warehouse
-from evoeye.store.features import FEATURES, FeatureSpec, FrameFeatures, unpack
+from evoeye.store.features import FEATURES, STORED_COLUMNS, FeatureSpec, FrameFeatures, unpack
+from evoeye.store.parts import PART_SUFFIX, PartStore
 from evoeye.store.selection import Runs, select_runs
 from evoeye.store.sqlfiles import query
 
@@ -27,7 +32,6 @@ if TYPE_CHECKING:  # torch is imported when tensors are asked for, not by the SQ
 
 DEFAULT_CONTEXT_LEN = 5  # L, paper §V "Implementation Settings"
 DEFAULT_HORIZON_S = 3.0  # H
-BATCH_ROWS = 65_536  # rows of windows.sql fetched at a time
 
 
 @dataclass
@@ -95,63 +99,79 @@ class Windows:
         )
 
 
-def _list_matrix(col: pa.Array | pa.ChunkedArray, width: int) -> np.ndarray:
-    """A list column whose rows all have `width` items → (rows, width) numpy array."""
-    if isinstance(col, pa.ChunkedArray):
-        col = col.combine_chunks()
-    return col.flatten().to_numpy(zero_copy_only=False).reshape(-1, width)
+FEATURE_KEYS = ("scenario_id", "frame", "ingest_id")  # what windows.sql matches feature_rows on
 
 
-class _WindowsBuilder:
-    """Collects the batches of windows.sql, which arrive in any order.
+def context_rows(run_start: np.ndarray, context_len: int) -> tuple[np.ndarray, np.ndarray]:
+    """(ctx_row, ctx_mask), both (B, L), of B rows in run order, row i of the run starting at
+    row run_start[i]: rows i-L+1 … i oldest first, clamped to the run's first row, and masked
+    exactly where clamped (Definition 2: c_t = (m_max(1,t-L+1), …, m_t) read element-wise)."""
+    back = np.arange(len(run_start))[:, None] - run_start[:, None] - context_len + 1 \
+        + np.arange(context_len)[None, :]  # (B, L) position in the run, negative before it
+    return run_start[:, None] + np.maximum(back, 0), back >= 0
 
-    Frame inputs are copied in arrival order (sequential writes); the per-window arrays go to
-    their `row`, and context rows are translated to arrival positions at the end.
-    """
 
-    def __init__(self, n_frames: int, context_len: int, horizon_s: float, spec: FeatureSpec):
-        self.features = FrameFeatures.empty(n_frames, spec)
-        self.arrival = np.full(n_frames, -1, np.int64)  # row → position in self.features
-        self.context = np.zeros((n_frames, context_len), np.int64)  # in rows, until build()
-        self.context_mask = np.zeros((n_frames, context_len), bool)
-        self.label = np.zeros(n_frames, np.int8)
-        self.scenario_id = np.empty(n_frames, object)
-        self.frame = np.zeros(n_frames, np.int32)
-        self.t_s = np.zeros(n_frames, np.float64)
-        self.ego_xy_m = np.zeros((n_frames, 2), np.float64)
-        self.n_arrived = 0
-        self.horizon_s, self.spec = horizon_s, spec
+def _part_paths(con: duckdb.DuckDBPyConnection, root: DataRoot) -> list[Path]:
+    """The frame_features part files holding the runs in `selected_runs` (query window_parts)
+    that exist (a run whose part is missing gets no feature rows, and load_windows says so)."""
+    store = PartStore(root)
+    paths = [store.partition_dir("frame_features", (ls, batch)) / f"{part}{PART_SUFFIX}"
+             for ls, batch, part in con.sql(query("window_parts")).fetchall()]
+    return [path for path in paths if path.is_file()]
 
-    def add(self, batch: pa.RecordBatch) -> None:
-        rows = batch.column("row").to_numpy()
-        start, stop = self.n_arrived, self.n_arrived + len(rows)
-        if stop > len(self.arrival):
-            raise RuntimeError("windows.sql returned more rows than the selected runs have frames")
-        self.features.fill(start, unpack(batch, self.spec))
-        self.arrival[rows] = np.arange(start, stop)
-        self.n_arrived = stop
-        width = self.context.shape[1]
-        self.context[rows] = _list_matrix(batch.column("ctx_row"), width)
-        self.context_mask[rows] = _list_matrix(batch.column("ctx_mask"), width)
-        self.label[rows] = batch.column("label").to_numpy()
-        self.scenario_id[rows] = batch.column("scenario_id").to_numpy(zero_copy_only=False)
-        self.frame[rows] = batch.column("frame").to_numpy()
-        self.t_s[rows] = batch.column("t_s").to_numpy()
-        for i, name in enumerate(("loc_x_m", "loc_y_m")):
-            self.ego_xy_m[rows, i] = batch.column(name).to_numpy(zero_copy_only=False)
 
-    def build(self) -> Windows:
-        if self.n_arrived != len(self.arrival) or (self.arrival < 0).any():
-            missing = len(self.arrival) - self.n_arrived
-            raise RuntimeError(f"{missing} frames of the selected runs have no frame_features")
-        return Windows(
-            self.features, self.arrival[self.context], self.context_mask, self.label,
-            self.scenario_id, self.frame, self.t_s, self.horizon_s, self.spec, self.ego_xy_m,
-        )
+def _feature_rows(paths: list[Path]) -> pa.Table:
+    """The keys of the rows of `paths`, in file order, numbered: relation `feature_rows`."""
+    keys = [pq.read_table(path, columns=list(FEATURE_KEYS), partitioning=None) for path in paths]
+    table = pa.concat_tables(keys) if keys else pa.table(
+        {"scenario_id": pa.array([], pa.string()), "frame": pa.array([], pa.int32()),
+         "ingest_id": pa.array([], pa.string())})
+    return table.append_column("feature_row", pa.array(np.arange(table.num_rows)))
+
+
+def _gather_features(paths: list[Path], source: np.ndarray, spec: FeatureSpec
+                     ) -> tuple[FrameFeatures, np.ndarray]:
+    """The feature rows `source` (positions in the concatenated rows of `paths`, as numbered by
+    `_feature_rows`) in one FrameFeatures, and where each entry of `source` went.
+
+    Arrow decodes one part at a time straight from Parquet (DuckDB never materialises the float
+    lists); the rows used are copied once, in file order, and the part is freed."""
+    order = np.argsort(source, kind="stable")
+    sorted_source = source[order]
+    features = FrameFeatures.empty(len(source), spec)
+    offset = 0
+    for path in paths:
+        part = pq.read_table(path, columns=list(STORED_COLUMNS), partitioning=None)
+        lo, hi = np.searchsorted(sorted_source, [offset, offset + part.num_rows])
+        if hi > lo:
+            rows = sorted_source[lo:hi] - offset
+            start = int(lo)
+            for batch in part.to_batches():
+                take = rows[(rows >= 0) & (rows < batch.num_rows)]
+                if len(take):
+                    features.fill(start, unpack(batch, spec), take)
+                    start += len(take)
+                rows = rows - batch.num_rows
+        offset += part.num_rows
+    position = np.empty(len(source), np.int64)
+    position[order] = np.arange(len(source))
+    return features, position
+
+
+def _runs(col: pa.ChunkedArray) -> tuple[np.ndarray, np.ndarray]:
+    """A scenario_id column grouped by run → (object array, one Python str per run; (B,) the
+    first row of each row's run)."""
+    encoded = col.combine_chunks().dictionary_encode()
+    names = np.array(encoded.dictionary.to_pylist(), dtype=object)
+    code = encoded.indices.to_numpy(zero_copy_only=False)
+    new_run = np.ones(len(code), bool)
+    new_run[1:] = code[1:] != code[:-1]
+    starts = np.flatnonzero(new_run)
+    return names[code], np.repeat(starts, np.diff(np.append(starts, len(code))))
 
 
 def load_windows(
-    root: Warehouse | DataRoot | str | Path | None = None,
+    root: Warehouse | DataRoot,
     runs: Runs = None,
     *,
     context_len: int = DEFAULT_CONTEXT_LEN,
@@ -171,12 +191,21 @@ def load_windows(
     con = warehouse.connect()
     try:
         con.register("selected_runs", select_runs(con, runs))
-        n_frames = con.sql(query("count_frames")).fetchall()[0][0]
-        builder = _WindowsBuilder(n_frames, context_len, horizon_s, FEATURES)
-        params = {"context_len": context_len, "horizon_s": float(horizon_s)}
-        reader = con.sql(query("windows"), params=params).to_arrow_reader(BATCH_ROWS)
-        for batch in reader:
-            builder.add(batch)
+        paths = _part_paths(con, warehouse.root)
+        con.register("feature_rows", _feature_rows(paths))
+        rows = con.sql(query("windows"), params={"horizon_s": float(horizon_s)}).to_arrow_table()
     finally:
         con.close()
-    return builder.build()
+    missing = rows.column("feature_row").null_count
+    if missing:
+        raise RuntimeError(f"{missing} frames of the selected runs have no frame_features")
+    features, position = _gather_features(paths, rows.column("feature_row").to_numpy(), FEATURES)
+    scenario_id, run_start = _runs(rows.column("scenario_id"))
+    ctx_row, ctx_mask = context_rows(run_start, context_len)
+    ego_xy_m = np.stack([rows.column(c).to_numpy(zero_copy_only=False).astype(np.float64)
+                         for c in ("loc_x_m", "loc_y_m")], axis=1)
+    return Windows(
+        features, position[ctx_row], ctx_mask, rows.column("label").to_numpy().astype(np.int8),
+        scenario_id, rows.column("frame").to_numpy().astype(np.int32),
+        rows.column("t_s").to_numpy(), horizon_s, FEATURES, ego_xy_m,
+    )

@@ -9,11 +9,11 @@ import pytest
 
 from evoeye.baselines.aem import (
     AEMConfig,
-    AEMLoadError,
     AEMMonitor,
     train_aem,
     window_vectors,
 )
+from evoeye.monitor.families import MonitorLoadError
 from evoeye.monitor.protocol import Monitor
 
 SMALL = AEMConfig(context_len=1, hidden=(48,), latent=4, epochs=30, batch_size=64, seed=3)
@@ -78,12 +78,12 @@ def test_load_checks_the_sha256_in_meta(windows_of, obs, tmp_path: Path) -> None
     meta = json.loads((folder / "meta.json").read_text())
     model = (folder / "model.pt").read_bytes()
     (folder / "model.pt").write_bytes(model[:-1] + bytes([model[-1] ^ 1]))
-    with pytest.raises(AEMLoadError, match="sha256 differs"):
+    with pytest.raises(MonitorLoadError, match="sha256 differs"):
         AEMMonitor.load(folder)
     (folder / "model.pt").write_bytes(model)
     del meta["model_sha256"]
     (folder / "meta.json").write_text(json.dumps(meta))
-    with pytest.raises(AEMLoadError, match="no model_sha256"):
+    with pytest.raises(MonitorLoadError, match="no model_sha256"):
         AEMMonitor.load(folder)
 
 

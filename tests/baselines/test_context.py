@@ -13,6 +13,7 @@ from evoeye.baselines.context import (
     train_context_only,
 )
 from evoeye.evaluation.metrics import auroc
+from evoeye.monitor.families import MonitorLoadError
 from evoeye.store.features import CONTROL_FEATURES, FEATURES, FrameFeatures
 from evoeye.store.windows import Windows
 
@@ -70,7 +71,7 @@ def test_same_data_same_version_and_a_saved_model_round_trips(tmp_path) -> None:
     np.testing.assert_array_equal(back.score(w), a.score(w))
     assert back.version == a.version and back.name == "context-only"
     (folder / "model.pkl").write_bytes((folder / "model.pkl").read_bytes() + b"x")
-    with pytest.raises(ValueError, match="sha256"):
+    with pytest.raises(MonitorLoadError, match="sha256 differs"):
         ContextOnlyMonitor.load(folder)
 
 

@@ -14,6 +14,7 @@ from evoeye.baselines.rss import (
     RSSMonitor,
     RssParams,
 )
+from evoeye.evaluation.monitors import BASELINES
 from evoeye.monitor.protocol import Monitor
 
 P = RssParams()  # rho 1 s, a_max 3.5, b_min 4, b_max 8, b_min_correct 3, lat 0.2 / 0.8, mu 0.1
@@ -114,3 +115,15 @@ def test_a_car_swerving_in_from_the_next_lane_raises_the_risk(windows_of, obs) -
 
 def test_is_a_monitor() -> None:
     assert isinstance(RSSMonitor(), Monitor) and RSSMonitor().version.startswith("rss-")
+
+
+def test_the_rss_2s_variant_gives_other_vehicles_carlas_2s_response_time(windows_of,
+                                                                        obs) -> None:
+    m = BASELINES["rss-2s"](None, "s", None)
+    assert m.name == "rss-2s" and m.other.response_time_s == 2.0 and m.ego == P
+    assert m.version != RSSMonitor().version
+    slow = RssParams(response_time_s=2.0)
+    w = windows_of([[obs(-30.0 - 5.0, 0.0, dvx_mps=+10.0)]], ego_speed_mps=[20.0])  # followed
+    safe_m = same_direction_m(30.0, 20.0, slow)  # the follower is the other vehicle: its 2 s
+    assert m.score(w)[0] == pytest.approx(safe_m / (safe_m + 30.0), abs=1e-3)
+    assert m.score(w)[0] > RSSMonitor().score(w)[0]

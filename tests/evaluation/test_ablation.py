@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import json
 
-from evoeye.evaluation.ablation import Variant, run_ablation, variants
+from evoeye.evaluation.ablation import AblationReport, AblationRow, Variant, run_ablation, variants
 
 
 def test_paper_variants_l_rows_then_input_rows_at_l5() -> None:
@@ -21,10 +21,13 @@ def test_paper_variants_l_rows_then_input_rows_at_l5() -> None:
 def test_small_ablation_trains_evaluates_and_tabulates(eval_root, splits) -> None:
     report = run_ablation(eval_root, ["highway-cut-in"], splits, context_lens=(1,),
                           inputs=("perception",), store_scores=False, epochs=1)
-    assert [r.label for r in report.rows] == ["L=1", "perception", "context-only"]
+    assert [r.label for r in report.rows] == ["L=1", "perception", "context-only", "ttc",
+                                              "ttc-2d", "rss", "rss-2s"]
     versions = [r.results["highway-cut-in"]["version"] for r in report.rows]
     assert len(set(versions[:2])) == 2 and all(v.startswith("fusion-") for v in versions[:2])
     assert versions[2].startswith("ctx-")  # the control row
+    assert [v.split("-")[0] for v in versions[3:]] == ["ttc", "ttc2d", "rss", "rss"]
+    assert len(set(versions)) == len(versions)
     md = report.markdown()
     for row in report.rows:
         r = row.results["highway-cut-in"]
@@ -32,3 +35,14 @@ def test_small_ablation_trains_evaluates_and_tabulates(eval_root, splits) -> Non
         assert f"| {100 * r['auroc']:.1f} |" in line and f"| {100 * r['auprc']:.1f} |" in line
     folder = report.write(eval_root, "ablation-test")
     assert json.loads((folder / "ablation.json").read_text())["rows"][0]["context_len"] == 1
+
+
+def test_an_unreachable_fpr_shows_as_such_in_the_ablation_table() -> None:
+    rows = [AblationRow("L=1", 1, "all", {"s": {"f1": 0.5, "reachable": True, "auroc": 0.9,
+                                                "auprc": 0.4, "version": "a"}}),
+            AblationRow("context-only", 1, "context-only",
+                        {"s": {"f1": None, "reachable": False, "auroc": 0.7, "auprc": 0.2,
+                               "version": "b"}})]
+    md = AblationReport(["s"], 0.05, 0, rows).markdown()
+    assert "| L=1 | 50.0 | 90.0 | 40.0 |" in md
+    assert "| context-only | n/r | 70.0 | 20.0 |" in md and "n/r: the target FPR" in md

@@ -7,13 +7,15 @@ import json
 import shutil
 
 from evoeye.baselines.context import ContextOnlyMonitor
-from evoeye.evaluation.monitors import CONTEXT_DIR
+from evoeye.baselines.families import CONTEXT_ONLY
+from evoeye.paths import DataRoot
 
 
 def test_trained_on_train_runs_scored_on_val_and_test_and_in_every_rq1_table(
         eval_root, splits, monkeypatch, tmp_path) -> None:
     import evoeye.baselines.context as ctx_mod
-    from evoeye.evaluation.monitors import fit_context_only, load_monitors
+    from evoeye.baselines.families import fit_context_only
+    from evoeye.evaluation.monitors import load_monitors
     from evoeye.evaluation.report import write_report
     from evoeye.evaluation.rq1 import rq1
     from evoeye.store import RunFilter, load_windows
@@ -23,7 +25,7 @@ def test_trained_on_train_runs_scored_on_val_and_test_and_in_every_rq1_table(
         return set(load_windows(eval_root, runs, context_len=1).scenario_id.tolist())
 
     # eval_root is shared: another test may have trained and saved the control already
-    shutil.rmtree(eval_root.path / CONTEXT_DIR, ignore_errors=True)
+    shutil.rmtree(CONTEXT_ONLY.versions_dir(eval_root), ignore_errors=True)
     trained_on, scored = [], []
     real_train, real_score = ctx_mod.train_context_only, ContextOnlyMonitor.score
     monkeypatch.setattr(ctx_mod, "train_context_only",
@@ -41,7 +43,7 @@ def test_trained_on_train_runs_scored_on_val_and_test_and_in_every_rq1_table(
     again = fit_context_only(eval_root, "highway-cut-in", splits)
     assert len(trained_on) == 1 and again.version == m.version
     assert load_monitors(eval_root, [m.version])[0].version == m.version
-    files = write_report(tmp_path, [report.to_dict()], "ctx")
+    files = write_report(DataRoot.resolve(tmp_path), [report.to_dict()], "ctx")
     for path in (files.markdown, files.html):
         assert "context-only" in path.read_text()
     names = [x["name"] for x in json.loads(files.json.read_text())[0]["monitors"]]

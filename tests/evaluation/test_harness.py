@@ -11,9 +11,10 @@ import pytest
 
 from evoeye.baselines import RSSMonitor, TTCMonitor
 from evoeye.baselines.aem import AEMConfig
+from evoeye.baselines.families import AEM, fit_aem
 from evoeye.evaluation import evaluate
 from evoeye.evaluation.dataset import load_split
-from evoeye.evaluation.monitors import AEM_DIR, baseline_monitors, fit_aem
+from evoeye.evaluation.monitors import baseline_monitors
 from evoeye.evaluation.report import html_report, markdown_report, write_report
 from evoeye.evaluation.rq1 import rq1_report
 from evoeye.store.attribution import AttributionRow, write_attribution
@@ -115,8 +116,8 @@ def test_aem_is_trained_once_and_evaluated(eval_root, splits) -> None:
     first = fit_aem(eval_root, SCENARIO, splits, small)
     again = fit_aem(eval_root, SCENARIO, splits, small)
     assert again.version == first.version
-    assert (eval_root.path / AEM_DIR / first.version / "model.pt").is_file()
-    assert len(list((eval_root.path / AEM_DIR).iterdir())) == 1
+    assert (AEM.version_dir(eval_root, first.version) / "model.pt").is_file()
+    assert len(list(AEM.versions_dir(eval_root).iterdir())) == 1
     rep = evaluate(eval_root, [first], SCENARIO, splits, store_scores=False)
     assert rep.monitors[0].context_len == 5 and rep.monitors[0].scores_written == 0
     assert rep.monitors[0].frame.auroc is not None
@@ -138,3 +139,35 @@ def test_bad_monitor_scores_are_refused(eval_root, splits) -> None:
 
     with pytest.raises(ValueError, match=r"outside \[0, 1\]"):
         evaluate(eval_root, [Broken()], SCENARIO, splits, store_scores=False)
+
+
+def test_an_unreachable_fpr_is_reported_as_such_never_as_zero(eval_root, splits) -> None:
+    class Saturated:
+        """Scores every frame 1.0 but the last tenth of each run: the top score ties for far
+        more than 5 % of the negatives, so neither target FPR can be met with any alarm."""
+        name, version, context_len = "saturated", "saturated-0", 1
+
+        def score(self, windows):
+            return np.where(windows.t_s % 5.0 < 4.5, 1.0, 0.5)
+
+    d = evaluate(eval_root, [Saturated()], SCENARIO, splits, store_scores=False).to_dict()
+    m = d["monitors"][0]
+    assert m["reachable"] == {"0.05": False, "0.01": False}
+    assert m["thresholds"]["0.05"] == 1.0 and m["val_fpr"]["0.05"] == 0.0
+    for level in (m["frame"], m["scenario"]["1"]):
+        point = level["at_fpr"]["0.05"]
+        assert point["reachable"] is False and point["f1"] is None and point["recall"] is None
+    md = markdown_report([d])
+    row = next(x for x in md.splitlines() if x.startswith("| saturated |"))
+    assert row.count("| n/r ") == 6 and "| 0.0 |" not in row  # P, R, F1 at both FPRs
+    assert "n/r: the target FPR is unreachable" in md
+    assert "0.0 n/r" in next(x for x in md.splitlines() if x.startswith(f"| {SCENARIO} | sat"))
+    assert "n/r" in html_report([d])
+
+
+def test_the_realised_fpr_sits_next_to_its_target(report) -> None:
+    md = markdown_report([report.to_dict()])
+    assert "val FPR % (target 5.0)" in md and "val FPR % (target 1.0)" in md
+    ttc = report.monitors[0]
+    line = next(x for x in md.splitlines() if x.startswith(f"| {SCENARIO} | ttc |"))
+    assert f"| {100 * ttc.val_fpr[0.05]:.1f} |" in line

@@ -45,3 +45,13 @@ def test_curves_start_and_end_at_the_corners() -> None:
     assert (c.roc_fpr[0], c.roc_tpr[0], c.roc_fpr[-1], c.roc_tpr[-1]) == (0, 0, 1, 1)
     assert c.pr_recall[0] == 0.0 and c.pr_recall[-1] == 1.0
     assert c.pr_precision[-1] == pytest.approx(0.4)  # every frame alarms: 4 / 10
+
+
+def test_an_unreachable_operating_point_has_no_rates_but_keeps_its_counts() -> None:
+    thr = Thresholds({0.05: 0.65, 0.01: 0.85}, {0.05: 0.04, 0.01: 0.0}, frozenset({0.01}))
+    m = frame_metrics(SCORES, LABELS, thr)
+    assert m.at_fpr[0.05].reachable and m.at_fpr[0.05].f1 == pytest.approx(4 / 7)
+    strict = m.at_fpr[0.01]
+    assert (strict.precision, strict.recall, strict.f1) == (None, None, None)
+    assert (strict.tp, strict.fp) == (1, 0) and strict.fpr == 0.0
+    assert strict.to_dict()["reachable"] is False and strict.to_dict()["f1"] is None

@@ -83,8 +83,8 @@ def test_fusion_training_windows_pos_weight_and_calibration(eval_root, splits, c
 def test_aem_training_and_calibration(eval_root, splits, collided, layout,
                                       monkeypatch) -> None:
     import evoeye.baselines.aem as aem_mod
-    import evoeye.evaluation.calibration as cal_mod
-    from evoeye.evolve.families import train_aem_version
+    import evoeye.monitor.calibration as cal_mod
+    from evoeye.baselines.families import train_aem_version
 
     seen: dict[str, object] = {}
     real_train, real_cal = aem_mod.train_aem, cal_mod.calibrate_on_validation
@@ -134,7 +134,8 @@ def test_rq1_calibration_and_metrics(eval_root, splits, collided, layout, monkey
 
 
 def test_feedback_from_the_warehouse_and_from_a_log(eval_root, collided, layout) -> None:
-    from evoeye.evolve.scoring import read_logged_run, warehouse_feedback
+    from evoeye.evolve.campaign.scoring import warehouse_feedback
+    from evoeye.store.log_windows import read_logged_run
 
     class Half:
         context_len = 3
@@ -160,7 +161,7 @@ def test_feedback_from_the_warehouse_and_from_a_log(eval_root, collided, layout)
 
 def test_hard_set_ignores_scores_of_post_collision_frames(eval_root, splits, collided,
                                                           layout) -> None:
-    from evoeye.evolve.assess import hard_set
+    from evoeye.evolve.campaign.assess import hard_set
 
     wh = Warehouse(eval_root)
     frames = wh.sql("SELECT scenario_id, frame FROM frames").to_pydict()

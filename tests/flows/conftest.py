@@ -41,11 +41,11 @@ def prefect_server() -> Iterator[None]:
 
 
 @pytest.fixture(scope="session")
-def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[Path, str]:
+def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[DataRoot, str]:
     """A data root with 16 ingested intersection runs and a G_0 (campaign tests add to it)."""
     from evoeye.monitor import train_monitor
 
     root = DataRoot.resolve(tmp_path_factory.mktemp("evolve-flow") / "data")
-    run_batch(plan_uniform(SCENARIO, 16, 3), root.path)
+    run_batch(plan_uniform(SCENARIO, 16, 3), root)
     ingest(root)
-    return root.path, train_monitor(root, SCENARIO, seed=0, splits=SPLITS, epochs=1)
+    return root, train_monitor(root, SCENARIO, seed=0, splits=SPLITS, epochs=1)

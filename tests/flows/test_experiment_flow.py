@@ -8,9 +8,11 @@ from dataclasses import replace
 import pytest
 from pydantic import ValidationError
 
-from evoeye.evolve.campaign import Campaign, CampaignConfig, initial_monitor
-from evoeye.evolve.experiment import plan_experiment
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.experiment import plan_experiment
+from evoeye.evolve.campaign.loop import Campaign
 from evoeye.monitor import list_versions
+from evoeye.monitor.families import initial_monitor
 from evoeye.store import SplitSpec
 from evoeye.store.feedback import read_rounds
 from flows.experiment import ExperimentParams, experiment_flow
@@ -53,7 +55,7 @@ def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_serv
     from prefect.client.schemas.filters import FlowRunFilter, FlowRunFilterName
 
     root, g0 = seeded
-    params = ExperimentParams(root=str(root), scenarios=[SCENARIO],
+    params = ExperimentParams(root=str(root.path), scenarios=[SCENARIO],
                               strategies=["uniform", "evoeye", "aem-evo"], repetitions=1,
                               budget_s=45.0,
                               n_round=2, epochs=1, train_frac=0.5, val_frac=0.25,
@@ -78,15 +80,15 @@ def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_serv
             name=FlowRunFilterName(any_=names)))
     assert sorted(r.name for r in runs) == sorted(names)
     assert all(r.state.is_completed() for r in runs)
-    report = json.loads((root / "reports" / "rq2-test" / "rq2.json").read_text())
+    report = json.loads((root.reports / "rq2-test" / "rq2.json").read_text())
     assert report[SCENARIO]["evoeye"][0]["campaign_id"] == res["evoeye"][0]["campaign_id"]
-    md = (root / "reports" / "rq2-test" / "rq2.md").read_text()
+    md = (root.reports / "rq2-test" / "rq2.md").read_text()
     assert "| evoeye |" in md and "| aem-evo |" in md and "| AEM (AEM-Evo's G_0) |" in md
     assert res["aem-evo"][0]["rounds"][-1]["version"].startswith("aem-")
     # the control: G_0's recipe on D_init with another seed, assessed like every G_r
     (control,) = res["reseeded"]
     assert control["version"] not in (g0, res["evoeye"][0]["rounds"][-1]["version"])
-    assert "| G_0 re-seeded ×1 (no new data) |" in (root / "reports" / "rq2-test" / "rq2.md"
+    assert "| G_0 re-seeded ×1 (no new data) |" in (root.reports / "rq2-test" / "rq2.md"
                                                     ).read_text()
     assert initial_monitor(root, SCENARIO) == g0  # a control never becomes G_0
     # re-running resumes: same campaigns, nothing simulated twice, the control reused

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import json
+
 import numpy as np
 import pytest
 
@@ -10,7 +12,9 @@ from evoeye.monitor.card import (
     ranking_metrics,
     split_metrics,
     threshold_metrics,
+    thresholds_from_card,
     thresholds_from_json,
+    thresholds_to_card,
     thresholds_to_json,
 )
 from evoeye.monitor.protocol import Thresholds
@@ -40,6 +44,24 @@ def test_thresholds_round_trip_through_json() -> None:
     as_json = thresholds_to_json(thr)
     assert as_json == {"0.05": 0.25, "0.01": 0.75}
     assert thresholds_from_json(as_json) == thr
+
+
+def test_calibration_round_trips_through_a_card_and_old_cards_still_load() -> None:
+    thr = Thresholds({0.05: 0.25, 0.01: 1.0}, {0.05: 0.049, 0.01: 0.0}, frozenset({0.01}))
+    card = json.loads(json.dumps(thresholds_to_card(thr)))
+    assert card["thresholds"] == {"0.05": 0.25, "0.01": 1.0}  # the format older readers know
+    assert card["calibration"]["0.01"] == {"realised_fpr": 0.0, "reachable": False}
+    assert thresholds_from_card(card) == thr
+    old = thresholds_from_card({"thresholds": {"0.05": 0.25, "0.01": 0.75}})
+    assert old.at(0.01) == 0.75 and old.reachable(0.01) and old.realised_fpr == {}
+
+
+def test_an_unreachable_target_has_no_rates_on_the_card() -> None:
+    scores, labels = np.array([1.0, 1.0, 1.0, 0.2]), np.array([1, 0, 0, 0])
+    thr = Thresholds({0.05: 1.0}, {0.05: 0.0}, frozenset({0.05}))
+    m = split_metrics(scores, labels, thr)["fpr_0.05"]
+    assert m["reachable"] is False and (m["precision"], m["recall"], m["f1"]) == (None,) * 3
+    assert m["fpr"] == 0.0 and m["threshold"] == 1.0
 
 
 def test_selections_are_described_without_storing_long_id_lists() -> None:

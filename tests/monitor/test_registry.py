@@ -21,14 +21,15 @@ from evoeye.monitor.registry import (
     save_version,
     version_dir,
 )
+from evoeye.paths import DataRoot
 from evoeye.store import load_windows
 
 
 @pytest.fixture
 def copy_of(tiny, trained, tmp_path):
     """A private copy of the trained version, safe to damage."""
-    root = tmp_path / "root"
-    shutil.copytree(version_dir(tiny.root, trained), root / "monitors" / trained)
+    root = DataRoot.resolve(tmp_path / "root")
+    shutil.copytree(version_dir(tiny.root, trained), root.monitors / trained)
     return root
 
 
@@ -60,7 +61,7 @@ def test_scoring_windows_of_another_length_is_refused(tiny, trained: str) -> Non
 
 
 def test_a_modified_checkpoint_is_refused(copy_of, trained: str) -> None:
-    path = copy_of / "monitors" / trained / MODEL_FILE
+    path = copy_of.monitors / trained / MODEL_FILE
     data = bytearray(path.read_bytes())
     data[len(data) // 2] ^= 0xFF
     path.write_bytes(bytes(data))
@@ -88,10 +89,10 @@ def test_a_truncated_or_foreign_checkpoint_is_refused(tmp_path) -> None:
 def test_missing_version_and_missing_checkpoint_are_named(copy_of, trained: str) -> None:
     with pytest.raises(MonitorLoadError, match="no monitor version 'fusion-nope'"):
         load_monitor(copy_of, "fusion-nope")
-    (copy_of / "monitors" / trained / MODEL_FILE).unlink()
+    (copy_of.monitors / trained / MODEL_FILE).unlink()
     with pytest.raises(MonitorLoadError, match="cannot read checkpoint"):
         load_monitor(copy_of, trained)
-    (copy_of / "monitors" / trained / CARD_FILE).write_text("{not json")
+    (copy_of.monitors / trained / CARD_FILE).write_text("{not json")
     with pytest.raises(MonitorLoadError, match="unreadable card"):
         load_monitor(copy_of, trained)
     with pytest.raises(MonitorLoadError, match="not a monitor version"):

@@ -62,9 +62,11 @@ def test_card_records_data_hyperparameters_metrics_and_thresholds(
     assert card["thresholds"]["0.01"] >= card["thresholds"]["0.05"]
     val = card["metrics"]["val"]
     for key in ("fpr_0.05", "fpr_0.01"):
-        m = val[key]
-        assert m["fpr"] <= float(key[4:]) + 1e-9
-        assert 0.0 <= m["f1"] <= 1.0 and m["threshold"] == card["thresholds"][key[4:]]
+        m, cal = val[key], card["calibration"][key[4:]]
+        assert m["fpr"] <= float(key[4:]) + 1e-9 and m["fpr"] == cal["realised_fpr"]
+        assert m["threshold"] == card["thresholds"][key[4:]]
+        assert m["reachable"] is cal["reachable"]
+        assert 0.0 <= m["f1"] <= 1.0 if cal["reachable"] else m["f1"] is None
     assert 1 <= card["training"]["best_epoch"] <= card["training"]["epochs_run"]
     assert card["created_at"] and card["software_version"] and card["model_sha256"]
 

@@ -6,12 +6,14 @@ import subprocess
 import sys
 
 import duckdb
+import numpy as np
 import pyarrow.parquet as pq
 import pytest
 
 from evoeye.paths import DataRoot
 from evoeye.store import Warehouse, ingest
 from evoeye.store.attribution import AttributionRow, write_attribution
+from evoeye.store.feedback import FeedbackRows, RoundRow, write_feedback, write_round
 from evoeye.store.schema import (
     PARTITION_KEYS,
     TABLES,
@@ -19,12 +21,12 @@ from evoeye.store.schema import (
     file_schema,
     table_schema,
 )
+from evoeye.store.scores import ScoreRows, write_scores
 from evoeye.store.sqlfiles import query, query_names
 
 # Sample parameters for every file in warehouse/queries (a new query must be added here).
 QUERY_PARAMS = {
     "committed_runs": {},
-    "count_frames": {},
     "dataset_stats": {"horizon_s": 3.0, "seed": 0, "train_frac": 0.5, "val_frac": 0.125},
     "run_frames": {"scenario_id": "c-0"},
     "select_runs": {
@@ -32,7 +34,8 @@ QUERY_PARAMS = {
         "max_round": None, "collided": None, "status": "ok", "seed": 0, "train_frac": 0.5,
         "val_frac": 0.125,
     },
-    "windows": {"context_len": 5, "horizon_s": 3.0},
+    "windows": {"horizon_s": 3.0},
+    "window_parts": {},
     "collision_runs": {"logical_scenario": None, "batch": None, "software_version": "other",
                        "variants": 5},
     "attribution_shares": {"logical_scenario": "highway-cut-in"},
@@ -42,7 +45,20 @@ QUERY_PARAMS = {
     },
     "audit_attribution": {"scenario_ids": ["c-0", "c-1"]},
     "audit_clock_frames": {"scenario_ids": ["c-0", "c-1"], "horizon_s": 3.0},
+    "initial_records": {"scenario": "highway-cut-in", "seed": 0, "train_frac": 1.0,
+                        "val_frac": 0.0},
+    "run_outcomes": {"logical_scenario": "highway-cut-in"},
+    "logical_scenarios": {},
+    # queries over a derived table's parts: $glob is bound to them (DERIVED_PARTS)
+    "monitor_scores_rows": {"version": None},
+    "monitor_scores_scenarios": {"version": "m-1"},
+    "feedback_rows": {"version": "m-1", "mode": "raw"},
+    "campaign_rounds_rows": {"campaign_id": None},
+    "attribution_rows": {"version": "v"},
 }
+DERIVED_PARTS = {"monitor_scores_rows": "monitor_scores", "monitor_scores_scenarios":
+                 "monitor_scores", "feedback_rows": "feedback",
+                 "campaign_rounds_rows": "campaign_rounds", "attribution_rows": "attribution"}
 
 
 @pytest.fixture
@@ -56,6 +72,12 @@ def filled(root: DataRoot, add_run) -> DataRoot:
         for variant in ("careful_driver", "oracle_perception", "oracle_prediction",
                         "oracle_planning", "oracle_control")
     ])
+    ids = np.array(["c-0", "c-1"], dtype=object)
+    write_scores(root, ScoreRows("m", "m-1", "highway-cut-in", ids, np.array([0, 1]),
+                                 np.array([0.0, 0.05]), np.array([0.1, 0.9])))
+    write_feedback(root, FeedbackRows("highway-cut-in", "m-1", "raw", ids, np.array([0.1, 0.2]),
+                                      np.array([4, 5])))
+    write_round(root, RoundRow("evo-x", "highway-cut-in", "uniform", 0, 0, "m-1", [], 0, 0.0))
     return root
 
 
@@ -122,9 +144,15 @@ def test_every_query_runs(name: str, filled: DataRoot) -> None:
     con = Warehouse(filled).connect()
     try:
         con.register("selected_runs", con.sql("SELECT scenario_id FROM scenarios"))
+        con.register("feature_rows", con.sql(
+            "SELECT scenario_id, frame, ingest_id, row_number() OVER () AS feature_row "
+            "FROM frame_features"))
         con.register("monitor_scores", con.sql(
             "SELECT scenario_id, frame, 'm' AS monitor_version, 0.0 AS score FROM frames"))
-        rows = con.sql(query(name), params=QUERY_PARAMS[name] or None).fetchall()
+        params = dict(QUERY_PARAMS[name])
+        if name in DERIVED_PARTS:
+            params["glob"] = str(filled.table_dir(DERIVED_PARTS[name]) / "*.parquet")
+        rows = con.sql(query(name), params=params or None).fetchall()
         assert rows, name
     finally:
         con.close()

@@ -149,3 +149,28 @@ def test_prediction_takes_each_obstacles_most_probable_mode_only() -> None:
     # no slot holds the second mode (5 m to the left): obstacle 1 (0 m) and 2 (3 m) do
     lateral = sorted(float(v) for v in f.prediction[0, :, 0, 1])
     assert lateral == pytest.approx([0.0, 3.0], abs=1e-5)
+
+
+@pytest.mark.parametrize("n_obstacles", [0, 1, 6])
+def test_live_messages_give_exactly_the_inputs_stored_at_ingest(
+    root, episode_factory, log_writer, n_obstacles
+) -> None:
+    """The run-time source (MessageSignals: one frame's messages, as the ADS sends them or as
+    decoded from its log) feeds the one feature code the very numbers ingest stored."""
+    from evoeye.monitor.replay import log_frames
+    from evoeye.store.records import MessageSignals
+
+    episode = episode_factory("live", n_frames=12, seed=4, n_obstacles=n_obstacles)
+    episode.frames[3].messages.plan.decision = "teleport"  # not a known decision: no hot entry
+    log = log_writer(root, episode)
+    ingest(root)
+    stored = unpack(Warehouse(root).sql("SELECT * FROM frame_features ORDER BY frame"), FEATURES)
+    for frames in ([f.messages for f in episode.frames], log_frames(log)):
+        for i, messages in enumerate(frames):
+            live = frame_features(MessageSignals(messages), FEATURES)
+            through_arrow = frame_features(runtime_table([messages]), FEATURES)
+            for name, arr in stored.arrays().items():
+                np.testing.assert_array_equal(getattr(live, name)[0], arr[i], err_msg=name)
+                np.testing.assert_array_equal(getattr(through_arrow, name)[0], arr[i])
+    assert stored.perception_mask.sum(axis=1).max() == n_obstacles
+    assert not stored.plan_info[3, 1:].any() and stored.plan_info[4, 1:].sum() == 1

@@ -1,43 +1,35 @@
--- Runtime contexts c_t of length L (Definition 2) and labels y_t for horizon H (Definition 1),
--- one row per eligible frame (view eligible_frames: none at or after a run's collision) of the
--- runs listed in `selected_runs` (a relation with a scenario_id column that the caller
--- registers). Parameters: $context_len = L >= 1, $horizon_s = H.
+-- Labels y_t for horizon H (Definition 1) of every eligible frame (view eligible_frames: none at
+-- or after a run's collision) of the runs listed in `selected_runs` (a relation with a
+-- scenario_id column that the caller registers), in (scenario_id, frame) order: the order of the
+-- windows, one per row. Parameter: $horizon_s = H.
 --
--- `row` numbers the frames in (scenario_id, frame) order from 0; rows may arrive in any order.
--- ctx_row[k], k = 0 .. L-1 oldest first, is the `row` of frame t-L+1+k clamped to the run's
--- first frame: c_t = (m_max(1,t-L+1), ..., m_t) read element-wise, so the first frames of a run
--- repeat its first frame on the left, and ctx_mask[k] is false exactly on those repeated slots.
--- A frame's context frames are earlier than it, so they are eligible too.
--- The monitor inputs come from frame_features (runtime signals only; no ground truth), the
--- ego's localization estimate (map frame) from runtime_frames.
-WITH labelled AS (
-    SELECT l.scenario_id, l.frame, l.t_s, l.label
-    FROM frame_labels_h($horizon_s) AS l
-    SEMI JOIN selected_runs AS sel ON l.scenario_id = sel.scenario_id
-),
-numbered AS (
-    SELECT
-        *,
-        row_number() OVER (ORDER BY scenario_id, frame) - 1 AS row,
-        row_number() OVER (PARTITION BY scenario_id ORDER BY frame) - 1 AS pos
-    FROM labelled
-)
+-- `evoeye/store/windows.py` builds the runtime contexts c_t of length L (Definition 2) on this
+-- order: the context of the row at position p of its run holds the rows of positions
+-- p-L+1 … p, clamped to the run's first row and masked where clamped (the first frames of a run
+-- repeat its first frame on the left). A frame's context frames are earlier than it, so they
+-- are eligible too.
+--
+-- The monitor inputs (table frame_features: runtime signals only, no ground truth) are not
+-- carried here: `feature_rows` (a relation the caller registers: scenario_id, frame, ingest_id,
+-- feature_row) numbers the frame_features rows the caller read from the runs' parts (query
+-- window_parts), and `feature_row` names the one holding the frame's inputs (NULL if the caller
+-- holds none). As in view frame_features, a row counts only from the part its run is committed
+-- with (same ingest_id). The ego's localization estimate (map frame) comes from runtime_frames.
 SELECT
-    n.row,
+    k.feature_row,
     n.scenario_id,
     n.frame,
     n.t_s,
     n.label,
-    list_transform(
-        range($context_len),
-        lambda k: n.row - n.pos + greatest(n.pos - $context_len + 1 + k, 0)
-    ) AS ctx_row,
-    list_transform(range($context_len), lambda k: n.pos - $context_len + 1 + k >= 0) AS ctx_mask,
     r.loc_x_m,
-    r.loc_y_m,
-    x.* EXCLUDE (scenario_id, frame, ingest_id, logical_scenario, batch)
-FROM numbered AS n
-JOIN frame_features AS x
-    ON x.scenario_id = n.scenario_id AND x.frame = n.frame
+    r.loc_y_m
+FROM frame_labels_h($horizon_s) AS n
+SEMI JOIN selected_runs AS sel
+    ON n.scenario_id = sel.scenario_id
+JOIN scenarios AS s
+    ON s.scenario_id = n.scenario_id
+LEFT JOIN feature_rows AS k
+    ON k.scenario_id = n.scenario_id AND k.frame = n.frame AND k.ingest_id = s.ingest_id
 JOIN runtime_frames AS r
-    ON r.scenario_id = n.scenario_id AND r.frame = n.frame;
+    ON r.scenario_id = n.scenario_id AND r.frame = n.frame
+ORDER BY n.scenario_id, n.frame;

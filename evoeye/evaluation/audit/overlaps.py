@@ -11,8 +11,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from evoeye.boxes import box_corners, box_gaps
 from evoeye.evaluation.audit.tracks import Tracks
-from evoeye.sim.footprint import box_corners, box_gaps
 
 MIN_OVERLAP_S = 0.2
 

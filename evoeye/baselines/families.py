@@ -1,0 +1,156 @@
+"""The trained baselines as monitor families: the AEM (evolvable: AEM-Evo) and the context-only
+control, each kept under `<root>/baselines/<name>/<version>/` with `meta.json`.
+
+RQ1 (`fit`): trained on the train split of a logical scenario and found again by a training key
+(a hash of the scenario, split, config, horizon and run ids), so a later evaluation loads the
+version instead of training again. AEM-Evo (paper RQ3, `train`): Algorithm 1 runs unchanged with
+the AEM as the monitor — fine-tuned (or retrained) on the collision-free windows of D_r every
+round, its thresholds calibrated on the validation runs and kept in `meta.json`; its G_0
+(`initial`) is the AEM trained on D_init by the same recipe, found again by its training key.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, replace
+from typing import TYPE_CHECKING, Any
+
+from evoeye.monitor.families import MonitorFamily, register_family, training_key
+from evoeye.paths import DataRoot
+from evoeye.store.selection import RunFilter, Runs, SplitSpec
+from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S
+
+if TYPE_CHECKING:  # torch / scikit-learn are imported when an AEM / the control is used
+    from evoeye.baselines.aem import AEMConfig, AEMMonitor
+    from evoeye.baselines.context import ContextConfig, ContextOnlyMonitor
+
+
+def _decode_aem(data: bytes, meta: dict[str, Any], version: str) -> AEMMonitor:
+    from evoeye.baselines.aem import AEMMonitor
+
+    return AEMMonitor.decode(data, meta)
+
+
+def _decode_context(data: bytes, meta: dict[str, Any], version: str) -> ContextOnlyMonitor:
+    from evoeye.baselines.context import ContextOnlyMonitor
+
+    return ContextOnlyMonitor.decode(data, meta)
+
+
+def _train_ids(root: DataRoot, scenario: str, splits: SplitSpec) -> list[str]:
+    from evoeye.store import Warehouse, select_runs
+
+    con = Warehouse(root).connect()
+    try:
+        runs = select_runs(con, RunFilter(logical_scenario=scenario, split="train", splits=splits))
+    finally:
+        con.close()
+    return sorted(runs.column("scenario_id").to_pylist())
+
+
+def _train_windows(root: DataRoot, runs: Runs, context_len: int, horizon_s: float):
+    from evoeye.store import load_windows
+
+    return load_windows(root, runs, context_len=context_len, horizon_s=horizon_s)
+
+
+def _training_meta(key: str, scenario: str, splits: SplitSpec, horizon_s: float,
+                   ids: list[str], n_windows: int) -> dict:
+    """What meta.json records of an RQ1 baseline's training (the key it is found again by)."""
+    return {"training_key": key, "logical_scenario": scenario, "splits": asdict(splits),
+            "horizon_s": horizon_s, "train_scenarios": len(ids), "train_windows": n_windows}
+
+
+def fit_aem(root: DataRoot, scenario: str,
+            splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
+            config: AEMConfig | None = None, *,
+            horizon_s: float = DEFAULT_HORIZON_S) -> AEMMonitor:
+    """The AEM of this scenario's train split: loaded if trained before, else trained and saved.
+
+    Trained on the collision-free windows of the split: label 0 (all windows are before their
+    run's collision, see `load_windows`)."""
+    from evoeye.baselines.aem import AEMConfig, train_aem
+
+    config = config or AEMConfig()
+    ids = _train_ids(root, scenario, splits)
+    key = training_key(scenario, asdict(splits), asdict(config), horizon_s, ids)
+    if (version := AEM.find(root, key)) is not None:
+        return AEM.load(root, version)
+    train = _train_windows(root, RunFilter(logical_scenario=scenario, split="train",
+                                           splits=splits), config.context_len, horizon_s)
+    normal = train.label == 0
+    monitor = train_aem(train, normal, config)
+    monitor.save(AEM.versions_dir(root), _training_meta(key, scenario, splits, horizon_s, ids,
+                                                        int(normal.sum())))
+    return monitor
+
+
+def fit_context_only(root: DataRoot, scenario: str,
+                     splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
+                     config: ContextConfig | None = None, *,
+                     horizon_s: float = DEFAULT_HORIZON_S) -> ContextOnlyMonitor:
+    """The context-only control of this scenario's train split: loaded if trained before, else
+    trained on every (eligible) training window and saved."""
+    from evoeye.baselines.context import ContextConfig, train_context_only
+
+    config = config or ContextConfig()
+    ids = _train_ids(root, scenario, splits)
+    key = training_key("context-only", scenario, asdict(splits), asdict(config), horizon_s, ids)
+    if (version := CONTEXT_ONLY.find(root, key)) is not None:
+        return CONTEXT_ONLY.load(root, version)
+    train = _train_windows(root, RunFilter(logical_scenario=scenario, split="train",
+                                           splits=splits), 1, horizon_s)
+    monitor = train_context_only(train, config)
+    monitor.save(CONTEXT_ONLY.versions_dir(root),
+                 _training_meta(key, scenario, splits, horizon_s, ids, len(train)))
+    return monitor
+
+
+def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_runs: Runs,
+                      seed: int = 0, init_from: str | None = None, context_len: int | None = None,
+                      horizon_s: float = DEFAULT_HORIZON_S, epochs: int | None = None,
+                      **_fusion_only: Any) -> str:
+    """Train (or fine-tune, `init_from`) an AEM on the collision-free windows of `train_runs`,
+    calibrate its thresholds on `val_runs` (`calibrate_on_validation`), save it; its version. A
+    version with the same training key (selection, seed, recipe, parent) is reused.
+    FusionMonitor options (splits, patience, …) do not apply and are ignored."""
+    from evoeye.baselines.aem import AEMConfig, train_aem
+    from evoeye.monitor.calibration import calibrate_on_validation
+    from evoeye.monitor.card import describe_selection, thresholds_to_card
+
+    parent = AEM.load(root, init_from) if init_from else None
+    config = parent.config if parent else AEMConfig(
+        context_len=context_len or DEFAULT_CONTEXT_LEN)
+    config = replace(config, seed=seed, **({"epochs": epochs} if epochs else {}))
+    selection = {"train": describe_selection(train_runs), "val": describe_selection(val_runs)}
+    key = training_key(scenario, selection, asdict(config), init_from, horizon_s)
+    if (version := AEM.find(root, key)) is not None:
+        return version
+    train = _train_windows(root, train_runs, config.context_len, horizon_s)
+    val = _train_windows(root, val_runs, config.context_len, horizon_s)
+    normal = train.label == 0
+    aem = train_aem(train, normal, config, init=parent)
+    thresholds = calibrate_on_validation(aem.score(val), val)
+    aem.save(AEM.versions_dir(root), {
+        "training_key": key, "logical_scenario": scenario, "parent": init_from,
+        "horizon_s": horizon_s, "selection": selection,
+        "train_windows": int(normal.sum()),
+        **thresholds_to_card(thresholds),
+    })
+    return aem.version
+
+
+def initial_aem(root: DataRoot, scenario: str, *, train_runs: Runs, val_runs: Runs,
+                horizon_s: float = DEFAULT_HORIZON_S) -> str:
+    """AEM-Evo's G_0: the AEM trained from scratch on D_init (seed 0), trained once."""
+    return train_aem_version(root, scenario, train_runs=list(train_runs), val_runs=val_runs,
+                             seed=0, horizon_s=horizon_s)
+
+
+AEM = register_family(MonitorFamily(
+    "aem", "AEM", "aem-", "baselines/aem", "model.pt", "meta.json", decode=_decode_aem,
+    train=train_aem_version, initial=initial_aem, fit=fit_aem,
+))
+CONTEXT_ONLY = register_family(MonitorFamily(
+    "context-only", "context-only control", "ctx-", "baselines/context-only", "model.pkl",
+    "meta.json", decode=_decode_context, fit=fit_context_only,
+))

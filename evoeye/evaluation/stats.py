@@ -1,0 +1,229 @@
+"""How sure a figure over seeds is: sample SDs, confidence intervals, paired tests and power.
+
+Every method of an experiment runs on the same campaign seeds, so two methods are compared pair
+by pair (seed by seed). The choices, and why:
+
+* Spread: the sample SD (ddof = 1). The population SD (ddof = 0) understates it by
+  √(n / (n − 1)), 1.22× at n = 3.
+* The mean over seeds of one method: Student's t interval (`scipy.stats.t`), exact for normal
+  values and the usual choice at the handful of seeds one method has.
+* The mean paired difference: a bootstrap CI (`scipy.stats.bootstrap`, seeded) of the mean of
+  the differences, resampling whole pairs. BCa rather than percentile: it corrects the
+  bootstrap distribution's bias and skew (second-order accurate; Efron 1987), which matters for
+  differences of bounded rates (F1 near 0 or 1) at the 16–25 pairs the design needs; the
+  percentile interval is first-order only and covers less at that size. Where BCa is undefined
+  (its jackknife acceleration is 0/0, e.g. all but one difference equal) the percentile interval
+  stands in and `ci_method` says so; all differences equal give the point itself.
+* The paired test: Wilcoxon signed-rank, two-sided (`scipy.stats.wilcoxon`), free of the
+  normality a paired t-test needs. Zero differences are dropped ("wilcox": a pair that did not
+  differ says nothing about the direction) and counted in `zeros`; none left gives p = 1. The
+  p-value is exact for ≤ 50 distinct non-zero differences; with tied differences it comes from
+  the sign-flip permutation distribution of the signed ranks (exact enumeration up to 13 pairs,
+  else 9999 seeded flips), above 50 from the normal approximation. With m non-zero differences no
+  two-sided p can fall below 2 / 2^m (`min_p`): 5 pairs can never reach p < 0.05.
+* Power and sample size: the paired t-test's power from the noncentral t (`scipy.stats.nct`),
+  standardised effect d / SD(a − b) with SD(a − b)² = SD_a² + SD_b² − 2ρ·SD_a·SD_b for the
+  measured pair correlation ρ. The Wilcoxon test's power uses its asymptotic relative efficiency
+  to the t-test, 3/π for normal differences (Lehmann; G*Power's A.R.E. method): n pairs for the
+  Wilcoxon count as 3n/π for the t-test. That is asymptotic; below it, the floor on p rules: with
+  2 / 2^n > α the test can never reject, and its power is 0.
+"""
+
+from __future__ import annotations
+
+import math
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+
+import numpy as np
+from scipy import stats
+
+CONFIDENCE = 0.95
+N_RESAMPLES = 9999
+WILCOXON_ARE = 3.0 / math.pi  # Wilcoxon signed-rank vs t-test, normal differences
+EXACT_MAX_PAIRS = 50  # scipy's own bound for the exact signed-rank distribution
+POWER_TESTS = ("wilcoxon", "t")
+
+
+def _finite(values: Sequence[float] | np.ndarray) -> np.ndarray:
+    a = np.asarray(values, dtype=float).reshape(-1)
+    return a[np.isfinite(a)]
+
+
+def sample_sd(values: Sequence[float] | np.ndarray) -> float | None:
+    """Sample SD (ddof = 1) of the finite values; None for fewer than two."""
+    a = _finite(values)
+    return float(np.std(a, ddof=1)) if len(a) > 1 else None
+
+
+@dataclass(frozen=True)
+class MeanCI:
+    """A mean over seeds with its sample SD and Student-t confidence interval (None: n < 2)."""
+
+    n: int
+    mean: float | None
+    sd: float | None
+    low: float | None
+    high: float | None
+    confidence: float = CONFIDENCE
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def mean_ci(values: Sequence[float] | np.ndarray, confidence: float = CONFIDENCE) -> MeanCI:
+    """The mean of the finite values and its t interval (NaN, e.g. undefined seeds, left out)."""
+    _check_confidence(confidence)
+    a = _finite(values)
+    if len(a) == 0:
+        return MeanCI(0, None, None, None, None, confidence)
+    mean, sd = float(a.mean()), sample_sd(a)
+    if sd is None:
+        return MeanCI(1, mean, None, None, None, confidence)
+    half = float(stats.t.ppf(0.5 + confidence / 2, len(a) - 1)) * sd / math.sqrt(len(a))
+    return MeanCI(len(a), mean, sd, mean - half, mean + half, confidence)
+
+
+@dataclass(frozen=True)
+class PairedComparison:
+    """Method a against method b over the seeds both have a finite value for."""
+
+    n: int  # pairs
+    mean_a: float | None
+    mean_b: float | None
+    sd_a: float | None
+    sd_b: float | None
+    correlation: float | None  # Pearson ρ of a and b over the pairs (None if undefined)
+    mean_diff: float | None  # mean of a − b
+    sd_diff: float | None
+    ci_low: float | None  # bootstrap CI of mean_diff (None: n < 2)
+    ci_high: float | None
+    ci_method: str | None  # "BCa", "percentile" or "degenerate" (all differences equal)
+    p_value: float | None  # two-sided Wilcoxon signed-rank (None: no pairs)
+    zeros: int  # pairs with a − b = 0, left out of the test
+    min_p: float | None  # the smallest p the test can give with these pairs
+    confidence: float = CONFIDENCE
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def compare_paired(a: Sequence[float] | np.ndarray, b: Sequence[float] | np.ndarray, *,
+                   confidence: float = CONFIDENCE, n_resamples: int = N_RESAMPLES,
+                   seed: int = 0) -> PairedComparison:
+    """Mean paired difference a − b with its bootstrap CI, the Wilcoxon signed-rank p and the
+    sample SDs (module doc); a[i] and b[i] come from the same seed, pairs with a non-finite
+    side are left out. The same inputs and seed give the same result."""
+    _check_confidence(confidence)
+    a, b = np.asarray(a, dtype=float).reshape(-1), np.asarray(b, dtype=float).reshape(-1)
+    if a.shape != b.shape:
+        raise ValueError(f"paired values need one of each per seed: {len(a)} against {len(b)}")
+    keep = np.isfinite(a) & np.isfinite(b)
+    a, b = a[keep], b[keep]
+    d = a - b
+    n = len(d)
+    if n == 0:
+        return PairedComparison(0, None, None, None, None, None, None, None, None, None, None,
+                                None, 0, None, confidence)
+    low, high, method = _bootstrap_ci(d, confidence, n_resamples, seed)
+    p, zeros, min_p = _wilcoxon(d, n_resamples, seed)
+    return PairedComparison(n, float(a.mean()), float(b.mean()), sample_sd(a), sample_sd(b),
+                            _correlation(a, b), float(d.mean()), sample_sd(d), low, high,
+                            method, p, zeros, min_p, confidence)
+
+
+def _check_confidence(confidence: float) -> None:
+    if not 0.0 < confidence < 1.0:
+        raise ValueError(f"confidence must be in (0, 1), got {confidence}")
+
+
+def _correlation(a: np.ndarray, b: np.ndarray) -> float | None:
+    if len(a) < 2 or np.ptp(a) == 0 or np.ptp(b) == 0:
+        return None
+    return float(stats.pearsonr(a, b).statistic)
+
+
+def _bootstrap_ci(d: np.ndarray, confidence: float, n_resamples: int, seed: int
+                  ) -> tuple[float | None, float | None, str | None]:
+    if len(d) < 2:
+        return None, None, None
+    if np.ptp(d) == 0:
+        return float(d[0]), float(d[0]), "degenerate"
+    for method in ("BCa", "percentile"):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            ci = stats.bootstrap((d,), np.mean, confidence_level=confidence,
+                                 n_resamples=n_resamples, method=method,
+                                 rng=np.random.default_rng(seed)).confidence_interval
+        if np.isfinite(ci.low) and np.isfinite(ci.high):
+            return float(ci.low), float(ci.high), method
+    raise RuntimeError("bootstrap gave no finite interval")  # unreachable for ptp(d) > 0
+
+
+def _wilcoxon(d: np.ndarray, n_resamples: int, seed: int
+              ) -> tuple[float, int, float | None]:
+    """(two-sided p, zero differences, smallest attainable p)."""
+    nonzero = d[d != 0]
+    zeros, m = len(d) - len(nonzero), len(nonzero)
+    if m == 0:
+        return 1.0, zeros, None
+    tied = len(np.unique(np.abs(nonzero))) < m
+    if m > EXACT_MAX_PAIRS:
+        method: str | stats.PermutationMethod = "asymptotic"
+    elif tied:
+        method = stats.PermutationMethod(n_resamples=n_resamples,
+                                         rng=np.random.default_rng(seed))
+    else:
+        method = "exact"
+    p = float(stats.wilcoxon(nonzero, zero_method="wilcox", method=method).pvalue)
+    return min(p, 1.0), zeros, min(1.0, 2.0 / 2.0 ** m)
+
+
+def sd_of_differences(sd_a: float, sd_b: float, correlation: float) -> float:
+    """SD of a − b for SDs sd_a, sd_b and pair correlation ρ."""
+    if sd_a < 0 or sd_b < 0 or not -1.0 <= correlation <= 1.0:
+        raise ValueError(f"need SDs ≥ 0 and a correlation in [-1, 1], got {sd_a}, {sd_b}, "
+                         f"{correlation}")
+    return math.sqrt(max(sd_a**2 + sd_b**2 - 2.0 * correlation * sd_a * sd_b, 0.0))
+
+
+def paired_power(n_pairs: int, diff: float, sd_diff: float, *, alpha: float = 0.05,
+                 test: str = "wilcoxon") -> float:
+    """Power of a two-sided paired test at level alpha to detect a true mean difference
+    `diff` with SD(a − b) = sd_diff, over n_pairs pairs (module doc)."""
+    if test not in POWER_TESTS:
+        raise ValueError(f"test must be one of {POWER_TESTS}, got {test!r}")
+    if not 0.0 < alpha < 1.0 or sd_diff <= 0 or n_pairs < 2:
+        raise ValueError(f"need 0 < alpha < 1, sd_diff > 0 and ≥ 2 pairs, got {alpha}, "
+                         f"{sd_diff}, {n_pairs}")
+    if test == "wilcoxon" and 2.0 / 2.0**n_pairs > alpha:
+        return 0.0  # no outcome of so few pairs reaches p ≤ alpha
+    n = n_pairs * (WILCOXON_ARE if test == "wilcoxon" else 1.0)
+    df = max(n - 1.0, 1e-9)
+    ncp = abs(diff) / sd_diff * math.sqrt(n)
+    crit = float(stats.t.ppf(1.0 - alpha / 2.0, df))
+    return float(stats.nct.sf(crit, df, ncp) + stats.nct.cdf(-crit, df, ncp))
+
+
+def pairs_needed(diff: float, sd_a: float, sd_b: float, correlation: float, *,
+                 power: float = 0.8, alpha: float = 0.05, test: str = "wilcoxon",
+                 max_pairs: int = 100_000) -> int:
+    """The fewest seed pairs with which a two-sided paired test at level alpha detects a true
+    mean difference `diff` with probability `power`, for per-method SDs sd_a, sd_b and pair
+    correlation ρ (module doc)."""
+    if not 0.0 < power < 1.0 or diff == 0:
+        raise ValueError(f"need 0 < power < 1 and a non-zero difference, got {power}, {diff}")
+    sd = sd_of_differences(sd_a, sd_b, correlation)
+    if sd == 0:
+        return 2  # no noise in the differences: the smallest design decides
+    lo, hi = 2, 2
+    while paired_power(hi, diff, sd, alpha=alpha, test=test) < power:  # power rises with n
+        lo, hi = hi, 2 * hi
+        if hi > max_pairs:
+            raise ValueError(f"more than {max_pairs} pairs needed for a difference of {diff}")
+    while lo < hi:
+        mid = (lo + hi) // 2
+        if paired_power(mid, diff, sd, alpha=alpha, test=test) >= power:
+            hi = mid
+        else:
+            lo = mid + 1
+    return lo

@@ -1,0 +1,225 @@
+"""What an evolution campaign does: its options, declared once and validated.
+
+`CampaignConfig` is the one declaration of a campaign's options. The command line (`evoeye
+evolve`, `evoeye experiment`) and the flows' pydantic parameters (`flows/evolve.py`,
+`flows/experiment.py`) are built from its fields (`campaign_options`, with the split flattened
+into `split_seed`, `train_frac`, `val_frac`), so an option is added here and nowhere else. Each
+field's metadata (`option`) carries its help, its bounds and, where its value must name
+something registered, which registry (`known`). This module imports nothing heavy — the command
+line reads it at start-up — so the defaults below that come from elsewhere are literals, checked
+against their sources by tests/evolve/campaign/test_config.py; validation loads the registries.
+
+Every field but `budget_s` and `reference` enters the campaign id (`Campaign.campaign_id`), so
+the same configuration resumes the same campaign.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import operator
+import typing
+from collections.abc import Callable, Collection, Mapping
+from dataclasses import dataclass, field, fields
+from typing import Any
+
+from evoeye.splits import SplitSpec
+
+UPDATE_MODES = ("finetune", "retrain")
+FEEDBACK_MODES = ("raw", "prior-corrected")  # ŷ as the monitor scores it, or σ(logit − log w)
+FINETUNE_EPOCHS, FINETUNE_PATIENCE = 10, 4
+DEFAULT_FAMILY = "fusion"  # evoeye.monitor.families.DEFAULT_FAMILY
+DEFAULT_DELTA = 0.2  # evoeye.scenarios.DEFAULT_DELTA
+DEFAULT_HORIZON_S = 3.0  # evoeye.store.windows.DEFAULT_HORIZON_S
+MAX_RUN_S = 20.0  # no run lasts longer than this: evoeye.sim.runner.SimConfig().duration_s
+SPLIT_OPTIONS = {  # the split's fields as options: SplitSpec field → (option, help)
+    "seed": ("split_seed", "Seed of the train/val/test split."),
+    "train_frac": ("train_frac", "Train share of round-0 runs."),
+    "val_frac": ("val_frac", "Validation share of round-0 runs."),
+}
+
+
+def _scenarios() -> Collection[str]:
+    from evoeye.scenarios import SCENARIOS
+
+    return SCENARIOS
+
+
+def _strategies() -> Collection[str]:
+    from evoeye.evolve.search import STRATEGIES
+
+    return STRATEGIES
+
+
+def _families() -> Collection[str]:
+    import evoeye.baselines  # noqa: F401  (registers the baseline families: aem, …)
+    from evoeye.monitor.families import evolvable_families
+
+    return evolvable_families()
+
+
+def _methods() -> Collection[str]:
+    from evoeye.evolve.campaign.experiment import methods
+
+    return methods()
+
+
+KNOWN: dict[str, Callable[[], Collection[str]]] = {  # the names a value of each kind may take
+    "scenario": _scenarios, "strategy": _strategies, "update": lambda: UPDATE_MODES,
+    "feedback": lambda: FEEDBACK_MODES, "family": _families, "method": _methods,
+}
+
+
+def known(kind: str) -> Collection[str]:
+    """The names a value of `kind` (a key of KNOWN) may take, from their registries."""
+    return KNOWN[kind]()
+
+
+def check_known(kind: str, values: Collection[str]) -> None:
+    """ValueError naming the values of `kind` that are unknown (or that there is no value)."""
+    names = known(kind)
+    unknown = [v for v in values if v not in names]
+    if unknown or not values:
+        raise ValueError(f"unknown {kind} {unknown}; known: {sorted(names)}")
+
+
+def option(default: Any = dataclasses.MISSING, help: str = "", *,  # noqa: A002 (as typer's)
+           factory: Callable[[], Any] | None = None, ge: float | None = None,
+           gt: float | None = None, le: float | None = None, names: str | None = None,
+           internal: bool = False) -> Any:
+    """A CampaignConfig field with what the command line and the flows show and check:
+    its help, bounds (ge / gt / le), the registry its value names (a KNOWN key), and whether it
+    is `internal` (not an option: set by the code, never by a user)."""
+    meta = {"help": help, "ge": ge, "gt": gt, "le": le, "names": names, "internal": internal}
+    if factory is not None:
+        return field(default_factory=factory, metadata=meta)
+    return field(default=default, metadata=meta)
+
+
+@dataclass(frozen=True)
+class CampaignConfig:
+    """What a campaign does. Every field but `budget_s` and `reference` is part of its id."""
+
+    scenario: str = option("highway-cut-in", "Logical scenario.", names="scenario")
+    strategy: str = option("evoeye", "Acquisition strategy.", names="strategy")
+    budget_s: float = option(600.0, "Simulated seconds the acquired runs may use in total.",
+                             ge=0.0)
+    seed: int = option(0, "Campaign seed: the proposals and the runs' seeds.", ge=0)
+    monitor: str | None = option(None, "G_0 (default: the newest monitor of the family "
+                                 "trained from scratch on the scenario, or its initial "
+                                 "version).")
+    n_round: int = option(20, "Runs per round (N_round).", ge=1)
+    update: str = option("finetune", "Monitor update per round: finetune (from G_r) or retrain.",
+                         names="update")
+    epochs: int | None = option(None, "Epochs per monitor update (default: 10 when "
+                                "fine-tuning, the trainer's otherwise).", ge=1)
+    patience: int | None = option(None, "Early-stopping patience per update (default: 4 when "
+                                  "fine-tuning, the trainer's otherwise).", ge=1)
+    delta: float = option(DEFAULT_DELTA, "Neighbourhood radius δ of the density-aware "
+                          "strategies, a share of each parameter's range.", gt=0.0, le=1.0)
+    feedback: str = option("raw", "ŷ in f_r = mean |ŷ − y|: raw monitor scores, or "
+                           "prior-corrected (undo the training pos_weight; see "
+                           "evoeye.evolve.search.feedback).", names="feedback")
+    family: str = option(DEFAULT_FAMILY, "The monitor family evolved: fusion, or another "
+                         "evolvable one, e.g. aem (AEM-Evo; judged on the FusionMonitor's Hard "
+                         "Set).", names="family")
+    reference: str | None = option(None, "Another family than fusion: the FusionMonitor G_0 "
+                                   "whose Hard Set judges (default: the newest).")
+    horizon_s: float = option(DEFAULT_HORIZON_S, "Label horizon H, s.", gt=0.0)
+    splits: SplitSpec = option(factory=SplitSpec, help="The train/val/test split.")
+    max_run_s: float = option(MAX_RUN_S, "No run lasts longer, s (the simulator's duration).",
+                              gt=0.0, internal=True)
+
+    def __post_init__(self) -> None:
+        for f in fields(self):
+            value, meta = getattr(self, f.name), f.metadata
+            if value is None or isinstance(value, SplitSpec):
+                continue
+            if meta["names"]:
+                names = known(meta["names"])
+                if value not in names:
+                    raise ValueError(f"unknown {f.name} {value!r}; known: {sorted(names)}")
+            _check_bounds(f.name, value, meta)
+        if self.monitor:
+            from evoeye.monitor.families import family_of
+
+            if (of := family_of(self.monitor).name) != self.family:
+                raise ValueError(f"G_0 {self.monitor} is a {of} monitor, but the campaign "
+                                 f"evolves the {self.family} family")
+
+    def train_overrides(self) -> dict[str, int]:
+        """TrainParams fields of one monitor update."""
+        out = {}
+        epochs = self.epochs or (FINETUNE_EPOCHS if self.update == "finetune" else None)
+        patience = self.patience or (FINETUNE_PATIENCE if self.update == "finetune" else None)
+        if epochs:
+            out["epochs"] = epochs
+        if patience:
+            out["patience"] = patience
+        return out
+
+
+def _check_bounds(name: str, value: float, meta: Mapping[str, Any]) -> None:
+    for bound, holds, word in (("ge", operator.ge, ">="), ("gt", operator.gt, ">"),
+                               ("le", operator.le, "<=")):
+        if meta[bound] is not None and not holds(value, meta[bound]):
+            raise ValueError(f"{name} must be {word} {meta[bound]}, got {value}")
+
+
+@dataclass(frozen=True)
+class Option:
+    """One campaign option as the command line and the flows show it (`campaign_options`)."""
+
+    name: str  # flat: budget_s, split_seed, …
+    type: type  # int, float or str
+    optional: bool  # None is a value (the default decides)
+    default: Any
+    help: str
+    ge: float | None = None
+    gt: float | None = None
+    le: float | None = None
+    names: str | None = None  # a KNOWN key
+
+
+def campaign_options(exclude: Collection[str] = ()) -> list[Option]:
+    """CampaignConfig's options, in field order, the split flattened; minus `exclude` (flat
+    names) and the internal fields."""
+    hints = typing.get_type_hints(CampaignConfig)
+    out = []
+    for f in fields(CampaignConfig):
+        if f.metadata["internal"]:
+            continue
+        if hints[f.name] is SplitSpec:
+            split = {s.name: s for s in fields(SplitSpec)}
+            bounds = {"seed": {}, "train_frac": {"ge": 0.0, "le": 1.0},
+                      "val_frac": {"ge": 0.0, "le": 1.0}}
+            out += [Option(name, type(split[key].default), False, split[key].default, text,
+                           **bounds[key]) for key, (name, text) in SPLIT_OPTIONS.items()]
+            continue
+        args = [a for a in typing.get_args(hints[f.name]) if a is not type(None)]
+        m = f.metadata
+        out.append(Option(f.name, args[0] if args else hints[f.name], bool(args), f.default,
+                          m["help"], m["ge"], m["gt"], m["le"], m["names"]))
+    return [o for o in out if o.name not in exclude]
+
+
+def config_from(values: Mapping[str, Any], **fixed: Any) -> CampaignConfig:
+    """The CampaignConfig of flat option values (`campaign_options`' names; absent ones keep
+    their defaults) and `fixed` fields."""
+    flat = {**values, **fixed}
+    given = {k: v for k, v in flat.items() if k in {f.name for f in fields(CampaignConfig)}}
+    split = {key: flat[name] for key, (name, _) in SPLIT_OPTIONS.items() if name in flat}
+    if split and "splits" not in given:
+        given["splits"] = SplitSpec(**split)
+    return CampaignConfig(**given)
+
+
+def option_values(config: CampaignConfig, exclude: Collection[str] = ()) -> dict[str, Any]:
+    """The flat option values of `config` (the inverse of `config_from`); ValueError if an
+    internal field is not at its default (no option could carry it)."""
+    default = CampaignConfig(config.scenario)
+    for f in fields(CampaignConfig):
+        if f.metadata["internal"] and getattr(config, f.name) != getattr(default, f.name):
+            raise ValueError(f"{f.name} is no campaign option: it must keep its default")
+    out = {k: v for k, v in dataclasses.asdict(config).items() if k != "splits"}
+    out.update({name: getattr(config.splits, key) for key, (name, _) in SPLIT_OPTIONS.items()})
+    return {o.name: out[o.name] for o in campaign_options(exclude)}

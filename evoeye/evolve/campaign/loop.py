@@ -1,0 +1,352 @@
+"""An evolution campaign: Algorithm 1 as a resumable loop of acquisition rounds.
+
+Round r+1 starts from the monitor G_r and the records D_r (D_init, then every run acquired so
+far, each with its feedback under G_r). It proposes one scenario at a time, simulates it, scores
+the new run with G_r and adds it to D_r, until N_round runs or the budget is spent; then it
+ingests the round's logs, updates the monitor on D_r, refreshes the feedback of every record
+with G_{r+1} and stores the round. The campaign stops when no run fits in the budget left.
+
+Monitor update, `update="finetune"` (the default): G_{r+1} starts from G_r's weights and input
+normalisers and trains a few epochs on D_r — Algorithm 1, line 12 is Train(G_r, D_r), and a
+round adds only N_round runs to hundreds, so re-fitting from scratch every round would spend
+most of a campaign's wall time relearning what G_r knows. `update="retrain"` trains from scratch
+on D_r every round (slower; useful to check that fine-tuning does not drift).
+
+State and resume. Everything a campaign knows is in the data root: run logs under
+`runs/<scenario>/<campaign id>/`, the feedback table (f_r per run and monitor version) and the
+campaign_rounds table (per round: G_r and the runs acquired, in order). `start()` rebuilds D_r
+and the strategy (`replay`) from the last stored round; a round interrupted anywhere (mid-run,
+mid-round, mid-training) is re-done from its start — its proposals are deterministic (the
+strategy's, and run seed k for proposal k), logs already on disk are read instead of simulated,
+so no run is lost, duplicated or charged twice. A run is started only if the budget left is at
+least the longest run (`max_run_s`), so the budget is never overspent.
+
+Deviation from Algorithm 1: a last round cut short by the budget still updates the monitor (its
+runs were paid for; training costs no simulated time).
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import time
+from collections.abc import Callable, Sequence
+from dataclasses import asdict, dataclass
+from functools import cached_property
+from pathlib import Path
+
+import numpy as np
+
+from evoeye.batch import simulate_and_log
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
+from evoeye.evolve.search.fitness import criticality
+from evoeye.evolve.search.protocol import Strategy
+from evoeye.evolve.search.records import Records
+from evoeye.evolve.search.strategies import FEEDBACK_BLIND, make_strategy
+from evoeye.log import read_run
+from evoeye.monitor.families import (
+    DEFAULT_FAMILY,
+    FAMILIES,
+    SavedMonitor,
+    initial_monitor,
+    load_calibrated,
+)
+from evoeye.paths import DataRoot
+from evoeye.scenarios import DEFAULT_DELTA, get_scenario
+from evoeye.sim.runner import run_spec
+from evoeye.store import RunFilter, Warehouse, ingest
+from evoeye.store.feedback import (
+    FeedbackRows,
+    RoundMetrics,
+    RoundRow,
+    feedback_of,
+    read_rounds,
+    write_feedback,
+)
+from evoeye.store.feedback import write_round as store_round
+from evoeye.store.log_windows import read_logged_run
+
+
+class NoInitialDataError(LookupError):
+    """A campaign needs the scenario's initial (round 0) runs in the warehouse."""
+
+
+@dataclass
+class CampaignState:
+    """D_r and G_r after `round` finished rounds, with the strategy that acquired D_r \\ D_init."""
+
+    campaign_id: str
+    round: int
+    monitor: str
+    records: Records
+    ok: np.ndarray  # (n,) bool: the run finished and can train the monitor
+    n_init: int
+    strategy: Strategy
+    rounds: list[RoundRow]
+
+    @property
+    def spent_s(self) -> float:
+        return float(self.records.tail(self.n_init).duration_s.sum())
+
+    @property
+    def acquired(self) -> int:
+        return self.records.n - self.n_init
+
+
+Trainer = Callable[..., str]  # train_monitor's signature
+Assessor = Callable[[str], RoundMetrics]  # monitor version → metrics, stored with the round
+
+
+def run_seed(campaign_seed: int, k: int) -> int:
+    """The simulation seed of proposal k (0-based) of a campaign."""
+    return int(np.random.SeedSequence([campaign_seed, k]).generate_state(1)[0])
+
+
+class Campaign:
+    """One campaign over a data root: `start()` (or resume), then `run_round` until `done`."""
+
+    def __init__(self, root: DataRoot, config: CampaignConfig, *,
+                 train: Trainer | None = None, assess: Assessor | None = None) -> None:
+        self.root = root
+        self.config = config
+        self.space = get_scenario(config.scenario)
+        self.family = FAMILIES[config.family]
+        self._train = train or self.family.train
+        self._assess = assess
+        self._monitors: dict[str, object] = {}
+
+    # -- identity and initial data -------------------------------------------------------------
+    @cached_property
+    def initial(self) -> dict[str, np.ndarray]:
+        """D_init: the train split of the scenario's round-0 runs, by scenario id."""
+        cfg = self.config
+        t = Warehouse(self.root).query("initial_records", scenario=cfg.scenario,
+                                       **asdict(cfg.splits)).to_pydict()
+        if not t["scenario_id"]:
+            raise NoInitialDataError(f"no initial (round 0) training runs of {cfg.scenario!r} in "
+                              f"{self.root.warehouse}: simulate and ingest them first")
+        return {k: np.asarray(v, dtype=object if k == "scenario_id" else None)
+                for k, v in t.items()}
+
+    @cached_property
+    def g0(self) -> str:
+        cfg = self.config
+        if cfg.monitor:
+            return cfg.monitor
+        return self.family.initial(self.root, cfg.scenario,
+                                   train_runs=list(self.initial["scenario_id"]),
+                                   val_runs=self.val_runs, horizon_s=cfg.horizon_s)
+
+    @cached_property
+    def reference(self) -> str:
+        """The FusionMonitor G_0 whose Hard Set judges this campaign (G_0 itself, or for another
+        family, e.g. AEM-Evo, the configured / newest from-scratch FusionMonitor of the scenario).
+        """
+        if self.config.family == DEFAULT_FAMILY:
+            return self.g0
+        return self.config.reference or initial_monitor(self.root, self.config.scenario)
+
+    @property
+    def val_runs(self) -> RunFilter:
+        """The fixed validation split every G_r is early-stopped and calibrated on."""
+        return RunFilter(logical_scenario=self.config.scenario, split="val",
+                         splits=self.config.splits)
+
+    @cached_property
+    def campaign_id(self) -> str:
+        """`evo-[aem-]<strategy>-s<seed>-<hash>` of everything but the budget and the reference:
+        same inputs, same id."""
+        cfg = asdict(self.config)
+        cfg.pop("budget_s")
+        cfg.pop("reference")
+        # raw: the original loop, whose campaigns keep their ids; a feedback-blind strategy
+        # acquires the same runs and trains the same monitors under either mode
+        if cfg["feedback"] == "raw" or cfg["strategy"] in FEEDBACK_BLIND:
+            cfg.pop("feedback")
+        if cfg["family"] == DEFAULT_FAMILY:  # likewise
+            cfg.pop("family")
+        cfg["monitor"] = self.g0
+        cfg["initial"] = hashlib.sha256("\n".join(self.initial["scenario_id"]).encode()).hexdigest()
+        digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]
+        family = "" if self.config.family == DEFAULT_FAMILY else f"{self.config.family}-"
+        return f"evo-{family}{self.config.strategy}-s{self.config.seed}-{digest}"
+
+    def stored_feedback(self, version: str) -> dict[str, float]:
+        """scenario_id → f stored under `version` in this campaign's feedback mode (G_0's is
+        shared by every campaign of the mode)."""
+        return feedback_of(self.root, version, self.config.feedback)
+
+    def log_path(self, scenario_id: str) -> Path:
+        return self.root.run_log(self.config.scenario, self.campaign_id, scenario_id)
+
+    def monitor(self, version: str) -> SavedMonitor:
+        """A version of the campaign's family, with thresholds (loaded once)."""
+        if version not in self._monitors:
+            self._monitors[version] = load_calibrated(self.root, version)
+        return self._monitors[version]
+
+    # -- state -----------------------------------------------------------------------------------
+    def start(self, new_ids: Sequence[str] = ()) -> CampaignState:
+        """The state after the last stored round; round 0 (G_0, D_init scored) is stored first.
+        `new_ids`: runs `acquire` added since, by id (the flow's round tasks pass them on), read
+        back from their logs with their feedback under G_r."""
+        rounds = read_rounds(self.root, self.campaign_id)
+        if not rounds:
+            self._store_feedback(self.g0, self.initial["scenario_id"])
+            row = RoundRow(self.campaign_id, self.config.scenario, self.config.strategy,
+                           self.config.seed, 0, self.g0, [], 0, 0.0,
+                           metrics=self._metrics(self.g0))
+            store_round(self.root, row)
+            rounds = read_rounds(self.root, self.campaign_id)
+        last = rounds[-1]
+        init = self.initial
+        records = Records(
+            params=np.stack([np.asarray(p, float) for p in init["params"]]),
+            feedback=np.full(len(init["scenario_id"]), np.nan),
+            fitness=criticality(init["collided"].astype(bool),
+                                np.array(init["min_distance_m"], dtype=float)),
+            collided=init["collided"].astype(bool), duration_s=init["duration_s"].astype(float),
+            scenario_id=init["scenario_id"],
+        )
+        ok = [True] * records.n
+        for sid in [*(s for r in rounds for s in r.scenario_ids), *new_ids]:
+            meta = read_run(self.log_path(sid), topics=()).metadata
+            records = records.append(np.asarray(meta["params"], float), **_outcome(meta))
+            ok.append(meta["status"] == "ok")
+        n_init = len(init["scenario_id"])
+        stored = self.stored_feedback(last.monitor_version)
+        records = records.with_feedback(np.array(
+            [stored.get(s, np.nan) for s in records.scenario_id], dtype=float))
+        options = {"delta": self.config.delta} if self.config.delta != DEFAULT_DELTA else {}
+        strategy = make_strategy(self.config.strategy, self.space, self.config.seed, **options)
+        mine = records.tail(n_init)
+        strategy.replay(mine.params, mine.fitness)
+        return CampaignState(self.campaign_id, last.round, last.monitor_version, records,
+                             np.array(ok, bool), n_init, strategy, rounds)
+
+    def remaining_s(self, state: CampaignState) -> float:
+        return self.config.budget_s - state.spent_s
+
+    def done(self, state: CampaignState) -> bool:
+        """No run fits in the budget left."""
+        return self.remaining_s(state) < self.config.max_run_s
+
+    # -- one round, in the steps a flow runs as tasks ----------------------------------------------
+    def acquire(self, state: CampaignState) -> list[str]:
+        """Lines 5–10, up to N_round times: propose, simulate, score with G_r, add; then store the
+        new runs' f_r. Their ids."""
+        cfg, monitor = self.config, self.monitor(state.monitor)
+        new: list[str] = []
+        while len(new) < cfg.n_round and not self.done(state):
+            prop = state.strategy.propose(state.records)
+            spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
+                            batch=self.campaign_id, source=cfg.strategy, round=state.round + 1)
+            result = simulate_and_log(spec, self.root)
+            if result.status == "error":
+                raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
+                                   f"{result.reason}")
+            run = read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
+            fb = (windows_feedback(monitor, run.windows, cfg.feedback).feedback[0]
+                  if run.ok and run.windows is not None else np.nan)
+            outcome = _outcome(run.metadata)
+            state.strategy.tell(prop.x, outcome["fitness"])
+            state.records = state.records.append(
+                np.asarray(run.metadata["params"], float), feedback=float(fb), **outcome)
+            state.ok = np.append(state.ok, run.ok)
+            new.append(spec.scenario_id)
+        if new:  # f_r of the new runs, stored now so that a later step can read them by id
+            added = state.records.tail(state.records.n - len(new))
+            self._write_feedback(state.monitor, added.scenario_id, added.feedback)
+        return new
+
+    def ingest(self):
+        """Put the round's logs into the warehouse (every log not yet there)."""
+        return ingest(self.root)
+
+    def update_monitor(self, state: CampaignState) -> tuple[str, float]:
+        """Line 12: G_{r+1} from D_r (train) and the fixed val split; (version, wall seconds)."""
+        cfg = self.config
+        ids = [str(s) for s, ok in zip(state.records.scenario_id, state.ok, strict=True) if ok]
+        t0 = time.perf_counter()
+        version = self._train(
+            self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
+            horizon_s=cfg.horizon_s,
+            seed=cfg.seed * 1000 + state.round + 1, splits=cfg.splits,
+            init_from=state.monitor if cfg.update == "finetune" else None,
+            context_len=None if cfg.update == "finetune" else self.monitor(self.g0).context_len,
+            **cfg.train_overrides(),
+        )
+        return version, time.perf_counter() - t0
+
+    def finish_round(self, state: CampaignState, new_ids: list[str], version: str,
+                     train_s: float) -> RoundRow:
+        """Line 13 and the commit: store f_{r+1} of every record, then the round."""
+        ok_ids = state.records.scenario_id[state.ok]
+        self._store_feedback(version, ok_ids)
+        row = RoundRow(self.campaign_id, self.config.scenario, self.config.strategy,
+                       self.config.seed, state.round + 1, version, list(new_ids),
+                       state.acquired, state.spent_s, train_s, self._metrics(version))
+        store_round(self.root, row)
+        stored = self.stored_feedback(version)
+        state.records = state.records.with_feedback(np.array(
+            [stored.get(s, np.nan) for s in state.records.scenario_id], dtype=float))
+        state.round, state.monitor = row.round, version
+        state.rounds.append(row)
+        return row
+
+    def run_round(self, state: CampaignState) -> RoundRow | None:
+        """One whole round (acquire → ingest → update → refresh); None when the budget is spent."""
+        new_ids = self.acquire(state)
+        if not new_ids:
+            return None
+        self.ingest()
+        version, train_s = self.update_monitor(state)
+        return self.finish_round(state, new_ids, version, train_s)
+
+    def run(self, max_rounds: int | None = None,
+            on_round: Callable[[RoundRow, CampaignState], None] | None = None) -> CampaignState:
+        """Resume, then run rounds until the budget is spent (or `max_rounds` more are done)."""
+        state = self.start()
+        done_rounds = 0
+        while not self.done(state) and (max_rounds is None or done_rounds < max_rounds):
+            row = self.run_round(state)
+            if row is None:
+                break
+            done_rounds += 1
+            if on_round is not None:
+                on_round(row, state)
+        return state
+
+    # -- helpers ---------------------------------------------------------------------------------
+    def _store_feedback(self, version: str, scenario_ids) -> None:
+        """Score ingested runs with `version` and store f (runs already stored are skipped)."""
+        have = self.stored_feedback(version)
+        todo = [str(s) for s in scenario_ids if s not in have]
+        if not todo:
+            return
+        fb = warehouse_feedback(self.root, self.monitor(version), todo, self.config.horizon_s,
+                                self.config.feedback)
+        self._write_feedback(version, fb.scenario_id, fb.feedback, fb.n_contexts)
+
+    def _write_feedback(self, version: str, ids, feedback, n_contexts=None) -> None:
+        ids, feedback = np.asarray(ids, dtype=object), np.asarray(feedback, float)
+        keep = np.isfinite(feedback)
+        n = np.zeros(len(ids), int) if n_contexts is None else np.asarray(n_contexts)
+        write_feedback(self.root, FeedbackRows(self.config.scenario, version,
+                                               self.config.feedback, ids[keep], feedback[keep],
+                                               n[keep]))
+
+    def _metrics(self, version: str) -> RoundMetrics | None:
+        return self._assess(version) if self._assess else None
+
+
+def _outcome(meta: dict) -> dict:
+    """Records columns of one run from its log metadata (a failed run is not critical)."""
+    collided = bool(meta["collided"])
+    gap = meta.get("min_distance_m")
+    return {
+        "fitness": float(criticality(collided, np.nan if gap is None else float(gap))),
+        "collided": collided, "duration_s": float(meta["duration_s"]),
+        "scenario_id": str(meta["scenario_id"]),
+    }

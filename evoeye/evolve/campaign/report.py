@@ -1,0 +1,205 @@
+"""The RQ2 report: tables (mean ± sample SD over seeds), per-round curves and the blind-spot map.
+
+Input is `collect_results`' dict ({scenario: {"initial", "aem-initial", method: [runs]}}); output
+Markdown, self-contained HTML (SVG charts) and the JSON under `<root>/reports/<name>/`.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from datetime import UTC, datetime
+from html import escape
+from pathlib import Path
+
+import numpy as np
+
+from evoeye.evaluation.plots import line_chart
+from evoeye.evaluation.report import UNREACHABLE, UNREACHABLE_NOTE
+from evoeye.evaluation.stats import sample_sd
+from evoeye.evolve.campaign.experiment import ABLATION, MAIN, methods
+from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
+from evoeye.paths import DataRoot
+
+COLUMNS = ("f1@0.05", "f1@0.01", "auroc", "auprc")
+ACQUISITION_HEAD = ("method", "runs", "collisions %", "near misses (< 1 m, no collision) %",
+                    "within δ of an earlier record %")
+
+
+def ran(res: dict) -> tuple[str, ...]:
+    """The methods with runs in `res`: the RQ2 ones, the ablations, then any other."""
+    return tuple(m for m in dict.fromkeys(MAIN + ABLATION + tuple(methods())) if res.get(m))
+
+
+def tables(res: dict) -> tuple[tuple[str, tuple[str, ...]], ...]:
+    """(title, methods) of each table: RQ2 (with methods that are neither RQ2 nor ablation),
+    and the evolution ablation."""
+    other = tuple(m for m in ran(res) if m not in MAIN + ABLATION)
+    return ("RQ2", MAIN + other), ("Evolution ablation", ("evoeye",) + ABLATION)
+
+
+def own_initial(method: str) -> tuple[str, str] | None:
+    """(row label, results key) of a method's starting monitor when it is not the FusionMonitor
+    G_0 (a `<family>-evo` method starts from its family's G_0)."""
+    family = methods().get(method, ("", DEFAULT_FAMILY))[1]
+    if family == DEFAULT_FAMILY:
+        return None
+    label = FAMILIES[family].label
+    return f"{label} ({label}-Evo's G_0)", f"{family}-initial"
+
+
+def _value(v: float | None) -> float:
+    """A metric as a float; None (undefined, e.g. AUPRC with one class) becomes NaN."""
+    return np.nan if v is None else float(v)
+
+
+def _mean_std(values: list[float], reachable: Sequence[bool] | None = None) -> str:
+    """Mean ± sample SD (in %) of one figure over seeds; seeds whose target FPR was unreachable
+    are left out and counted ('n/r' if every seed's was)."""
+    a = np.asarray(values, float)
+    if not len(a):
+        return "–"
+    ok = np.ones(len(a), bool) if reachable is None else np.asarray(reachable, bool)
+    if not ok.any():
+        return UNREACHABLE
+    a = a[ok]
+    mean, sd = f"{100 * np.nanmean(a):.1f}", sample_sd(a)
+    # one seed has no spread to report: "± 0.0" would read as zero variance
+    cell = mean if sd is None else f"{mean} ± {100 * sd:.1f}"
+    return cell if ok.all() else f"{cell} ({int((~ok).sum())}/{len(ok)} {UNREACHABLE})"
+
+
+def _cells(per_seed: Sequence[dict]) -> list[str]:
+    """Mean ± sample SD over seeds of every column on the Test Set and the Hard Set, from each
+    seed's {"test": metrics, "hard": metrics} (`Assessor`'s)."""
+    cells = []
+    for split in ("test", "hard"):
+        for col in COLUMNS:
+            ms = [m[split] for m in per_seed]
+            fpr = col.partition("@")[2]
+            ok = [m.get(f"reachable@{fpr}", True) for m in ms] if fpr else None
+            cells.append(_mean_std([_value(m[col]) for m in ms], ok))
+    return cells
+
+
+def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
+    """Rows: method (those that ran), then mean ± sample SD (in %) of each column on the Test
+    Set and the Hard Set."""
+    rows = [["initial (G_0)", *_cells([res["initial"]])]] if res.get("initial") else []
+    if res.get("reseeded"):
+        rows.append([f"G_0 re-seeded ×{len(res['reseeded'])} (no new data)",
+                     *_cells(res["reseeded"])])
+    for strategy in strategies:
+        if (own := own_initial(strategy)) and res.get(own[1]):
+            label, key = own
+            rows.append([label, *_cells([res[key]])])
+        runs = res.get(strategy, [])
+        if not runs:  # not part of this experiment
+            continue
+        rows.append([strategy, *_cells([r["rounds"][-1] for r in runs])])
+    return rows
+
+
+def acquisition_rows(res: dict) -> list[list[str]]:
+    """Per strategy: acquired runs, collision, near-miss and near-record shares (mean ± sample
+    SD over seeds)."""
+    rows = []
+    for strategy in ran(res):
+        acq = [r["acquisition"] for r in res.get(strategy, []) if r.get("acquisition")]
+        if acq:
+            runs = np.array([a["runs"] for a in acq], float)
+            sd = sample_sd(runs)
+            runs_s = f"{runs.mean():.0f}" + ("" if sd is None else f" ± {sd:.0f}")
+            rows.append([strategy, runs_s,
+                         _mean_std([a["collision_share"] for a in acq]),
+                         _mean_std([a.get("near_miss_share", np.nan) for a in acq]),
+                         _mean_std([a["near_share"] for a in acq])])
+    return rows
+
+
+def _has_unreachable(results: dict) -> bool:
+    return any(UNREACHABLE in cell for res in results.values() for _, strategies in tables(res)
+               for row in table_rows(res, strategies) for cell in row)
+
+
+def markdown(results: dict) -> str:
+    head = ["method"] + [f"{s} {c}" for s in ("Test", "Hard") for c in COLUMNS]
+    out = ["# evoeye RQ2: self-evolution under the same budget", ""]
+    if _has_unreachable(results):
+        out += [UNREACHABLE_NOTE, ""]
+    for scenario, res in results.items():
+        for title, strategies in tables(res):
+            out += [f"## {scenario} — {title} (mean ± sample SD over seeds, %)", "",
+                    "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
+            out += ["| " + " | ".join(r) + " |" for r in table_rows(res, strategies)]
+            out.append("")
+        out += [f"## {scenario} — what each strategy acquired (mean ± sample SD over seeds)",
+                "",
+                "| " + " | ".join(ACQUISITION_HEAD) + " |", "|---" * len(ACQUISITION_HEAD) + "|"]
+        out += ["| " + " | ".join(r) + " |" for r in acquisition_rows(res)]
+        out.append("")
+    return "\n".join(out)
+
+
+def _curves(res: dict, split: str, col: str) -> str:
+    series = []
+    by_method = {s: res[s] for s in ran(res)}
+    n_max = max((len(r["rounds"]) for runs in by_method.values() for r in runs), default=1)
+    for strategy, runs in by_method.items():
+        n = min(len(r["rounds"]) for r in runs)
+        ys = [float(np.nanmean([_value(r["rounds"][i][split][col]) for r in runs]))
+              for i in range(n)]
+        series.append((strategy, [i / max(n_max - 1, 1) for i in range(n)], ys))
+    return line_chart(series, title=f"{split} {col} per round", xlabel="round (0 … last)",
+                      ylabel=col)
+
+
+def _scatter(b: dict) -> str:
+    pts = []
+    hi = max(b["feedback"]) or 1.0
+    for x, y, f, new in zip(b["u0"], b["u1"], b["feedback"], b["acquired"], strict=True):
+        red = int(255 * f / hi)
+        pts.append(f'<circle cx="{40 + 300 * x:.1f}" cy="{330 - 300 * y:.1f}" r="{4 if new else 3}"'
+                   f' fill="rgb({red},60,{255 - red})" stroke="{"#000" if new else "none"}"/>')
+    return (f'<svg xmlns="http://www.w3.org/2000/svg" width="360" height="370">'
+            f'<rect x="40" y="30" width="300" height="300" fill="none" stroke="#999"/>'
+            f'{"".join(pts)}<text x="120" y="360">{escape(b["names"][0])}</text>'
+            f'<text x="5" y="20">{escape(b["names"][1])} (red = high feedback, ringed = '
+            f'acquired)</text></svg>')
+
+
+def _html_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
+    cells = "".join("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in r) + "</tr>" for r in rows)
+    return ("<table border=1 cellpadding=3><tr>" + "".join(f"<th>{escape(h)}</th>" for h in head)
+            + f"</tr>{cells}</table>")
+
+
+def html(results: dict) -> str:
+    body = [f"<p>{escape(UNREACHABLE_NOTE)}</p>"] if _has_unreachable(results) else []
+    for scenario, res in results.items():
+        body.append(f"<h2>{escape(scenario)}</h2>")
+        for title, strategies in tables(res):
+            head = ["method"] + [f"{s} {c}" for s in ("Test", "Hard") for c in COLUMNS]
+            body.append(f"<h3>{title}</h3>" + _html_table(head, table_rows(res, strategies)))
+        body.append("<h3>What each strategy acquired</h3>" + _html_table(
+            ACQUISITION_HEAD, acquisition_rows(res)))
+        for split in ("test", "hard"):
+            for col in ("f1@0.05", "auprc"):
+                body.append(_curves(res, split, col))
+        spots = [r["blind_spots"] for r in res.get("evoeye", []) if r.get("blind_spots")]
+        if spots:
+            body.append("<h3>Blind-spot map (EvoEye, first seed)</h3>" + _scatter(spots[0]))
+    return ("<!doctype html><meta charset=utf-8><title>evoeye RQ2</title>"
+            "<body style='font-family:sans-serif'>" + "".join(body) + "</body>")
+
+
+def write_experiment_report(root: DataRoot, results: dict,
+                            name: str | None = None) -> Path:
+    """rq2.md, rq2.html and rq2.json under `<root>/reports/<name>/`; the folder."""
+    folder = root.reports / (name or f"rq2-{datetime.now(UTC):%Y%m%dT%H%M%SZ}")
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / "rq2.md").write_text(markdown(results), encoding="utf-8")
+    (folder / "rq2.html").write_text(html(results), encoding="utf-8")
+    (folder / "rq2.json").write_text(json.dumps(results, indent=1, default=float),
+                                     encoding="utf-8")
+    return folder

@@ -1,0 +1,146 @@
+"""Acquisition strategies picked by name: BlindSpotEvolver, its two ablations, Uniform, AV-Fuzzer.
+
+* `evoeye` — Algorithm 1, lines 6–7: a uniformly random seed from D_r, then density-aware
+  mutation steered by the normalised monitor-oriented feedback of the δ-neighbourhood.
+* `no-feedback` (paper RQ3 "w/o Feedback") — the same loop with the monitor-oriented feedback
+  removed. Without a feedback signal every region potential q_δ is equal, so p_δ = 1 for every
+  seed: each proposal is a uniform sample of N_δ around a uniformly random executed record.
+* `no-density` (paper RQ3 "w/o Density") — the feedback is kept but the density awareness is
+  removed: the potential of a seed is its own normalised feedback (S_δ(x) shrinks to {x}), so
+  p(x) = (f̄(x) + ε) / (max_D f̄ + ε), regardless of how its neighbourhood was explored.
+* `uniform` — uniform samples of X (the paper's Uniform baseline).
+* `avfuzzer` — the GA of DESIGN.md §4, see `evoeye.evolve.search.avfuzzer`.
+
+Proposal k of a density-aware or uniform strategy draws from `default_rng([seed, k])` only, so
+the same seed, counter and records give the same proposal; `replay` just restores the counter.
+"""
+
+from __future__ import annotations
+
+import sys
+from collections.abc import Callable
+
+import numpy as np
+
+from evoeye.evolve.search.avfuzzer import AVFuzzer
+from evoeye.evolve.search.feedback import normalise_feedback
+from evoeye.evolve.search.mutation import (
+    EPSILON,
+    ConstantPotential,
+    NeighbourhoodPotential,
+    Potential,
+    SeedPotential,
+    density_aware_mutation,
+    exploit_probability,
+)
+from evoeye.evolve.search.protocol import Proposal, Strategy, StrategyError
+from evoeye.evolve.search.records import Records
+from evoeye.scenarios import DEFAULT_DELTA, LogicalScenario
+
+
+class _Counted:
+    """A strategy whose only state is how many proposals it made: proposal k uses rng([seed, k])."""
+
+    name = ""
+
+    def __init__(self, space: LogicalScenario, seed: int) -> None:
+        self.space = space
+        self.seed = seed
+        self.proposals = 0
+
+    def _next_rng(self) -> np.random.Generator:
+        rng = np.random.default_rng([self.seed, self.proposals])
+        self.proposals += 1
+        return rng
+
+    def tell(self, x: np.ndarray, fitness: float) -> None:
+        """Nothing to learn: the feedback reaches these strategies through the records."""
+
+    def available(self) -> int:
+        return sys.maxsize
+
+    def replay(self, params: np.ndarray, fitness: np.ndarray) -> None:
+        self.proposals = len(np.asarray(params).reshape(-1, self.space.dim))
+
+
+class UniformStrategy(_Counted):
+    """Uniform samples of the whole scenario space."""
+
+    name = "uniform"
+
+    def propose(self, records: Records | None = None) -> Proposal:
+        return Proposal(x=self.space.sample(self._next_rng()), kind="uniform")
+
+
+class DensityStrategy(_Counted):
+    """A random executed record as seed, mutated locally with probability p from its potential."""
+
+    def __init__(
+        self,
+        space: LogicalScenario,
+        seed: int,
+        potential: Potential,
+        name: str,
+        delta: float = DEFAULT_DELTA,
+        epsilon: float = EPSILON,
+    ) -> None:
+        super().__init__(space, seed)
+        self.potential = potential
+        self.name = name
+        self.delta = delta
+        self.epsilon = epsilon
+
+    def exploit_probabilities(self, records: Records) -> np.ndarray:
+        """p_δ (n,) of every executed record under the current feedback."""
+        u = self.space.normalise(records.params)
+        q = self.potential(u, normalise_feedback(records.feedback))
+        return exploit_probability(q, self.epsilon)
+
+    def propose(self, records: Records) -> Proposal:
+        if records.n == 0:
+            raise StrategyError(f"{self.name}: needs executed records (D_init) to pick seeds from")
+        if records.params.shape[1] != self.space.dim:
+            raise StrategyError(
+                f"{self.name}: records have {records.params.shape[1]} parameters, "
+                f"{self.space.name} has {self.space.dim}"
+            )
+        rng = self._next_rng()
+        p = self.exploit_probabilities(records)
+        i = int(rng.integers(records.n))
+        m = density_aware_mutation(self.space, records.params[i], p[i], rng, self.delta)
+        return Proposal(x=m.x, kind="local" if m.local else "global", parent=i, p_local=float(p[i]))
+
+
+StrategyFactory = Callable[..., Strategy]
+
+
+def _density(potential: Callable[[float], Potential], name: str) -> StrategyFactory:
+    def make(
+        space: LogicalScenario, seed: int, delta: float = DEFAULT_DELTA, epsilon: float = EPSILON
+    ) -> DensityStrategy:
+        return DensityStrategy(space, seed, potential(delta), name, delta, epsilon)
+
+    return make
+
+
+STRATEGIES: dict[str, StrategyFactory] = {
+    "evoeye": _density(NeighbourhoodPotential, "evoeye"),
+    "no-feedback": _density(lambda _delta: ConstantPotential(), "no-feedback"),
+    "no-density": _density(lambda _delta: SeedPotential(), "no-density"),
+    "uniform": UniformStrategy,
+    "avfuzzer": AVFuzzer,
+}
+# Strategies whose proposals never read the records' feedback: the feedback mode cannot change
+# what they acquire (the monitor updates are the same too), so it is not part of their identity.
+FEEDBACK_BLIND = frozenset({"uniform", "avfuzzer", "no-feedback"})
+
+
+def make_strategy(name: str, space: LogicalScenario, seed: int, **options) -> Strategy:
+    """The strategy called `name` over `space`, seeded; options go to its factory."""
+    try:
+        factory = STRATEGIES[name]
+    except KeyError:
+        raise StrategyError(
+            f"unknown acquisition strategy {name!r}; known: {sorted(STRATEGIES)}"
+        ) from None
+    return factory(space, seed, **options)

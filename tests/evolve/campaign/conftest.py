@@ -1,0 +1,38 @@
+"""A seeded data root for campaigns, and private copies of it."""
+
+from __future__ import annotations
+
+import shutil
+from collections.abc import Callable
+from pathlib import Path
+
+import pytest
+
+from evoeye.batch import plan_uniform, run_batch
+from evoeye.paths import DataRoot
+from evoeye.store import SplitSpec, ingest
+
+SCENARIO = "unprotected-intersection"  # ~half its runs collide: both classes in tiny splits
+SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
+
+
+@pytest.fixture(scope="session")
+def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[DataRoot, str]:
+    """(root, G_0): 16 ingested runs and a G_0 trained for one epoch, shared by the tests of
+    this folder (campaigns run on a `root_copy`)."""
+    from evoeye.monitor import train_monitor
+
+    data = DataRoot.resolve(tmp_path_factory.mktemp("seeded") / "data")
+    run_batch(plan_uniform(SCENARIO, 16, 3), data)
+    ingest(data)
+    return data, train_monitor(data, SCENARIO, seed=0, splits=SPLITS, epochs=1)
+
+
+@pytest.fixture
+def root_copy(seeded, tmp_path: Path) -> Callable[[str], DataRoot]:
+    """A private copy of the seeded root, so each test's campaign starts from the same data."""
+    def make(name: str) -> DataRoot:
+        dst = tmp_path / name
+        shutil.copytree(seeded[0].path, dst)
+        return DataRoot.resolve(dst)
+    return make

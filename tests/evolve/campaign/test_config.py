@@ -1,0 +1,94 @@
+"""A campaign's options: declared once in CampaignConfig, read by the command line and the flows."""
+
+from __future__ import annotations
+
+import inspect
+import json
+import subprocess
+import sys
+from dataclasses import replace
+
+import pytest
+
+from evoeye.evolve.campaign.config import (
+    CampaignConfig,
+    campaign_options,
+    config_from,
+    option_values,
+)
+from evoeye.splits import SplitSpec
+
+
+def test_literal_defaults_equal_their_sources() -> None:
+    from evoeye.evolve.campaign import config
+    from evoeye.monitor.families import DEFAULT_FAMILY
+    from evoeye.scenarios import DEFAULT_DELTA
+    from evoeye.sim.runner import SimConfig
+    from evoeye.store.windows import DEFAULT_HORIZON_S
+
+    literal = {"delta": config.DEFAULT_DELTA, "horizon_s": config.DEFAULT_HORIZON_S,
+               "max_run_s": config.MAX_RUN_S, "family": config.DEFAULT_FAMILY}
+    assert literal == {"delta": DEFAULT_DELTA, "horizon_s": DEFAULT_HORIZON_S,
+                       "max_run_s": SimConfig().duration_s, "family": DEFAULT_FAMILY}
+
+
+def test_the_config_module_imports_nothing_heavy() -> None:
+    probe = ("import json, sys; import evoeye.evolve.campaign.config; "
+             "print(json.dumps(sorted({m.split('.')[0] for m in sys.modules})))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          check=True)
+    loaded = set(json.loads(done.stdout))
+    assert "evoeye" in loaded
+    assert not loaded & {"numpy", "torch", "duckdb", "pyarrow", "highway_env", "prefect"}
+
+
+def test_options_are_the_fields_with_the_split_flattened_and_round_trip() -> None:
+    names = [o.name for o in campaign_options()]
+    assert names[:3] == ["scenario", "strategy", "budget_s"]
+    assert names[-3:] == ["split_seed", "train_frac", "val_frac"]
+    assert "splits" not in names and "max_run_s" not in names  # flattened; internal
+    cfg = CampaignConfig("unprotected-intersection", strategy="uniform", budget_s=90.0, seed=3,
+                         n_round=4, epochs=2, feedback="prior-corrected", delta=0.1,
+                         splits=SplitSpec(7, 0.6, 0.2))
+    values = option_values(cfg)
+    assert values["split_seed"] == 7 and values["val_frac"] == 0.2
+    assert config_from(values) == cfg
+    assert "seed" not in option_values(cfg, exclude=("seed",))
+    with pytest.raises(ValueError, match="max_run_s is no campaign option"):
+        option_values(replace(cfg, max_run_s=5.0))
+
+
+@pytest.mark.parametrize(("field", "value", "message"), [
+    ("n_round", 0, "n_round must be >= 1"), ("budget_s", -1.0, "budget_s must be >= 0"),
+    ("delta", 0.0, "delta must be > 0"), ("delta", 1.5, "delta must be <= 1"),
+    ("strategy", "random-walk", "unknown strategy 'random-walk'"),
+    ("scenario", "roundabout", "unknown scenario 'roundabout'"),
+    ("family", "context-only", "unknown family 'context-only'"),  # not evolvable
+])
+def test_bad_values_are_refused_naming_the_field(field: str, value, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        CampaignConfig(**{field: value})
+
+
+def test_the_cli_commands_and_the_flows_take_every_option() -> None:
+    from typer.main import get_command
+
+    from evoeye.cli import app
+    from flows.evolve import EvolveParams
+    from flows.experiment import PER_CAMPAIGN, ExperimentParams
+
+    options = {o.name for o in campaign_options()}
+    commands = get_command(app).commands
+    evolve_cli = {p.name for p in commands["evolve"].params}
+    experiment_cli = {p.name for p in commands["experiment"].params}
+    assert options <= evolve_cli and options <= set(EvolveParams.model_fields)
+    shared = options - set(PER_CAMPAIGN)
+    assert shared <= experiment_cli and shared <= set(ExperimentParams.model_fields)
+    assert "scenarios" in ExperimentParams.model_fields and "scenario" in experiment_cli
+    # the flow's defaults and bounds are the config's
+    field = EvolveParams.model_fields["n_round"]
+    assert field.default == CampaignConfig().n_round
+    assert any(getattr(m, "ge", None) == 1 for m in field.metadata)
+    help_of = {p.name: p.help for p in commands["evolve"].params}
+    assert help_of["budget_s"] == inspect.cleandoc(
+        next(o.help for o in campaign_options() if o.name == "budget_s"))
