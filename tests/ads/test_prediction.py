@@ -154,7 +154,8 @@ def test_a_car_that_can_still_stop_where_its_lane_gives_way_is_expected_to():
     m = modes(p)
     c = ADSConfig().prediction
     need = 10.0**2 / (2.0 * 40.0)
-    expected = c.yield_prior / (1.0 + math.exp((need - c.yield_decel_mps2) / c.yield_decel_scale_mps2))
+    fade = math.exp((need - c.yield_decel_mps2) / c.yield_decel_scale_mps2)
+    expected = c.yield_prior / (1.0 + fade)
     assert p.model[0] == "yield" and m["yield"] == pytest.approx(expected, abs=0.01)
     k = p.model.index("yield")
     t = (np.arange(30) + 1) * 0.1  # it brakes evenly to a stop at the end of its lane …

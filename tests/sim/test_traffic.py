@@ -1,4 +1,4 @@
-"""NPC drivers' rules in isolation: giving way to the ego, settling crossings, what blocks a turn."""
+"""NPC drivers' rules in isolation: giving way to the ego, settling crossings, a blocked turn."""
 
 import math
 
