@@ -39,8 +39,12 @@ CROSSING_RADIUS_M = 4.5  # a waiting NPC's centre keeps this far from the other'
 # half-diagonal, 2.7 m, plus the other's half-width and a margin)
 MIN_SPACING_M = 10.0  # centre spacing between NPCs placed on one approach
 
-BUILDING_FROM_M, BUILDING_TO_M = 12.5, 90.0  # a building fills each corner between these
-# distances from the centre lines, both ways: crossing traffic shows late, as at a city corner
+# a building fills each corner from its setback to BUILDING_TO_M off the centre lines, both
+# ways: crossing traffic shows late, as at a city corner. The corners east of the ego's road
+# stand closer than the western ones (a wider pavement there), so the two crossings show at
+# different moments
+BUILDING_SETBACK_M = {"east": 12.5, "west": 18.0}
+BUILDING_TO_M = 90.0
 EGO_CLEARANCE_M = 6.5  # a turning NPC yielding to the ego stops this far from its route
 TURN_GAP_S = 2.0  # a turning NPC goes if the ego would reach the crossing this much after it
 # name → (approach, destination); parameters are f"{name}_speed_mps", f"{name}_offset_s"
@@ -189,7 +193,10 @@ def build_intersection(p: dict[str, float], rng: np.random.Generator) -> tuple[W
 @functools.cache
 def _buildings() -> np.ndarray:
     """(4, 4) one building per corner, [x_min, y_min, x_max, y_max]."""
-    a, b = BUILDING_FROM_M, BUILDING_TO_M
-    return np.array([[sx * a if sx > 0 else -b, sy * a if sy > 0 else -b,
-                      b if sx > 0 else -a, b if sy > 0 else -a]
-                     for sx in (1, -1) for sy in (1, -1)], dtype=float)
+    b = BUILDING_TO_M
+    corners = []
+    for sx in (1, -1):
+        a = BUILDING_SETBACK_M["east" if sx > 0 else "west"]
+        corners += [[a if sx > 0 else -b, a if sy > 0 else -b, b if sx > 0 else -a,
+                     b if sy > 0 else -a] for sy in (1, -1)]
+    return np.array(corners, dtype=float)

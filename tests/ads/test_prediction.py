@@ -65,8 +65,8 @@ def test_a_car_on_a_curved_lane_follows_the_curve():
 
 
 def test_lateral_motion_makes_a_lane_change_the_likely_mode():
-    heading = -math.atan2(1.5, 20.0)  # drifting right at 1.5 m/s: a cut-in into y = 0
-    p = predict(straight_road(), [(30.0, 3.6, heading, math.hypot(20.0, 1.5))])
+    heading = -math.atan2(2.0, 20.0)  # a quarter into the change, drifting right at 2 m/s
+    p = predict(straight_road(), [(30.0, 3.0, heading, math.hypot(20.0, 2.0))])
     assert p.model[0] == "right" and p.mode_prob[0] > 0.5
     assert (np.diff(p.mode_prob) <= 0.0).all() and p.mode_prob.sum() <= 1.0 + 1e-9
     right = p.model.index("right")
@@ -79,7 +79,7 @@ def test_the_lane_change_probability_grows_with_lateral_speed_and_offset():
         h = -math.atan2(lat_speed, 20.0)
         return modes(predict(straight_road(), [(30.0, y, h, 20.0)])).get("right", 0.0)
 
-    assert p_right(0.0, 4.0) < p_right(0.5, 4.0) < p_right(1.0, 4.0) < p_right(1.0, 3.2)
+    assert p_right(1.0, 4.0) < p_right(1.5, 4.0) < p_right(2.0, 4.0) < p_right(2.0, 3.2)
 
 
 def test_no_lane_change_towards_a_side_without_a_lane():
@@ -182,12 +182,12 @@ def test_a_car_too_fast_to_stop_where_its_lane_gives_way_is_expected_to_go_on():
 def test_the_give_way_belief_fades_with_the_braking_stopping_would_need():
     c = ADSConfig().prediction
     probs = []
-    for to_line_m in (60.0, 30.0, 20.0, 15.0, 12.0):
+    for share in (0.3, 0.6, 0.85, 1.0, 1.4):  # the braking a stop needs, over the limit
+        to_line_m = 10.0**2 / (2.0 * share * c.yield_decel_mps2)
         m = modes(predict(give_way_road(), [(-6.0 - to_line_m, 0.0, 0.0, 10.0)]))
         probs.append(m.get("yield", 0.0))
     assert probs == sorted(probs, reverse=True) and probs[0] > 0.85 and probs[-1] < 0.2
-    need = 100.0 / (2.0 * 15.0)  # 3.3 m/s² at 15 m: around the yield braking limit
-    assert abs(need - c.yield_decel_mps2) < 1.0 and 0.1 < probs[3] < 0.8
+    assert 0.1 < probs[3] < 0.8  # around the limit: either is plausible
 
 
 def test_no_give_way_hypothesis_on_a_lane_with_the_right_of_way():
