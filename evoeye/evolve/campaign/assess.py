@@ -9,6 +9,8 @@ fixed validation split when it was trained).
 
 from __future__ import annotations
 
+from dataclasses import asdict
+
 import numpy as np
 import pyarrow as pa
 
@@ -36,7 +38,7 @@ def hard_set(warehouse: Warehouse, scores: pa.Table, *, monitor_version: str, th
         return con.sql(query("hard_set"), params={
             "monitor_version": monitor_version, "threshold": float(threshold),
             "logical_scenario": logical_scenario, "horizon_s": float(horizon_s),
-            "seed": splits.seed, "train_frac": splits.train_frac, "val_frac": splits.val_frac,
+            **asdict(splits),
         }).to_arrow_table()
     finally:
         con.close()
