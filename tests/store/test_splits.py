@@ -100,6 +100,7 @@ def test_a_held_out_batch_is_the_test_split_and_never_initial_data(root: DataRoo
     for i in range(6):
         add_run(f"init-{i}", n_frames=2, seed=i, batch="init")
         add_run(f"held-{i}", n_frames=2, seed=10 + i, batch="held")
+    add_run("acquired", n_frames=2, seed=30, batch="campaign", round=1)
     ingest(root)
     splits = SplitSpec(train_frac=0.7, val_frac=0.3, test_batch="held")
     wh = Warehouse(root)
@@ -114,7 +115,11 @@ def test_a_held_out_batch_is_the_test_split_and_never_initial_data(root: DataRoo
     assert not any(i.startswith("held") for i in initial.column("scenario_id").to_pylist())
     stats = {r["split"]: r["scenarios"] for r in wh.query(
         "dataset_stats", horizon_s=3.0, **asdict(splits)).to_pylist()}
-    assert stats["test"] == 6 and stats["train"] + stats["val"] == 6
+    assert stats["test"] == 6 and stats["train"] + stats["val"] == 7  # with the acquired run
+    initial = {r["split"]: r["scenarios"] for r in wh.query(
+        "initial_split_stats", logical_scenario="highway-cut-in", horizon_s=3.0,
+        **asdict(splits)).to_pylist()}
+    assert initial["test"] == 6 and initial["train"] + initial["val"] == 6
 
 
 def test_bad_split_arguments_are_refused() -> None:
