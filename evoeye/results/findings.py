@@ -11,9 +11,11 @@ claims; each check is one comparison on one scenario, set and metric, and gets a
   +5 points (the difference the design is sized for), and **does not reproduce** when its lower
   end is at or above +5 points; otherwise it is not shown.
 
-A finding reproduces when every check does; does not reproduce when one is reversed (or, for
-"little", does not reproduce); is partly shown when some reproduce and none goes against it;
-and is not run yet when the results have none of its comparisons.
+A finding reproduces when every check does — on every scenario that ran, with every
+comparison it names (a method or baseline left out of the run leaves it partly shown at best);
+does not reproduce when one is reversed (or, for "little", does not reproduce); is partly shown
+when some reproduce and none goes against it; and is not run yet when the results have none of
+its comparisons.
 """
 
 from __future__ import annotations
@@ -85,13 +87,14 @@ def check_verdict(cell: dict, kind: str) -> str:
     return NOT_SHOWN
 
 
-def _overall(verdicts: list[str]) -> str:
+def _overall(verdicts: list[str], missing: int) -> str:
+    """A finding's verdict from its checks' (`missing`: checks whose comparison did not run)."""
     if not verdicts:
         return NOT_RUN
-    if all(v == REPRODUCES for v in verdicts):
-        return REPRODUCES
     if any(v in (REVERSED, AGAINST) for v in verdicts):
         return AGAINST
+    if all(v == REPRODUCES for v in verdicts) and not missing:
+        return REPRODUCES
     return PARTLY if REPRODUCES in verdicts else NOT_SHOWN
 
 
@@ -100,8 +103,9 @@ def check_findings(tables: list[dict]) -> list[dict]:
     verdict) and an overall verdict."""
     out = []
     for f in FINDINGS:
-        checks = []
+        checks, expected = [], 0
         for table in (t for t in tables if t["id"] == f.table):
+            expected += len(f.pairs) * len(f.sets) * len(f.metrics)
             for comparison in table["comparisons"]:
                 if (comparison["a"], comparison["b"]) not in f.pairs:
                     continue
@@ -113,6 +117,8 @@ def check_findings(tables: list[dict]) -> list[dict]:
                                            "metric": m, "a": comparison["a"],
                                            "b": comparison["b"], "cell": cell,
                                            "verdict": check_verdict(cell, f.kind)})
+        missing = expected - len(checks)
         out.append({"id": f.id, "claim": f.claim, "paper": f.paper, "kind": f.kind,
-                    "checks": checks, "verdict": _overall([c["verdict"] for c in checks])})
+                    "checks": checks, "missing": missing,
+                    "verdict": _overall([c["verdict"] for c in checks], missing)})
     return out

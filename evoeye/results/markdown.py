@@ -150,8 +150,14 @@ FINDINGS_RULE = (f"A \"beats\" claim reproduces when the mean paired difference 
 
 def findings_summary(findings: list[dict]) -> tuple[list[str], list[list[str]]]:
     """Header and rows: each finding, what the paper reports, the verdict."""
-    return ["finding", "paper", "verdict"], [[f["claim"], f["paper"], f["verdict"]]
+    return ["finding", "paper", "verdict"], [[f["claim"], f["paper"], _verdict(f)]
                                              for f in findings]
+
+
+def _verdict(finding: dict) -> str:
+    missing = finding.get("missing", 0)
+    return finding["verdict"] + (f" ({missing} of its comparisons not run)"
+                                 if missing and finding["checks"] else "")
 
 
 def finding_checks(finding: dict) -> tuple[list[str], list[list[str]]]:
@@ -170,7 +176,7 @@ def findings_markdown(findings: list[dict], source: str) -> str:
            *_md(header, [[c, p, f"**{v}**"] for c, p, v in rows], numbers=False), ""]
     for f in findings:
         if f["checks"]:
-            out += [f"**{f['claim']}** — {f['verdict']}", "",
+            out += [f"**{f['claim']}** — {_verdict(f)}", "",
                     *_md(*finding_checks(f), numbers=False), ""]
     if any(FLOOR_MARK in diff_cell(c["cell"]) for f in findings for c in f["checks"]):
         out += [FLOOR_NOTE, ""]
