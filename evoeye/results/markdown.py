@@ -36,21 +36,20 @@ def p_text(p: float | None) -> str:
     return "p<0.001" if p < 0.001 else f"p={p:.2g}"
 
 
-def _undefined(cell: dict, metric: str, n: int) -> str:
-    if not cell["undefined"]:
-        return ""
-    word = UNREACHABLE if metric.startswith(("f1@", "precision@", "recall@")) else "undefined"
-    return f" ({cell['undefined']}/{n} {word})"
+def _undefined(cell: dict, n: int) -> str:
+    """How many seeds were left out, and why: an unreachable target FPR, or undefined."""
+    return "".join(f" ({cell[key]}/{n} {word})" for key, word in (
+        ("unreachable", UNREACHABLE), ("undefined", "undefined")) if cell.get(key))
 
 
 def mean_cell(cell: dict, metric: str, n: int) -> str:
-    """A row's cell: mean [t CI] in %, or the one value where nothing varies."""
+    """A row's cell: mean [t CI] in %, or the one value where nothing varies; 'n/r' where every
+    seed's target FPR was unreachable."""
     if cell["mean"] is None:
-        return UNREACHABLE if metric.startswith("f1@") and cell["undefined"] else DASH
+        return UNREACHABLE if cell.get("unreachable") == n else DASH
     if not cell["sd"]:  # one seed, or the same figure for every seed (a rule)
-        return pct(cell["mean"]) + _undefined(cell, metric, n)
-    return (f"{pct(cell['mean'])} [{pct(cell['low'])}, {pct(cell['high'])}]"
-            + _undefined(cell, metric, n))
+        return pct(cell["mean"]) + _undefined(cell, n)
+    return f"{pct(cell['mean'])} [{pct(cell['low'])}, {pct(cell['high'])}]" + _undefined(cell, n)
 
 
 def diff_cell(cell: dict) -> str:

@@ -51,15 +51,17 @@ def g0_label(family: str, seeds: bool = False) -> str:
 
 def mean_figures(figures: Sequence[dict]) -> dict:
     """The mean over several monitors' {set: metrics} of every numeric metric (undefined ones —
-    an unreachable target's F1, AUROC on one class — left out; None where none is defined)."""
+    an unreachable target's F1, AUROC on one class — left out; None where none is defined); a
+    target FPR is reachable if any of the monitors reached it."""
     out: dict = {}
     for name in figures[0]:
         out[name] = {}
-        for key, first in figures[0][name].items():
-            if isinstance(first, bool) or key.startswith("reachable@"):
-                continue
-            values = [f[name][key] for f in figures if f[name][key] is not None]
-            out[name][key] = float(np.mean(values)) if values else None
+        for key in figures[0][name]:
+            values = [f[name][key] for f in figures if f[name].get(key) is not None]
+            if key.startswith("reachable@"):
+                out[name][key] = any(values)
+            else:
+                out[name][key] = float(np.mean(values)) if values else None
     return out
 
 

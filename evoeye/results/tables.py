@@ -6,8 +6,9 @@ alone: per row the mean over seeds with its Student-t 95 % CI (`mean_ci`), per c
 mean paired difference a − b with its BCa bootstrap 95 % CI and the Wilcoxon signed-rank p
 (`compare_paired`, pairs by seed: training seeds in RQ1 and the monitor ablation, campaign seeds
 in RQ2), plus the seed pairs a 5-point difference would need at 80 % power given the SDs and
-pair correlation measured (`pairs_needed`). A seed whose figure is undefined (an unreachable
-target FPR: F1 None) is left out of its row's mean and of its pairs, and counted. Rows marked
+pair correlation measured (`pairs_needed`). A seed whose figure is undefined — an unreachable
+target FPR (F1 None), or a set without unsafe frames — is left out of its row's mean and of its
+pairs, and counted (unreachable ones apart). Rows marked
 unpaired (G_0's recipe over k training seeds, in RQ2) have a mean and CI but no comparison.
 """
 
@@ -99,8 +100,16 @@ def values(row: dict, set_name: str, metric: str) -> np.ndarray:
                      for f in row["figures"]], dtype=float)
 
 
-def _row_cell(v: np.ndarray) -> dict:
-    return {**mean_ci(v).to_dict(), "undefined": int(np.isnan(v).sum())}
+def unreachable(row: dict, set_name: str, metric: str) -> int:
+    """Seeds of a row whose figure is undefined because its target FPR was unreachable."""
+    fpr = metric.partition("@")[2]
+    return sum(1 for f in row["figures"] if fpr and f[set_name].get(f"reachable@{fpr}") is False)
+
+
+def _row_cell(row: dict, set_name: str, metric: str) -> dict:
+    v = values(row, set_name, metric)
+    n_r = unreachable(row, set_name, metric)
+    return {**mean_ci(v).to_dict(), "unreachable": n_r, "undefined": int(np.isnan(v).sum()) - n_r}
 
 
 def _comparison_cell(a: np.ndarray, b: np.ndarray) -> dict:
@@ -125,7 +134,7 @@ def build_table(spec: TableSpec, scenario: str, part: dict) -> dict | None:
         return None
     out_rows = [{"method": m, "n": len(methods[m]["figures"]),
                  "unpaired": bool(methods[m].get("unpaired")),
-                 "cells": {cell_key(s, k): _row_cell(values(methods[m], s, k))
+                 "cells": {cell_key(s, k): _row_cell(methods[m], s, k)
                            for s in spec.sets for k in spec.metrics}} for m in rows]
     paired = [m for m in rows if not methods[m].get("unpaired")]
     comparisons = [{"a": a, "b": b,

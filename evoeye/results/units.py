@@ -130,6 +130,14 @@ class Judge:
                 for name, m in self.masks.items()}
 
 
+def set_metrics(scores: np.ndarray, labels: np.ndarray, thresholds) -> dict:
+    """`metrics_dict` of one set; only its sizes where it holds no unsafe frame (every rate of
+    it is undefined then, not 0)."""
+    if not labels.any():
+        return {"frames": int(len(labels)), "unsafe": 0}
+    return metrics_dict(scores, labels, thresholds)
+
+
 def set_figures(study: Study, judge: Judge, version: str) -> dict:
     """A version's figures on the Test Set, the Hard Set and the robust Hard Set, at the
     thresholds it was calibrated at when trained."""
@@ -140,7 +148,7 @@ def set_figures(study: Study, judge: Judge, version: str) -> dict:
         monitor = load_calibrated(study.root, version)
         w = study.windows(judge.scenario, "test").windows
         scores = check_scores(monitor, monitor.score(narrow(w, monitor.context_len)), len(w))
-        return {name: metrics_dict(scores[m], w.label[m], monitor.thresholds)
+        return {name: set_metrics(scores[m], w.label[m], monitor.thresholds)
                 for name, m in judge.masks.items()}
 
     return study.ledger.remember("assess", inputs, assess,

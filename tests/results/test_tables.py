@@ -15,7 +15,11 @@ N = 8
 
 
 def _figures(values: list[float | None], set_name: str = "test") -> list[dict]:
-    return [{set_name: {"f1@0.05": v, "f1@0.01": v, "auroc": v, "auprc": v}} for v in values]
+    """Per seed, every metric at the value; None: the target FPRs unreachable (and the areas
+    undefined, as on a set with one class)."""
+    return [{set_name: {"f1@0.05": v, "f1@0.01": v, "auroc": v, "auprc": v,
+                        "reachable@0.05": v is not None, "reachable@0.01": v is not None}}
+            for v in values]
 
 
 def _rq1(fusion: list, **others: list) -> dict:
@@ -50,8 +54,11 @@ def test_an_undefined_seed_is_left_out_and_counted() -> None:
     table = build_table(next(s for s in _specs() if s.id == "rq1"), "s1",
                         _rq1(fusion, aem=[0.3] * 6))
     row = table["rows"][0]["cells"]["test/f1@0.05"]
-    assert row["n"] == 5 and row["undefined"] == 1
+    assert row["n"] == 5 and (row["unreachable"], row["undefined"]) == (1, 0)
     assert mean_cell(row, "f1@0.05", 6).endswith("(1/6 n/r)")
+    area = table["rows"][0]["cells"]["test/auroc"]  # undefined, not for want of a threshold
+    assert (area["unreachable"], area["undefined"]) == (0, 1)
+    assert mean_cell(area, "auroc", 6).endswith("(1/6 undefined)")
     cell = table["comparisons"][0]["cells"]["test/f1@0.05"]
     assert cell["n"] == 5 and cell["undefined"] == 1
     assert diff_cell(cell).endswith("‡")  # 5 pairs: p ≥ 2/2^5 > 0.05
