@@ -26,7 +26,8 @@ FLOOR_NOTE = (f"{FLOOR_MARK}: with so few pairs no outcome can give p ≤ {ALPHA
 def pct(x: float | None, signed: bool = False) -> str:
     if x is None or (isinstance(x, float) and math.isnan(x)):
         return DASH
-    text = f"{100 * x:+.1f}" if signed else f"{100 * x:.1f}"
+    value = round(100 * x, 1) + 0.0  # + 0.0: a difference that rounds to 0 is not "−0.0"
+    text = f"{value:+.1f}" if signed else f"{value:.1f}"
     return text.replace("-", MINUS)
 
 

@@ -7,7 +7,7 @@ import pytest
 from scipy import stats
 
 from evoeye.results.findings import FINDINGS, check_findings, check_verdict
-from evoeye.results.markdown import diff_cell, mean_cell
+from evoeye.results.markdown import diff_cell, mean_cell, pct
 from evoeye.results.tables import build_table, build_tables
 
 RNG = np.random.default_rng(5)
@@ -128,3 +128,9 @@ def test_every_finding_names_a_registered_table() -> None:
     ids = {s.id for s in _specs()}
     assert {f.table for f in FINDINGS} <= ids
     assert {f.kind for f in FINDINGS} == {"better", "little"}
+
+
+def test_percentages_in_the_tables() -> None:
+    assert (pct(0.3124), pct(-0.0312, signed=True), pct(0.05, signed=True)) == (
+        "31.2", "−3.1", "+5.0")
+    assert pct(-1e-5, signed=True) == "+0.0" and pct(None) == "–"  # no "−0.0"
