@@ -15,6 +15,7 @@ import pyarrow as pa
 from evoeye.evaluation.dataset import SplitWindows, load_split
 from evoeye.evaluation.metrics import frame_metrics
 from evoeye.monitor.families import load_calibrated
+from evoeye.monitor.threads import intra_op_threads
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse
 from evoeye.store.feedback import RoundMetrics
@@ -57,6 +58,7 @@ def metrics_dict(scores: np.ndarray, labels: np.ndarray, thresholds) -> dict:
 class Assessor:
     """Scores monitor versions on the Test Set and the Hard Set of G_0 of one scenario."""
 
+    @intra_op_threads()
     def __init__(self, root: DataRoot, scenario: str, g0: str, *,
                  splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen)
                  horizon_s: float = DEFAULT_HORIZON_S) -> None:
@@ -85,6 +87,7 @@ class Assessor:
         return cls(campaign.root, cfg.scenario, campaign.reference, splits=cfg.splits,
                    horizon_s=cfg.horizon_s)
 
+    @intra_op_threads()
     def __call__(self, version: str) -> RoundMetrics:
         """`version` on the Test Set and the Hard Set, at its own thresholds."""
         monitor = load_calibrated(self.root, version)

@@ -52,6 +52,7 @@ from evoeye.monitor.families import (
     initial_monitor,
     load_calibrated,
 )
+from evoeye.monitor.threads import intra_op_threads
 from evoeye.paths import DataRoot
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
 from evoeye.sim.runner import run_spec
@@ -187,6 +188,7 @@ class Campaign:
         return self._monitors[version]
 
     # -- state -----------------------------------------------------------------------------------
+    @intra_op_threads()
     def start(self, new_ids: Sequence[str] = ()) -> CampaignState:
         """The state after the last stored round; round 0 (G_0, D_init scored) is stored first.
         `new_ids`: runs `acquire` added since, by id (the flow's round tasks pass them on), read
@@ -233,6 +235,7 @@ class Campaign:
         return self.remaining_s(state) < self.config.max_run_s
 
     # -- one round, in the steps a flow runs as tasks ----------------------------------------------
+    @intra_op_threads()
     def acquire(self, state: CampaignState) -> list[str]:
         """Lines 5–10, up to N_round times: propose, simulate, score with G_r, add; then store the
         new runs' f_r. Their ids."""
@@ -264,6 +267,7 @@ class Campaign:
         """Put the round's logs into the warehouse (every log not yet there)."""
         return ingest(self.root)
 
+    @intra_op_threads()
     def update_monitor(self, state: CampaignState) -> tuple[str, float]:
         """Line 12: G_{r+1} from D_r (train) and the fixed val split; (version, wall seconds)."""
         cfg = self.config
@@ -279,6 +283,7 @@ class Campaign:
         )
         return version, time.perf_counter() - t0
 
+    @intra_op_threads()
     def finish_round(self, state: CampaignState, new_ids: list[str], version: str,
                      train_s: float) -> RoundRow:
         """Line 13 and the commit: store f_{r+1} of every record, then the round."""
