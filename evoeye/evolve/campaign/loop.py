@@ -39,6 +39,7 @@ import numpy as np
 
 from evoeye.batch import simulate_and_log
 from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
 from evoeye.evolve.search.fitness import criticality
 from evoeye.evolve.search.protocol import Strategy
@@ -116,6 +117,7 @@ class Campaign:
         self._train = train or self.family.train
         self._assess = assess
         self._monitors: dict[str, object] = {}
+        self.clock = PhaseClock()  # wall seconds per phase of this object's calls
 
     # -- identity and initial data -------------------------------------------------------------
     @cached_property
@@ -193,6 +195,10 @@ class Campaign:
         """The state after the last stored round; round 0 (G_0, D_init scored) is stored first.
         `new_ids`: runs `acquire` added since, by id (the flow's round tasks pass them on), read
         back from their logs with their feedback under G_r."""
+        with self.clock("state"):
+            return self._start(new_ids)
+
+    def _start(self, new_ids: Sequence[str]) -> CampaignState:
         rounds = read_rounds(self.root, self.campaign_id)
         if not rounds:
             self._store_feedback(self.g0, self.initial["scenario_id"])
@@ -242,16 +248,19 @@ class Campaign:
         cfg, monitor = self.config, self.monitor(state.monitor)
         new: list[str] = []
         while len(new) < cfg.n_round and not self.done(state):
-            prop = state.strategy.propose(state.records)
-            spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
-                            batch=self.campaign_id, source=cfg.strategy, round=state.round + 1)
-            result = simulate_and_log(spec, self.root)
+            with self.clock("simulate"):
+                prop = state.strategy.propose(state.records)
+                spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
+                                batch=self.campaign_id, source=cfg.strategy,
+                                round=state.round + 1)
+                result = simulate_and_log(spec, self.root)
             if result.status == "error":
                 raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
                                    f"{result.reason}")
-            run = read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
-            fb = (windows_feedback(monitor, run.windows, cfg.feedback).feedback[0]
-                  if run.ok and run.windows is not None else np.nan)
+            with self.clock("score"):
+                run = read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
+                fb = (windows_feedback(monitor, run.windows, cfg.feedback).feedback[0]
+                      if run.ok and run.windows is not None else np.nan)
             outcome = _outcome(run.metadata)
             state.strategy.tell(prop.x, outcome["fitness"])
             state.records = state.records.append(
@@ -265,7 +274,8 @@ class Campaign:
 
     def ingest(self):
         """Put the round's logs into the warehouse (every log not yet there)."""
-        return ingest(self.root)
+        with self.clock("ingest"):
+            return ingest(self.root)
 
     @intra_op_threads()
     def update_monitor(self, state: CampaignState) -> tuple[str, float]:
@@ -273,20 +283,26 @@ class Campaign:
         cfg = self.config
         ids = [str(s) for s, ok in zip(state.records.scenario_id, state.ok, strict=True) if ok]
         t0 = time.perf_counter()
-        version = self._train(
-            self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
-            horizon_s=cfg.horizon_s,
-            seed=cfg.seed * 1000 + state.round + 1, splits=cfg.splits,
-            init_from=state.monitor if cfg.update == "finetune" else None,
-            context_len=None if cfg.update == "finetune" else self.monitor(self.g0).context_len,
-            **cfg.train_overrides(),
-        )
+        with self.clock("train"):
+            version = self._train(
+                self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
+                horizon_s=cfg.horizon_s, seed=cfg.seed * 1000 + state.round + 1,
+                splits=cfg.splits, init_from=state.monitor if cfg.update == "finetune" else None,
+                context_len=(None if cfg.update == "finetune"
+                             else self.monitor(self.g0).context_len),
+                **cfg.train_overrides(),
+            )
         return version, time.perf_counter() - t0
 
     @intra_op_threads()
     def finish_round(self, state: CampaignState, new_ids: list[str], version: str,
                      train_s: float) -> RoundRow:
         """Line 13 and the commit: store f_{r+1} of every record, then the round."""
+        with self.clock("state"):
+            return self._finish_round(state, new_ids, version, train_s)
+
+    def _finish_round(self, state: CampaignState, new_ids: list[str], version: str,
+                      train_s: float) -> RoundRow:
         ok_ids = state.records.scenario_id[state.ok]
         self._store_feedback(version, ok_ids)
         row = RoundRow(self.campaign_id, self.config.scenario, self.config.strategy,
@@ -330,8 +346,9 @@ class Campaign:
         todo = [str(s) for s in scenario_ids if s not in have]
         if not todo:
             return
-        fb = warehouse_feedback(self.root, self.monitor(version), todo, self.config.horizon_s,
-                                self.config.feedback)
+        with self.clock("refresh"):
+            fb = warehouse_feedback(self.root, self.monitor(version), todo,
+                                    self.config.horizon_s, self.config.feedback)
         self._write_feedback(version, fb.scenario_id, fb.feedback, fb.n_contexts)
 
     def _write_feedback(self, version: str, ids, feedback, n_contexts=None) -> None:
@@ -343,7 +360,8 @@ class Campaign:
                                                n[keep]))
 
     def _metrics(self, version: str) -> RoundMetrics | None:
-        return self._assess(version) if self._assess else None
+        with self.clock("assess"):
+            return self._assess(version) if self._assess else None
 
 
 def _outcome(meta: dict) -> dict:
