@@ -22,12 +22,12 @@ def test_writers_of_other_keys_go_on_while_a_full_writer_excludes_them(root: Dat
     with key_lock(root, "feedback", [a]):
         with key_lock(root, "feedback", [b]):  # another stripe: no wait
             pass
-        with pytest.raises(WarehouseLockedError, match="writers of single keys"):
-            with WriterLock(root.writer_lock):  # e.g. a full ingest
-                pass
-    with WriterLock(root.writer_lock), pytest.raises(WarehouseLockedError, match="pid"):
-        with key_lock(root, "feedback", [a]):
+        with (pytest.raises(WarehouseLockedError, match="writers of single keys"),
+              WriterLock(root.writer_lock)):  # e.g. a full ingest
             pass
+    with (WriterLock(root.writer_lock), pytest.raises(WarehouseLockedError, match="pid"),
+          key_lock(root, "feedback", [a])):
+        pass
 
 
 def test_a_writer_of_the_same_key_waits_for_the_holder(root: DataRoot) -> None:
