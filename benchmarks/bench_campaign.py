@@ -7,7 +7,9 @@ temporary folder first). Each round is broken into the campaign's phases
 (`evoeye.evolve.campaign.phases`): simulate, score, ingest, train, refresh, assess, state. Then
 the very runs the campaign acquired are simulated and logged again, alone, one after another in
 this process: the campaign's cost is its wall time over that (target ≤ 1.5×, issue 12). Round 0
-(G_0 scores D_init and is assessed) is paid once per campaign and shown apart.
+(G_0 scores D_init and is assessed) is paid once per campaign and shown apart. Wall seconds
+and this process's CPU seconds are both given: on a shared machine the CPU ratio is the one
+that load distorts less (everything runs in this one process, torch on one thread).
 """
 
 from __future__ import annotations
@@ -54,8 +56,8 @@ def copy_root(src: DataRoot, dst: Path) -> DataRoot:
 
 
 def simulate_alone(root: DataRoot, campaign_id: str, scenario: str,
-                   out: DataRoot) -> tuple[float, int]:
-    """(wall seconds, runs) to simulate and log the campaign's acquired runs again, one by
+                   out: DataRoot) -> tuple[float, float, int]:
+    """(wall s, CPU s, runs) to simulate and log the campaign's acquired runs again, one by
     one."""
     ids = [s for r in read_rounds(root, campaign_id) for s in r.scenario_ids]
     specs = []
@@ -63,33 +65,51 @@ def simulate_alone(root: DataRoot, campaign_id: str, scenario: str,
         meta = read_run(root.run_log(scenario, campaign_id, sid), topics=()).metadata
         specs.append(run_spec(scenario, meta["params"], int(meta["seed"]), batch="alone",
                               source=str(meta["source"]), round=int(meta["round"])))
-    t0 = time.perf_counter()
+    t0, c0 = time.perf_counter(), time.process_time()
     for spec in specs:
         simulate_and_log(spec, out)
-    return time.perf_counter() - t0, len(specs)
+    return time.perf_counter() - t0, time.process_time() - c0, len(specs)
 
 
-def profile(root: DataRoot, cfg: CampaignConfig, rounds: int) -> tuple[list[dict], dict, float]:
-    """([per-round phase seconds + wall], round-0 phase seconds + wall, campaign wall s)."""
-    t0 = time.perf_counter()
+def profile(root: DataRoot, cfg: CampaignConfig, rounds: int
+            ) -> tuple[list[tuple[dict, dict]], tuple[dict, dict]]:
+    """([(wall, CPU) phase seconds of each round], those of round 0), each with "total"."""
+    t0, c0 = time.perf_counter(), time.process_time()
     campaign = Campaign(root, cfg)
-    campaign = Campaign(root, cfg, assess=Assessor.of(campaign))
+    campaign = Campaign(root, cfg, assess=Assessor.of(campaign))  # its set-up is round 0's
     state = campaign.start()
-    first = {**campaign.clock.seconds, "wall": time.perf_counter() - t0}
+    clock = campaign.clock
+    first = ({**clock.seconds, "total": time.perf_counter() - t0},
+             {**clock.cpu_seconds, "total": time.process_time() - c0})
     out = []
     for _ in range(rounds):
-        before, t1 = dict(campaign.clock.seconds), time.perf_counter()
+        before, t1, c1 = (dict(clock.seconds), dict(clock.cpu_seconds), time.perf_counter(),
+                          time.process_time())
         if campaign.done(state) or campaign.run_round(state) is None:
             break
-        out.append({**{p: campaign.clock.seconds[p] - before[p] for p in PHASES},
-                    "wall": time.perf_counter() - t1})
-    return out, first, time.perf_counter() - t0
+        out.append(({**{p: clock.seconds[p] - before[0][p] for p in PHASES},
+                     "total": time.perf_counter() - t1},
+                    {**{p: clock.cpu_seconds[p] - before[1][p] for p in PHASES},
+                     "total": time.process_time() - c1}))
+    return out, first
 
 
 def row(label: str, seconds: dict) -> str:
     cells = " | ".join(f"{seconds[p]:.2f}" for p in PHASES)
-    other = seconds["wall"] - sum(seconds[p] for p in PHASES)
-    return f"| {label} | {cells} | {other:.2f} | {seconds['wall']:.2f} |"
+    other = seconds["total"] - sum(seconds[p] for p in PHASES)
+    return f"| {label} | {cells} | {other:.2f} | {seconds['total']:.2f} |"
+
+
+def table(kind: str, rounds: list[dict], first: dict) -> dict:
+    """Print one table (wall or CPU seconds) of the rounds; the rounds' sums."""
+    print(f"\n{kind} seconds\n\n| round | {' | '.join(PHASES)} | other | total |")
+    print(f"|---|{'---|' * (len(PHASES) + 2)}")
+    print(row("0 (G_0)", first))
+    for i, seconds in enumerate(rounds, start=1):
+        print(row(str(i), seconds))
+    total = {k: sum(r[k] for r in rounds) for k in (*PHASES, "total")}
+    print(row("rounds 1+", total))
+    return total
 
 
 def main() -> None:
@@ -99,31 +119,33 @@ def main() -> None:
     ap.add_argument("--strategy", default="evoeye")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--n-round", type=int, default=20)
+    ap.add_argument("--epochs", type=int, help="campaign option (default: its own)")
+    ap.add_argument("--patience", type=int, help="campaign option (default: its own)")
     ap.add_argument("--runs", type=int, default=60, help="initial runs without --root")
     args = ap.parse_args()
-    print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}\n")
+    print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}")
     splits = SplitSpec() if args.root else SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
     with tempfile.TemporaryDirectory(prefix="bench-campaign-") as tmp:
         src = (DataRoot.existing(args.root) if args.root
                else seed_root(Path(tmp) / "seed", [args.scenario], args.runs, splits))
         root = copy_root(src, Path(tmp) / "data")
         cfg = CampaignConfig(args.scenario, strategy=args.strategy, budget_s=1e9,
-                             n_round=args.n_round, splits=splits)
-        rounds, first, wall = profile(root, cfg, args.rounds)
+                             n_round=args.n_round, splits=splits, epochs=args.epochs,
+                             patience=args.patience)
+        rounds, first = profile(root, cfg, args.rounds)
         campaign_id = Campaign(root, cfg).campaign_id
-        alone, n_runs = simulate_alone(root, campaign_id, args.scenario,
-                               DataRoot.resolve(Path(tmp) / "alone"))
-    print(f"campaign {campaign_id}: {args.scenario}, {args.strategy}, N_round {args.n_round}\n")
-    print(f"| round | {' | '.join(PHASES)} | other | wall s |")
-    print(f"|---|{'---|' * (len(PHASES) + 2)}")
-    print(row("0 (G_0)", first))
-    for i, seconds in enumerate(rounds, start=1):
-        print(row(str(i), seconds))
-    total = {k: sum(r[k] for r in rounds) for k in (*PHASES, "wall")}
-    print(row("rounds 1+", total))
-    print(f"\nsimulate + log the same {n_runs} runs alone: {alone:.2f} s")
-    print(f"campaign cost, rounds 1+: {total['wall'] / alone:.2f}× (target ≤ {TARGET}×); "
-          f"with round 0: {wall / alone:.2f}×")
+        alone_s, alone_cpu_s, n_runs = simulate_alone(root, campaign_id, args.scenario,
+                                                      DataRoot.resolve(Path(tmp) / "alone"))
+    print(f"\ncampaign {campaign_id}: {args.scenario}, {args.strategy}, N_round {args.n_round}, "
+          f"epochs {args.epochs or 'default'}, patience {args.patience or 'default'}")
+    wall = table("wall", [w for w, _ in rounds], first[0])
+    cpu = table("CPU", [c for _, c in rounds], first[1])
+    print(f"\nsimulate + log the same {n_runs} runs alone: {alone_s:.2f} s wall, "
+          f"{alone_cpu_s:.2f} s CPU")
+    print(f"campaign cost, rounds 1+: {wall['total'] / alone_s:.2f}× wall, "
+          f"{cpu['total'] / alone_cpu_s:.2f}× CPU (target ≤ {TARGET}×); with round 0: "
+          f"{(wall['total'] + first[0]['total']) / alone_s:.2f}× wall, "
+          f"{(cpu['total'] + first[1]['total']) / alone_cpu_s:.2f}× CPU")
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

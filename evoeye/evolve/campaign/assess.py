@@ -79,6 +79,7 @@ class Assessor:
         self.hard = np.array([(s, int(f)) in keys for s, f in
                               zip(w.scenario_id.tolist(), w.frame.tolist(), strict=True)])
         self.context_len = monitor.context_len
+        self._assessed: dict[str, RoundMetrics] = {}  # a version never changes
 
     @classmethod
     def of(cls, campaign) -> Assessor:
@@ -89,12 +90,15 @@ class Assessor:
 
     @intra_op_threads()
     def __call__(self, version: str) -> RoundMetrics:
-        """`version` on the Test Set and the Hard Set, at its own thresholds."""
+        """`version` on the Test Set and the Hard Set, at its own thresholds (once a version)."""
+        if version in self._assessed:
+            return self._assessed[version]
         monitor = load_calibrated(self.root, version)
         scores = monitor.score(self.test.windows)
         labels = self.test.windows.label
-        return RoundMetrics(
+        self._assessed[version] = RoundMetrics(
             version,
             test=metrics_dict(scores, labels, monitor.thresholds),
             hard=metrics_dict(scores[self.hard], labels[self.hard], monitor.thresholds),
         )
+        return self._assessed[version]

@@ -1,4 +1,4 @@
-"""Where a campaign's wall time goes: seconds per phase of its rounds, for profiling.
+"""Where a campaign's time goes: wall and CPU seconds per phase of its rounds, for profiling.
 
     simulate  propose and simulate the round's runs, writing their logs
     score     read each new log (the warehouse's conversion) and score it with G_r
@@ -19,13 +19,14 @@ PHASES = ("simulate", "score", "ingest", "train", "refresh", "assess", "state")
 
 
 class PhaseClock:
-    """Wall seconds per phase; a phase entered inside another pauses the outer one, so every
-    second is counted once."""
+    """Wall and CPU seconds (of this process) per phase; a phase entered inside another pauses
+    the outer one, so every second is counted once."""
 
     def __init__(self) -> None:
         self.seconds = dict.fromkeys(PHASES, 0.0)
+        self.cpu_seconds = dict.fromkeys(PHASES, 0.0)
         self._stack: list[str] = []
-        self._since = 0.0
+        self._since = (0.0, 0.0)
 
     @contextmanager
     def __call__(self, phase: str) -> Iterator[None]:
@@ -38,14 +39,12 @@ class PhaseClock:
             self._switch(None)
 
     def _switch(self, entering: str | None) -> None:
-        now = time.perf_counter()
+        now = (time.perf_counter(), time.process_time())
         if self._stack:
-            self.seconds[self._stack[-1]] += now - self._since
+            self.seconds[self._stack[-1]] += now[0] - self._since[0]
+            self.cpu_seconds[self._stack[-1]] += now[1] - self._since[1]
         if entering is None:
             self._stack.pop()
         else:
             self._stack.append(entering)
         self._since = now
-
-    def total_s(self) -> float:
-        return sum(self.seconds.values())
