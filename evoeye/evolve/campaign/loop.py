@@ -171,8 +171,8 @@ class Campaign:
     @intra_op_threads()
     def start(self, new_ids: Sequence[str] = ()) -> CampaignState:
         """The state after the last stored round; round 0 (G_0, D_init scored) is stored first.
-        `new_ids`: runs `acquire` added since, by id (the flow's round tasks pass them on), read
-        back from their logs with their feedback under G_r."""
+        `new_ids`: runs `acquire` added since, by id (the flow's round tasks pass them on), with
+        their feedback under G_r. The runs' outcomes come from the warehouse, not their logs."""
         with self.clock("state"):
             return self._start(new_ids)
 
