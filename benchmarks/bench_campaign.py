@@ -73,24 +73,24 @@ def simulate_alone(root: DataRoot, campaign_id: str, scenario: str,
 
 def profile(root: DataRoot, cfg: CampaignConfig, rounds: int
             ) -> tuple[list[tuple[dict, dict]], tuple[dict, dict]]:
-    """([(wall, CPU) phase seconds of each round], those of round 0), each with "total"."""
+    """([(wall, CPU) phase seconds of each round], those of round 0), each with "total". The
+    rounds run as `Campaign.run` runs them (a round's share of resuming counts in round 1)."""
     t0, c0 = time.perf_counter(), time.process_time()
     campaign = Campaign(root, cfg)
     campaign = Campaign(root, cfg, assess=Assessor.of(campaign))  # its set-up is round 0's
-    state = campaign.start()
+    campaign.start()
     clock = campaign.clock
-    first = ({**clock.seconds, "total": time.perf_counter() - t0},
-             {**clock.cpu_seconds, "total": time.process_time() - c0})
-    out = []
-    for _ in range(rounds):
-        before, t1, c1 = (dict(clock.seconds), dict(clock.cpu_seconds), time.perf_counter(),
-                          time.process_time())
-        if campaign.done(state) or campaign.run_round(state) is None:
-            break
-        out.append(({**{p: clock.seconds[p] - before[0][p] for p in PHASES},
-                     "total": time.perf_counter() - t1},
-                    {**{p: clock.cpu_seconds[p] - before[1][p] for p in PHASES},
-                     "total": time.process_time() - c1}))
+
+    def mark() -> tuple[dict, dict]:
+        return ({**clock.seconds, "total": time.perf_counter()},
+                {**clock.cpu_seconds, "total": time.process_time()})
+
+    marks = [mark()]
+    first = ({**clock.seconds, "total": marks[0][0]["total"] - t0},
+             {**clock.cpu_seconds, "total": marks[0][1]["total"] - c0})
+    campaign.run(max_rounds=rounds, on_round=lambda row, state: marks.append(mark()))
+    out = [tuple({k: b[i][k] - a[i][k] for k in a[i]} for i in (0, 1))
+           for a, b in zip(marks, marks[1:], strict=False)]
     return out, first
 
 
