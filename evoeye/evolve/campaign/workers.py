@@ -139,19 +139,25 @@ def run_campaigns(jobs: Sequence[CampaignJob], *, workers: int | None = None,
         raise ValueError(f"workers must be at least 1, got {workers}")
     prepare_campaigns(jobs)
     workers = min(workers or os.cpu_count() or 1, max(len(jobs), 1))
+    lock = threading.Lock()  # the workers' lines arrive on a thread of their own
+
+    def say(line: str) -> None:
+        with lock:
+            progress(line)
+
     if workers == 1 and not dask_address:
         return [run_campaign(job, brief, progress) for job in jobs]
     done: dict[int, CampaignDone] = {}
-    with _executor(workers, dask_address, progress) as pool:
+    with _executor(workers, dask_address, say) as pool:
         futures = {pool.submit(run_campaign, job, brief): i for i, job in enumerate(jobs)}
         try:
             for future in as_completed(futures):
                 done[futures[future]] = result = future.result()
                 if dask_address:  # a cluster's workers cannot speak to us as they go
                     for line in result.lines:
-                        progress(line)
-                progress(f"{result.label}: campaign {result.campaign_id}, "
-                         f"{result.rounds} round(s) run, budget spent")
+                        say(line)
+                say(f"{result.label}: campaign {result.campaign_id}, {result.rounds} round(s) "
+                    "run, budget spent")
         except BaseException:
             for future in futures:
                 future.cancel()
