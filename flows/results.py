@@ -84,7 +84,7 @@ def results_flow(params: ResultsParams | None = None) -> dict[str, Any]:
     data_task(root, config)
     study = Study(root, config)
     scenarios = {}
-    for scenario in config.scenarios:  # one after the other: campaigns share the warehouse lock
+    for scenario in config.scenarios:  # one after the other; a part's campaigns side by side
         scenarios[scenario] = {"data": data_summary(study, scenario)}
         for part in config.parts:
             scenarios[scenario][part] = part_task(root, config, scenario, part)

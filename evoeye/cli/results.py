@@ -78,7 +78,9 @@ def results_command(
         min=1, help="Epochs of every training (default: each trainer's).")] = None,
     patience: Annotated[int | None, typer.Option(min=1, help="Early-stopping patience.")] =
         None,
-    workers: Annotated[int, typer.Option(min=1, help="Simulation processes.")] = D.workers,
+    workers: Annotated[int, typer.Option(
+        min=1, help="Processes simulating the data, then running campaigns side by side.")
+    ] = D.workers,
     name: Annotated[str, typer.Option(help="Report folder under <root>/reports.")] =
         "results",
     docs: Annotated[Path | None, typer.Option(

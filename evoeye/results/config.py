@@ -67,7 +67,7 @@ class ResultsConfig:
     n_round: int = 20
     update: str = "finetune"
     feedback: str = "raw"
-    workers: int = 1  # simulation processes for the data batches
+    workers: int = 1  # processes simulating the data batches, then running campaigns
 
     def __post_init__(self) -> None:
         for name in ("scenarios", "training_seeds", "campaign_seeds", "parts", "baselines",

@@ -1,8 +1,9 @@
 """RQ2, the evolution ablations and AEM-Evo over paired campaign seeds, on three sets.
 
-Campaigns run (or resume) through the experiment API (`evoeye.evolve.campaign.experiment`):
-every method runs on the same campaign seeds, from the same G_0 — the study's FusionMonitor of
-its first training seed — with the same budget, so methods are compared seed by seed.
+Campaigns run (or resume) through the experiment API (`evoeye.evolve.campaign.experiment`),
+side by side over `workers` local processes: every method runs on the same campaign seeds, from
+the same G_0 — the study's FusionMonitor of its first training seed — with the same budget, so
+methods are compared seed by seed.
 
 **Each final monitor is judged by the mean over k training seeds** (`final_seeds`), not by one
 training and not as a k-seed ensemble: the last update (G_{R-1} fine-tuned, or retrained, on
@@ -111,7 +112,7 @@ def rq2(study: Study, scenario: str) -> dict:
     study.say(f"{scenario}: RQ2 campaigns {list(cfg.methods)} × seeds {list(cfg.campaign_seeds)}")
     ran = run_experiment(study.root, [scenario], base, strategies=cfg.methods,
                          seeds=cfg.campaign_seeds, budget_s=cfg.budget_s, controls=0,
-                         progress=study.say).get(scenario, {})
+                         progress=study.say, workers=cfg.workers).get(scenario, {})
     plan = plan_experiment(study.root, [scenario], base, strategies=cfg.methods,
                            seeds=cfg.campaign_seeds, budget_s=cfg.budget_s)
     judge = Judge.of(study, scenario, g0s)

@@ -3,7 +3,8 @@ in the ledger by its inputs, so a re-run finds it instead of doing it again.
 
 A unit's figures are `{set: metrics}` with the metrics of `assess.metrics_dict` (F1, precision
 and recall at each target FPR — None where the target was unreachable — AUROC, AUPRC, frame
-counts): set "test" for RQ1 and the ablation; "test", "hard" and "robust" for RQ2.
+counts): set "test" for RQ1 and the ablation; "test", "hard" and "robust" for RQ2. Monitors
+score with one intra-op thread, as campaigns do (`evoeye.monitor.threads`).
 """
 
 from __future__ import annotations
@@ -28,6 +29,7 @@ from evoeye.evolve.campaign.assess import (
 from evoeye.monitor.calibration import calibrate_on_validation
 from evoeye.monitor.families import FAMILIES, MonitorFamily, family_of, load_calibrated
 from evoeye.monitor.protocol import Monitor
+from evoeye.monitor.threads import intra_op_threads
 from evoeye.results.study import Study
 from evoeye.store import Warehouse
 from evoeye.store.scores import read_scores
@@ -82,6 +84,7 @@ def test_figures(study: Study, scenario: str, monitor: Monitor) -> dict:
     kept), metrics on the test split."""
     inputs = {"version": monitor.version, **study.data_key(scenario, "val", "test")}
 
+    @intra_op_threads()
     def evaluate() -> dict:
         study.say(f"{scenario}: evaluating {monitor.name} {monitor.version}")
         L = monitor_context_len(monitor)
@@ -107,6 +110,7 @@ class Judge:
     masks: Mapping[str, np.ndarray]  # set → (B,) bool over the test windows
 
     @classmethod
+    @intra_op_threads()
     def of(cls, study: Study, scenario: str, g0s: Sequence[str]) -> Judge:
         """The sets of G_0 = g0s[0] and the robust set of all of `g0s`."""
         w = study.windows(scenario, "test").windows
@@ -144,6 +148,7 @@ def set_figures(study: Study, judge: Judge, version: str) -> dict:
     inputs = {"version": version, **study.data_key(judge.scenario, "test"), "g0": judge.g0,
               "reseeded": list(judge.reseeded)}
 
+    @intra_op_threads()
     def assess() -> dict:
         monitor = load_calibrated(study.root, version)
         w = study.windows(judge.scenario, "test").windows

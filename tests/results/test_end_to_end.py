@@ -1,6 +1,6 @@
 """`evoeye results` end to end on a tiny root (2 training seeds, 2 campaign seeds, one-run
-campaigns): every table carries CIs and p-values computed from the per-seed figures, and a
-re-run redoes nothing."""
+campaigns over 2 worker processes): every table carries CIs and p-values computed from the
+per-seed figures, and a re-run redoes nothing."""
 
 from __future__ import annotations
 
@@ -36,7 +36,7 @@ def _args(root: DataRoot, docs: Path, readme: Path) -> list[str]:
             "--test-batch", "held", "--epochs", "1", "--patience", "1", "--budget-s", "20",
             "--n-round", "1", "--context-len", "1", "--context-len", "5", "--inputs",
             "perception", "--inputs", "all", "--name", "tiny", "--docs", str(docs),
-            "--readme", str(readme)]
+            "--readme", str(readme), "--workers", "2"]
     for m in METHODS:
         args += ["--method", m]
     return args
@@ -156,6 +156,20 @@ def test_each_final_monitor_is_the_mean_over_k_training_seeds(done) -> None:
     sets = rq2["sets"]
     assert sets["test"]["frames"] > sets["robust"]["frames"] and sets["robust"]["unsafe"] > 0
     assert sets["hard"]["unsafe"] <= sets["test"]["unsafe"]
+
+
+def test_the_campaigns_ran_side_by_side_on_the_held_out_test_set(done) -> None:
+    campaigns = len(METHODS) * 2  # campaign seeds
+    # each reported by the worker pool once it ended (a campaign run in-process is not)
+    assert done.first.output.count("1 round(s) run, budget spent") == campaigns
+    assert done.second.output.count("0 round(s) run, budget spent") == campaigns
+    assert done.results["splits"]["test_batch"] == "held"
+    for method in METHODS:  # every round assessed by its worker on the held-out batch's windows
+        for campaign in done.results["scenarios"][SCENARIO]["rq2"]["methods"][method][
+                "campaigns"]:
+            metrics = read_rounds(done.root, campaign)[-1].metrics
+            assert metrics.test["frames"] == done.results["scenarios"][SCENARIO]["rq2"][
+                "sets"]["test"]["frames"]
 
 
 def test_a_rerun_reuses_every_unit(done) -> None:

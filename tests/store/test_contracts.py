@@ -27,6 +27,8 @@ from evoeye.store.sqlfiles import query, query_names
 # Sample parameters for every file in warehouse/queries (a new query must be added here).
 QUERY_PARAMS = {
     "committed_runs": {},
+    "committed_ids": {"ids": ["c-0", "c-1"]},
+    "campaign_records": {"ids": ["c-0", "c-1"]},
     "dataset_stats": {"horizon_s": 3.0, "seed": 0, "train_frac": 0.5, "val_frac": 0.125,
                       "test_batch": None},
     "run_frames": {"scenario_id": "c-0"},

@@ -21,6 +21,7 @@ import pyarrow as pa
 from evoeye.evaluation.dataset import SplitWindows, load_split
 from evoeye.evaluation.metrics import frame_metrics
 from evoeye.monitor.families import load_calibrated
+from evoeye.monitor.threads import intra_op_threads
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse
 from evoeye.store.feedback import RoundMetrics
@@ -98,6 +99,7 @@ def metrics_dict(scores: np.ndarray, labels: np.ndarray, thresholds) -> dict:
 class Assessor:
     """Scores monitor versions on the Test Set and the Hard Set of G_0 of one scenario."""
 
+    @intra_op_threads()
     def __init__(self, root: DataRoot, scenario: str, g0: str, *,
                  splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen)
                  horizon_s: float = DEFAULT_HORIZON_S) -> None:
@@ -113,6 +115,7 @@ class Assessor:
                         logical_scenario=scenario, horizon_s=horizon_s, splits=splits)
         self.hard = frame_mask(hard, w)
         self.context_len = monitor.context_len
+        self._assessed: dict[str, RoundMetrics] = {}  # a version never changes
 
     @classmethod
     def of(cls, campaign) -> Assessor:
@@ -121,13 +124,17 @@ class Assessor:
         return cls(campaign.root, cfg.scenario, campaign.reference, splits=cfg.splits,
                    horizon_s=cfg.horizon_s)
 
+    @intra_op_threads()
     def __call__(self, version: str) -> RoundMetrics:
-        """`version` on the Test Set and the Hard Set, at its own thresholds."""
+        """`version` on the Test Set and the Hard Set, at its own thresholds (once a version)."""
+        if version in self._assessed:
+            return self._assessed[version]
         monitor = load_calibrated(self.root, version)
         scores = monitor.score(self.test.windows)
         labels = self.test.windows.label
-        return RoundMetrics(
+        self._assessed[version] = RoundMetrics(
             version,
             test=metrics_dict(scores, labels, monitor.thresholds),
             hard=metrics_dict(scores[self.hard], labels[self.hard], monitor.thresholds),
         )
+        return self._assessed[version]
