@@ -31,12 +31,13 @@ class EvaluateParams(BaseModel):
     split_seed: int = Field(SplitSpec().seed, ge=0)
     train_frac: float = Field(SplitSpec().train_frac, ge=0.0, le=1.0)
     val_frac: float = Field(SplitSpec().val_frac, ge=0.0, le=1.0)
+    test_batch: str | None = None  # a round-0 batch held out as the Test Set
     latency: bool = True
     report_name: str | None = None
 
     @property
     def splits(self) -> SplitSpec:
-        return SplitSpec(self.split_seed, self.train_frac, self.val_frac)
+        return SplitSpec(self.split_seed, self.train_frac, self.val_frac, self.test_batch)
 
     def model_post_init(self, __context) -> None:
         self.splits  # noqa: B018  (validates the fractions)

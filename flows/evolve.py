@@ -1,7 +1,9 @@
 """Flow: an evolution campaign; every acquisition round is its own (sub)flow run `round-<r>`.
 
-A round flow run runs propose → simulate (task `acquire`), `ingest`, `train` and `score`
-(feedback refresh and the round's commit). The tasks pass only the parameters and run ids: each
+A round flow run runs propose → simulate → score → ingest (task `acquire`, which ingests its
+runs from the conversion it scored them with), `ingest` (any of the campaign's logs an
+interrupted `acquire` left out, and the DuckDB catalog file), `train` and `score` (feedback
+refresh and the round's commit). The tasks pass only the parameters and run ids: each
 rebuilds the campaign's state from the data root (`Campaign.start`, with the round's new run
 ids), where `acquire` left the new logs and their feedback. Because the state lives in the
 warehouse, a round flow run that crashed is simply run again by the next flow run (e.g.
@@ -64,7 +66,8 @@ def acquire(params: CampaignRun) -> list[str]:
 
 @task(cache_policy=NONE, retries=1, retry_delay_seconds=2)
 def ingest_round(params: CampaignRun) -> int:
-    """The round's logs into the warehouse (idempotent)."""
+    """The campaign's logs `acquire` did not ingest (none unless it was interrupted), and the
+    DuckDB catalog file's views (idempotent)."""
     return len(make_campaign(params).ingest().ingested)
 
 

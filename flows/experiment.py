@@ -1,17 +1,20 @@
-"""Flow: the RQ2 experiment — every (scenario, seed, method) campaign as an evolution flow run.
+"""Flow: the RQ2 experiment — every (scenario, seed, method) campaign a task, side by side.
 
-Each campaign is a sub-flow run named `<scenario>-<method>-s<seed>` whose rounds are in turn
-`round-<r>` flow runs, so the UI shows the experiment's progress round by round. Campaigns are
-resumable, so a crashed experiment flow run is simply started again. The RQ2 and ablation tables
-are written under `<root>/reports/<name>/` and published as a Markdown artifact.
+The campaigns are independent: each is a task run named `<scenario>-<method>-s<seed>` that runs
+the campaign to its budget (`evoeye.evolve.campaign.workers.run_campaign`), fanned out over the
+task runner — `workers` local processes, or the Dask cluster at `dask_address` (prefect-dask),
+one campaign per worker. What they would all write alike (G_0's round 0) is written first.
+Campaigns are resumable, so a crashed experiment flow run is simply started again. The RQ2 and
+ablation tables are written under `<root>/reports/<name>/` and published as a Markdown artifact.
 """
 
 from __future__ import annotations
 
 from typing import Any
 
-from prefect import flow, get_run_logger
+from prefect import flow, get_run_logger, task
 from prefect.artifacts import create_markdown_artifact
+from prefect.cache_policies import NONE
 from pydantic import Field
 
 from evoeye.evolve.campaign.config import CampaignConfig, config_from
@@ -19,15 +22,24 @@ from evoeye.evolve.campaign.experiment import (
     ABLATION,
     MAIN,
     add_controls,
+    brief,
+    campaign_jobs,
     collect_results,
     method_of,
     plan_experiment,
 )
 from evoeye.evolve.campaign.report import markdown, write_experiment_report
+from evoeye.evolve.campaign.workers import (
+    CampaignDone,
+    CampaignJob,
+    prepare_campaigns,
+    run_campaign,
+)
 from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
+from evoeye.store.ingest import refresh_catalog
 from flows.campaign_params import KnownNames, campaign_model
-from flows.evolve import EvolveParams, evolution_flow
+from flows.runners import task_runner
 
 # options the experiment sets per campaign; the others apply to all of its campaigns
 PER_CAMPAIGN = ("scenario", "strategy", "seed", "budget_s", "family", "reference")
@@ -45,6 +57,8 @@ class ExperimentRun(KnownNames):
     budget_s: float | None = Field(None, ge=0.0)  # None: simulated time of the initial data
     controls: int = Field(3, ge=0)  # re-seeded G_0 per scenario (no new data)
     report_name: str | None = None
+    workers: int = Field(2, ge=1, le=64)  # local processes running campaigns side by side
+    dask_address: str | None = None  # or the Dask scheduler whose workers run them
 
     def base(self) -> CampaignConfig:
         """The options every campaign shares (the first scenario's, whose G_0 `monitor` is)."""
@@ -56,6 +70,19 @@ ExperimentParams = campaign_model("ExperimentParams", ExperimentRun, __name__,
                                   exclude=PER_CAMPAIGN)
 
 
+@task(cache_policy=NONE, task_run_name="{name}")
+def campaign(job: CampaignJob, name: str) -> CampaignDone:
+    """One campaign, run (or resumed) to its budget in a worker."""
+    return run_campaign(job, brief, say=print)
+
+
+@flow(name="evoeye-experiment-campaigns", log_prints=True)
+def campaigns_flow(jobs: list[CampaignJob], names: list[str]) -> list[CampaignDone]:
+    """Every campaign as a task on the flow's task runner (experiment_flow picks it)."""
+    futures = [campaign.submit(job, name) for job, name in zip(jobs, names, strict=True)]
+    return [f.result() for f in futures]
+
+
 @flow(name="evoeye-experiment", log_prints=True)
 def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
     """Run (or resume) every campaign, then write and publish the RQ2 report."""
@@ -63,10 +90,11 @@ def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
     root = DataRoot.resolve(params.root)
     plan = plan_experiment(root, params.scenarios, params.base(), strategies=params.strategies,
                            seeds=range(params.repetitions), budget_s=params.budget_s)
-    for cfg in plan:
-        name = f"{cfg.scenario}-{method_of(cfg)}-s{cfg.seed}"
-        evolution_flow.with_options(flow_run_name=name)(
-            EvolveParams.of(cfg, str(root.path), assess=True))
+    jobs = campaign_jobs(root, plan)
+    prepare_campaigns(jobs)
+    campaigns_flow.with_options(task_runner=task_runner(params.workers, params.dask_address))(
+        jobs, [f"{c.scenario}-{method_of(c)}-s{c.seed}" for c in plan])
+    refresh_catalog(root)
     results = add_controls(root, plan, collect_results(root, plan), params.controls)
     folder = write_experiment_report(root, results, params.report_name)
     create_markdown_artifact(markdown=markdown(results), key="evoeye-rq2",

@@ -14,7 +14,6 @@ from __future__ import annotations
 import hashlib
 import io
 import json
-from contextlib import contextmanager
 from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
@@ -26,6 +25,7 @@ from torch import nn
 from evoeye.monitor.card import thresholds_from_card
 from evoeye.monitor.families import read_version
 from evoeye.monitor.protocol import Thresholds
+from evoeye.monitor.threads import intra_op_threads
 from evoeye.store.windows import Windows
 
 INPUT_ARRAYS = (  # (array, mask or None): the FusionMonitor's module inputs
@@ -169,23 +169,12 @@ class AEMMonitor:
         return cls.decode(*read_version(version_dir, MODEL_FILE, META_FILE))
 
 
-@contextmanager
-def _threads(n: int):
-    """Run torch with n intra-op threads (small MLPs are slower with more on a busy CPU)."""
-    was = torch.get_num_threads()
-    torch.set_num_threads(n)
-    try:
-        yield
-    finally:
-        torch.set_num_threads(was)
-
-
 def train_aem(train: Windows, normal: np.ndarray, config: AEMConfig = AEMConfig(), *,
               init: AEMMonitor | None = None, threads: int = 1) -> AEMMonitor:
     """Fit the autoencoder on the windows `normal` (bool (B,)) of `train`; seeded by config
     (the same seed, data and thread count give the same weights). With `init`, fine-tune it:
     its weights and input standardisation are the start, only the error scale is re-measured."""
-    with _threads(threads):
+    with intra_op_threads(threads):
         return _train(train, normal, config, init)
 
 

@@ -1,9 +1,10 @@
 """The trained baselines as monitor families: the AEM (evolvable: AEM-Evo) and the context-only
 control, each kept under `<root>/baselines/<name>/<version>/` with `meta.json`.
 
-RQ1 (`fit`): trained on the train split of a logical scenario and found again by a training key
-(a hash of the scenario, split, config, horizon and run ids), so a later evaluation loads the
-version instead of training again. AEM-Evo (paper RQ3, `train`): Algorithm 1 runs unchanged with
+RQ1 (`fit`): trained on the train split of a logical scenario (or any RunFilter, e.g. its
+round-0 runs only) with a seed, and found again by a training key (a hash of the scenario,
+split, config with its seed, horizon and run ids), so a later evaluation loads the version
+instead of training again. AEM-Evo (paper RQ3, `train`): Algorithm 1 runs unchanged with
 the AEM as the monitor — fine-tuned (or retrained) on the collision-free windows of D_r every
 round, its thresholds calibrated on the validation runs and kept in `meta.json`; its G_0
 (`initial`) is the AEM trained on D_init by the same recipe, found again by its training key.
@@ -36,21 +37,31 @@ def _decode_context(data: bytes, meta: dict[str, Any], version: str) -> ContextO
     return ContextOnlyMonitor.decode(data, meta)
 
 
-def _train_ids(root: DataRoot, scenario: str, splits: SplitSpec) -> list[str]:
+def _train_runs(scenario: str, splits: SplitSpec, runs: RunFilter | None) -> RunFilter:
+    """The runs an RQ1 baseline trains on: `runs`, by default the scenario's train split."""
+    return runs or RunFilter(logical_scenario=scenario, split="train", splits=splits)
+
+
+def _train_ids(root: DataRoot, runs: RunFilter) -> list[str]:
     from evoeye.store import Warehouse, select_runs
 
     con = Warehouse(root).connect()
     try:
-        runs = select_runs(con, RunFilter(logical_scenario=scenario, split="train", splits=splits))
+        table = select_runs(con, runs)
     finally:
         con.close()
-    return sorted(runs.column("scenario_id").to_pylist())
+    return sorted(table.column("scenario_id").to_pylist())
 
 
 def _train_windows(root: DataRoot, runs: Runs, context_len: int, horizon_s: float):
     from evoeye.store import load_windows
 
     return load_windows(root, runs, context_len=context_len, horizon_s=horizon_s)
+
+
+def _seeded(config, seed: int | None):
+    """The config with its `seed` replaced (None: as it is)."""
+    return config if seed is None else replace(config, seed=seed)
 
 
 def _training_meta(key: str, scenario: str, splits: SplitSpec, horizon_s: float,
@@ -63,20 +74,22 @@ def _training_meta(key: str, scenario: str, splits: SplitSpec, horizon_s: float,
 def fit_aem(root: DataRoot, scenario: str,
             splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
             config: AEMConfig | None = None, *,
-            horizon_s: float = DEFAULT_HORIZON_S) -> AEMMonitor:
-    """The AEM of this scenario's train split: loaded if trained before, else trained and saved.
+            horizon_s: float = DEFAULT_HORIZON_S, seed: int | None = None,
+            runs: RunFilter | None = None) -> AEMMonitor:
+    """The AEM of this scenario's train split (or of `runs`): loaded if trained before, else
+    trained and saved; `seed` replaces the config's.
 
     Trained on the collision-free windows of the split: label 0 (all windows are before their
     run's collision, see `load_windows`)."""
     from evoeye.baselines.aem import AEMConfig, train_aem
 
-    config = config or AEMConfig()
-    ids = _train_ids(root, scenario, splits)
+    config = _seeded(config or AEMConfig(), seed)
+    runs = _train_runs(scenario, splits, runs)
+    ids = _train_ids(root, runs)
     key = training_key(scenario, asdict(splits), asdict(config), horizon_s, ids)
     if (version := AEM.find(root, key)) is not None:
         return AEM.load(root, version)
-    train = _train_windows(root, RunFilter(logical_scenario=scenario, split="train",
-                                           splits=splits), config.context_len, horizon_s)
+    train = _train_windows(root, runs, config.context_len, horizon_s)
     normal = train.label == 0
     monitor = train_aem(train, normal, config)
     monitor.save(AEM.versions_dir(root), _training_meta(key, scenario, splits, horizon_s, ids,
@@ -87,18 +100,20 @@ def fit_aem(root: DataRoot, scenario: str,
 def fit_context_only(root: DataRoot, scenario: str,
                      splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
                      config: ContextConfig | None = None, *,
-                     horizon_s: float = DEFAULT_HORIZON_S) -> ContextOnlyMonitor:
-    """The context-only control of this scenario's train split: loaded if trained before, else
-    trained on every (eligible) training window and saved."""
+                     horizon_s: float = DEFAULT_HORIZON_S, seed: int | None = None,
+                     runs: RunFilter | None = None) -> ContextOnlyMonitor:
+    """The context-only control of this scenario's train split (or of `runs`): loaded if
+    trained before, else trained on every (eligible) training window and saved; `seed`
+    replaces the config's."""
     from evoeye.baselines.context import ContextConfig, train_context_only
 
-    config = config or ContextConfig()
-    ids = _train_ids(root, scenario, splits)
+    config = _seeded(config or ContextConfig(), seed)
+    runs = _train_runs(scenario, splits, runs)
+    ids = _train_ids(root, runs)
     key = training_key("context-only", scenario, asdict(splits), asdict(config), horizon_s, ids)
     if (version := CONTEXT_ONLY.find(root, key)) is not None:
         return CONTEXT_ONLY.load(root, version)
-    train = _train_windows(root, RunFilter(logical_scenario=scenario, split="train",
-                                           splits=splits), 1, horizon_s)
+    train = _train_windows(root, runs, 1, horizon_s)
     monitor = train_context_only(train, config)
     monitor.save(CONTEXT_ONLY.versions_dir(root),
                  _training_meta(key, scenario, splits, horizon_s, ids, len(train)))

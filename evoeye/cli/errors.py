@@ -54,6 +54,9 @@ KNOWN_ERRORS: dict[str, str] = {
                                               "or name it with --monitor",
     "evoeye.evolve.campaign.loop.NoInitialDataError": "simulate and ingest the scenario's initial "
                                                  "runs: `evoeye simulate …`, `evoeye ingest`",
+    "evoeye.results.study.EmptySplitError": "simulate the data with the command (--initial-runs "
+                                            "N --test-runs M), or check --test-batch and the "
+                                            "shares",
     "evoeye.store.lock.WarehouseLockedError": "wait for the other writer to finish, then run "
                                               "again",
     "builtins.PermissionError": ROOT_HINT,

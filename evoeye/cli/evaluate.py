@@ -44,6 +44,8 @@ def evaluate_command(
     train_frac: Annotated[float, typer.Option(help="Train share of round-0 runs.")] = TRAIN_FRAC,
     val_frac: Annotated[float, typer.Option(help="Validation share of round-0 runs.")] =
         VAL_FRAC,
+    test_batch: Annotated[str | None, typer.Option(
+        help="A round-0 batch held out as the Test Set (its runs are always test).")] = None,
     latency: Annotated[bool, typer.Option(
         "--latency/--no-latency", help="Time inference on CPU (batch 1 and 1024).")] = True,
     store: Annotated[bool, typer.Option(
@@ -63,7 +65,7 @@ def evaluate_command(
         raise typer.BadParameter("nothing to evaluate: give --monitor, --train-fusion or "
                                  "--baselines")
     try:
-        splits = SplitSpec(split_seed, train_frac, val_frac)
+        splits = SplitSpec(split_seed, train_frac, val_frac, test_batch)
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from exc
     data = DataRoot.existing(root)

@@ -134,6 +134,12 @@ def experiment_command(
         "(evoeye evolving another monitor family, e.g. aem-evo); default: the RQ2 ones, plus "
         "the ablations (no-feedback, no-density, aem-evo) unless --no-ablation.")] = None,
     name: Annotated[str | None, typer.Option("--name", help="Report folder name.")] = None,
+    workers: Annotated[int | None, typer.Option(
+        "--workers", min=1, help="Campaigns run side by side in this many local processes "
+        "(default: one per CPU; 1: one after another).")] = None,
+    dask_address: Annotated[str | None, typer.Option(
+        "--dask-address", help="Run the campaigns on the Dask cluster at this scheduler "
+        "address instead, one per worker (give the workers one thread each).")] = None,
 ) -> None:
     """The RQ2 table (+ evolution ablation): G_0 vs uniform / avfuzzer / evoeye, R seeds."""
     from evoeye.evolve.campaign.config import check_known
@@ -151,7 +157,7 @@ def experiment_command(
         results = run_experiment(data, scenarios, base,
                                  strategies=strategy or MAIN + (ABLATION if ablation else ()),
                                  seeds=range(repetitions), budget_s=budget_s, controls=controls,
-                                 progress=bar)
+                                 progress=bar, workers=workers, dask_address=dask_address)
     folder = write_experiment_report(data, results, name)
     typer.echo((folder / "rq2.md").read_text(encoding="utf-8"))
     typer.echo(f"report: {folder / 'rq2.html'}")

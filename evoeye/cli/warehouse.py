@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import csv
 import sys
+from dataclasses import asdict
 from enum import StrEnum
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
@@ -196,13 +197,15 @@ def stats_command(
     train_frac: Annotated[float, typer.Option(help="Train share of round-0 runs.")] = TRAIN_FRAC,
     val_frac: Annotated[float, typer.Option(help="Validation share of round-0 runs.")] =
         VAL_FRAC,
+    test_batch: Annotated[str | None, typer.Option(
+        help="A round-0 batch held out as the Test Set (its runs are always test).")] = None,
 ) -> None:
     """Per logical scenario and split: scenarios, violations, frames, unsafe frames."""
     from evoeye.store import SplitSpec
 
     data = DataRoot.existing(root)
     try:
-        splits = SplitSpec(seed, train_frac, val_frac)
+        splits = SplitSpec(seed, train_frac, val_frac, test_batch)
     except ValueError as exc:
         raise UserError(str(exc), "see `evoeye warehouse stats --help`") from exc
     print_stats(data, horizon_s, splits)
@@ -215,9 +218,7 @@ def print_stats(data: DataRoot, horizon_s: float = HORIZON_S, splits: SplitSpec 
 
     splits = splits or SplitSpec()
     rows = Warehouse(data).query(
-        "dataset_stats", horizon_s=horizon_s, seed=splits.seed,
-        train_frac=splits.train_frac, val_frac=splits.val_frac,
-    ).to_pylist()
+        "dataset_stats", horizon_s=horizon_s, **asdict(splits)).to_pylist()
     t = table(f"dataset statistics (H = {horizon_s:g} s, split seed {splits.seed})",
               ["LS", "Set", "#Scena.", "#Viol. (%)", "#Frame", "#Unsafe (%)", "#Failed"],
               left=("LS", "Set"))

@@ -14,6 +14,7 @@ PALETTE = ("#1f77b4", "#d62728", "#2ca02c", "#9467bd", "#ff7f0e", "#8c564b", "#e
            "#17becf", "#7f7f7f", "#bcbd22")
 WIDTH, HEIGHT = 420, 340
 MARGIN = {"left": 52, "right": 14, "top": 30, "bottom": 46}
+LABEL_ROOM_MAX = 260  # px left of an interval chart for its row labels
 
 
 def _color(i: int) -> str:
@@ -126,4 +127,47 @@ def strip_chart(rows: Sequence[tuple[str, Sequence[float]]], *, title: str, xlab
                         f'y2="{yc + 11:.1f}" stroke="#000" stroke-width="2"/>')
             body.append(f'<text x="{f.x(med) + 4:.1f}" y="{yc + 22:.1f}" class="s">'
                         f"median {med:.2f} s</text>")
+    return f.svg(body, title)
+
+
+def _nice_limits(values: Sequence[float], reference: float | None) -> tuple[float, float]:
+    """Axis limits around `values` (and the reference line), padded, on a 5-unit grid."""
+    points = [*values, *([] if reference is None else [reference])]
+    if not points:
+        return 0.0, 1.0
+    lo, hi = min(points), max(points)
+    pad = max((hi - lo) * 0.08, 1.0)
+    return float(np.floor((lo - pad) / 5) * 5), float(np.ceil((hi + pad) / 5) * 5)
+
+
+def interval_chart(rows: Sequence[tuple[str, float | None, float | None, float | None]], *,
+                   title: str, xlabel: str, reference: float | None = None) -> str:
+    """One row per label: its estimate as a dot and its interval (low, high) as an error bar
+    with caps; a row without an interval shows the dot alone, one without an estimate only its
+    label. `reference` draws a dashed vertical line (0 for differences)."""
+    shown = [v for _, *vs in rows for v in vs if v is not None]
+    xlim = _nice_limits(shown, reference)
+    height = max(140, 26 * len(rows) + MARGIN["top"] + MARGIN["bottom"])
+    room = min(LABEL_ROOM_MAX, 7 * max((len(label) for label, *_ in rows), default=0))
+    f = _Frame(xlim, (0.0, float(max(len(rows), 1))), width=WIDTH + room, height=height)
+    f.x0 += room - MARGIN["left"] + 8  # the labels stand left of the plotting area
+    step = max(5.0, float(np.ceil((xlim[1] - xlim[0]) / 6 / 5) * 5))
+    body = f.axes(title, xlabel, "", list(np.arange(xlim[0], xlim[1] + 1e-9, step)), [])
+    if reference is not None:
+        body.append(f'<line x1="{f.x(reference):.1f}" y1="{f.y0}" x2="{f.x(reference):.1f}" '
+                    f'y2="{f.y1}" stroke="#888" stroke-dasharray="4 3"/>')
+    for i, (label, mean, low, high) in enumerate(rows):
+        y = f.y(len(rows) - i - 0.5)
+        body.append(f'<text x="{f.x0 - 6}" y="{y + 4:.1f}" text-anchor="end">'
+                    f"{escape(label)}</text>")
+        if low is not None and high is not None:
+            body.append(f'<line x1="{f.x(low):.1f}" y1="{y:.1f}" x2="{f.x(high):.1f}" '
+                        f'y2="{y:.1f}" stroke="{_color(i)}" stroke-width="2" '
+                        f'data-interval="{low:.4g},{high:.4g}"/>')
+            for end in (low, high):
+                body.append(f'<line x1="{f.x(end):.1f}" y1="{y - 5:.1f}" x2="{f.x(end):.1f}" '
+                            f'y2="{y + 5:.1f}" stroke="{_color(i)}" stroke-width="2"/>')
+        if mean is not None:
+            body.append(f'<circle cx="{f.x(mean):.1f}" cy="{y:.1f}" r="4" fill="{_color(i)}" '
+                        f'data-estimate="{mean:.4g}"/>')
     return f.svg(body, title)

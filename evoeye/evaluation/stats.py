@@ -204,6 +204,16 @@ def paired_power(n_pairs: int, diff: float, sd_diff: float, *, alpha: float = 0.
     return float(stats.nct.sf(crit, df, ncp) + stats.nct.cdf(-crit, df, ncp))
 
 
+def smallest_design(alpha: float = 0.05, test: str = "wilcoxon") -> int:
+    """The fewest pairs with which the test can reject at level alpha at all: 2 for the t-test,
+    for the Wilcoxon test the first n with 2 / 2^n ≤ alpha (6 at α = 0.05)."""
+    if test not in POWER_TESTS:
+        raise ValueError(f"test must be one of {POWER_TESTS}, got {test!r}")
+    if test == "t":
+        return 2
+    return max(2, math.ceil(math.log2(2.0 / alpha) - 1e-12))
+
+
 def pairs_needed(diff: float, sd_a: float, sd_b: float, correlation: float, *,
                  power: float = 0.8, alpha: float = 0.05, test: str = "wilcoxon",
                  max_pairs: int = 100_000) -> int:
@@ -213,8 +223,8 @@ def pairs_needed(diff: float, sd_a: float, sd_b: float, correlation: float, *,
     if not 0.0 < power < 1.0 or diff == 0:
         raise ValueError(f"need 0 < power < 1 and a non-zero difference, got {power}, {diff}")
     sd = sd_of_differences(sd_a, sd_b, correlation)
-    if sd == 0:
-        return 2  # no noise in the differences: the smallest design decides
+    if sd == 0:  # no noise in the differences: the smallest design that can reject decides
+        return smallest_design(alpha, test)
     lo, hi = 2, 2
     while paired_power(hi, diff, sd, alpha=alpha, test=test) < power:  # power rises with n
         lo, hi = hi, 2 * hi

@@ -7,6 +7,7 @@ actor 0, times on the 20 Hz grid) match what `evoeye.sim` produces.
 from __future__ import annotations
 
 from dataclasses import replace
+from pathlib import Path
 
 import numpy as np
 
@@ -19,6 +20,8 @@ from evoeye.ads.messages import (
     PlannedTrajectory,
     Predictions,
 )
+from evoeye.log.writer import write_episode
+from evoeye.paths import DataRoot
 from evoeye.scenarios import get_scenario
 from evoeye.scene import Lane, RoadMap, SceneState
 from evoeye.sim.episode import STATUS_FAILED, STATUS_OK, Episode, Frame, Outcome, RunSpec
@@ -167,3 +170,19 @@ def with_collision(episode: Episode, frame: int | None) -> Episode:
         other_actor=1 if collided else None,
     )
     return episode
+
+
+def write_synthetic_batch(root: DataRoot, batch: str, n: int, *, first_seed: int = 0,
+                          n_frames: int = 100, collision_frame: int = 80) -> list[Path]:
+    """n synthetic runs of SCENARIO in `batch` under `root` (ids `<batch>-00`, …, seeds
+    first_seed …), the even ones colliding at `collision_frame`: data sure to hold both classes,
+    whatever the simulator does. Their logs' paths."""
+    paths = []
+    for i in range(n):
+        ep = with_collision(synthetic_episode(n_frames, first_seed + i, n_obstacles=3),
+                            collision_frame if i % 2 == 0 else None)
+        ep.spec = replace(ep.spec, scenario_id=f"{batch}-{i:02d}", batch=batch)
+        path = root.run_log(SCENARIO, batch, ep.spec.scenario_id)
+        path.parent.mkdir(parents=True, exist_ok=True)
+        paths.append(write_episode(ep, path))
+    return paths

@@ -63,7 +63,8 @@ class SavedMonitor(Protocol):
 Decoder = Callable[[bytes, dict[str, Any], str], SavedMonitor]  # (checked weights, meta, version)
 Trainer = Callable[..., str]  # (root, scenario, *, train_runs, val_runs, seed, init_from, …) → id
 Initial = Callable[..., str]  # (root, scenario, *, train_runs, val_runs, horizon_s) → G_0's id
-Fitter = Callable[..., SavedMonitor]  # (root, scenario, splits) → trained on the train split
+Fitter = Callable[..., SavedMonitor]  # (root, scenario, splits, *, seed, runs) → trained on the
+# train split (or the RunFilter `runs`), with a training seed (None: the family's default)
 
 
 @dataclass(frozen=True)

@@ -43,6 +43,7 @@ from evoeye.monitor.card import (
 from evoeye.monitor.fusion import FusionMonitor, net_inputs
 from evoeye.monitor.model import MODULES, FusionConfig, FusionNet
 from evoeye.monitor.registry import load_monitor, save_version
+from evoeye.monitor.threads import MONITOR_THREADS, intra_op_threads
 from evoeye.paths import DataRoot
 from evoeye.store.catalog import Warehouse
 from evoeye.store.features import FrameFeatures
@@ -64,9 +65,7 @@ class TrainParams:
     weight_decay: float = 1e-5
     grad_clip: float = 1.0
     pos_weight: float | None = None  # None: negatives / positives of the training windows
-    # One intra-op thread: at ~24 K parameters a step takes ~12 ms on one core and gains little
-    # from two, while two threads collapse (≈ 30× slower) when another process shares the cores.
-    threads: int = 1
+    threads: int = MONITOR_THREADS  # intra-op threads (evoeye.monitor.threads says why one)
 
 
 @dataclass
@@ -84,16 +83,13 @@ class FitResult:
 def _reproducible(seed: int, threads: int):
     """Seeded global RNG, deterministic kernels and a fixed thread count; all restored after."""
     was_deterministic = torch.are_deterministic_algorithms_enabled()
-    was_threads = torch.get_num_threads()
-    with torch.random.fork_rng(devices=[]):
+    with torch.random.fork_rng(devices=[]), intra_op_threads(threads):
         torch.manual_seed(seed)
         torch.use_deterministic_algorithms(True)
-        torch.set_num_threads(threads)
         try:
             yield
         finally:
             torch.use_deterministic_algorithms(was_deterministic)
-            torch.set_num_threads(was_threads)
 
 
 def _val_score(net: FusionNet, val: Windows) -> tuple[np.ndarray, float]:
@@ -216,7 +212,8 @@ def train_monitor(
             net = FusionNet(FusionConfig.for_spec(train.spec, **_sizes(config)))
             net.fit_normalizers(_frames_of(train))
         result = fit(net, train, val, params, progress)
-    scores = FusionMonitor(result.net, "training", None).score(val)  # type: ignore[arg-type]
+    with intra_op_threads(params.threads):
+        scores = FusionMonitor(result.net, "training", None).score(val)  # type: ignore[arg-type]
     thresholds = calibrate_on_validation(scores, val)
     card = {
         "name": FusionMonitor.name,

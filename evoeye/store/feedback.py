@@ -2,11 +2,13 @@
 
 Layout: `<root>/warehouse/<table>/part-<utc stamp>-<id>.parquet`, columns as declared in
 `schemas/warehouse/<table>.sql`, written and read as every derived table is
-(`evoeye.store.derived`). A write takes the warehouse writer lock, skips the keys already
-stored — (monitor_version, feedback_mode, scenario_id) for feedback, (campaign_id, round) for
-rounds — and writes the rest as one new part, so a killed campaign that re-runs a step adds
-nothing twice. Feedback written before the feedback_mode column existed (prior-corrected rows
-keyed `<version>+prior`) is read as if written now (warehouse/queries/feedback_rows.sql).
+(`evoeye.store.derived`): feedback keyed by monitor version, rounds by campaign. A write locks
+its key (`key_lock`: writers of other keys, e.g. other campaigns, go on in parallel), skips the
+rows already stored — (monitor_version, feedback_mode, scenario_id) for feedback, (campaign_id,
+round) for rounds — and writes the rest as one new part, so a killed campaign that re-runs a
+step adds nothing twice. Feedback written before the feedback_mode column existed
+(prior-corrected rows keyed `<version>+prior`) is read as if written now
+(warehouse/queries/feedback_rows.sql).
 """
 
 from __future__ import annotations
@@ -21,7 +23,7 @@ import pyarrow as pa
 
 from evoeye.paths import DataRoot
 from evoeye.store.derived import append_part, read_parts
-from evoeye.store.lock import WriterLock
+from evoeye.store.lock import key_lock
 
 FEEDBACK_TABLE = "feedback"
 ROUNDS_TABLE = "campaign_rounds"
@@ -48,8 +50,8 @@ def read_feedback(root: DataRoot, monitor_version: str | None = None,
                   feedback_mode: str | None = None) -> pa.Table:
     """Rows of feedback (all, or of one monitor version and / or mode), ordered by version,
     mode and run."""
-    return read_parts(root, FEEDBACK_TABLE, "feedback_rows", version=monitor_version,
-                      mode=feedback_mode)
+    return read_parts(root, FEEDBACK_TABLE, "feedback_rows", key=monitor_version,
+                      version=monitor_version, mode=feedback_mode)
 
 
 def feedback_of(root: DataRoot, monitor_version: str, feedback_mode: str) -> dict[str, float]:
@@ -63,7 +65,7 @@ def write_feedback(root: DataRoot, rows: FeedbackRows) -> int:
     """Append the feedback of every run not yet stored for this monitor version and mode; rows
     written."""
     ids = np.asarray(rows.scenario_id, dtype=object)
-    with WriterLock(root.writer_lock):
+    with key_lock(root, FEEDBACK_TABLE, [rows.monitor_version]):
         done = set(feedback_of(root, rows.monitor_version, rows.feedback_mode))
         _, first = np.unique(ids, return_index=True)
         keep = np.array([i in set(first) and ids[i] not in done for i in range(len(ids))],
@@ -78,7 +80,7 @@ def write_feedback(root: DataRoot, rows: FeedbackRows) -> int:
             "feedback_mode": pa.array([rows.feedback_mode] * n, pa.string()),
             "feedback": pa.array(np.asarray(rows.feedback, float)[keep], pa.float64()),
             "n_contexts": pa.array(np.asarray(rows.n_contexts)[keep], pa.int32()),
-        })
+        }, key=rows.monitor_version)
     return n
 
 
@@ -130,13 +132,14 @@ class RoundRow:
 
 def read_rounds(root: DataRoot, campaign_id: str | None = None) -> list[RoundRow]:
     """The finished rounds of one campaign (or all), in campaign and round order."""
-    t = read_parts(root, ROUNDS_TABLE, "campaign_rounds_rows", campaign_id=campaign_id)
+    t = read_parts(root, ROUNDS_TABLE, "campaign_rounds_rows", key=campaign_id,
+                   campaign_id=campaign_id)
     return [RoundRow.from_dict(d) for d in t.to_pylist()]
 
 
 def write_round(root: DataRoot, row: RoundRow) -> bool:
     """Store a finished round unless (campaign_id, round) is stored already; True if written."""
-    with WriterLock(root.writer_lock):
+    with key_lock(root, ROUNDS_TABLE, [row.campaign_id]):
         if any(r.round == row.round for r in read_rounds(root, row.campaign_id)):
             return False
         append_part(root, ROUNDS_TABLE, {
@@ -151,5 +154,5 @@ def write_round(root: DataRoot, row: RoundRow) -> bool:
             "simulated_s": pa.array([row.simulated_s], pa.float64()),
             "train_s": pa.array([row.train_s], pa.float64()),
             "metrics": pa.array([row.metrics.to_json() if row.metrics else ""], pa.string()),
-        })
+        }, key=row.campaign_id)
     return True

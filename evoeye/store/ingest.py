@@ -2,20 +2,25 @@
 
 * Idempotent: the ledger is the committed `scenarios` rows (log path and scenario id); a log
   already there is skipped without being read.
+* One conversion per log: a log the caller has converted already (`LoggedRun`, e.g. the
+  campaign's, which scored it) is written from that conversion, not read again.
 * Crash-safe: a part's frames and frame_features are written before its scenarios rows (see
   `parts.py`); the views hide uncommitted parts, and the next ingest deletes them and ingests
   those runs again.
 * Bad logs: a log that `read_run` rejects, whose metadata does not fit its logical scenario
   (`metadata.py`), or that cannot be a record, is moved to
   `<root>/quarantine/` with a `.reason.txt` beside it, and the rest is ingested.
-* One writer: everything runs under the writer lock (`lock.py`).
+* Writers (`lock.py`): a full ingest holds the writer lock exclusively. An ingest of one batch
+  folder (`batch=`, a campaign's) locks only its partition and its new runs' ids (a run id
+  committed by another batch meanwhile is a duplicate, never committed twice), so campaigns
+  ingest side by side; it leaves the DuckDB catalog file alone (`refresh_catalog`).
 """
 
 from __future__ import annotations
 
 import os
 import uuid
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -26,7 +31,9 @@ import pyarrow as pa
 from evoeye.log import LogError, read_run
 from evoeye.paths import LOG_SUFFIX, DataRoot
 from evoeye.store.catalog import Warehouse, write_catalog
-from evoeye.store.lock import WriterLock
+from evoeye.store.features import FEATURES, FrameFeatures
+from evoeye.store.lock import WarehouseLockedError, WriterLock, key_lock
+from evoeye.store.log_windows import LoggedRun
 from evoeye.store.metadata import check_metadata
 from evoeye.store.parts import PartStore
 from evoeye.store.records import (
@@ -37,8 +44,10 @@ from evoeye.store.records import (
     frames_table,
     scenario_row,
     scenarios_table,
+    with_ingest_id,
 )
 from evoeye.store.schema import PARTITION_KEYS
+from evoeye.store.windows import part_cache
 
 DEFAULT_RUNS_PER_PART = 32
 REASON_SUFFIX = ".reason.txt"
@@ -89,6 +98,11 @@ class _PendingPart:
     part: str
     rows: list[dict] = field(default_factory=list)
     frames: list[pa.Table] = field(default_factory=list)
+    features: list[pa.Table] = field(default_factory=list)  # frame_features, run by run
+    converted: list[FrameFeatures | None] = field(default_factory=list)  # as computed, if
+
+
+Partition = tuple[str, str]  # (logical scenario, batch)
 
 
 class Ingester:
@@ -101,6 +115,7 @@ class Ingester:
         runs_per_part: int = DEFAULT_RUNS_PER_PART,
         on_log: Callable[[Path], None] | None = None,
         on_start: Callable[[int], None] | None = None,
+        batch: Partition | None = None,
     ) -> None:
         if runs_per_part < 1:
             raise ValueError(f"runs_per_part must be at least 1, got {runs_per_part}")
@@ -111,28 +126,51 @@ class Ingester:
         self.store = PartStore(self.root)
         self.quarantine = Quarantine(self.root)
         self.topics = sorted({FRAME_CLOCK, *(t for t, _ in frame_column_sources().values())})
+        self.batch = batch  # only this batch's folder, as a writer of its keys (module doc)
 
-    def run(self) -> IngestReport:
+    def run(self, converted: Sequence[LoggedRun] = ()) -> IngestReport:
+        """One pass; `converted`: runs of the logs to ingest already converted (by path)."""
         report = IngestReport()
-        with WriterLock(self.root.writer_lock):
-            report.orphans_removed = [self.root.relative(p) for p in self.store.remove_orphans()]
-            ledger = Warehouse(self.root).query("committed_runs")
-            done_paths = set(ledger.column("log_path").to_pylist())
-            done_ids = set(ledger.column("scenario_id").to_pylist())
-            pending = list(self._pending(report, done_paths, done_ids))
-            if self.on_start is not None:
-                self.on_start(len(pending))
-            self._ingest(iter(pending), done_ids, report)
-            try:
-                write_catalog(self.root)
-            except duckdb.Error as e:
-                report.catalog_error = f"{self.root.duckdb_file}: {e}"
+        given = {self.root.relative(c.path): c for c in converted}
+        if self.batch is None:
+            with WriterLock(self.root.writer_lock):
+                report.orphans_removed = [self.root.relative(p)
+                                          for p in self.store.remove_orphans()]
+                ledger = Warehouse(self.root).query("committed_runs")
+                self._ingest_new(discover_logs(self.root.runs), ledger, given, report)
+                try:
+                    write_catalog(self.root)
+                except duckdb.Error as e:
+                    report.catalog_error = f"{self.root.duckdb_file}: {e}"
+            return report
+        logs = discover_logs(self.root.batch_dir(*self.batch))
+        with key_lock(self.root, "scenarios", ["/".join(self.batch)]):
+            report.orphans_removed = [self.root.relative(p)
+                                      for p in self.store.remove_orphans(self.batch)]
+            mine = self.store.committed(self.batch)
+            new = [log for log in logs if self.root.relative(log) not in mine]
+            ids = [log.name.removesuffix(LOG_SUFFIX) for log in new]
+            with key_lock(self.root, "scenarios", ids):  # committed by another batch meanwhile?
+                ledger = (Warehouse(self.root).query("committed_ids", ids=ids) if ids
+                          else pa.table({"scenario_id": [], "log_path": []}))
+                report.skipped += len(logs) - len(new)
+                self._ingest_new(new, ledger, given, report)
         return report
 
+    def _ingest_new(self, logs: Sequence[Path], ledger: pa.Table, given: dict[str, LoggedRun],
+                    report: IngestReport) -> None:
+        """Ingest those of `logs` the ledger (committed scenario_id, log_path) has not."""
+        done_paths = set(ledger.column("log_path").to_pylist())
+        done_ids = set(ledger.column("scenario_id").to_pylist())
+        pending = list(self._pending(logs, report, done_paths, done_ids))
+        if self.on_start is not None:
+            self.on_start(len(pending))
+        self._ingest(iter(pending), given, done_ids, report)
+
     def _pending(
-        self, report: IngestReport, done_paths: set[str], done_ids: set[str]
+        self, logs: Sequence[Path], report: IngestReport, done_paths: set[str], done_ids: set[str]
     ) -> Iterator[Path]:
-        for log in discover_logs(self.root.runs):
+        for log in logs:
             rel = self.root.relative(log)
             if rel in done_paths:
                 report.skipped += 1
@@ -141,7 +179,8 @@ class Ingester:
             else:
                 yield log
 
-    def _ingest(self, logs: Iterator[Path], done_ids: set[str], report: IngestReport) -> None:
+    def _ingest(self, logs: Iterator[Path], given: dict[str, LoggedRun], done_ids: set[str],
+                report: IngestReport) -> None:
         stamp = datetime.now(UTC)
         prefix = f"part-{stamp:%Y%m%dT%H%M%SZ}-{uuid.uuid4().hex[:8]}"
         counter = iter(range(1_000_000))
@@ -151,8 +190,9 @@ class Ingester:
                 self.on_log(log)
             rel = self.root.relative(log)
             try:
-                run = read_run(log, topics=self.topics)
-                meta = run.metadata
+                converted = given.get(rel)
+                source = None if converted else read_run(log, topics=self.topics)
+                meta = converted.metadata if converted else source.metadata
                 check_metadata(meta)
                 scenario_id = str(meta["scenario_id"])
                 if scenario_id in done_ids:
@@ -160,7 +200,10 @@ class Ingester:
                     continue
                 key = tuple(str(meta[k]) for k in PARTITION_KEYS)
                 part = pending.get(key) or _PendingPart(f"{prefix}-{next(counter):04d}")
-                frames = frames_table(run, scenario_id, part.part)
+                frames = (with_ingest_id(converted.frames, part.part) if converted
+                          else frames_table(source, scenario_id, part.part))
+                features = frame_features_table(
+                    frames, features=converted.features if converted else None)
                 row = scenario_row(
                     meta, n_frames=frames.num_rows, log_path=rel, ingest_id=part.part,
                     ingested_at=stamp,
@@ -172,16 +215,27 @@ class Ingester:
             done_ids.add(scenario_id)
             part.rows.append(row)
             part.frames.append(frames)
+            part.features.append(features)
+            part.converted.append(converted.features if converted else None)
             pending[key] = part
             if len(part.rows) >= self.runs_per_part:
                 self._write(key, pending.pop(key), report)
         for key, part in pending.items():
             self._write(key, part, report)
 
-    def _write(self, partition: tuple[str, str], part: _PendingPart, report: IngestReport) -> None:
+    def _write(self, partition: Partition, part: _PendingPart, report: IngestReport) -> None:
         frames = pa.concat_tables(part.frames)
         self.store.write("frames", partition, part.part, frames)
-        self.store.write("frame_features", partition, part.part, frame_features_table(frames))
+        path = self.store.write("frame_features", partition, part.part,
+                                pa.concat_tables(part.features))
+        cache = part_cache()
+        if cache is not None and all(f is not None for f in part.converted):
+            features = FrameFeatures.empty(frames.num_rows, FEATURES)
+            start = 0
+            for one in part.converted:
+                features.fill(start, one)
+                start += len(one)
+            cache.put(path, frames, features)  # this process will not decode it
         self.store.commit(partition, part.part, scenarios_table(part.rows))
         report.ingested += [r["scenario_id"] for r in part.rows]
         report.frames += frames.num_rows
@@ -197,3 +251,20 @@ def ingest(
     """Ingest every log under `<root>/runs` not yet in the warehouse (see the module doc);
     `on_start(n)` learns how many logs will be read, `on_log(path)` is called before each."""
     return Ingester(root, runs_per_part=runs_per_part, on_log=on_log, on_start=on_start).run()
+
+
+def ingest_batch(root: DataRoot, batch: Partition,
+                 converted: Sequence[LoggedRun] = ()) -> IngestReport:
+    """Ingest the logs of one batch folder not yet in the warehouse — those in `converted`
+    from their conversion — as a writer of that batch's keys only (module doc)."""
+    return Ingester(root, batch=batch).run(converted)
+
+
+def refresh_catalog(root: DataRoot) -> None:
+    """Rewrite the DuckDB catalog file's views (after batch ingests, which leave it alone), one
+    writer of the file at a time; a no-op while a full writer holds the warehouse."""
+    try:
+        with key_lock(root, "catalog", ["catalog"]):
+            write_catalog(root)
+    except WarehouseLockedError:
+        pass  # the full writer rewrites it when it finishes

@@ -7,7 +7,8 @@ by `load_windows`' own `context_rows`, so a run's windows are bit-identical to t
 `load_windows` returns once it is ingested (tests/store/test_log_windows.py checks it). The
 evolution campaign scores each freshly simulated run this way: reading the log (not the
 in-memory Episode) makes a new run and one found on disk by a resumed campaign go through the
-same code.
+same code. The conversion is kept (`LoggedRun.frames`, `.features`) and ingested as it is
+(`evoeye.store.ingest.ingest_logged`): one conversion per log.
 """
 
 from __future__ import annotations
@@ -20,20 +21,26 @@ import numpy as np
 import pyarrow as pa
 
 from evoeye.log import read_run
-from evoeye.store.features import FEATURES, frame_features
+from evoeye.store.features import FEATURES, FrameFeatures, frame_features
 from evoeye.store.records import frames_table
 from evoeye.store.windows import Windows, context_rows
 
 LABEL_EPS_S = 1e-6  # as eligible_frames / frame_labels_h: frame times sit on a float 20 Hz grid
 
 
+UNCOMMITTED = "in-memory"  # the ingest_id of a conversion not yet written to a part
+
+
 @dataclass(frozen=True)
 class LoggedRun:
-    """What the loop needs from one run log: its metadata (outcome) and its frames."""
+    """One run log converted: its metadata (outcome), its frames and their features as ingest
+    writes them, and its labelled windows."""
 
     path: Path
     metadata: dict[str, Any]
-    windows: Windows | None  # None for a run without frames
+    frames: pa.Table  # every frame, the frames file schema (ingest_id UNCOMMITTED)
+    features: FrameFeatures  # of every frame, in frame order
+    windows: Windows | None  # eligible frames only; None for a run without any
 
     @property
     def ok(self) -> bool:
@@ -68,20 +75,24 @@ def read_logged_run(path: str | Path, context_len: int, horizon_s: float) -> Log
     run = read_run(path)
     meta = dict(run.metadata)
     sid = str(meta["scenario_id"])
-    frames = frames_table(run, sid, "in-memory")
+    frames = frames_table(run, sid, UNCOMMITTED)
+    features = frame_features(frames, FEATURES)  # one row per frame, as ingest stores them
     t_s = frames.column("t_s").to_numpy()
     collided = frames.column("gt_ego_collision").to_numpy(zero_copy_only=False)
     keep = eligible_frames(t_s, collided)
     labels = frame_labels(t_s, collided, horizon_s)[keep]
-    frames, t_s = frames.filter(pa.array(keep)), t_s[keep]
-    n = frames.num_rows
+    rows = np.flatnonzero(keep)
+    n = len(rows)
     if n == 0:
-        return LoggedRun(Path(path), meta, None)
+        return LoggedRun(Path(path), meta, frames, features, None)
     ctx, mask = context_rows(np.zeros(n, np.int64), context_len)  # one run, from row 0
-    xy = np.stack([frames.column(c).to_numpy(zero_copy_only=False).astype(np.float64)
+    xy = np.stack([frames.column(c).to_numpy(zero_copy_only=False)[rows].astype(np.float64)
                    for c in ("loc_x_m", "loc_y_m")], axis=1)  # (N, 2)
+    eligible = FrameFeatures.empty(n, FEATURES)
+    eligible.fill(0, features, rows)
     windows = Windows(
-        frame_features(frames, FEATURES), ctx, mask, labels, np.full(n, sid, dtype=object),
-        frames.column("frame").to_numpy().astype(np.int32), t_s, horizon_s, FEATURES, xy,
+        eligible, ctx, mask, labels, np.full(n, sid, dtype=object),
+        frames.column("frame").to_numpy()[rows].astype(np.int32), t_s[keep], horizon_s,
+        FEATURES, xy,
     )
-    return LoggedRun(Path(path), meta, windows)
+    return LoggedRun(Path(path), meta, frames, features, windows)

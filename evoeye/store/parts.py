@@ -18,7 +18,6 @@ import pyarrow.parquet as pq
 
 from evoeye.atomic import atomic_file, fsync_dir
 from evoeye.paths import DataRoot
-from evoeye.store.catalog import PART_GLOB
 from evoeye.store.schema import PARTITION_KEYS, TABLES, canonical_schema, file_schema
 
 PART_SUFFIX = ".parquet"
@@ -68,24 +67,42 @@ class PartStore:
         """Write the scenarios part: from here on the part's runs are visible."""
         return self.write("scenarios", partition, part, scenarios)
 
-    def _parts(self, table: str) -> dict[Path, Path]:
-        """Part path relative to the table folder → absolute path."""
-        base = self.root.table_dir(table)
-        return {p.relative_to(base): p for p in base.glob(PART_GLOB)}
+    @staticmethod
+    def _folders(partition: tuple[str, str] | None) -> str:
+        """The partition folders under a table folder, as a glob: one partition's, or all."""
+        if partition is None:
+            return "/".join(["*"] * len(PARTITION_KEYS))
+        return "/".join(f"{k}={v}" for k, v in zip(PARTITION_KEYS, partition, strict=True))
 
-    def orphans(self) -> list[Path]:
-        """Parts without a committed scenarios twin, and leftover temporary files."""
-        committed = set(self._parts("scenarios"))
+    def _parts(self, table: str, partition: tuple[str, str] | None) -> dict[Path, Path]:
+        """Part path relative to the table folder → absolute path (of one partition, or all)."""
+        base = self.root.table_dir(table)
+        return {p.relative_to(base): p
+                for p in base.glob(f"{self._folders(partition)}/*{PART_SUFFIX}")}
+
+    def orphans(self, partition: tuple[str, str] | None = None) -> list[Path]:
+        """Parts without a committed scenarios twin, and leftover temporary files (of one
+        partition, or all)."""
+        committed = set(self._parts("scenarios", partition))
         found: list[Path] = []
         for table in TABLES:
             if table != "scenarios":
-                found += [p for rel, p in self._parts(table).items() if rel not in committed]
-            found += self.root.table_dir(table).glob(f"*/*/.*{TMP_SUFFIX}")
+                found += [p for rel, p in self._parts(table, partition).items()
+                          if rel not in committed]
+            found += self.root.table_dir(table).glob(
+                f"{self._folders(partition)}/.*{TMP_SUFFIX}")
         return sorted(found)
 
-    def remove_orphans(self) -> list[Path]:
-        """Delete what `orphans` lists; call only under the writer lock."""
-        removed = self.orphans()
+    def committed(self, partition: tuple[str, str]) -> set[str]:
+        """The log paths (relative to the root) of the runs committed in one partition."""
+        return {path for part in self._parts("scenarios", partition).values()
+                for path in pq.read_table(part, columns=["log_path"], partitioning=None)
+                .column("log_path").to_pylist()}
+
+    def remove_orphans(self, partition: tuple[str, str] | None = None) -> list[Path]:
+        """Delete what `orphans` lists; call only under a lock on what it covers (the writer
+        lock, or the partition's key)."""
+        removed = self.orphans(partition)
         for path in removed:
             path.unlink(missing_ok=True)
         return removed

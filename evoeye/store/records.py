@@ -23,7 +23,7 @@ from evoeye.ads.messages import FrameMessages
 from evoeye.log import TOPICS
 from evoeye.log.channels import CHANNELS
 from evoeye.scene import EGO_ID
-from evoeye.store.features import FEATURES, FeatureSpec, frame_features, pack
+from evoeye.store.features import FEATURES, FeatureSpec, FrameFeatures, frame_features, pack
 from evoeye.store.schema import PARTITION_KEYS, file_schema, table_schema
 
 PREFIX_TOPIC = {
@@ -149,9 +149,17 @@ def _check_list_lengths(columns: dict[str, pa.Array]) -> None:
                 raise RunRecordError(f"{name} and {nested[0][0]} differ in points per item")
 
 
-def frame_features_table(frames: pa.Table, spec: FeatureSpec = FEATURES) -> pa.Table:
-    """The frame_features rows of a frames table (file schema, same row order)."""
-    columns = pack(frame_features(frames, spec))
+def with_ingest_id(frames: pa.Table, ingest_id: str) -> pa.Table:
+    """A frames table whose rows say they are in part `ingest_id`."""
+    return frames.set_column(frames.schema.get_field_index("ingest_id"), "ingest_id",
+                             pa.array([ingest_id] * frames.num_rows, pa.string()))
+
+
+def frame_features_table(frames: pa.Table, spec: FeatureSpec = FEATURES, *,
+                         features: FrameFeatures | None = None) -> pa.Table:
+    """The frame_features rows of a frames table (file schema, same row order); `features`: its
+    rows' features computed already (with `spec`)."""
+    columns = pack(features if features is not None else frame_features(frames, spec))
     for name in ("scenario_id", "frame", "ingest_id"):
         columns[name] = frames.column(name)
     names = file_schema("frame_features").names  # the DDL's columns, with pack's list types

@@ -2,10 +2,10 @@
 
 Layout: `<root>/warehouse/monitor_scores/part-<utc stamp>-<id>.parquet`, one part per
 evaluation (`evaluation_id`), columns as declared in `schemas/warehouse/monitor_scores.sql`
-(written and read as every derived table is, `evoeye.store.derived`). A write takes the
-warehouse writer lock, skips every (monitor_version, scenario_id) already stored and writes the
-rest as one new part, so re-running an evaluation adds nothing and a killed write leaves no
-partial part.
+(written and read as every derived table is, `evoeye.store.derived`, keyed by monitor version).
+A write locks its version (`key_lock`), skips every (monitor_version, scenario_id) already
+stored and writes the rest as one new part, so re-running an evaluation adds nothing and a
+killed write leaves no partial part.
 """
 
 from __future__ import annotations
@@ -19,7 +19,7 @@ import pyarrow as pa
 
 from evoeye.paths import DataRoot
 from evoeye.store.derived import append_part, read_parts
-from evoeye.store.lock import WriterLock
+from evoeye.store.lock import key_lock
 from evoeye.store.schema import declared_schema
 
 SCORES_TABLE = "monitor_scores"
@@ -64,7 +64,8 @@ class ScoresWritten:
 
 def scored_scenarios(root: DataRoot, monitor_version: str) -> set[str]:
     """The scenario ids that monitor_scores already holds for `monitor_version`."""
-    table = read_parts(root, SCORES_TABLE, "monitor_scores_scenarios", version=monitor_version)
+    table = read_parts(root, SCORES_TABLE, "monitor_scores_scenarios", key=monitor_version,
+                       version=monitor_version)
     return set(table.column("scenario_id").to_pylist())
 
 
@@ -79,14 +80,14 @@ def read_scores(
     unknown = set(names) - set(scores_schema().names)
     if unknown:
         raise KeyError(f"monitor_scores has no column(s) {sorted(unknown)}")
-    return read_parts(root, SCORES_TABLE, "monitor_scores_rows",
+    return read_parts(root, SCORES_TABLE, "monitor_scores_rows", key=monitor_version,
                       version=monitor_version).select(names)
 
 
 def write_scores(root: DataRoot, rows: ScoreRows) -> ScoresWritten:
     """Append the scores of every run not yet stored for this monitor version, as one part."""
     ids = np.asarray(rows.scenario_id, dtype=object)
-    with WriterLock(root.writer_lock):
+    with key_lock(root, SCORES_TABLE, [rows.monitor_version]):
         done = scored_scenarios(root, rows.monitor_version)
         keep = np.array([i not in done for i in ids.tolist()], dtype=bool)
         new_ids = set(ids[keep].tolist())
@@ -102,5 +103,5 @@ def write_scores(root: DataRoot, rows: ScoreRows) -> ScoresWritten:
             "frame": pa.array(np.asarray(rows.frame)[keep], pa.int32()),
             "t_s": pa.array(np.asarray(rows.t_s, dtype=np.float64)[keep], pa.float64()),
             "score": pa.array(np.asarray(rows.score, dtype=np.float32)[keep], pa.float32()),
-        }, part_column="evaluation_id")
+        }, part_column="evaluation_id", key=rows.monitor_version)
     return ScoresWritten(n, len(new_ids), skipped, part)

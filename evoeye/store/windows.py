@@ -7,10 +7,19 @@ the L context frames follow from that order (`context_rows`). The inputs are dec
 straight from those Parquet parts into numpy (DuckDB never turns their float lists into rows of
 its own) and kept once per frame: a window is `features[context]`, gathered when asked for (all
 at once, or per training batch), so N frames cost N feature rows, not N·L.
+
+Inside `cached_parts()`, every part decoded is kept (a part is written once and never changed):
+a process that loads windows again and again — a campaign, whose training set grows by a
+round's runs and whose validation split never changes — decodes each part once, and a part it
+ingested from its own conversion (`evoeye.store.ingest`) never. The windows are the same, in the
+same layout, with the cache or without.
 """
 
 from __future__ import annotations
 
+from collections.abc import Iterator
+from contextlib import contextmanager
+from contextvars import ContextVar
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import TYPE_CHECKING
@@ -102,6 +111,68 @@ class Windows:
 FEATURE_KEYS = ("scenario_id", "frame", "ingest_id")  # what windows.sql matches feature_rows on
 
 
+class PartCache:
+    """frame_features parts decoded by this process, by path: their keys and their features."""
+
+    def __init__(self) -> None:
+        self._keys: dict[Path, pa.Table] = {}
+        self._features: dict[Path, FrameFeatures] = {}
+
+    def put(self, path: Path, keys: pa.Table, features: FrameFeatures | None = None) -> None:
+        """Keep a part's key columns (FEATURE_KEYS) and, if given, its features (every row)."""
+        self._keys[Path(path)] = _plain_keys(keys)
+        if features is not None:
+            self._features[Path(path)] = features
+
+    def keys(self, path: Path) -> pa.Table:
+        if path not in self._keys:
+            self._keys[path] = _read_keys(path)
+        return self._keys[path]
+
+    def features(self, path: Path) -> FrameFeatures:
+        if path not in self._features:
+            self._features[path] = _decode(path)
+        return self._features[path]
+
+
+_CACHE: ContextVar[PartCache | None] = ContextVar("evoeye_part_cache", default=None)
+
+
+@contextmanager
+def cached_parts() -> Iterator[PartCache]:
+    """Within the block, every frame_features part is decoded once (module doc)."""
+    token = _CACHE.set(PartCache())
+    try:
+        yield _CACHE.get()
+    finally:
+        _CACHE.reset(token)
+
+
+def part_cache() -> PartCache | None:
+    """The cache of the enclosing `cached_parts()` block, if any."""
+    return _CACHE.get()
+
+
+def _decode(path: Path) -> FrameFeatures:
+    """Every row of a frame_features part."""
+    part = pq.read_table(path, columns=list(STORED_COLUMNS), partitioning=None)
+    out = FrameFeatures.empty(part.num_rows, FEATURES)
+    start = 0
+    for batch in part.to_batches():
+        out.fill(start, unpack(batch, FEATURES))
+        start += batch.num_rows
+    return out
+
+
+def _plain_keys(table: pa.Table) -> pa.Table:
+    """The FEATURE_KEYS columns of a table, with plain fields (as every part's concatenate)."""
+    return pa.table({name: table.column(name) for name in FEATURE_KEYS})
+
+
+def _read_keys(path: Path) -> pa.Table:
+    return _plain_keys(pq.read_table(path, columns=list(FEATURE_KEYS), partitioning=None))
+
+
 def context_rows(run_start: np.ndarray, context_len: int) -> tuple[np.ndarray, np.ndarray]:
     """(ctx_row, ctx_mask), both (B, L), of B rows in run order, row i of the run starting at
     row run_start[i]: rows i-L+1 … i oldest first, clamped to the run's first row, and masked
@@ -122,7 +193,8 @@ def _part_paths(con: duckdb.DuckDBPyConnection, root: DataRoot) -> list[Path]:
 
 def _feature_rows(paths: list[Path]) -> pa.Table:
     """The keys of the rows of `paths`, in file order, numbered: relation `feature_rows`."""
-    keys = [pq.read_table(path, columns=list(FEATURE_KEYS), partitioning=None) for path in paths]
+    cache = part_cache()
+    keys = [cache.keys(path) if cache else _read_keys(path) for path in paths]
     table = pa.concat_tables(keys) if keys else pa.table(
         {"scenario_id": pa.array([], pa.string()), "frame": pa.array([], pa.int32()),
          "ingest_id": pa.array([], pa.string())})
@@ -139,8 +211,15 @@ def _gather_features(paths: list[Path], source: np.ndarray, spec: FeatureSpec
     order = np.argsort(source, kind="stable")
     sorted_source = source[order]
     features = FrameFeatures.empty(len(source), spec)
+    cache = part_cache() if spec == FEATURES else None  # it holds the warehouse's spec
     offset = 0
     for path in paths:
+        if cache is not None:
+            part_features = cache.features(path)
+            lo, hi = np.searchsorted(sorted_source, [offset, offset + len(part_features)])
+            features.fill(int(lo), part_features, sorted_source[lo:hi] - offset)
+            offset += len(part_features)
+            continue
         part = pq.read_table(path, columns=list(STORED_COLUMNS), partitioning=None)
         lo, hi = np.searchsorted(sorted_source, [offset, offset + part.num_rows])
         if hi > lo:

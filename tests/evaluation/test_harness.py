@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import json
 import re
+import shutil
+from dataclasses import replace
 
 import numpy as np
 import pyarrow.parquet as pq
@@ -17,6 +19,8 @@ from evoeye.evaluation.dataset import load_split
 from evoeye.evaluation.monitors import baseline_monitors
 from evoeye.evaluation.report import html_report, markdown_report, write_report
 from evoeye.evaluation.rq1 import rq1_report
+from evoeye.paths import DataRoot
+from evoeye.store import RunFilter
 from evoeye.store.attribution import AttributionRow, write_attribution
 from evoeye.store.scores import read_scores, scores_dir, scores_schema
 
@@ -121,6 +125,24 @@ def test_aem_is_trained_once_and_evaluated(eval_root, splits) -> None:
     rep = evaluate(eval_root, [first], SCENARIO, splits, store_scores=False)
     assert rep.monitors[0].context_len == 5 and rep.monitors[0].scores_written == 0
     assert rep.monitors[0].frame.auroc is not None
+
+
+def test_a_trained_baseline_fits_per_seed_and_on_the_runs_asked(eval_root, splits,
+                                                                tmp_path) -> None:
+    root = DataRoot.resolve(tmp_path / "copy")
+    shutil.copytree(eval_root.path, root.path)
+    small = AEMConfig(hidden=(16,), latent=4, epochs=2)
+    before = set(AEM.versions(root))
+    zero = fit_aem(root, SCENARIO, splits, small)
+    one = fit_aem(root, SCENARIO, splits, small, seed=1)
+    assert one.version != zero.version and one.config.seed == 1
+    assert fit_aem(root, SCENARIO, splits, small, seed=1).version == one.version  # found again
+    assert fit_aem(root, SCENARIO, splits, small, seed=0).version == zero.version
+    train = RunFilter(logical_scenario=SCENARIO, split="train", splits=splits)
+    fewer = fit_aem(root, SCENARIO, splits, small, runs=replace(train, collided=True))
+    meta = AEM.read_meta(root, fewer.version)
+    assert 0 < meta["train_scenarios"] < AEM.read_meta(root, zero.version)["train_scenarios"]
+    assert set(AEM.versions(root)) - before == {zero.version, one.version, fewer.version}
 
 
 def test_baselines_by_name(eval_root, splits) -> None:

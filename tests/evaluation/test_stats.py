@@ -169,4 +169,8 @@ def test_power_inputs_are_checked() -> None:
         paired_power(10, 0.5, 1.0, test="welch")
     with pytest.raises(ValueError, match="pairs"):
         paired_power(1, 0.5, 1.0)
-    assert pairs_needed(0.05, 0.1, 0.1, 1.0) == 2  # identical noise: differences are exact
+    # identical noise: differences are exact, and the smallest design that can reject decides
+    assert pairs_needed(0.05, 0.1, 0.1, 1.0, test="t") == 2
+    assert pairs_needed(0.05, 0.1, 0.1, 1.0) == 6  # Wilcoxon: 2/2⁵ > 0.05 ≥ 2/2⁶
+    assert pairs_needed(0.05, 0.1, 0.1, 1.0, alpha=0.01) == 8  # 2/2⁷ > 0.01 ≥ 2/2⁸
+    assert paired_power(6, 0.05, 1e-9) > 0.99 and paired_power(5, 0.05, 1e-9) == 0.0

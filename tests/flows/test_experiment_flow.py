@@ -52,7 +52,7 @@ def test_plan_is_seed_major_with_the_initial_data_budget(seeded) -> None:
 def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_server,
                                                                    seeded) -> None:
     from prefect.client.orchestration import get_client
-    from prefect.client.schemas.filters import FlowRunFilter, FlowRunFilterName
+    from prefect.client.schemas.filters import TaskRunFilter, TaskRunFilterName
 
     root, g0 = seeded
     params = ExperimentParams(root=str(root.path), scenarios=[SCENARIO],
@@ -75,9 +75,9 @@ def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_serv
         assert set(run["rounds"][-1]) >= {"test", "hard"}
         assert run["acquisition"]["runs"] == sum(sizes)
     names = [f"unprotected-intersection-{m}-s0" for m in ("uniform", "evoeye", "aem-evo")]
-    with get_client(sync_client=True) as client:
-        runs = client.read_flow_runs(flow_run_filter=FlowRunFilter(
-            name=FlowRunFilterName(any_=names)))
+    with get_client(sync_client=True) as client:  # one task run per campaign, side by side
+        runs = client.read_task_runs(task_run_filter=TaskRunFilter(
+            name=TaskRunFilterName(any_=names)))
     assert sorted(r.name for r in runs) == sorted(names)
     assert all(r.state.is_completed() for r in runs)
     report = json.loads((root.reports / "rq2-test" / "rq2.json").read_text())

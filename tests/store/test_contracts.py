@@ -27,12 +27,15 @@ from evoeye.store.sqlfiles import query, query_names
 # Sample parameters for every file in warehouse/queries (a new query must be added here).
 QUERY_PARAMS = {
     "committed_runs": {},
-    "dataset_stats": {"horizon_s": 3.0, "seed": 0, "train_frac": 0.5, "val_frac": 0.125},
+    "committed_ids": {"ids": ["c-0", "c-1"]},
+    "campaign_records": {"ids": ["c-0", "c-1"]},
+    "dataset_stats": {"horizon_s": 3.0, "seed": 0, "train_frac": 0.5, "val_frac": 0.125,
+                      "test_batch": None},
     "run_frames": {"scenario_id": "c-0"},
     "select_runs": {
         "logical_scenario": "highway-cut-in", "split": None, "source": None, "min_round": 0,
         "max_round": None, "collided": None, "status": "ok", "seed": 0, "train_frac": 0.5,
-        "val_frac": 0.125,
+        "val_frac": 0.125, "test_batch": None,
     },
     "windows": {"horizon_s": 3.0},
     "window_parts": {},
@@ -41,12 +44,18 @@ QUERY_PARAMS = {
     "attribution_shares": {"logical_scenario": "highway-cut-in"},
     "hard_set": {  # every run in test; a monitor scoring 0 everywhere misses every unsafe frame
         "monitor_version": "m", "threshold": 0.5, "logical_scenario": "highway-cut-in",
-        "horizon_s": 3.0, "seed": 0, "train_frac": 0.0, "val_frac": 0.0,
+        "horizon_s": 3.0, "seed": 0, "train_frac": 0.0, "val_frac": 0.0, "test_batch": None,
     },
+    "robust_hard_set": {  # one monitor scoring 0 everywhere misses every unsafe frame
+        "monitor_versions": ["m"], "thresholds": [0.5], "logical_scenario": "highway-cut-in",
+        "horizon_s": 3.0, "seed": 0, "train_frac": 0.0, "val_frac": 0.0, "test_batch": None,
+    },
+    "initial_split_stats": {"logical_scenario": "highway-cut-in", "horizon_s": 3.0, "seed": 0,
+                            "train_frac": 0.5, "val_frac": 0.125, "test_batch": None},
     "audit_attribution": {"scenario_ids": ["c-0", "c-1"]},
     "audit_clock_frames": {"scenario_ids": ["c-0", "c-1"], "horizon_s": 3.0},
     "initial_records": {"scenario": "highway-cut-in", "seed": 0, "train_frac": 1.0,
-                        "val_frac": 0.0},
+                        "val_frac": 0.0, "test_batch": "b1"},
     "run_outcomes": {"logical_scenario": "highway-cut-in"},
     "logical_scenarios": {},
     # queries over a derived table's parts: $glob is bound to them (DERIVED_PARTS)

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import asdict
+
 import duckdb
 import pytest
 
@@ -11,16 +13,18 @@ from evoeye.store.sqlfiles import view_scripts
 
 
 def _splits(ids: list[str], rounds: list[int] | None = None, seed: int = 0,
-            train: float = 0.5, val: float = 0.125) -> dict[str, str]:
+            train: float = 0.5, val: float = 0.125, batches: list[str] | None = None,
+            test_batch: str | None = None) -> dict[str, str]:
     """Run the real splits script over a stand-in `scenarios` table of `ids`."""
     con = duckdb.connect()
     con.execute("CREATE TABLE scenarios (scenario_id VARCHAR, logical_scenario VARCHAR, "
-                "round INTEGER)")
-    rows = [(i, "s", r) for i, r in zip(ids, rounds or [0] * len(ids), strict=True)]
-    con.executemany("INSERT INTO scenarios VALUES (?, ?, ?)", rows)
+                "round INTEGER, batch VARCHAR)")
+    rows = [(i, "s", r, b) for i, r, b in zip(ids, rounds or [0] * len(ids),
+                                               batches or ["b0"] * len(ids), strict=True)]
+    con.executemany("INSERT INTO scenarios VALUES (?, ?, ?, ?)", rows)
     con.execute(dict(view_scripts())["06_splits"])
-    result = con.execute("SELECT scenario_id, split FROM scenario_splits(?, ?, ?)",
-                         [seed, train, val]).fetchall()
+    result = con.execute("SELECT scenario_id, split FROM scenario_splits(?, ?, ?, "
+                         "test_batch := ?)", [seed, train, val, test_batch]).fetchall()
     con.close()
     return dict(result)
 
@@ -45,6 +49,23 @@ def test_split_is_stable_for_a_seed_and_independent_of_other_runs() -> None:
     assert {k: grown[k] for k in s} == s
     other = _splits(IDS[:1000], seed=1)
     assert sum(other[k] != s[k] for k in s) > 300  # another seed is another split
+
+
+def test_a_test_batch_is_all_test_and_leaves_the_other_runs_where_they_were() -> None:
+    batches = ["held" if i % 4 == 0 else "init" for i in range(len(IDS))]
+    without = _splits(IDS, batches=batches)
+    s = _splits(IDS, batches=batches, test_batch="held")
+    held = {i for i, b in zip(IDS, batches, strict=True) if b == "held"}
+    assert {s[i] for i in held} == {"test"}
+    assert {i: s[i] for i in IDS if i not in held} == {i: without[i] for i in IDS
+                                                        if i not in held}
+    assert sum(without[i] != "test" for i in held) > 500  # the batch did move runs
+    # shares summing to 1: the Test Set is the batch alone
+    whole = _splits(IDS, batches=batches, train=0.8, val=0.2, test_batch="held")
+    assert {i for i, v in whole.items() if v == "test"} == held
+    # a test batch's runs acquired in a campaign round would still train
+    assert set(_splits(IDS[:8], rounds=[1] * 8, batches=["held"] * 8,
+                       test_batch="held").values()) == {"train"}
 
 
 def test_runs_acquired_during_evolution_always_train() -> None:
@@ -74,8 +95,37 @@ def test_warehouse_splits_partition_the_runs(root: DataRoot, add_run) -> None:
     assert set(seeded.column("scenario_id").to_pylist()) != parts["train"]
 
 
+def test_a_held_out_batch_is_the_test_split_and_never_initial_data(root: DataRoot,
+                                                                     add_run) -> None:
+    for i in range(6):
+        add_run(f"init-{i}", n_frames=2, seed=i, batch="init")
+        add_run(f"held-{i}", n_frames=2, seed=10 + i, batch="held")
+    add_run("acquired", n_frames=2, seed=30, batch="campaign", round=1)
+    ingest(root)
+    splits = SplitSpec(train_frac=0.7, val_frac=0.3, test_batch="held")
+    wh = Warehouse(root)
+    con = wh.connect()
+    try:
+        test = select_runs(con, RunFilter(split="test", splits=splits))
+    finally:
+        con.close()
+    assert sorted(test.column("scenario_id").to_pylist()) == [f"held-{i}" for i in range(6)]
+    initial = wh.query("initial_records", scenario="highway-cut-in", **asdict(splits))
+    assert initial.num_rows > 0
+    assert not any(i.startswith("held") for i in initial.column("scenario_id").to_pylist())
+    stats = {r["split"]: r["scenarios"] for r in wh.query(
+        "dataset_stats", horizon_s=3.0, **asdict(splits)).to_pylist()}
+    assert stats["test"] == 6 and stats["train"] + stats["val"] == 7  # with the acquired run
+    initial = {r["split"]: r["scenarios"] for r in wh.query(
+        "initial_split_stats", logical_scenario="highway-cut-in", horizon_s=3.0,
+        **asdict(splits)).to_pylist()}
+    assert initial["test"] == 6 and initial["train"] + initial["val"] == 6
+
+
 def test_bad_split_arguments_are_refused() -> None:
     with pytest.raises(ValueError, match="split must be"):
         RunFilter(split="holdout")
     with pytest.raises(ValueError, match="sum <= 1"):
         SplitSpec(train_frac=0.9, val_frac=0.2)
+    with pytest.raises(ValueError, match="not a plain name"):
+        SplitSpec(test_batch="../elsewhere")

@@ -3,12 +3,14 @@
 -- same runs. Only eligible frames have labels (frame_labels_h), as in every evaluation.
 -- The caller registers `monitor_scores` (the table of that name, e.g. read_scores(...)).
 -- Parameters: $monitor_version, $threshold, $logical_scenario, $horizon_s, and the split
--- ($seed, $train_frac, $val_frac). One row per frame: scenario_id, frame, t_s, label, score.
+-- ($seed, $train_frac, $val_frac, $test_batch). One row per frame: scenario_id, frame, t_s,
+-- label, score.
 WITH scored AS (
     SELECT s.scenario_id, s.frame, l.t_s, l.label, s.score
     FROM monitor_scores AS s
     JOIN frame_labels_h($horizon_s) AS l USING (scenario_id, frame)
-    JOIN scenario_splits($seed, $train_frac, $val_frac) AS p USING (scenario_id)
+    JOIN scenario_splits($seed, $train_frac, $val_frac, test_batch := $test_batch) AS p
+        USING (scenario_id)
     WHERE s.monitor_version = $monitor_version
         AND p.logical_scenario = $logical_scenario
         AND p.split = 'test'

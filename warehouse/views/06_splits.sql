@@ -5,12 +5,15 @@
 -- Round-0 runs (the initial data) go to train if u < train_frac, to val if
 -- u < train_frac + val_frac, else to test. Runs acquired during evolution (round >= 1) are
 -- training data, D_{r+1} = D_r ∪ D'_r (Definition 3): they never enter the held-out sets.
-CREATE OR REPLACE MACRO scenario_splits(seed, train_frac, val_frac) AS TABLE
+-- test_batch (optional) names a round-0 batch simulated apart as a fixed Test Set: its runs are
+-- always 'test'; the other round-0 runs split by u as above.
+CREATE OR REPLACE MACRO scenario_splits(seed, train_frac, val_frac, test_batch := NULL) AS TABLE
 SELECT
     scenario_id,
     logical_scenario,
     CASE
         WHEN round >= 1 THEN 'train'
+        WHEN batch = test_batch THEN 'test'
         WHEN u < train_frac THEN 'train'
         WHEN u < train_frac + val_frac THEN 'val'
         ELSE 'test'
@@ -21,6 +24,7 @@ FROM (
         scenario_id,
         logical_scenario,
         round,
+        batch,
         ('0x' || md5(CAST(seed AS VARCHAR) || ':' || scenario_id)[1:8])::UBIGINT
             / 4294967296.0 AS u
     FROM scenarios

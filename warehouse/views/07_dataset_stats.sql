@@ -1,7 +1,10 @@
 -- The paper's dataset table (Table "Dataset statistics") per logical scenario and split:
--- scenarios, violations (%), frames, unsafe frames (%), for horizon h and a split seed.
+-- scenarios, violations (%), frames, unsafe frames (%), for horizon h and a split (seed, shares,
+-- optional held-out test batch); max_round (optional) leaves out the runs of later rounds, e.g.
+-- 0: the initial data only, without the runs campaigns acquired (which always train).
 -- Only runs with status 'ok' count; failed runs are counted apart.
-CREATE OR REPLACE MACRO dataset_stats_h(h, seed, train_frac, val_frac) AS TABLE
+CREATE OR REPLACE MACRO dataset_stats_h(h, seed, train_frac, val_frac, test_batch := NULL,
+                                        max_round := NULL) AS TABLE
 WITH per_run AS (
     SELECT
         s.scenario_id,
@@ -12,12 +15,14 @@ WITH per_run AS (
         coalesce(l.n_frames, 0) AS n_frames,
         coalesce(l.n_unsafe, 0) AS n_unsafe
     FROM scenarios AS s
-    JOIN scenario_splits(seed, train_frac, val_frac) AS p USING (scenario_id)
+    JOIN scenario_splits(seed, train_frac, val_frac, test_batch := test_batch) AS p
+        USING (scenario_id)
     LEFT JOIN (
         SELECT scenario_id, count(*) AS n_frames, sum(label) AS n_unsafe
         FROM frame_labels_h(h)
         GROUP BY scenario_id
     ) AS l USING (scenario_id)
+    WHERE max_round IS NULL OR s.round <= max_round
 )
 SELECT
     logical_scenario,

@@ -14,7 +14,7 @@ from evoeye.lazy import lazy_attributes
 _LAZY = {
     "CampaignConfig": "evoeye.evolve.campaign.config",
     "Campaign": "evoeye.evolve.campaign.loop",
-    "CampaignState": "evoeye.evolve.campaign.loop",
+    "CampaignState": "evoeye.evolve.campaign.state",
     "NoInitialDataError": "evoeye.evolve.campaign.loop",
     "Assessor": "evoeye.evolve.campaign.assess",
     "run_experiment": "evoeye.evolve.campaign.experiment",

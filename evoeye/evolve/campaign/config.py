@@ -35,6 +35,8 @@ SPLIT_OPTIONS = {  # the split's fields as options: SplitSpec field → (option,
     "seed": ("split_seed", "Seed of the train/val/test split."),
     "train_frac": ("train_frac", "Train share of round-0 runs."),
     "val_frac": ("val_frac", "Validation share of round-0 runs."),
+    "test_batch": ("test_batch", "A round-0 batch held out as the Test Set (its runs are "
+                   "always test; default: none)."),
 }
 
 
@@ -190,16 +192,21 @@ def campaign_options(exclude: Collection[str] = ()) -> list[Option]:
             continue
         if hints[f.name] is SplitSpec:
             split = {s.name: s for s in fields(SplitSpec)}
-            bounds = {"seed": {}, "train_frac": {"ge": 0.0, "le": 1.0},
-                      "val_frac": {"ge": 0.0, "le": 1.0}}
-            out += [Option(name, type(split[key].default), False, split[key].default, text,
-                           **bounds[key]) for key, (name, text) in SPLIT_OPTIONS.items()]
+            split_hints = typing.get_type_hints(SplitSpec)
+            bounds = {"train_frac": {"ge": 0.0, "le": 1.0}, "val_frac": {"ge": 0.0, "le": 1.0}}
+            out += [Option(name, *_kind(split_hints[key]), split[key].default, text,
+                           **bounds.get(key, {})) for key, (name, text) in SPLIT_OPTIONS.items()]
             continue
-        args = [a for a in typing.get_args(hints[f.name]) if a is not type(None)]
         m = f.metadata
-        out.append(Option(f.name, args[0] if args else hints[f.name], bool(args), f.default,
-                          m["help"], m["ge"], m["gt"], m["le"], m["names"]))
+        out.append(Option(f.name, *_kind(hints[f.name]), f.default, m["help"], m["ge"],
+                          m["gt"], m["le"], m["names"]))
     return [o for o in out if o.name not in exclude]
+
+
+def _kind(hint: Any) -> tuple[type, bool]:
+    """(type, optional) of a field's annotation: `str | None` → (str, True)."""
+    args = [a for a in typing.get_args(hint) if a is not type(None)]
+    return (args[0], True) if args else (hint, False)
 
 
 def config_from(values: Mapping[str, Any], **fixed: Any) -> CampaignConfig:

@@ -4,9 +4,10 @@ A method is a strategy evolving the FusionMonitor, or `<family>-evo`: the `evoey
 evolving another evolvable monitor family, e.g. `aem-evo` for the AEM baseline (paper RQ3),
 judged on the same Test Set and the FusionMonitor G_0's Hard Set.
 Each (scenario, method, seed) is one campaign (resumable, so a killed experiment re-run picks
-up where it stopped); every round's G_r is assessed and stored with the round, so the per-round
-curves come from the campaign_rounds table. The report (Markdown + self-contained HTML with SVG
-charts, `report.py`) goes to `<root>/reports/<name>/`.
+up where it stopped); the campaigns are independent and run side by side, over local processes
+or a Dask cluster (`workers.py`). Every round's G_r is assessed and stored with the round, so
+the per-round curves come from the campaign_rounds table. The report (Markdown +
+self-contained HTML with SVG charts, `report.py`) goes to `<root>/reports/<name>/`.
 """
 
 from __future__ import annotations
@@ -20,12 +21,15 @@ from scipy.stats import spearmanr
 from evoeye.evaluation.report import UNREACHABLE
 from evoeye.evolve.campaign.assess import Assessor
 from evoeye.evolve.campaign.config import CampaignConfig
-from evoeye.evolve.campaign.loop import Campaign, CampaignState
+from evoeye.evolve.campaign.loop import Campaign
+from evoeye.evolve.campaign.state import CampaignState
+from evoeye.evolve.campaign.workers import CampaignJob, assessor, run_campaigns
 from evoeye.evolve.search.fitness import CRITICALITY_SCALE_M
 from evoeye.evolve.search.strategies import STRATEGIES
 from evoeye.monitor.families import DEFAULT_FAMILY, evolvable_families, initial_monitor
 from evoeye.paths import DataRoot
 from evoeye.store.feedback import RoundMetrics, read_rounds
+from evoeye.store.ingest import refresh_catalog
 
 MAIN = ("uniform", "avfuzzer", "evoeye")
 ABLATION = ("no-feedback", "no-density", "aem-evo")
@@ -79,9 +83,10 @@ def plan_experiment(root: DataRoot, scenarios: Sequence[str],
 
 def assessors(root: DataRoot,
               plan: Sequence[CampaignConfig]) -> dict[str, Assessor]:
-    """One Test/Hard Set assessor per scenario of the plan, against that scenario's G_0."""
+    """One Test/Hard Set assessor per scenario of the plan, against that scenario's G_0 (this
+    process's, built once: `workers.assessor`)."""
     first = {c.scenario: c for c in reversed(plan)}  # one each: an Assessor loads the Test Set
-    return {scenario: Assessor.of(Campaign(root, c)) for scenario, c in first.items()}
+    return {scenario: assessor(Campaign(root, c)) for scenario, c in first.items()}
 
 
 def collect_results(root: DataRoot, plan: Sequence[CampaignConfig]) -> dict:
@@ -108,23 +113,30 @@ def collect_results(root: DataRoot, plan: Sequence[CampaignConfig]) -> dict:
     return out
 
 
+def campaign_jobs(root: DataRoot, plan: Sequence[CampaignConfig]) -> list[CampaignJob]:
+    """The plan's campaigns as jobs for `run_campaigns`, each assessed every round."""
+    return [CampaignJob(str(root.path), cfg, f"{cfg.scenario} {method_of(cfg)} seed {cfg.seed}")
+            for cfg in plan]
+
+
 def run_experiment(root: DataRoot, scenarios: Sequence[str],
                    base: CampaignConfig, *, strategies: Sequence[str] = MAIN + ABLATION,
                    seeds: Sequence[int] = (0, 1, 2), budget_s: float | None = None,
-                   controls: int = 3, progress: Callable[[str], None] = print) -> dict:
-    """Run (or resume) every campaign of the plan, then `collect_results`, with `controls`
-    re-seeded G_0 per scenario."""
+                   controls: int = 3, progress: Callable[[str], None] = print,
+                   workers: int | None = None, dask_address: str | None = None) -> dict:
+    """Run (or resume) every campaign of the plan — over `workers` local processes (default:
+    one per CPU; 1: one after another here) or the Dask cluster at `dask_address` — then
+    `collect_results`, with `controls` re-seeded G_0 per scenario."""
     plan = plan_experiment(root, scenarios, base, strategies=strategies, seeds=seeds,
                            budget_s=budget_s)
-    assess = assessors(root, plan)
-    for cfg in plan:
-        c = Campaign(root, cfg, assess=assess[cfg.scenario])
-        method = method_of(cfg)
-        progress(f"{cfg.scenario} {method} seed {cfg.seed}: campaign {c.campaign_id}, "
-                 f"budget {cfg.budget_s:.0f} s")
-        c.run(on_round=lambda row, st, s=method: progress(
-            f"  {s} round {row.round}: {brief(row.metrics)}"))
-    return add_controls(root, plan, collect_results(root, plan), controls, assess, progress)
+    jobs = campaign_jobs(root, plan)
+    for job in jobs:
+        progress(f"{job.label}: budget {job.config.budget_s:.0f} s")
+    run_campaigns(jobs, workers=workers, dask_address=dask_address, brief=brief,
+                  progress=progress)
+    refresh_catalog(root)
+    return add_controls(root, plan, collect_results(root, plan), controls,
+                        assessors(root, plan), progress)
 
 
 def add_controls(root: DataRoot, plan: Sequence[CampaignConfig],

@@ -3,8 +3,9 @@
 Round r+1 starts from the monitor G_r and the records D_r (D_init, then every run acquired so
 far, each with its feedback under G_r). It proposes one scenario at a time, simulates it, scores
 the new run with G_r and adds it to D_r, until N_round runs or the budget is spent; then it
-ingests the round's logs, updates the monitor on D_r, refreshes the feedback of every record
-with G_{r+1} and stores the round. The campaign stops when no run fits in the budget left.
+ingests the round's runs (as converted for scoring: one conversion per log), updates the
+monitor on D_r, refreshes the feedback of every record with G_{r+1} and stores the round. The
+campaign stops when no run fits in the budget left.
 
 Monitor update, `update="finetune"` (the default): G_{r+1} starts from G_r's weights and input
 normalisers and trains a few epochs on D_r — Algorithm 1, line 12 is Train(G_r, D_r), and a
@@ -15,10 +16,13 @@ on D_r every round (slower; useful to check that fine-tuning does not drift).
 State and resume. Everything a campaign knows is in the data root: run logs under
 `runs/<scenario>/<campaign id>/`, the feedback table (f_r per run and monitor version) and the
 campaign_rounds table (per round: G_r and the runs acquired, in order). `start()` rebuilds D_r
-and the strategy (`replay`) from the last stored round; a round interrupted anywhere (mid-run,
+(the runs' outcomes from the warehouse, no log read again) and the strategy (`replay`) from the
+last stored round; a round interrupted anywhere (mid-run,
 mid-round, mid-training) is re-done from its start — its proposals are deterministic (the
 strategy's, and run seed k for proposal k), logs already on disk are read instead of simulated,
-so no run is lost, duplicated or charged twice. A run is started only if the budget left is at
+so no run is lost, duplicated or charged twice. A campaign writes only its own keys (its
+batch's partition, its rounds, its monitor versions' feedback: `evoeye.store.lock`), so
+campaigns run side by side (`experiment.py`). A run is started only if the budget left is at
 least the longest run (`max_run_s`), so the budget is never overspent.
 
 Deviation from Algorithm 1: a last round cut short by the budget still updates the monitor (its
@@ -31,18 +35,18 @@ import hashlib
 import json
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict, dataclass
+from dataclasses import asdict
 from functools import cached_property
 from pathlib import Path
 
 import numpy as np
 
+from evoeye.atomic import remove_stale_temps
 from evoeye.batch import simulate_and_log
 from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
-from evoeye.evolve.search.fitness import criticality
-from evoeye.evolve.search.protocol import Strategy
-from evoeye.evolve.search.records import Records
+from evoeye.evolve.campaign.state import CampaignState, records_of, run_outcome, run_seed
 from evoeye.evolve.search.strategies import FEEDBACK_BLIND, make_strategy
 from evoeye.log import read_run
 from evoeye.monitor.families import (
@@ -52,10 +56,11 @@ from evoeye.monitor.families import (
     initial_monitor,
     load_calibrated,
 )
+from evoeye.monitor.threads import intra_op_threads
 from evoeye.paths import DataRoot
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
 from evoeye.sim.runner import run_spec
-from evoeye.store import RunFilter, Warehouse, ingest
+from evoeye.store import RunFilter, Warehouse
 from evoeye.store.feedback import (
     FeedbackRows,
     RoundMetrics,
@@ -65,42 +70,17 @@ from evoeye.store.feedback import (
     write_feedback,
 )
 from evoeye.store.feedback import write_round as store_round
-from evoeye.store.log_windows import read_logged_run
+from evoeye.store.ingest import IngestReport, ingest_batch, refresh_catalog
+from evoeye.store.log_windows import LoggedRun, read_logged_run
+from evoeye.store.windows import cached_parts
 
 
 class NoInitialDataError(LookupError):
     """A campaign needs the scenario's initial (round 0) runs in the warehouse."""
 
 
-@dataclass
-class CampaignState:
-    """D_r and G_r after `round` finished rounds, with the strategy that acquired D_r \\ D_init."""
-
-    campaign_id: str
-    round: int
-    monitor: str
-    records: Records
-    ok: np.ndarray  # (n,) bool: the run finished and can train the monitor
-    n_init: int
-    strategy: Strategy
-    rounds: list[RoundRow]
-
-    @property
-    def spent_s(self) -> float:
-        return float(self.records.tail(self.n_init).duration_s.sum())
-
-    @property
-    def acquired(self) -> int:
-        return self.records.n - self.n_init
-
-
 Trainer = Callable[..., str]  # train_monitor's signature
 Assessor = Callable[[str], RoundMetrics]  # monitor version → metrics, stored with the round
-
-
-def run_seed(campaign_seed: int, k: int) -> int:
-    """The simulation seed of proposal k (0-based) of a campaign."""
-    return int(np.random.SeedSequence([campaign_seed, k]).generate_state(1)[0])
 
 
 class Campaign:
@@ -115,6 +95,7 @@ class Campaign:
         self._train = train or self.family.train
         self._assess = assess
         self._monitors: dict[str, object] = {}
+        self.clock = PhaseClock()  # wall seconds per phase of this object's calls
 
     # -- identity and initial data -------------------------------------------------------------
     @cached_property
@@ -187,10 +168,16 @@ class Campaign:
         return self._monitors[version]
 
     # -- state -----------------------------------------------------------------------------------
+    @intra_op_threads()
     def start(self, new_ids: Sequence[str] = ()) -> CampaignState:
         """The state after the last stored round; round 0 (G_0, D_init scored) is stored first.
-        `new_ids`: runs `acquire` added since, by id (the flow's round tasks pass them on), read
-        back from their logs with their feedback under G_r."""
+        `new_ids`: runs `acquire` added since, by id (the flow's round tasks pass them on), with
+        their feedback under G_r. The runs' outcomes come from the warehouse, not their logs."""
+        with self.clock("state"):
+            return self._start(new_ids)
+
+    def _start(self, new_ids: Sequence[str]) -> CampaignState:
+        remove_stale_temps(self.root.batch_dir(self.config.scenario, self.campaign_id))
         rounds = read_rounds(self.root, self.campaign_id)
         if not rounds:
             self._store_feedback(self.g0, self.initial["scenario_id"])
@@ -200,21 +187,9 @@ class Campaign:
             store_round(self.root, row)
             rounds = read_rounds(self.root, self.campaign_id)
         last = rounds[-1]
-        init = self.initial
-        records = Records(
-            params=np.stack([np.asarray(p, float) for p in init["params"]]),
-            feedback=np.full(len(init["scenario_id"]), np.nan),
-            fitness=criticality(init["collided"].astype(bool),
-                                np.array(init["min_distance_m"], dtype=float)),
-            collided=init["collided"].astype(bool), duration_s=init["duration_s"].astype(float),
-            scenario_id=init["scenario_id"],
-        )
-        ok = [True] * records.n
-        for sid in [*(s for r in rounds for s in r.scenario_ids), *new_ids]:
-            meta = read_run(self.log_path(sid), topics=()).metadata
-            records = records.append(np.asarray(meta["params"], float), **_outcome(meta))
-            ok.append(meta["status"] == "ok")
-        n_init = len(init["scenario_id"])
+        records, ok = records_of(self.initial, self._acquired(
+            [*(s for r in rounds for s in r.scenario_ids), *new_ids]))
+        n_init = len(self.initial["scenario_id"])
         stored = self.stored_feedback(last.monitor_version)
         records = records.with_feedback(np.array(
             [stored.get(s, np.nan) for s in records.scenario_id], dtype=float))
@@ -223,7 +198,15 @@ class Campaign:
         mine = records.tail(n_init)
         strategy.replay(mine.params, mine.fitness)
         return CampaignState(self.campaign_id, last.round, last.monitor_version, records,
-                             np.array(ok, bool), n_init, strategy, rounds)
+                             ok, n_init, strategy, rounds)
+
+    def _acquired(self, ids: list[str]) -> list[dict]:
+        """The outcome (params, collided, min_distance_m, duration_s, status) of acquired runs,
+        from the warehouse; from its log's metadata for a run not ingested."""
+        found = {r["scenario_id"]: r for r in (Warehouse(self.root).query(
+            "campaign_records", ids=ids).to_pylist() if ids else [])}
+        return [found.get(sid) or read_run(self.log_path(sid), topics=()).metadata
+                for sid in ids]
 
     def remaining_s(self, state: CampaignState) -> float:
         return self.config.budget_s - state.spent_s
@@ -233,55 +216,77 @@ class Campaign:
         return self.remaining_s(state) < self.config.max_run_s
 
     # -- one round, in the steps a flow runs as tasks ----------------------------------------------
+    @intra_op_threads()
     def acquire(self, state: CampaignState) -> list[str]:
-        """Lines 5–10, up to N_round times: propose, simulate, score with G_r, add; then store the
-        new runs' f_r. Their ids."""
+        """Lines 5–10, up to N_round times: propose, simulate, score with G_r, add; then ingest
+        the new runs (from their scoring's conversion) and store their f_r. Their ids."""
         cfg, monitor = self.config, self.monitor(state.monitor)
         new: list[str] = []
+        runs: list[LoggedRun] = []
         while len(new) < cfg.n_round and not self.done(state):
-            prop = state.strategy.propose(state.records)
-            spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
-                            batch=self.campaign_id, source=cfg.strategy, round=state.round + 1)
-            result = simulate_and_log(spec, self.root)
+            with self.clock("simulate"):
+                prop = state.strategy.propose(state.records)
+                spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
+                                batch=self.campaign_id, source=cfg.strategy,
+                                round=state.round + 1)
+                result = simulate_and_log(spec, self.root)
             if result.status == "error":
                 raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
                                    f"{result.reason}")
-            run = read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
-            fb = (windows_feedback(monitor, run.windows, cfg.feedback).feedback[0]
-                  if run.ok and run.windows is not None else np.nan)
-            outcome = _outcome(run.metadata)
+            with self.clock("score"):
+                run = read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
+                fb = (windows_feedback(monitor, run.windows, cfg.feedback).feedback[0]
+                      if run.ok and run.windows is not None else np.nan)
+            outcome = run_outcome(run.metadata)
             state.strategy.tell(prop.x, outcome["fitness"])
             state.records = state.records.append(
                 np.asarray(run.metadata["params"], float), feedback=float(fb), **outcome)
             state.ok = np.append(state.ok, run.ok)
             new.append(spec.scenario_id)
-        if new:  # f_r of the new runs, stored now so that a later step can read them by id
+            runs.append(run)
+        if new:  # in the warehouse, with f_r stored, so that a later step can read them by id
+            self._ingest(runs)
             added = state.records.tail(state.records.n - len(new))
             self._write_feedback(state.monitor, added.scenario_id, added.feedback)
         return new
 
-    def ingest(self):
-        """Put the round's logs into the warehouse (every log not yet there)."""
-        return ingest(self.root)
+    def ingest(self) -> IngestReport:
+        """Put the campaign's logs not yet in the warehouse there (`acquire` ingests its runs:
+        this finds none unless it was interrupted), and refresh the DuckDB catalog file."""
+        report = self._ingest([])
+        refresh_catalog(self.root)
+        return report
 
+    def _ingest(self, runs: Sequence[LoggedRun]) -> IngestReport:
+        with self.clock("ingest"):
+            return ingest_batch(self.root, (self.config.scenario, self.campaign_id), runs)
+
+    @intra_op_threads()
     def update_monitor(self, state: CampaignState) -> tuple[str, float]:
         """Line 12: G_{r+1} from D_r (train) and the fixed val split; (version, wall seconds)."""
         cfg = self.config
         ids = [str(s) for s, ok in zip(state.records.scenario_id, state.ok, strict=True) if ok]
         t0 = time.perf_counter()
-        version = self._train(
-            self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
-            horizon_s=cfg.horizon_s,
-            seed=cfg.seed * 1000 + state.round + 1, splits=cfg.splits,
-            init_from=state.monitor if cfg.update == "finetune" else None,
-            context_len=None if cfg.update == "finetune" else self.monitor(self.g0).context_len,
-            **cfg.train_overrides(),
-        )
+        with self.clock("train"):
+            version = self._train(
+                self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
+                horizon_s=cfg.horizon_s, seed=cfg.seed * 1000 + state.round + 1,
+                splits=cfg.splits, init_from=state.monitor if cfg.update == "finetune" else None,
+                context_len=(None if cfg.update == "finetune"
+                             else self.monitor(self.g0).context_len),
+                **cfg.train_overrides(),
+            )
         return version, time.perf_counter() - t0
 
+    @intra_op_threads()
     def finish_round(self, state: CampaignState, new_ids: list[str], version: str,
                      train_s: float) -> RoundRow:
         """Line 13 and the commit: store f_{r+1} of every record, then the round."""
+        with self.clock("state"):
+            return self._finish_round(state, new_ids, version, train_s)
+
+    def _finish_round(self, state: CampaignState, new_ids: list[str], version: str,
+                      train_s: float) -> RoundRow:
         ok_ids = state.records.scenario_id[state.ok]
         self._store_feedback(version, ok_ids)
         row = RoundRow(self.campaign_id, self.config.scenario, self.config.strategy,
@@ -296,26 +301,29 @@ class Campaign:
         return row
 
     def run_round(self, state: CampaignState) -> RoundRow | None:
-        """One whole round (acquire → ingest → update → refresh); None when the budget is spent."""
+        """One whole round (acquire and ingest → update → refresh); None when the budget is
+        spent."""
         new_ids = self.acquire(state)
         if not new_ids:
             return None
-        self.ingest()
         version, train_s = self.update_monitor(state)
         return self.finish_round(state, new_ids, version, train_s)
 
     def run(self, max_rounds: int | None = None,
             on_round: Callable[[RoundRow, CampaignState], None] | None = None) -> CampaignState:
-        """Resume, then run rounds until the budget is spent (or `max_rounds` more are done)."""
-        state = self.start()
-        done_rounds = 0
-        while not self.done(state) and (max_rounds is None or done_rounds < max_rounds):
-            row = self.run_round(state)
-            if row is None:
-                break
-            done_rounds += 1
-            if on_round is not None:
-                on_round(row, state)
+        """Resume, then run rounds until the budget is spent (or `max_rounds` more are done).
+        Each warehouse part is decoded once for all rounds (`cached_parts`)."""
+        with cached_parts():
+            state = self.start()
+            done_rounds = 0
+            while not self.done(state) and (max_rounds is None or done_rounds < max_rounds):
+                row = self.run_round(state)
+                if row is None:
+                    break
+                done_rounds += 1
+                if on_round is not None:
+                    on_round(row, state)
+        refresh_catalog(self.root)  # its views see the tables the campaign added to
         return state
 
     # -- helpers ---------------------------------------------------------------------------------
@@ -325,8 +333,9 @@ class Campaign:
         todo = [str(s) for s in scenario_ids if s not in have]
         if not todo:
             return
-        fb = warehouse_feedback(self.root, self.monitor(version), todo, self.config.horizon_s,
-                                self.config.feedback)
+        with self.clock("refresh"):
+            fb = warehouse_feedback(self.root, self.monitor(version), todo,
+                                    self.config.horizon_s, self.config.feedback)
         self._write_feedback(version, fb.scenario_id, fb.feedback, fb.n_contexts)
 
     def _write_feedback(self, version: str, ids, feedback, n_contexts=None) -> None:
@@ -338,15 +347,5 @@ class Campaign:
                                                n[keep]))
 
     def _metrics(self, version: str) -> RoundMetrics | None:
-        return self._assess(version) if self._assess else None
-
-
-def _outcome(meta: dict) -> dict:
-    """Records columns of one run from its log metadata (a failed run is not critical)."""
-    collided = bool(meta["collided"])
-    gap = meta.get("min_distance_m")
-    return {
-        "fitness": float(criticality(collided, np.nan if gap is None else float(gap))),
-        "collided": collided, "duration_s": float(meta["duration_s"]),
-        "scenario_id": str(meta["scenario_id"]),
-    }
+        with self.clock("assess"):
+            return self._assess(version) if self._assess else None

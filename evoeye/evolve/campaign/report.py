@@ -1,4 +1,5 @@
-"""The RQ2 report: tables (mean ± sample SD over seeds), per-round curves and the blind-spot map.
+"""The RQ2 report: tables (mean ± sample SD over seeds), the last round's means with their 95 %
+CIs as error bars, per-round curves and the blind-spot map.
 
 Input is `collect_results`' dict ({scenario: {"initial", "aem-initial", method: [runs]}}); output
 Markdown, self-contained HTML (SVG charts) and the JSON under `<root>/reports/<name>/`.
@@ -14,9 +15,9 @@ from pathlib import Path
 
 import numpy as np
 
-from evoeye.evaluation.plots import line_chart
+from evoeye.evaluation.plots import interval_chart, line_chart
 from evoeye.evaluation.report import UNREACHABLE, UNREACHABLE_NOTE
-from evoeye.evaluation.stats import sample_sd
+from evoeye.evaluation.stats import mean_ci, sample_sd
 from evoeye.evolve.campaign.experiment import ABLATION, MAIN, methods
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.paths import DataRoot
@@ -154,6 +155,17 @@ def _curves(res: dict, split: str, col: str) -> str:
                       ylabel=col)
 
 
+def _intervals(res: dict, split: str, col: str) -> str:
+    """Each method's last-round mean over seeds with its 95 % t interval, as error bars."""
+    rows = []
+    for method in ran(res):
+        ci = mean_ci([_value(r["rounds"][-1][split][col]) for r in res[method]])
+        rows.append((method, *(None if v is None else 100 * v
+                               for v in (ci.mean, ci.low, ci.high))))
+    return interval_chart(rows, title=f"{split} {col}, last round: mean, 95 % CI",
+                          xlabel=f"{col} (%)")
+
+
 def _scatter(b: dict) -> str:
     pts = []
     hi = max(b["feedback"]) or 1.0
@@ -185,7 +197,7 @@ def html(results: dict) -> str:
             ACQUISITION_HEAD, acquisition_rows(res)))
         for split in ("test", "hard"):
             for col in ("f1@0.05", "auprc"):
-                body.append(_curves(res, split, col))
+                body += [_intervals(res, split, col), _curves(res, split, col)]
         spots = [r["blind_spots"] for r in res.get("evoeye", []) if r.get("blind_spots")]
         if spots:
             body.append("<h3>Blind-spot map (EvoEye, first seed)</h3>" + _scatter(spots[0]))

@@ -1,4 +1,5 @@
-"""The RQ2 report: mean ± sample SD per strategy, per-round curves and the blind-spot map."""
+"""The RQ2 report: mean ± sample SD per strategy, CIs as error bars, per-round curves and the
+blind-spot map."""
 
 from __future__ import annotations
 
@@ -46,7 +47,7 @@ def test_the_reseeded_control_is_a_row_of_its_own() -> None:
     rows = {r[0]: r for r in table_rows(res, ("uniform",))}
     row = rows["G_0 re-seeded ×2 (no new data)"]
     assert row[1] == "30.0 ± 14.1" and row[5] == "25.0 ± 7.1"
-    assert html({"highway-cut-in": res}).count("<svg") == 5  # controls add no curve
+    assert html({"highway-cut-in": res}).count("<svg") == 9  # controls add no chart
 
 
 def test_aem_evo_is_shown_after_its_own_initial_aem() -> None:
@@ -88,8 +89,12 @@ def test_report_files_hold_tables_curves_and_map(tmp_path) -> None:
     md = markdown(RESULTS)
     assert "## highway-cut-in — RQ2" in md and "Evolution ablation" in md
     page = html(RESULTS)
-    assert page.count("<svg") == 5  # 4 curves + the blind-spot map
+    assert page.count("<svg") == 9  # 4 error-bar charts, 4 curves, the blind-spot map
     assert 'data-series="evoeye"' in page
+    # uniform's last-round test F1 over its two seeds, 0.3 and 0.5: mean 40, t CI 40 ± 127.06
+    half = 12.706204736174707 * 10.0
+    assert f'data-interval="{40 - half:.4g},{40 + half:.4g}"' in page
+    assert 'data-estimate="60"' in page and 'data-interval="60,60"' in page  # evoeye: no spread
     folder = write_experiment_report(DataRoot.resolve(tmp_path), RESULTS, "t")
     assert {p.name for p in folder.iterdir()} == {"rq2.md", "rq2.html", "rq2.json"}
 

@@ -45,13 +45,15 @@ def test_the_config_module_imports_nothing_heavy() -> None:
 def test_options_are_the_fields_with_the_split_flattened_and_round_trip() -> None:
     names = [o.name for o in campaign_options()]
     assert names[:3] == ["scenario", "strategy", "budget_s"]
-    assert names[-3:] == ["split_seed", "train_frac", "val_frac"]
+    assert names[-4:] == ["split_seed", "train_frac", "val_frac", "test_batch"]
     assert "splits" not in names and "max_run_s" not in names  # flattened; internal
     cfg = CampaignConfig("unprotected-intersection", strategy="uniform", budget_s=90.0, seed=3,
                          n_round=4, epochs=2, feedback="prior-corrected", delta=0.1,
-                         splits=SplitSpec(7, 0.6, 0.2))
+                         splits=SplitSpec(7, 0.6, 0.2, "held-out"))
     values = option_values(cfg)
     assert values["split_seed"] == 7 and values["val_frac"] == 0.2
+    assert values["test_batch"] == "held-out"
+    assert next(o for o in campaign_options() if o.name == "test_batch").optional
     assert config_from(values) == cfg
     assert "seed" not in option_values(cfg, exclude=("seed",))
     with pytest.raises(ValueError, match="max_run_s is no campaign option"):

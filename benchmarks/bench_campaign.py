@@ -1,0 +1,153 @@
+"""A campaign's rounds, profiled: where the wall time goes, and its cost against simulation alone.
+
+One campaign (`--strategy`, default evoeye; fine-tune updates, N_round = `--n-round`) runs
+`--rounds` rounds on a private copy of a data root holding the scenario's initial runs and a
+G_0 (`--root`; without it, `--runs` uniform runs are simulated, ingested and a G_0 trained in a
+temporary folder first). Each round is broken into the campaign's phases
+(`evoeye.evolve.campaign.phases`): simulate, score, ingest, train, refresh, assess, state. Then
+the very runs the campaign acquired are simulated and logged again, alone, one after another in
+this process: the campaign's cost is its wall time over that (target ≤ 1.5×, issue 12). Round 0
+(G_0 scores D_init and is assessed) is paid once per campaign and shown apart. Wall seconds
+and this process's CPU seconds are both given: on a shared machine the CPU ratio is the one
+that load distorts less (everything runs in this one process, torch on one thread).
+"""
+
+from __future__ import annotations
+
+import argparse
+import os
+import shutil
+import tempfile
+import time
+from pathlib import Path
+
+from benchmarks.machine import describe
+from evoeye.batch import plan_uniform, run_batch, simulate_and_log
+from evoeye.evolve.campaign.assess import Assessor
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.loop import Campaign
+from evoeye.evolve.campaign.phases import PHASES
+from evoeye.log import read_run
+from evoeye.paths import DataRoot
+from evoeye.sim.runner import run_spec
+from evoeye.store import SplitSpec, ingest
+from evoeye.store.feedback import read_rounds
+
+TARGET = 1.5
+
+
+def seed_root(path: Path, scenarios: list[str], runs: int, splits: SplitSpec) -> DataRoot:
+    """A data root with `runs` uniform runs per scenario, ingested, and a G_0 for each."""
+    from evoeye.monitor import train_monitor
+
+    root = DataRoot.resolve(path)
+    for scenario in scenarios:
+        run_batch(plan_uniform(scenario, runs, seed=11), root, workers=1)
+    ingest(root)
+    for scenario in scenarios:
+        train_monitor(root, scenario, seed=0, splits=splits, epochs=5)
+    return root
+
+
+def copy_root(src: DataRoot, dst: Path) -> DataRoot:
+    """A private copy of a data root (campaigns write into it)."""
+    shutil.copytree(src.path, dst, ignore=shutil.ignore_patterns("reports", "quarantine"))
+    return DataRoot.resolve(dst)
+
+
+def simulate_alone(root: DataRoot, campaign_id: str, scenario: str,
+                   out: DataRoot) -> tuple[float, float, int]:
+    """(wall s, CPU s, runs) to simulate and log the campaign's acquired runs again, one by
+    one."""
+    ids = [s for r in read_rounds(root, campaign_id) for s in r.scenario_ids]
+    specs = []
+    for sid in ids:
+        meta = read_run(root.run_log(scenario, campaign_id, sid), topics=()).metadata
+        specs.append(run_spec(scenario, meta["params"], int(meta["seed"]), batch="alone",
+                              source=str(meta["source"]), round=int(meta["round"])))
+    t0, c0 = time.perf_counter(), time.process_time()
+    for spec in specs:
+        simulate_and_log(spec, out)
+    return time.perf_counter() - t0, time.process_time() - c0, len(specs)
+
+
+def profile(root: DataRoot, cfg: CampaignConfig, rounds: int
+            ) -> tuple[list[tuple[dict, dict]], tuple[dict, dict]]:
+    """([(wall, CPU) phase seconds of each round], those of round 0), each with "total". The
+    rounds run as `Campaign.run` runs them (a round's share of resuming counts in round 1)."""
+    t0, c0 = time.perf_counter(), time.process_time()
+    campaign = Campaign(root, cfg)
+    campaign = Campaign(root, cfg, assess=Assessor.of(campaign))  # its set-up is round 0's
+    campaign.start()
+    clock = campaign.clock
+
+    def mark() -> tuple[dict, dict]:
+        return ({**clock.seconds, "total": time.perf_counter()},
+                {**clock.cpu_seconds, "total": time.process_time()})
+
+    marks = [mark()]
+    first = ({**clock.seconds, "total": marks[0][0]["total"] - t0},
+             {**clock.cpu_seconds, "total": marks[0][1]["total"] - c0})
+    campaign.run(max_rounds=rounds, on_round=lambda row, state: marks.append(mark()))
+    out = [tuple({k: b[i][k] - a[i][k] for k in a[i]} for i in (0, 1))
+           for a, b in zip(marks, marks[1:], strict=False)]
+    return out, first
+
+
+def row(label: str, seconds: dict) -> str:
+    cells = " | ".join(f"{seconds[p]:.2f}" for p in PHASES)
+    other = seconds["total"] - sum(seconds[p] for p in PHASES)
+    return f"| {label} | {cells} | {other:.2f} | {seconds['total']:.2f} |"
+
+
+def table(kind: str, rounds: list[dict], first: dict) -> dict:
+    """Print one table (wall or CPU seconds) of the rounds; the rounds' sums."""
+    print(f"\n{kind} seconds\n\n| round | {' | '.join(PHASES)} | other | total |")
+    print(f"|---|{'---|' * (len(PHASES) + 2)}")
+    print(row("0 (G_0)", first))
+    for i, seconds in enumerate(rounds, start=1):
+        print(row(str(i), seconds))
+    total = {k: sum(r[k] for r in rounds) for k in (*PHASES, "total")}
+    print(row("rounds 1+", total))
+    return total
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__)
+    ap.add_argument("--root", type=Path, help="data root with initial runs and a G_0")
+    ap.add_argument("--scenario", default="highway-cut-in")
+    ap.add_argument("--strategy", default="evoeye")
+    ap.add_argument("--rounds", type=int, default=3)
+    ap.add_argument("--n-round", type=int, default=20)
+    ap.add_argument("--epochs", type=int, help="campaign option (default: its own)")
+    ap.add_argument("--patience", type=int, help="campaign option (default: its own)")
+    ap.add_argument("--runs", type=int, default=60, help="initial runs without --root")
+    args = ap.parse_args()
+    print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}")
+    splits = SplitSpec() if args.root else SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
+    with tempfile.TemporaryDirectory(prefix="bench-campaign-") as tmp:
+        src = (DataRoot.existing(args.root) if args.root
+               else seed_root(Path(tmp) / "seed", [args.scenario], args.runs, splits))
+        root = copy_root(src, Path(tmp) / "data")
+        cfg = CampaignConfig(args.scenario, strategy=args.strategy, budget_s=1e9,
+                             n_round=args.n_round, splits=splits, epochs=args.epochs,
+                             patience=args.patience)
+        rounds, first = profile(root, cfg, args.rounds)
+        campaign_id = Campaign(root, cfg).campaign_id
+        alone_s, alone_cpu_s, n_runs = simulate_alone(root, campaign_id, args.scenario,
+                                                      DataRoot.resolve(Path(tmp) / "alone"))
+    print(f"\ncampaign {campaign_id}: {args.scenario}, {args.strategy}, N_round {args.n_round}, "
+          f"epochs {args.epochs or 'default'}, patience {args.patience or 'default'}")
+    wall = table("wall", [w for w, _ in rounds], first[0])
+    cpu = table("CPU", [c for _, c in rounds], first[1])
+    print(f"\nsimulate + log the same {n_runs} runs alone: {alone_s:.2f} s wall, "
+          f"{alone_cpu_s:.2f} s CPU")
+    print(f"campaign cost, rounds 1+: {wall['total'] / alone_s:.2f}× wall, "
+          f"{cpu['total'] / alone_cpu_s:.2f}× CPU (target ≤ {TARGET}×); with round 0: "
+          f"{(wall['total'] + first[0]['total']) / alone_s:.2f}× wall, "
+          f"{(cpu['total'] + first[1]['total']) / alone_cpu_s:.2f}× CPU")
+    print(f"load average after: {os.getloadavg()[0]:.2f}")
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,118 @@
+"""`evoeye results`: every table of docs/results, with its CIs and p-values, in one command."""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from evoeye.cli.app import app
+from evoeye.cli.output import StepBar
+from evoeye.paths import DataRoot
+from evoeye.results.config import PARTS, ResultsConfig
+
+D = ResultsConfig()  # the defaults --help shows (config.py imports nothing heavy)
+
+
+def _csv(text: str) -> tuple[str, ...]:
+    return tuple(n.strip() for n in text.split(",") if n.strip() and n.strip() != "none")
+
+
+@app.command("results")
+def results_command(
+    root: Annotated[Path | None, typer.Option(
+        "--root", help="Data root (default: $EVOEYE_HOME or ./evoeye-data).")] = None,
+    scenario: Annotated[list[str] | None, typer.Option(
+        "--scenario", help="Logical scenario (repeatable; default: both).")] = None,
+    part: Annotated[list[str] | None, typer.Option(
+        "--part", help=f"Run only these parts (repeatable): {', '.join(PARTS)}.")] = None,
+    training_seeds: Annotated[int, typer.Option(
+        min=2, help="Training seeds 0 … N−1 (RQ1, the ablation, the re-seeded G_0s).")] =
+        len(D.training_seeds),
+    campaign_seeds: Annotated[int, typer.Option(
+        min=2, help="Campaign seeds 0 … N−1, paired across the RQ2 methods.")] =
+        len(D.campaign_seeds),
+    final_seeds: Annotated[int, typer.Option(
+        min=1, help="k: a campaign's final monitor is judged by the mean over k training "
+                    "seeds of its last update.")] = D.final_seeds,
+    initial_runs: Annotated[int, typer.Option(
+        min=0, help="Simulate (or resume) this many initial runs per scenario, batch "
+                    "uniform-seed<sim-seed> (0: use the warehouse's).")] = D.initial_runs,
+    sim_seed: Annotated[int, typer.Option(min=0, help="Seed of the initial runs.")] =
+        D.sim_seed,
+    test_runs: Annotated[int, typer.Option(
+        min=0, help="Simulate (or resume) this many runs per scenario as the held-out Test Set "
+                    "batch (0: none, or the --test-batch already there).")] = D.test_runs,
+    test_seed: Annotated[int, typer.Option(min=0, help="Seed of the Test Set batch.")] =
+        D.test_seed,
+    test_batch: Annotated[str | None, typer.Option(
+        help="The Test Set batch's name (default test-seed<test-seed>).")] = None,
+    split_seed: Annotated[int, typer.Option(min=0, help="Seed of the train/val split.")] =
+        D.split_seed,
+    train_frac: Annotated[float | None, typer.Option(
+        help="Train share of the initial runs (default 0.8 with a Test Set batch, else 0.5).")
+    ] = None,
+    val_frac: Annotated[float | None, typer.Option(
+        help="Validation share (default 0.2 with a Test Set batch, else 0.125).")] = None,
+    baselines: Annotated[str, typer.Option(help="Comma-separated RQ1 baselines.")] =
+        ",".join(D.baselines),
+    context_len: Annotated[list[int] | None, typer.Option(
+        "--context-len", help="Context lengths of the ablation (repeatable; default 1 3 5 7).")
+    ] = None,
+    inputs: Annotated[list[str] | None, typer.Option(
+        "--inputs", help="Module inputs of the ablation (repeatable; default all four sets).")
+    ] = None,
+    method: Annotated[list[str] | None, typer.Option(
+        "--method", help="RQ2 methods (repeatable; default the RQ2 ones and the ablations).")
+    ] = None,
+    budget_s: Annotated[float | None, typer.Option(
+        min=0.0, help="Simulated seconds per campaign (default: the initial training data's).")
+    ] = None,
+    n_round: Annotated[int, typer.Option(min=1, help="Runs per round (N_round).")] = D.n_round,
+    update: Annotated[str, typer.Option(help="Monitor update: finetune or retrain.")] =
+        D.update,
+    feedback: Annotated[str, typer.Option(help="Feedback: raw or prior-corrected.")] =
+        D.feedback,
+    epochs: Annotated[int | None, typer.Option(
+        min=1, help="Epochs of every training (default: each trainer's).")] = None,
+    patience: Annotated[int | None, typer.Option(min=1, help="Early-stopping patience.")] =
+        None,
+    workers: Annotated[int, typer.Option(
+        min=1, help="Processes simulating the data, then running campaigns side by side.")
+    ] = D.workers,
+    name: Annotated[str, typer.Option(help="Report folder under <root>/reports.")] =
+        "results",
+    docs: Annotated[Path | None, typer.Option(
+        help="Also copy rq1.md, rq2.md, findings.md and results.json here (docs/results).")
+    ] = None,
+    readme: Annotated[Path | None, typer.Option(
+        help="Also rewrite this README's findings section (between its markers).")] = None,
+) -> None:
+    """Regenerate RQ1, the monitor ablation, RQ2, the evolution ablations and AEM-Evo, each
+    comparison with its mean, 95 % CI and p; re-running reuses every finished unit."""
+    from evoeye.results.run import run_results, write_results
+
+    try:
+        config = ResultsConfig(
+            scenarios=tuple(scenario or D.scenarios), parts=tuple(part or D.parts),
+            training_seeds=tuple(range(training_seeds)),
+            campaign_seeds=tuple(range(campaign_seeds)), final_seeds=final_seeds,
+            initial_runs=initial_runs, sim_seed=sim_seed, test_runs=test_runs,
+            test_seed=test_seed, test_batch=test_batch, split_seed=split_seed,
+            train_frac=train_frac, val_frac=val_frac, baselines=_csv(baselines),
+            context_lens=tuple(context_len or D.context_lens),
+            inputs=tuple(inputs or D.inputs), methods=tuple(method or D.methods),
+            budget_s=budget_s, n_round=n_round, update=update, feedback=feedback,
+            epochs=epochs, patience=patience, workers=workers)
+        config.check_names()
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc)) from None
+    data = DataRoot.resolve(root) if initial_runs or test_runs else DataRoot.existing(root)
+    with StepBar("results") as bar:
+        run = run_results(data, config, progress=bar)
+    folder = write_results(data, run.results, name, docs=docs, readme=readme)
+    typer.echo((folder / "findings.md").read_text(encoding="utf-8"))
+    found, done = sum(run.found.values()), sum(run.computed.values())
+    typer.echo(f"units: {found} found done, {done} done now ({run.computed or 'nothing new'})")
+    typer.echo(f"report: {folder / 'results.html'} (tables: rq1.md, rq2.md, results.json)")

@@ -1,0 +1,72 @@
+"""A campaign's state between rounds: D_r with its outcomes, G_r, and the run seeds."""
+
+from __future__ import annotations
+
+from collections.abc import Iterable
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from evoeye.evolve.search.fitness import criticality
+from evoeye.evolve.search.protocol import Strategy
+from evoeye.evolve.search.records import Records
+from evoeye.store.feedback import RoundRow
+
+
+@dataclass
+class CampaignState:
+    """D_r and G_r after `round` finished rounds, with the strategy that acquired D_r \\ D_init."""
+
+    campaign_id: str
+    round: int
+    monitor: str
+    records: Records
+    ok: np.ndarray  # (n,) bool: the run finished and can train the monitor
+    n_init: int
+    strategy: Strategy
+    rounds: list[RoundRow]
+
+    @property
+    def spent_s(self) -> float:
+        return float(self.records.tail(self.n_init).duration_s.sum())
+
+    @property
+    def acquired(self) -> int:
+        return self.records.n - self.n_init
+
+
+def run_seed(campaign_seed: int, k: int) -> int:
+    """The simulation seed of proposal k (0-based) of a campaign."""
+    return int(np.random.SeedSequence([campaign_seed, k]).generate_state(1)[0])
+
+
+def run_outcome(run: dict[str, Any]) -> dict[str, Any]:
+    """Records columns of one run from its log metadata or its scenarios row (a failed run is
+    not critical)."""
+    collided = bool(run["collided"])
+    gap = run.get("min_distance_m")
+    return {
+        "fitness": float(criticality(collided, np.nan if gap is None else float(gap))),
+        "collided": collided, "duration_s": float(run["duration_s"]),
+        "scenario_id": str(run["scenario_id"]),
+    }
+
+
+def records_of(initial: dict[str, np.ndarray],
+               acquired: Iterable[dict[str, Any]]) -> tuple[Records, np.ndarray]:
+    """(D_r without feedback, (n,) bool ok) of D_init (`Campaign.initial`) and the acquired runs
+    (each with params, the outcome and status), in order."""
+    records = Records(
+        params=np.stack([np.asarray(p, float) for p in initial["params"]]),
+        feedback=np.full(len(initial["scenario_id"]), np.nan),
+        fitness=criticality(initial["collided"].astype(bool),
+                            np.array(initial["min_distance_m"], dtype=float)),
+        collided=initial["collided"].astype(bool),
+        duration_s=initial["duration_s"].astype(float), scenario_id=initial["scenario_id"],
+    )
+    ok = [True] * records.n
+    for run in acquired:
+        records = records.append(np.asarray(run["params"], float), **run_outcome(run))
+        ok.append(run["status"] == "ok")
+    return records, np.array(ok, bool)

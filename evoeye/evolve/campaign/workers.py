@@ -1,0 +1,165 @@
+"""Independent campaigns side by side: local processes, or the workers of a Dask cluster.
+
+A campaign runs whole in one worker (`run_campaign`, a plain function of picklable arguments, so
+a Prefect task runner can run it too: flows/experiment.py). Campaigns share nothing but the data
+root, where each writes only its own keys (its batch's partition, its rounds, its monitor
+versions' feedback: `evoeye.store.lock`), so none waits for another and any of them can be
+killed and resumed alone. What several campaigns would write alike — G_0's feedback on D_init,
+its assessment, an AEM-Evo campaign's initial AEM — is written before they fan out
+(`prepare_campaigns`, in the calling process).
+
+Each worker process builds one Test/Hard-Set assessor per scenario on first use and keeps it;
+local workers are forked from the caller after it built them, so they start with them.
+"""
+
+from __future__ import annotations
+
+import multiprocessing as mp
+import os
+import threading
+from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
+from contextlib import contextmanager
+from dataclasses import dataclass
+
+from evoeye.batch import pool_context
+from evoeye.evolve.campaign.assess import Assessor
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.loop import Campaign
+from evoeye.lifeline import die_with_parent
+from evoeye.paths import DataRoot
+from evoeye.store.feedback import RoundMetrics
+
+
+@dataclass(frozen=True)
+class CampaignJob:
+    """One campaign to run (or resume) to its budget, from a worker."""
+
+    root: str  # the data root's path
+    config: CampaignConfig
+    label: str  # how progress names it, e.g. "highway-cut-in evoeye seed 0"
+    assess: bool = True  # every G_r on the Test Set and the Hard Set
+
+
+@dataclass(frozen=True)
+class CampaignDone:
+    """What a worker reports of a campaign it ran."""
+
+    label: str
+    campaign_id: str
+    rounds: int  # rounds run by this worker (0: it was finished already)
+    lines: tuple[str, ...]  # one per round
+
+
+Brief = Callable[[RoundMetrics | None], str]  # a round's metrics in one line (picklable)
+_ASSESSORS: dict[tuple, Assessor] = {}  # this process's, by (root, scenario, G_0, split, H)
+_LINES: mp.Queue | None = None  # where a local worker sends its round lines as they come
+
+
+def assessor(campaign: Campaign) -> Assessor:
+    """This process's assessor of the campaign's scenario and reference G_0 (built once)."""
+    cfg = campaign.config
+    key = (str(campaign.root.path), cfg.scenario, campaign.reference, cfg.splits, cfg.horizon_s)
+    if key not in _ASSESSORS:
+        _ASSESSORS[key] = Assessor.of(campaign)
+    return _ASSESSORS[key]
+
+
+def prepare_campaigns(jobs: Sequence[CampaignJob]) -> None:
+    """Resolve every campaign's G_0 and store its round 0 (G_0's feedback on D_init and its
+    assessment), one campaign after another: what the campaigns would otherwise all write."""
+    for job in jobs:
+        probe = Campaign(DataRoot.resolve(job.root), job.config)
+        assess = assessor(probe) if job.assess else None
+        Campaign(probe.root, job.config, assess=assess).start()
+
+
+def no_metrics(metrics: RoundMetrics | None) -> str:
+    return ""
+
+
+def run_campaign(job: CampaignJob, brief: Brief = no_metrics,
+                 say: Callable[[str], None] | None = None) -> CampaignDone:
+    """Run (or resume) one campaign to its budget; `say` each round's line as it ends (in a
+    local worker, it goes to the process that started the workers)."""
+    root = DataRoot.resolve(job.root)
+    probe = Campaign(root, job.config)
+    campaign = Campaign(root, job.config, assess=assessor(probe) if job.assess else None)
+    say = say or (_LINES.put if _LINES is not None else None)
+    lines: list[str] = []
+
+    def on_round(row, state) -> None:
+        lines.append(f"{job.label} round {row.round}: {brief(row.metrics)}")
+        if say is not None:
+            say(lines[-1])
+
+    campaign.run(on_round=on_round)
+    return CampaignDone(job.label, campaign.campaign_id, len(lines), tuple(lines))
+
+
+def _local_worker(parent: int, lines: mp.Queue) -> None:
+    global _LINES
+    die_with_parent(parent)
+    _LINES = lines
+
+
+@contextmanager
+def _executor(workers: int, dask_address: str | None,
+              say: Callable[[str], None]) -> Iterator[Executor]:
+    """`workers` local processes relaying round lines to `say`, or the Dask cluster's workers."""
+    if dask_address:
+        from distributed import Client
+
+        with Client(dask_address) as client:
+            yield client.get_executor(pure=False)
+        return
+    context = pool_context()
+    lines: mp.Queue = context.Queue()
+    relay = threading.Thread(target=lambda: [say(m) for m in iter(lines.get, None)],
+                             daemon=True)
+    relay.start()
+    try:
+        with ProcessPoolExecutor(max_workers=workers, mp_context=context,
+                                 initializer=_local_worker,
+                                 initargs=(os.getpid(), lines)) as pool:
+            yield pool
+    finally:
+        lines.put(None)
+        relay.join()
+
+
+def run_campaigns(jobs: Sequence[CampaignJob], *, workers: int | None = None,
+                  dask_address: str | None = None, brief: Brief = no_metrics,
+                  progress: Callable[[str], None] = print) -> list[CampaignDone]:
+    """Prepare, then run every campaign: one after another in this process (`workers` 1, no
+    address), over `workers` local processes (default: one per CPU), or over the workers of
+    the Dask scheduler at `dask_address` (give them one thread each: a campaign per worker at a
+    time). In job order; if one fails, those not started yet are not started."""
+    if workers is not None and workers < 1:
+        raise ValueError(f"workers must be at least 1, got {workers}")
+    prepare_campaigns(jobs)
+    workers = min(workers or os.cpu_count() or 1, max(len(jobs), 1))
+    lock = threading.Lock()  # the workers' lines arrive on a thread of their own
+
+    def say(line: str) -> None:
+        with lock:
+            progress(line)
+
+    if workers == 1 and not dask_address:
+        return [run_campaign(job, brief, progress) for job in jobs]
+    done: dict[int, CampaignDone] = {}
+    with _executor(workers, dask_address, say) as pool:
+        futures = {pool.submit(run_campaign, job, brief): i for i, job in enumerate(jobs)}
+        try:
+            for future in as_completed(futures):
+                done[futures[future]] = result = future.result()
+                if dask_address:  # a cluster's workers cannot speak to us as they go
+                    for line in result.lines:
+                        say(line)
+                say(f"{result.label}: campaign {result.campaign_id}, {result.rounds} round(s) "
+                    "run, budget spent")
+        except BaseException:
+            for future in futures:
+                future.cancel()
+            raise
+    return [done[i] for i in range(len(jobs))]

@@ -1,0 +1,132 @@
+"""What `evoeye results` runs: its sizes and choices, declared once and validated.
+
+Plain data that imports nothing heavy (the command line reads it at start-up); the defaults that
+come from elsewhere are literals checked against their sources by tests/results/test_config.py.
+
+Sizes, and why:
+
+* Training seeds (RQ1, the monitor ablation, the k re-seeded G_0s of the robust Hard Set): 6.
+  The issue asks for at least 5, but 5 pairs can never give a Wilcoxon p below 2 / 2^5 = 0.0625;
+  6 can reach 0.031.
+* Campaign seeds (RQ2 and the evolution ablations, paired across methods): 20, inside the 16–25
+  pairs the issue estimates for a 5-F1-point difference at 80 % power (the report prints the
+  pairs each comparison's measured SDs and pair correlation call for).
+* Final seeds: each campaign's final monitor is judged by the mean over k = 3 training seeds of
+  its last update (module doc of `evoeye.results.rq2`).
+* Test Set: a batch of 400 runs simulated apart at its own seed, at least 3× the paper's test
+  runs (75 on S1, 132 on S2); with it, the initial runs split train : val = 0.8 : 0.2 (the
+  paper's 6 h : 1.5 h), so the Test Set is that batch alone.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, fields
+
+SCENARIOS = ("highway-cut-in", "unprotected-intersection")  # evoeye.scenarios.SCENARIOS
+BASELINES = ("ttc", "ttc-2d", "rss", "rss-2s", "aem",
+             "context-only")  # evoeye.evaluation.monitors.BASELINES
+CONTEXT_LENS = (1, 3, 5, 7)  # evoeye.evaluation.ablation.CONTEXT_LENS
+INPUTS = ("perception", "perception+prediction", "perception+prediction+planning",
+          "all")  # evoeye.monitor.inputs.ABLATIONS
+METHODS = ("uniform", "avfuzzer", "evoeye", "no-feedback", "no-density",
+           "aem-evo")  # evoeye.evolve.campaign.experiment MAIN + ABLATION
+PARTS = ("rq1", "ablation", "rq2")
+PAPER_TEST_RUNS = {"highway-cut-in": 75, "unprotected-intersection": 132}
+TEST_SHARES = (0.8, 0.2)  # train, val shares of the initial runs when a test batch is held out
+DEFAULT_SHARES = (0.5, 0.125)  # evoeye.splits.SplitSpec() (no test batch)
+
+
+@dataclass(frozen=True)
+class ResultsConfig:
+    """Everything `evoeye results` regenerates, and at what size (module doc)."""
+
+    scenarios: tuple[str, ...] = SCENARIOS
+    training_seeds: tuple[int, ...] = (0, 1, 2, 3, 4, 5)
+    campaign_seeds: tuple[int, ...] = tuple(range(20))
+    final_seeds: int = 3  # k: a final monitor is judged by the mean over k training seeds
+    parts: tuple[str, ...] = PARTS
+    # data: simulated (or resumed) first, then ingested; 0 runs: use what the warehouse holds
+    initial_runs: int = 0  # round-0 runs per scenario, batch uniform-seed<sim_seed>
+    sim_seed: int = 0
+    test_runs: int = 400  # runs per scenario of the held-out Test Set batch
+    test_seed: int = 1_000_000
+    test_batch: str | None = None  # its name (default test-seed<test_seed> when test_runs > 0)
+    split_seed: int = 0
+    train_frac: float | None = None  # None: 0.8 with a test batch, else SplitSpec's 0.5
+    val_frac: float | None = None  # None: 0.2 with a test batch, else SplitSpec's 0.125
+    horizon_s: float = 3.0
+    # RQ1 and the monitor ablation
+    baselines: tuple[str, ...] = BASELINES
+    context_lens: tuple[int, ...] = CONTEXT_LENS
+    inputs: tuple[str, ...] = INPUTS
+    epochs: int | None = None  # every training (None: each trainer's default)
+    patience: int | None = None
+    # RQ2, the evolution ablations and AEM-Evo
+    methods: tuple[str, ...] = METHODS
+    budget_s: float | None = None  # None: the simulated time of the initial training data
+    n_round: int = 20
+    update: str = "finetune"
+    feedback: str = "raw"
+    workers: int = 1  # processes simulating the data batches, then running campaigns
+
+    def __post_init__(self) -> None:
+        for name in ("scenarios", "training_seeds", "campaign_seeds", "parts", "baselines",
+                     "context_lens", "inputs", "methods"):
+            object.__setattr__(self, name, tuple(getattr(self, name)))
+        if not self.scenarios:
+            raise ValueError("give at least one logical scenario")
+        for name in ("training_seeds", "campaign_seeds"):  # pairs need two seeds at least
+            seeds = getattr(self, name)
+            if len(seeds) < 2 or len(set(seeds)) != len(seeds):
+                raise ValueError(f"need at least 2 distinct {name.replace('_', ' ')}, "
+                                 f"got {seeds}")
+        if self.final_seeds < 1:
+            raise ValueError(f"final_seeds must be >= 1, got {self.final_seeds}")
+        unknown = set(self.parts) - set(PARTS)
+        if unknown or not self.parts:
+            raise ValueError(f"unknown part(s) {sorted(unknown)}; known: {list(PARTS)}")
+        for name, least in (("initial_runs", 0), ("test_runs", 0), ("n_round", 1),
+                            ("workers", 1)):
+            if getattr(self, name) < least:
+                raise ValueError(f"{name} must be >= {least}, got {getattr(self, name)}")
+        if self.test_runs and self.test_seed == self.sim_seed:
+            raise ValueError("the test batch needs its own seed: --test-seed equals --sim-seed")
+        if min(self.training_seeds + self.campaign_seeds + (self.sim_seed, self.test_seed)) < 0:
+            raise ValueError("seeds must be non-negative")
+
+    def check_names(self) -> None:
+        """ValueError naming any scenario, baseline, input set, method, update or feedback mode
+        no registry knows (loads the registries)."""
+        from evoeye.evaluation.monitors import BASELINES as KNOWN_BASELINES
+        from evoeye.evolve.campaign.config import check_known
+        from evoeye.monitor.inputs import ABLATIONS
+        from evoeye.splits import SplitSpec
+
+        check_known("scenario", self.scenarios)
+        check_known("method", self.methods)
+        check_known("update", [self.update])
+        check_known("feedback", [self.feedback])
+        for kind, given, known in (("baseline", self.baselines, KNOWN_BASELINES),
+                                   ("input set", self.inputs, ABLATIONS)):
+            if unknown := [n for n in given if n not in known]:
+                raise ValueError(f"unknown {kind} {unknown}; known: {sorted(known)}")
+        if bad := [n for n in self.context_lens if n < 1]:
+            raise ValueError(f"context lengths must be >= 1, got {bad}")
+        SplitSpec(self.split_seed, *self.shares, self.held_out_batch)  # shares and batch name
+
+    @property
+    def held_out_batch(self) -> str | None:
+        """The Test Set's batch: named, or test-seed<S> when its runs are simulated."""
+        if self.test_batch:
+            return self.test_batch
+        return f"test-seed{self.test_seed}" if self.test_runs else None
+
+    @property
+    def shares(self) -> tuple[float, float]:
+        """(train_frac, val_frac) of the initial runs."""
+        default = TEST_SHARES if self.held_out_batch else DEFAULT_SHARES
+        return (default[0] if self.train_frac is None else self.train_frac,
+                default[1] if self.val_frac is None else self.val_frac)
+
+    def to_dict(self) -> dict:
+        return {f.name: getattr(self, f.name) for f in fields(self)}

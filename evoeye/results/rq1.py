@@ -1,0 +1,69 @@
+"""RQ1 and the monitor ablation over the study's training seeds.
+
+Per logical scenario and training seed s: the full FusionMonitor (L = 5, every module input)
+trained with seed s, each trained baseline (AEM, the context-only control) fitted with seed s,
+and the rules (TTC, TTC-2D, RSS, RSS-2s), which have no seed and so the same figures for every
+s. The ablation trains every variant (L ∈ context_lens with every input; the input subsets at
+L = 5) with the same seeds; its "L=5" row is the RQ1 FusionMonitor (the same units), its
+reference rows are the RQ1 baselines that `ablation.REFERENCES` names. Methods and variants
+trained with the same seed on the same data are compared pair by pair (`evoeye.results.tables`).
+"""
+
+from __future__ import annotations
+
+from evoeye.evaluation.ablation import REFERENCES, input_sets, variants
+from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
+from evoeye.monitor.inputs import MODULES
+from evoeye.results.study import Study
+from evoeye.results.units import baseline, test_figures, trained_version, trains
+
+FUSION_LABEL = FAMILIES[DEFAULT_FAMILY].label  # "FusionMonitor"
+FULL_CONTEXT_LEN = 5
+
+
+def _fusion_rows(study: Study, scenario: str, context_len: int,
+                 modules: tuple[str, ...]) -> dict:
+    """One FusionMonitor recipe over the training seeds: versions and figures per seed."""
+    fusion = FAMILIES[DEFAULT_FAMILY]
+    versions = [trained_version(study, scenario, DEFAULT_FAMILY, seed=seed,
+                                context_len=context_len, modules=list(modules))
+                for seed in study.config.training_seeds]
+    return {"versions": versions,
+            "figures": [test_figures(study, scenario, fusion.load(study.root, v))
+                        for v in versions]}
+
+
+def _baseline_rows(study: Study, scenario: str, name: str) -> dict:
+    """A baseline over the training seeds (a rule: one evaluation, the same for every seed)."""
+    seeds = study.config.training_seeds
+    if not trains(name):
+        monitor = baseline(study, scenario, name, seeds[0])
+        figures = test_figures(study, scenario, monitor)
+        return {"versions": [monitor.version] * len(seeds), "figures": [figures] * len(seeds)}
+    monitors = [baseline(study, scenario, name, seed) for seed in seeds]
+    return {"versions": [m.version for m in monitors],
+            "figures": [test_figures(study, scenario, m) for m in monitors]}
+
+
+def rq1(study: Study, scenario: str) -> dict:
+    """{"seeds", "methods": {name: {"versions", "figures"}}}: the FusionMonitor, then every
+    baseline of the config, each with one entry per training seed."""
+    study.say(f"{scenario}: RQ1 over training seeds {list(study.config.training_seeds)}")
+    methods = {FUSION_LABEL: _fusion_rows(study, scenario, FULL_CONTEXT_LEN, MODULES)}
+    for name in study.config.baselines:
+        methods[name] = _baseline_rows(study, scenario, name)
+    return {"seeds": list(study.config.training_seeds), "methods": methods}
+
+
+def ablation(study: Study, scenario: str) -> dict:
+    """{"seeds", "methods": {label: {"versions", "figures"}}}: every variant, then the
+    reference baselines (those of REFERENCES the config evaluates)."""
+    study.say(f"{scenario}: monitor ablation over training seeds "
+              f"{list(study.config.training_seeds)}")
+    sets = input_sets()
+    methods = {v.label: _fusion_rows(study, scenario, v.context_len, sets[v.inputs])
+               for v in variants(study.config.context_lens, study.config.inputs)}
+    for name in REFERENCES:
+        if name in study.config.baselines:
+            methods[name] = _baseline_rows(study, scenario, name)
+    return {"seeds": list(study.config.training_seeds), "methods": methods}

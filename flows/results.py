@@ -1,0 +1,105 @@
+"""Flow: `evoeye results` — the data, then each (scenario, part) as a task, then the files.
+
+A thin wrapper over `evoeye.results`: every training, evaluation and campaign is a ledger unit
+or a resumable campaign, so a crashed flow run is simply started again and redoes nothing that
+finished. The findings are published as a Markdown artifact.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+from typing import Any
+
+from prefect import flow, get_run_logger, task
+from prefect.artifacts import create_markdown_artifact
+from pydantic import BaseModel, Field
+
+from evoeye.paths import DataRoot
+from evoeye.results.config import ResultsConfig
+from evoeye.results.markdown import findings_markdown
+from evoeye.results.run import PARTS, assemble, data_summary, write_results
+from evoeye.results.study import Study, prepare_data
+
+D = ResultsConfig()
+
+
+class ResultsParams(BaseModel):
+    """What `evoeye results` runs, at what size (ResultsConfig's fields; seeds as counts)."""
+
+    root: str | None = None
+    scenarios: list[str] = Field(default_factory=lambda: list(D.scenarios))
+    parts: list[str] = Field(default_factory=lambda: list(D.parts))
+    training_seeds: int = Field(len(D.training_seeds), ge=2)
+    campaign_seeds: int = Field(len(D.campaign_seeds), ge=2)
+    final_seeds: int = Field(D.final_seeds, ge=1)
+    initial_runs: int = Field(D.initial_runs, ge=0)
+    sim_seed: int = Field(D.sim_seed, ge=0)
+    test_runs: int = Field(D.test_runs, ge=0)
+    test_seed: int = Field(D.test_seed, ge=0)
+    test_batch: str | None = None
+    split_seed: int = Field(D.split_seed, ge=0)
+    train_frac: float | None = Field(None, ge=0.0, le=1.0)
+    val_frac: float | None = Field(None, ge=0.0, le=1.0)
+    baselines: list[str] = Field(default_factory=lambda: list(D.baselines))
+    context_lens: list[int] = Field(default_factory=lambda: list(D.context_lens))
+    inputs: list[str] = Field(default_factory=lambda: list(D.inputs))
+    methods: list[str] = Field(default_factory=lambda: list(D.methods))
+    budget_s: float | None = Field(None, ge=0.0)
+    n_round: int = Field(D.n_round, ge=1)
+    update: str = D.update
+    feedback: str = D.feedback
+    epochs: int | None = Field(None, ge=1)
+    patience: int | None = Field(None, ge=1)
+    workers: int = Field(D.workers, ge=1)
+    report_name: str = "results"
+    docs: str | None = None  # also copy the tables here (docs/results)
+    readme: str | None = None  # also rewrite this README's findings section
+
+    def config(self) -> ResultsConfig:
+        values = self.model_dump(exclude={"root", "report_name", "docs", "readme"})
+        values["training_seeds"] = tuple(range(self.training_seeds))
+        values["campaign_seeds"] = tuple(range(self.campaign_seeds))
+        return ResultsConfig(**values)
+
+    def model_post_init(self, __context) -> None:
+        self.config().check_names()  # every name and size checked before anything runs
+
+
+@task(task_run_name="data")
+def data_task(root: DataRoot, config: ResultsConfig) -> None:
+    prepare_data(root, config, print)
+
+
+@task(task_run_name="{part}-{scenario}")
+def part_task(root: DataRoot, config: ResultsConfig, scenario: str, part: str) -> dict:
+    """One part (rq1, ablation, rq2) of one logical scenario: its per-seed figures."""
+    return PARTS[part](Study(root, config, print), scenario)
+
+
+@flow(name="evoeye-results", log_prints=True)
+def results_flow(params: ResultsParams | None = None) -> dict[str, Any]:
+    """Run every part of every scenario, write the files, publish the findings."""
+    params = params or ResultsParams()
+    config, root = params.config(), DataRoot.resolve(params.root)
+    data_task(root, config)
+    study = Study(root, config)
+    scenarios = {}
+    for scenario in config.scenarios:  # one after the other; a part's campaigns side by side
+        scenarios[scenario] = {"data": data_summary(study, scenario)}
+        for part in config.parts:
+            scenarios[scenario][part] = part_task(root, config, scenario, part)
+    results = assemble(study, scenarios)
+    folder = write_results(root, results, params.report_name,
+                           docs=Path(params.docs) if params.docs else None,
+                           readme=Path(params.readme) if params.readme else None)
+    create_markdown_artifact(markdown=findings_markdown(results["findings"], "this run"),
+                             key="evoeye-results", description=f"{folder / 'results.html'}")
+    get_run_logger().info("results: %s", folder / "results.html")
+    return {"report_dir": str(folder), "findings": [(f["id"], f["verdict"])
+                                                    for f in results["findings"]]}
+
+
+if __name__ == "__main__":
+    from flows.command_line import run_from_command_line
+
+    run_from_command_line(ResultsParams, results_flow, __doc__)

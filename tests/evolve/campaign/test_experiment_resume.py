@@ -1,0 +1,104 @@
+"""Campaigns side by side: the same records on local workers, killed or not, and on Dask."""
+
+from __future__ import annotations
+
+import os
+import shutil
+import signal
+import subprocess
+import sys
+import time
+
+import pytest
+
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.experiment import run_experiment
+from evoeye.paths import DataRoot
+from evoeye.store import SplitSpec, Warehouse
+from evoeye.store.feedback import read_feedback, read_rounds
+
+SCENARIO = "unprotected-intersection"  # of the `seeded` data root (conftest.py)
+SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
+METHODS = ["uniform", "evoeye"]
+BUDGET_S = 60.0  # a few rounds of one run each
+EXPERIMENT = f"""
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.experiment import run_experiment
+from evoeye.paths import DataRoot
+from evoeye.store import SplitSpec
+
+root = DataRoot.resolve({{root!r}})
+base = CampaignConfig({SCENARIO!r}, n_round=1, epochs=1,
+                      splits=SplitSpec(seed=0, train_frac=0.5, val_frac=0.25))
+run_experiment(root, [{SCENARIO!r}], base, strategies={METHODS!r}, seeds=[0],
+               budget_s={BUDGET_S}, controls=0, workers=2, progress=lambda line: None)
+"""
+
+
+def experiment(root: DataRoot, workers: int = 1, dask_address: str | None = None) -> None:
+    base = CampaignConfig(SCENARIO, n_round=1, epochs=1, splits=SPLITS)
+    run_experiment(root, [SCENARIO], base, strategies=METHODS, seeds=[0], budget_s=BUDGET_S,
+                   controls=0, workers=workers, dask_address=dask_address,
+                   progress=lambda line: None)
+
+
+def records(root: DataRoot) -> dict:
+    """Everything the experiment's campaigns left behind that must not depend on a kill."""
+    rounds = [r for r in read_rounds(root) if r.campaign_id.startswith("evo-")]
+    fb = read_feedback(root)
+    committed = Warehouse(root).sql(
+        "SELECT scenario_id, count(*) AS n FROM scenarios GROUP BY 1 ORDER BY 1").to_pylist()
+    return {
+        "rounds": [(r.campaign_id, r.round, r.monitor_version, list(r.scenario_ids),
+                    r.n_records, r.simulated_s, r.metrics) for r in rounds],
+        "feedback": sorted(zip(*(fb.column(c).to_pylist() for c in (
+            "monitor_version", "feedback_mode", "scenario_id", "feedback")), strict=True)),
+        "logs": sorted(root.relative(p) for p in root.runs.rglob("*.mcap")),
+        "committed": committed,
+    }
+
+
+@pytest.fixture(scope="module")
+def uninterrupted(seeded, tmp_path_factory: pytest.TempPathFactory) -> dict:
+    """The records of the experiment run without a break, one campaign after the other."""
+    clean = DataRoot.resolve(tmp_path_factory.mktemp("clean") / "data")
+    shutil.copytree(seeded[0].path, clean.path)
+    experiment(clean, workers=1)
+    return records(clean)
+
+
+def test_a_killed_two_worker_experiment_resumes_to_the_same_records(root_copy,
+                                                                    uninterrupted) -> None:
+    expected = uninterrupted
+    per_campaign = {}
+    for campaign_id, *_rest in expected["rounds"]:
+        per_campaign[campaign_id] = per_campaign.get(campaign_id, 0) + 1
+    assert len(per_campaign) == 2 and min(per_campaign.values()) >= 3  # rounds 0, 1, 2, …
+    assert all(row["n"] == 1 for row in expected["committed"])
+
+    root = root_copy("killed")
+    proc = subprocess.Popen([sys.executable, "-c", EXPERIMENT.format(root=str(root.path))],
+                            start_new_session=True, env=os.environ.copy())
+    try:  # killed, with its workers, once some campaign has finished its first round
+        deadline = time.monotonic() + 600
+        while not any(r.round >= 1 for r in read_rounds(root)):
+            assert proc.poll() is None, "the experiment ended before it could be killed"
+            assert time.monotonic() < deadline, "no round finished in 10 minutes"
+            time.sleep(0.05)
+    finally:
+        os.killpg(proc.pid, signal.SIGKILL)
+        proc.wait()
+    cut = records(root)
+    assert cut["rounds"] != expected["rounds"]  # it was stopped part-way
+    experiment(root, workers=2)
+    assert records(root) == expected
+
+
+def test_a_dask_cluster_runs_the_campaigns_to_the_same_records(root_copy, uninterrupted) -> None:
+    from distributed import LocalCluster
+
+    root = root_copy("dask")
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster:
+        experiment(root, dask_address=cluster.scheduler_address)
+    assert records(root) == uninterrupted

@@ -1,0 +1,73 @@
+"""ResultsConfig: its literal defaults match their sources, bad values are refused by name."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+
+import pytest
+
+from evoeye.results import config
+from evoeye.results.config import ResultsConfig
+
+
+def test_the_literal_defaults_are_their_sources() -> None:
+    from evoeye.evaluation.ablation import CONTEXT_LENS
+    from evoeye.evaluation.monitors import BASELINES
+    from evoeye.evolve.campaign.experiment import ABLATION, MAIN
+    from evoeye.monitor.inputs import ABLATIONS
+    from evoeye.scenarios import SCENARIOS
+    from evoeye.splits import SplitSpec
+
+    assert tuple(SCENARIOS) == config.SCENARIOS
+    assert tuple(BASELINES) == config.BASELINES
+    assert config.CONTEXT_LENS == CONTEXT_LENS
+    assert tuple(ABLATIONS) == config.INPUTS
+    assert config.METHODS == MAIN + ABLATION
+    assert (SplitSpec().train_frac, SplitSpec().val_frac) == config.DEFAULT_SHARES
+
+
+def test_the_config_module_imports_nothing_heavy() -> None:
+    probe = ("import json, sys; import evoeye.results.config; "
+             "print(json.dumps(sorted({m.split('.')[0] for m in sys.modules})))")
+    done = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
+                          check=True)
+    assert not set(json.loads(done.stdout)) & {"numpy", "torch", "duckdb", "pyarrow", "scipy"}
+
+
+def test_the_defaults_are_the_issues_sizes() -> None:
+    cfg = ResultsConfig()
+    assert len(cfg.training_seeds) >= 5 and 2 / 2 ** len(cfg.training_seeds) <= 0.05
+    assert 16 <= len(cfg.campaign_seeds) <= 25
+    assert all(cfg.test_runs >= 3 * n for n in config.PAPER_TEST_RUNS.values())
+    assert cfg.held_out_batch == "test-seed1000000" and cfg.shares == (0.8, 0.2)
+    assert ResultsConfig(test_runs=0).shares == config.DEFAULT_SHARES
+    assert ResultsConfig(test_runs=0, test_batch="held").held_out_batch == "held"
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [
+    ({"training_seeds": (0,)}, "at least 2 distinct training seeds"),
+    ({"campaign_seeds": (1, 1)}, "at least 2 distinct campaign seeds"),
+    ({"final_seeds": 0}, "final_seeds must be >= 1"),
+    ({"parts": ("rq1", "rq4")}, r"unknown part\(s\) \['rq4'\]"),
+    ({"test_seed": 0}, "its own seed"),
+    ({"n_round": 0}, "n_round must be >= 1"),
+])
+def test_bad_sizes_are_refused(kwargs: dict, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        ResultsConfig(**kwargs)
+
+
+@pytest.mark.parametrize(("kwargs", "message"), [
+    ({"scenarios": ("roundabout",)}, "unknown scenario"),
+    ({"methods": ("evoeye", "random-walk")}, "unknown method"),
+    ({"baselines": ("ttc", "radar")}, r"unknown baseline \['radar'\]"),
+    ({"inputs": ("lidar",)}, "unknown input set"),
+    ({"context_lens": (0, 5)}, "context lengths must be >= 1"),
+    ({"train_frac": 0.9, "val_frac": 0.3}, "sum <= 1"),
+    ({"test_batch": "../x"}, "not a plain name"),
+])
+def test_unknown_names_are_refused(kwargs: dict, message: str) -> None:
+    with pytest.raises(ValueError, match=message):
+        ResultsConfig(**kwargs).check_names()
