@@ -55,6 +55,9 @@ class Lane:
     points: np.ndarray  # (K, 2) metres
     width_m: float
     speed_limit_mps: float
+    # traffic on this lane must give way to traffic on the route where it ends (a minor road,
+    # priority to the right): it is expected to stop at the lane's end unless the way is clear
+    yields_to_route: bool = False
 
     @property
     def s_m(self) -> np.ndarray:

@@ -90,7 +90,9 @@ class PredictionConfig:
     # lane-change intent: log-odds = v_lat / speed_scale + offset / offset_scale − bias
     intent_lat_speed_scale_mps: float = 0.4
     intent_offset_scale_m: float = 1.0
-    intent_change_bias: float = 3.5  # prior against a lane change at zero evidence
+    intent_change_bias: float = 4.5  # prior against a lane change at zero evidence: a cut-in
+    # becomes the likelier hypothesis only about half-way into the lane, as a production
+    # stack's in-path selection has it
     lane_change_duration_s: float = 3.0  # predicted duration of a change over a whole lane
     # lane continuations (turns): heading vs each continuation's tangent a little ahead
     turn_lookahead_s: float = 1.0
@@ -98,6 +100,12 @@ class PredictionConfig:
     turn_heading_sigma_rad: float = 0.2
     successor_join_m: float = 1.5  # a lane starting this close to another's end continues it
     min_mode_prob: float = 0.05  # less probable modes are dropped (the best one always stays)
+    # give way: a car on a lane that yields to the route (the map's rule of the road) is expected
+    # to stop at the lane's end; the belief fades as the braking it would need to stop grows
+    yield_prior: float = 0.9  # P(it stops) while it could still stop comfortably
+    yield_decel_mps2: float = 4.0  # the braking a driver who means to stop would not exceed …
+    yield_decel_scale_mps2: float = 0.5  # … logistic width of the fade around it
+    yield_range_m: float = 60.0  # within this of the lane's end the hypothesis is made
     lane_resample_m: float = 1.0  # lane polylines are resampled to this spacing at start-up
     grid_cell_m: float = 1.0  # cell of the lookup grid used to project onto lanes
 
@@ -112,7 +120,7 @@ class PlanningConfig:
     ego_width_m: float = 2.0
     corridor_margin_m: float = 0.3  # lateral margin added to both half-widths for "in path"
     max_obstacle_half_length_m: float = 3.0  # bounds the corridor search (route grid reach)
-    mode_prob_min: float = 0.2  # plans against every predicted mode at least this probable
+    mode_prob_min: float = 0.5  # plans against a track's best mode and any as likely as not
     idm_accel_mps2: float = 2.0  # IDM a: max acceleration
     idm_decel_mps2: float = 3.0  # IDM b: comfortable deceleration
     idm_delta: float = 4.0
@@ -122,18 +130,20 @@ class PlanningConfig:
     follow_soft_headway_s: float = 0.6  # … or the gap is below min_gap + v · this
     comfort_decel_mps2: float = 3.5  # no normal decision brakes harder; beyond it is AEB's job
     follow_range_m: float = 120.0  # leaders farther than this along the route are ignored
-    cutin_horizon_s: float = 2.0  # an aligned car predicted in the path within this is a leader
+    cutin_horizon_s: float = 1.0  # an aligned car predicted in the path within this is a leader
     aligned_max_rad: float = 0.6  # heading gap to the route below which a car "follows"
     gap_margin_s: float = 0.5  # a crossing gap is taken only with this much time to spare …
     arrival_uncertainty_frac: float = 0.1  # … the other's arrival taken this much earlier
     go_accel_mps2: float = 2.0  # accel assumed for the ego's arrival estimate
     stop_buffer_m: float = 1.5  # the ego stops this far before a conflict region
-    yield_decel_max_mps2: float = 1.5  # beyond this the ego is committed and goes on
+    yield_decel_max_mps2: float = 1.75  # beyond this the ego is committed and goes on
     proceed_hold_margin_s: float = 0.5  # a proceed is revoked only if the gap is this much short
     release_frames: int = 6  # a yield / AEB is held until its conflict is clear this many frames
     emergency_ttc_s: float = 0.8  # time to collision below which the ego brakes hard (AEB)
     emergency_decel_mps2: float = 8.5  # AEB deceleration …
     emergency_jerk_mps3: float = 30.0  # … reached at this jerk
+    aeb_on_predicted_crossings: bool = False  # AEB also for a crossing car only predicted to
+    # enter the path (junction AEB); the default acts once it is in the path
     stitch_tolerance_mps: float = 1.0  # replan from the measured speed if the plan drifts more
     route_resample_m: float = 1.0
     grid_cell_m: float = 1.0
@@ -181,7 +191,9 @@ class ADSConfig:
         return cls(
             sensor=SensorConfig(latency_s=0.10),
             prediction=PredictionConfig(intent_change_bias=2.0),
-            planning=PlanningConfig(time_headway_s=1.5, gap_margin_s=1.0,
+            planning=PlanningConfig(mode_prob_min=0.2, cutin_horizon_s=2.0,
+                                    aeb_on_predicted_crossings=True,
+                                    time_headway_s=1.5, gap_margin_s=1.0,
                                     arrival_uncertainty_frac=0.2, go_accel_mps2=1.5,
                                     yield_decel_max_mps2=5.0, comfort_decel_mps2=4.0,
                                     emergency_ttc_s=1.2),

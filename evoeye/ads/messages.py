@@ -92,8 +92,9 @@ class PlannedTrajectory(Message):
     accel_mps2: np.ndarray
 
 
-# constant velocity; along a lane (or one of its continuations); a lane change left or right
-PREDICTION_MODES = ("cv", "lane", "left", "right")
+# constant velocity; along a lane (or one of its continuations); a lane change left or right;
+# stopping at the end of a lane that gives way (the rule of the road)
+PREDICTION_MODES = ("cv", "lane", "left", "right", "yield")
 PLANNING_DECISIONS = ("cruise", "follow", "yield", "proceed", "emergency_brake")
 
 

@@ -118,9 +118,12 @@ class TrueFuturePredictor:
 
 def careful_planning(config: PlanningConfig) -> PlanningConfig:
     """The planner's configuration for a careful reference driver: long headway, positive gap
-    margins, cautious arrival estimates, earlier and firmer AEB, yielding up to a firm brake."""
+    margins, cautious arrival estimates, every plausible mode planned against and a cut-in
+    taken as a leader early, earlier and firmer AEB (also for predicted crossings), yielding up
+    to a firm brake."""
     return replace(
-        config, time_headway_s=2.0, min_gap_m=4.0, follow_soft_headway_s=1.2,
+        config, mode_prob_min=0.2, cutin_horizon_s=2.0, aeb_on_predicted_crossings=True,
+        time_headway_s=2.0, min_gap_m=4.0, follow_soft_headway_s=1.2,
         follow_decel_max_mps2=6.0, comfort_decel_mps2=6.0, corridor_margin_m=0.5,
         gap_margin_s=1.5, arrival_uncertainty_frac=0.2, go_accel_mps2=1.5,
         yield_decel_max_mps2=6.0, emergency_ttc_s=2.0,

@@ -300,6 +300,8 @@ class RoutePlanner:
         urgent = ~safe & ~stoppable & (d_in > -c.ego_length_m) & (
             np.maximum(te_in, t_in) <= c.emergency_ttc_s
         )
+        if not c.aeb_on_predicted_crossings:  # AEB sees a crossing car once it is in the path
+            urgent &= k0 == 0
         if np.count_nonzero(urgent):
             j = int(np.where(urgent, d_in, np.inf).argmin())
             return -c.emergency_decel_mps2, "emergency_brake", int(p.track_id[i[j]]), 0.0

@@ -12,6 +12,12 @@ gets these modes:
   v_lat / intent_lat_speed_scale_mps + offset / intent_offset_scale_m − intent_change_bias
   against lane keeping.
 
+* "yield": on a lane that gives way to the route (the map's rule of the road), within
+  `yield_range_m` of the lane's end, it brakes to stop there. Its probability is
+  `yield_prior` while stopping needs at most about `yield_decel_mps2`, and fades as the braking
+  it would need grows: a driver who ignores the rule shows it only by not slowing down, late.
+  The lane's other modes share what is left.
+
 Any other obstacle gets one "cv" (constant velocity) mode. Modes below `min_mode_prob` are
 dropped, except each obstacle's most probable one. The hypotheses can be wrong, as a real
 predictor's are: a cut-in is likely only once lateral motion shows, a turn once the heading
@@ -31,8 +37,8 @@ from evoeye.ads.messages import PREDICTION_MODES, Localization, Obstacles, Predi
 from evoeye.scene import RoadMap
 
 HEADING_SECTORS = 8  # the lane grid keeps the nearest lane per 45° heading sector
-CV, LANE, LEFT, RIGHT = range(4)  # indices into PREDICTION_MODES
-MODE_AFTER_PATHS = np.array([LANE, LEFT, RIGHT, CV])  # the mode of columns M − 1, M, M + 1, M + 2
+CV, LANE, LEFT, RIGHT, YIELD = range(5)  # indices into PREDICTION_MODES
+MODE_AFTER_PATHS = np.array([LANE, LEFT, RIGHT, CV, YIELD])  # the mode of columns M − 1 … M + 3
 _GRAPHS: dict[tuple, LaneGraph] = {}  # lane graphs by (lane index, parameters)
 GRAPH_CACHE_MAX = 16
 
@@ -71,6 +77,8 @@ class IntentPredictor:
                     _GRAPHS.pop(next(iter(_GRAPHS)))
                 _GRAPHS[key] = graph
             self.graph = graph
+            self.lane_len = np.array([float(ln.s_m[-1]) for ln in road_map.lanes])  # (L,)
+            self.gives_way = np.array([ln.yields_to_route for ln in road_map.lanes])  # (L,)
 
     def predict(self, obstacles: Obstacles, ego: Localization) -> Predictions:
         c = self.c
@@ -113,9 +121,18 @@ class IntentPredictor:
             w = np.exp(dh * dh * (-0.5 / c.turn_heading_sigma_rad**2)) * (paths >= 0)
             p_path = w * (p_keep / np.maximum(w.sum(axis=1), 1e-12))[:, None]  # (n, M)
 
-        # rows (obstacle, mode, probability): columns lane continuations, left, right, cv
-        p_all = np.concatenate((p_path, (w_left * p_keep)[:, None], (w_right * p_keep)[:, None],
-                                (~on)[:, None]), axis=1)  # (n, M + 3)
+        # give way: P(it stops at its lane's end), from the braking that stopping would need
+        to_end = self.lane_len.take(lane) - s  # (n,) to the lane's end (its stop line)
+        may_yield = on & self.gives_way.take(lane) & (to_end > 0.0) & (to_end <= c.yield_range_m)
+        need = v_along * v_along / (2.0 * np.maximum(to_end, 0.5))  # (n,) m/s²
+        p_yield = may_yield * c.yield_prior / (
+            1.0 + np.exp(np.minimum((need - c.yield_decel_mps2) / c.yield_decel_scale_mps2, 50.0)))
+        go = 1.0 - p_yield
+
+        # rows (obstacle, mode, probability): columns lane continuations, left, right, cv, yield
+        p_all = np.concatenate((p_path * go[:, None], (w_left * p_keep * go)[:, None],
+                                (w_right * p_keep * go)[:, None], (~on)[:, None],
+                                (on * p_yield)[:, None]), axis=1)  # (n, M + 4)
         best = p_all.max(axis=1, keepdims=True)
         obs, col = ((p_all >= np.minimum(best, c.min_mode_prob)) & (p_all > 0.0)).nonzero()
         prob = p_all[obs, col]
@@ -135,6 +152,15 @@ class IntentPredictor:
             o = obs[is_cv]
             x[is_cv] = ox.take(o)[:, None] + vx.take(o)[:, None] * t
             y[is_cv] = oy.take(o)[:, None] + vy.take(o)[:, None] * t
+        stops = mode == YIELD
+        if np.count_nonzero(stops):  # brake evenly to a stop at the lane's end
+            o = obs[stops]
+            v0, d_end = v_along.take(o)[:, None], np.maximum(to_end.take(o), 0.5)[:, None]
+            t_stop = 2.0 * d_end / np.maximum(v0, 1e-6)  # (r, 1)
+            tt = np.minimum(t, t_stop)
+            ds = v0 * tt - 0.5 * (v0 / t_stop) * tt * tt
+            gl = lanes.offset.take(lane.take(o))[:, None] + s.take(o)[:, None] + ds
+            x[stops], y[stops] = lanes.xy_at(gl)
         change = (mode == LEFT) | (mode == RIGHT)
         if np.count_nonzero(change):
             o = obs[change]

@@ -111,6 +111,7 @@ def _lane_dict(lane: Lane) -> dict[str, Any]:
         "points": np.ascontiguousarray(lane.points, dtype=np.float64),
         "width_m": float(lane.width_m),
         "speed_limit_mps": float(lane.speed_limit_mps),
+        "yields_to_route": bool(lane.yields_to_route),
     }
 
 
@@ -125,7 +126,8 @@ def road_map_dict(road_map: RoadMap) -> dict[str, Any]:
 
 def _lane(d: dict[str, Any]) -> Lane:
     points = np.asarray(d["points"], dtype=np.float64).reshape(-1, 2)
-    return Lane(d["lane_id"], points, float(d["width_m"]), float(d["speed_limit_mps"]))
+    return Lane(d["lane_id"], points, float(d["width_m"]), float(d["speed_limit_mps"]),
+                bool(d.get("yields_to_route", False)))
 
 
 def decode_road_map(data: bytes) -> RoadMap:

@@ -39,8 +39,12 @@ CROSSING_RADIUS_M = 4.5  # a waiting NPC's centre keeps this far from the other'
 # half-diagonal, 2.7 m, plus the other's half-width and a margin)
 MIN_SPACING_M = 10.0  # centre spacing between NPCs placed on one approach
 
-BUILDING_FROM_M, BUILDING_TO_M = 12.5, 90.0  # a building fills each corner between these
-# distances from the centre lines, both ways: crossing traffic shows late, as at a city corner
+# a building fills each corner from its setback to BUILDING_TO_M off the centre lines, both
+# ways: crossing traffic shows late, as at a city corner. The corners east of the ego's road
+# stand closer than the western ones (a wider pavement there), so the two crossings show at
+# different moments
+BUILDING_SETBACK_M = {"east": 12.5, "west": 18.0}
+BUILDING_TO_M = 90.0
 EGO_CLEARANCE_M = 6.5  # a turning NPC yielding to the ego stops this far from its route
 TURN_GAP_S = 2.0  # a turning NPC goes if the ego would reach the crossing this much after it
 # name → (approach, destination); parameters are f"{name}_speed_mps", f"{name}_offset_s"
@@ -52,8 +56,12 @@ NPC_MOVES = {
     "left_merge": (1, 2),  # west → north: left turn into the ego's exit lane
 }
 # turning traffic yields to the ego's straight movement (accepting short gaps); the crossing
-# traffic on the major road does not
+# traffic does not
 TURNS_YIELD = ("opp_left", "right_merge", "left_merge")
+# the rule of the road the ADS's map encodes (priority to the right): traffic from the ego's
+# left (west) gives way to it; the ego gives way to traffic from its right (east). The west
+# crossing car does not keep to it — a right-of-way violation the ADS must see in time
+GIVE_WAY_APPROACHES = (1,)
 
 
 def _route(src: int, dst: int) -> list[tuple[str, str, int]]:
@@ -81,7 +89,9 @@ def _network() -> tuple[RoadNetwork, RoadMap]:
         net.add_lane(f"o{k}", f"x{k}", StraightLane(
             out.end, out.end + EXTENSION_M * out.direction,
             line_types=[LineType.NONE, LineType.CONTINUOUS], speed_limit=EGO_CRUISE_MPS))
-    return net, road_map_from_network("unprotected-intersection", net, EGO_ROUTE)
+    yielding = frozenset(pair for k in GIVE_WAY_APPROACHES
+                         for pair in ((f"e{k}", f"o{k}"), (f"o{k}", f"ir{k}")))
+    return net, road_map_from_network("unprotected-intersection", net, EGO_ROUTE, yielding)
 
 
 @functools.cache
@@ -100,9 +110,11 @@ def _conflict(src: int, dst: int) -> tuple[float, float]:
 
 
 @functools.cache
-def _npc_crossings() -> tuple[tuple[int, int, float, float, float, float], ...]:
-    """(row i, row j, s_i, s_j, stop_i, stop_j) for every pair of NPC moves from different
-    approaches whose paths meet (rows as in the world: NPCs from 1)."""
+def _npc_crossings() -> tuple[tuple[int, int, float, float, float, float, int | None], ...]:
+    """(row i, row j, s_i, s_j, stop_i, stop_j, first) for every pair of NPC moves from different
+    approaches whose paths meet (rows as in the world: NPCs from 1). `first` is the straight
+    move where the other turns (turning traffic gives way to straight traffic), else None:
+    whoever would arrive first goes."""
     moves = list(NPC_MOVES.values())
     out = []
     for a in range(len(moves)):
@@ -114,7 +126,10 @@ def _npc_crossings() -> tuple[tuple[int, int, float, float, float, float], ...]:
             if hit is not None:
                 stop_a = pa.stop_before(pb, hit[0], hit[1], CROSSING_RADIUS_M)
                 stop_b = pb.stop_before(pa, hit[1], hit[0], CROSSING_RADIUS_M)
-                out.append((a + 1, b + 1, *hit, stop_a, stop_b))
+                straight = [r for r, (src, dst) in ((a + 1, moves[a]), (b + 1, moves[b]))
+                            if (src - dst) % 2 == 0]
+                out.append((a + 1, b + 1, *hit, stop_a, stop_b,
+                            straight[0] if len(straight) == 1 else None))
     return tuple(out)
 
 
@@ -178,7 +193,10 @@ def build_intersection(p: dict[str, float], rng: np.random.Generator) -> tuple[W
 @functools.cache
 def _buildings() -> np.ndarray:
     """(4, 4) one building per corner, [x_min, y_min, x_max, y_max]."""
-    a, b = BUILDING_FROM_M, BUILDING_TO_M
-    return np.array([[sx * a if sx > 0 else -b, sy * a if sy > 0 else -b,
-                      b if sx > 0 else -a, b if sy > 0 else -a]
-                     for sx in (1, -1) for sy in (1, -1)], dtype=float)
+    b = BUILDING_TO_M
+    corners = []
+    for sx in (1, -1):
+        a = BUILDING_SETBACK_M["east" if sx > 0 else "west"]
+        corners += [[a if sx > 0 else -b, a if sy > 0 else -b, b if sx > 0 else -a,
+                     b if sy > 0 else -a] for sy in (1, -1)]
+    return np.array(corners, dtype=float)

@@ -21,7 +21,11 @@ from highway_env.vehicle.kinematics import Vehicle
 from evoeye.sim.path import Path
 
 LANE_WIDTH_M = 4.0
-CUT_IN_MIN_TTC_S = 2.0  # a cut-in waits while the ego would reach it sooner than this
+CRASH_DECEL_MPS2 = 8.0  # a vehicle in a contact brakes to a standstill at this rate
+# a cut-in goes only into a gap the ego could still keep by braking at CUT_IN_EGO_DECEL_MPS2
+# after CUT_IN_EGO_REACTION_S: gap ≥ closing·t + closing²/(2·b) (aggressive, not suicidal)
+CUT_IN_EGO_REACTION_S = 1.5
+CUT_IN_EGO_DECEL_MPS2 = 4.0
 CATCH_UP_GAIN_PER_S = 2.0  # braking towards a lower desired speed: 2 m/s² per m/s above it
 PROFILE_DECEL_SHARE = 0.6  # curves are planned for at this share of the comfortable braking,
 # so that the speed tracks the profile with a small lag and the curve is entered on it
@@ -39,7 +43,7 @@ class DriverModel:
     max_accel_mps2: float = 3.0
     max_decel_mps2: float = 9.0
     lat_accel_mps2: float = 3.0  # curve speed: v² · |κ| ≤ this
-    crash_decel_mps2: float = 8.0  # a vehicle in a contact brakes to a standstill
+    crash_decel_mps2: float = CRASH_DECEL_MPS2
 
 
 @dataclass(frozen=True)
@@ -65,6 +69,14 @@ class LaneChange:
         """(peak lateral speed m/s, peak lateral acceleration m/s²) of the offset profile."""
         w, t = abs(self.offset_m), self.duration_s
         return math.pi * w / (2.0 * t), math.pi**2 * w / (2.0 * t * t)
+
+
+def cut_in_gap_m(closing_mps: float) -> float:
+    """The smallest bumper gap ahead of the ego a cut-in accepts while the ego closes on it at
+    closing_mps: the ego, braking at CUT_IN_EGO_DECEL_MPS2 after CUT_IN_EGO_REACTION_S, keeps
+    it. At 5 m/s that is 10.6 m (2.1 s), at 10 m/s 27.5 m, at 15 m/s 50.6 m."""
+    v = max(closing_mps, 0.0)
+    return v * CUT_IN_EGO_REACTION_S + v * v / (2.0 * CUT_IN_EGO_DECEL_MPS2)
 
 
 def curve_speed(path: Path, driver: DriverModel) -> np.ndarray:
@@ -116,8 +128,9 @@ class Npc(Vehicle):
 
     def wants_lane_change(self, gap_to_ego_m: float, ego_closing_mps: float) -> bool:
         """Update the trigger with the current bumper gap ahead of the ego and the speed at which
-        the ego closes it; True once it fired, the ego is at least `CUT_IN_MIN_TTC_S` away (an
-        aggressive driver, not a suicidal one) and the change has not started yet."""
+        the ego closes it; True once it fired, the gap is one the ego could still keep (see
+        `cut_in_gap_m`: an aggressive driver, not a suicidal one) and the change has not started
+        yet."""
         lc = self.lane_change
         if lc is None or self._lc_start_s is not None or self.crashed:
             return False
@@ -127,7 +140,7 @@ class Npc(Vehicle):
         self._trigger_side = side
         if self._armed and gap_to_ego_m < 0.0:  # fell behind the ego again: the moment passed
             self._armed = False
-        return self._armed and gap_to_ego_m >= CUT_IN_MIN_TTC_S * max(ego_closing_mps, 0.0)
+        return self._armed and gap_to_ego_m >= cut_in_gap_m(ego_closing_mps)
 
     def start_lane_change(self) -> None:
         self._lc_start_s = self.clock_s
@@ -205,6 +218,13 @@ class EgoVehicle(Vehicle):
 
     def on_state_update(self) -> None:
         return
+
+    def clip_actions(self) -> None:
+        """After a contact the ego brakes to a standstill like a crashed NPC (highway-env's own
+        rule, accel = −speed, would let it roll on through what it hit for seconds)."""
+        super().clip_actions()
+        if self.crashed:
+            self.action["acceleration"] = -CRASH_DECEL_MPS2 if self.speed > 0.0 else 0.0
 
     def step(self, dt: float) -> None:
         super().step(dt)

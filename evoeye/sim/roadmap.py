@@ -20,9 +20,11 @@ def _sample(lane, step_m: float = SAMPLE_STEP_M) -> np.ndarray:
 
 
 def road_map_from_network(
-    name: str, network: RoadNetwork, route: list[tuple[str, str, int]]
+    name: str, network: RoadNetwork, route: list[tuple[str, str, int]],
+    yielding: frozenset[tuple[str, str]] = frozenset(),
 ) -> RoadMap:
-    """Every lane of `network`, plus the ego route as one polyline through the `route` lanes."""
+    """Every lane of `network`, plus the ego route as one polyline through the `route` lanes.
+    Lanes (from, to) in `yielding` give way to the route's traffic where they end."""
     lanes = []
     for _from, tos in network.graph.items():
         for _to, group in tos.items():
@@ -33,6 +35,7 @@ def road_map_from_network(
                         points=_sample(lane),
                         width_m=float(lane.width_at(0.0)),
                         speed_limit_mps=float(lane.speed_limit or 30.0),
+                        yields_to_route=(_from, _to) in yielding,
                     )
                 )
     parts = [_sample(network.get_lane(idx)) for idx in route]

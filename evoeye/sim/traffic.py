@@ -74,6 +74,35 @@ def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray
     return best, np.where(np.isfinite(best), rel.speed[j] * rel.cos_dh[rows, j], 0.0), block
 
 
+CURVE_AHEAD_RAD = 0.1  # a path turning more than this within BLOCKING_M is checked along its arc
+
+
+def path_block(path, s_m: float, half_len_m: float, half_wid_m: float, x: np.ndarray,
+               y: np.ndarray, heading: np.ndarray, half_l: np.ndarray, half_w: np.ndarray,
+               others: np.ndarray) -> float:
+    """Bumper gap along a *curved* path to the first vehicle (rows `others`) whose footprint
+    lies on it within `BLOCKING_M` and that does not drive its way there (a car standing in a
+    turn, the ego's nose in the crossing); inf if none, or if the path ahead is straight (the
+    straight corridor of `leaders` already covers it). Footprints are exact boxes: the distance
+    from every path sample to each box, against the NPC's half-width plus the corridor margin."""
+    k0 = path.index(s_m)
+    k1 = path.index(s_m + half_len_m + BLOCKING_M)
+    if k1 <= k0 or abs(path.h[k1] - path.h[k0]) < CURVE_AHEAD_RAD or not len(others):
+        return np.inf
+    px, py, ph = path.x[k0:k1 + 1], path.y[k0:k1 + 1], path.h[k0:k1 + 1]  # (K,)
+    c, s = np.cos(heading[others])[:, None], np.sin(heading[others])[:, None]  # (m, 1)
+    dx, dy = px[None, :] - x[others, None], py[None, :] - y[others, None]  # (m, K)
+    ex = np.maximum(np.abs(c * dx + s * dy) - half_l[others, None], 0.0)
+    ey = np.maximum(np.abs(c * dy - s * dx) - half_w[others, None], 0.0)
+    on_path = ex * ex + ey * ey < (half_wid_m + CORRIDOR_MARGIN_M) ** 2  # (m, K)
+    on_path &= np.cos(heading[others, None] - ph[None, :]) <= ALIGNED_COS  # not a leader
+    on_path[:, : int(half_len_m / path.step_m) + 1] = False  # behind its own front bumper
+    hit = on_path.any(axis=0)
+    if not hit.any():
+        return np.inf
+    return max(float(path.s[k0 + int(hit.argmax())] - s_m) - half_len_m, 0.0)
+
+
 def clear_to_change(rel: Relations, i: int, offset_m: float) -> bool:
     """Whether NPC i may move `offset_m` sideways: no other NPC (the ego is not asked) in the
     target lane within the bumper gaps a careful driver leaves ahead and behind."""
@@ -89,6 +118,8 @@ def clear_to_change(rel: Relations, i: int, offset_m: float) -> bool:
 
 DECIDE_WITHIN_M = 60.0  # a crossing's order is settled once both NPCs are this close to it
 PASSED_M = 6.0  # the first NPC is through once its centre is this far past the crossing point
+COMMIT_DECEL_MPS2 = 3.0  # a yielding NPC that could no longer stop at this rate goes on
+CLEAR_MARGIN_S = 1.0  # an NPC slows for a crossing NPC that clears less than this before it
 
 
 @dataclass
@@ -105,8 +136,10 @@ class Conflict:
     first: int | None = field(default=None)  # the row that goes first, once settled
 
     def wait_gap(self, s: dict[int, float], v: dict[int, float]) -> tuple[int, float] | None:
-        """(row that waits, its distance to its stop point) while the first NPC is not through;
-        None once there is nothing to wait for (or nothing settled yet)."""
+        """(row that waits, its distance to its stop point) while the first NPC is not through
+        and the other would reach its stop point before the first has cleared the crossing
+        (with `CLEAR_MARGIN_S` to spare); None once there is nothing to wait for (or nothing
+        settled yet). A driver slows for a crossing car only if their timing calls for it."""
         to_i, to_j = self.s_i - s[self.i], self.s_j - s[self.j]
         if to_i < -PASSED_M or to_j < -PASSED_M:  # one is through: the other may go
             return None
@@ -115,16 +148,22 @@ class Conflict:
                 return None
             t_i, t_j = to_i / max(v[self.i], 1.0), to_j / max(v[self.j], 1.0)
             self.first = self.i if t_i <= t_j else self.j
-        if self.first == self.i:
-            return self.j, self.stop_j - s[self.j]
-        return self.i, self.stop_i - s[self.i]
+        f, to_f, w, stop_w = ((self.i, to_i, self.j, self.stop_j) if self.first == self.i
+                              else (self.j, to_j, self.i, self.stop_i))
+        to_stop = stop_w - s[w]
+        t_clear = (to_f + PASSED_M) / max(v[f], 1.0)
+        if to_stop / max(v[w], 1.0) > t_clear + CLEAR_MARGIN_S:
+            return None
+        return w, to_stop
 
 
 @dataclass
 class YieldToEgo:
     """NPC row i turns across or into the ego's path and yields to it: it goes only if the ego
     would reach the crossing at least `gap_s` after it (an assertive driver's accepted gap),
-    otherwise it waits with its centre at stop_i. Once past its stop point it is committed."""
+    otherwise it waits with its centre at stop_i. The gap is judged again every step until the
+    NPC is committed: past its stop point, or too fast to stop before it at `COMMIT_DECEL_MPS2`
+    (a driver who saw a gap 60 m out still brakes when the ego turns out to arrive sooner)."""
 
     i: int
     s_i: float  # arc length of the crossing on the NPC's path
@@ -144,6 +183,6 @@ class YieldToEgo:
         t_npc = (self.s_i - s) / max(v, 1.0)
         t_ego = to_ego / max(v_ego, 0.1)
         if t_ego > t_npc + self.gap_s:
-            self.going = True
+            self.going = v * v > 2.0 * COMMIT_DECEL_MPS2 * max(self.stop_i - s, 0.0)
             return None
         return self.stop_i - s

@@ -19,7 +19,14 @@ from evoeye.scene import EGO_ID, RoadMap, SceneState
 from evoeye.sim.footprint import box_corners, box_gaps
 from evoeye.sim.npc import EgoVehicle, Npc
 from evoeye.sim.path import Path
-from evoeye.sim.traffic import Conflict, Relations, YieldToEgo, clear_to_change, leaders
+from evoeye.sim.traffic import (
+    Conflict,
+    Relations,
+    YieldToEgo,
+    clear_to_change,
+    leaders,
+    path_block,
+)
 
 NPC_REACTION_S = 1.0  # an NPC driver brakes for a car crossing its way after this long
 
@@ -77,6 +84,7 @@ class World:
         rel = Relations.of(x, y, heading, speed, self.length_m, self.width_m)
         shift = np.array([0.0] + [n.lateral_target_m() for n in self.npcs])
         gap, v_lead, block = leaders(rel, shift)
+        self._block_along_paths(block, x, y, heading)
         self._blocked_s = np.where(np.isfinite(block), self._blocked_s + dt, 0.0)
         seen = self._blocked_s > NPC_REACTION_S  # a crossing car, answered after a reaction time
         gap, v_lead = np.where(seen & (block < gap), block, gap), np.where(
@@ -100,6 +108,20 @@ class World:
         self.t_s += dt
         self._accel = np.array([(ego.speed - v_before) / dt] + [n.accel_mps2 for n in self.npcs])
         self._contacts()
+
+    def _block_along_paths(self, block: np.ndarray, x: np.ndarray, y: np.ndarray,
+                           heading: np.ndarray) -> None:
+        """Where an NPC's path curves ahead (a turn), what blocks it is looked for along the
+        arc rather than straight ahead: a car standing in the turn is seen as a driver sees it."""
+        half_l, half_w = 0.5 * self.length_m, 0.5 * self.width_m
+        rows = np.arange(len(self.vehicles))
+        for i, npc in enumerate(self.npcs, start=1):
+            if npc.crashed or npc.changing_lanes:
+                continue
+            g = path_block(npc.path, npc.s_m, half_l[i], half_w[i], x, y, heading, half_l,
+                           half_w, rows[rows != i])
+            if g < block[i]:
+                block[i] = g
 
     def _wait_at_crossings(self, gap: np.ndarray, v_lead: np.ndarray) -> None:
         """An NPC waiting at a crossing (for another NPC, or yielding to the ego) sees a

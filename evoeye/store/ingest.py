@@ -144,17 +144,19 @@ class Ingester:
                     report.catalog_error = f"{self.root.duckdb_file}: {e}"
             return report
         logs = discover_logs(self.root.batch_dir(*self.batch))
-        with key_lock(self.root, "scenarios", ["/".join(self.batch)]):
+        # the batch's key and every run id it may write, taken in one sorted acquisition: two
+        # keys can share a stripe, and a stripe taken twice by one process waits for itself
+        keys = ["/".join(self.batch), *(log.name.removesuffix(LOG_SUFFIX) for log in logs)]
+        with key_lock(self.root, "scenarios", keys):
             report.orphans_removed = [self.root.relative(p)
                                       for p in self.store.remove_orphans(self.batch)]
             mine = self.store.committed(self.batch)
             new = [log for log in logs if self.root.relative(log) not in mine]
             ids = [log.name.removesuffix(LOG_SUFFIX) for log in new]
-            with key_lock(self.root, "scenarios", ids):  # committed by another batch meanwhile?
-                ledger = (Warehouse(self.root).query("committed_ids", ids=ids) if ids
-                          else pa.table({"scenario_id": [], "log_path": []}))
-                report.skipped += len(logs) - len(new)
-                self._ingest_new(new, ledger, given, report)
+            ledger = (Warehouse(self.root).query("committed_ids", ids=ids) if ids
+                      else pa.table({"scenario_id": [], "log_path": []}))  # by another batch?
+            report.skipped += len(logs) - len(new)
+            self._ingest_new(new, ledger, given, report)
         return report
 
     def _ingest_new(self, logs: Sequence[Path], ledger: pa.Table, given: dict[str, LoggedRun],

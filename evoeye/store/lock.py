@@ -91,7 +91,9 @@ def stripe_path(root: DataRoot, table: str, key: str) -> Path:
 @contextmanager
 def key_lock(root: DataRoot, table: str, keys: Iterable[str]) -> Iterator[None]:
     """Write access to `keys` of `table`: the writer lock shared (WarehouseLockedError while an
-    exclusive writer holds it) and the keys' stripes exclusively, waited for."""
+    exclusive writer holds it) and the keys' stripes exclusively, waited for, in sorted order.
+    Take all of one table's keys in one call: a nested call whose key shares a stripe with a
+    held one would wait for its own process."""
     with ExitStack() as stack:
         stack.enter_context(WriterLock(root.writer_lock, shared=True))
         for path in sorted({stripe_path(root, table, k) for k in keys}):

@@ -4,11 +4,20 @@ import math
 
 import numpy as np
 import pytest
-from conftest import crossing_road, curved_road, ego_at, lane, obstacles, polyline, straight_road
+from conftest import (
+    LANE_W_M,
+    crossing_road,
+    curved_road,
+    ego_at,
+    lane,
+    obstacles,
+    polyline,
+    straight_road,
+)
 
 from evoeye.ads import ADSConfig
 from evoeye.ads.prediction import IntentPredictor
-from evoeye.scene import RoadMap
+from evoeye.scene import Lane, RoadMap
 
 EGO = ego_at(0.0, 0.0)
 
@@ -56,8 +65,8 @@ def test_a_car_on_a_curved_lane_follows_the_curve():
 
 
 def test_lateral_motion_makes_a_lane_change_the_likely_mode():
-    heading = -math.atan2(1.5, 20.0)  # drifting right at 1.5 m/s: a cut-in into y = 0
-    p = predict(straight_road(), [(30.0, 3.6, heading, math.hypot(20.0, 1.5))])
+    heading = -math.atan2(2.0, 20.0)  # a quarter into the change, drifting right at 2 m/s
+    p = predict(straight_road(), [(30.0, 3.0, heading, math.hypot(20.0, 2.0))])
     assert p.model[0] == "right" and p.mode_prob[0] > 0.5
     assert (np.diff(p.mode_prob) <= 0.0).all() and p.mode_prob.sum() <= 1.0 + 1e-9
     right = p.model.index("right")
@@ -70,7 +79,7 @@ def test_the_lane_change_probability_grows_with_lateral_speed_and_offset():
         h = -math.atan2(lat_speed, 20.0)
         return modes(predict(straight_road(), [(30.0, y, h, 20.0)])).get("right", 0.0)
 
-    assert p_right(0.0, 4.0) < p_right(0.5, 4.0) < p_right(1.0, 4.0) < p_right(1.0, 3.2)
+    assert p_right(1.0, 4.0) < p_right(1.5, 4.0) < p_right(2.0, 4.0) < p_right(2.0, 3.2)
 
 
 def test_no_lane_change_towards_a_side_without_a_lane():
@@ -126,3 +135,61 @@ def test_a_map_without_lanes_predicts_constant_velocity():
     bare = type(road)(name="bare", lanes=(), route=road.route)
     p = predict(bare, [(30.0, 0.0, 0.0, 10.0)])
     assert p.model == ["cv"] and np.allclose(p.x_m[0, -1], 60.0)
+
+
+def give_way_road() -> RoadMap:
+    """The route goes north along x = 0; a minor road from the west ends at (−6, 0), where its
+    traffic gives way to the route's, and goes on east across it."""
+    north = lane("north", polyline(0.0, -200.0, math.pi / 2, 400.0))
+    minor = Lane("minor", polyline(-106.0, 0.0, 0.0, 100.0), LANE_W_M, 30.0,
+                 yields_to_route=True)
+    across = lane("across", polyline(-6.0, 0.0, 0.0, 100.0))
+    return RoadMap(name="give-way", lanes=(north, minor, across), route=north)
+
+
+
+def test_a_car_that_can_still_stop_where_its_lane_gives_way_is_expected_to():
+    # 40 m before its stop line at 10 m/s: stopping needs 1.25 m/s², well within a yield
+    p = predict(give_way_road(), [(-46.0, 0.0, 0.0, 10.0)])
+    m = modes(p)
+    c = ADSConfig().prediction
+    need = 10.0**2 / (2.0 * 40.0)
+    fade = math.exp((need - c.yield_decel_mps2) / c.yield_decel_scale_mps2)
+    expected = c.yield_prior / (1.0 + fade)
+    assert p.model[0] == "yield" and m["yield"] == pytest.approx(expected, abs=0.01)
+    k = p.model.index("yield")
+    t = (np.arange(30) + 1) * 0.1  # it brakes evenly to a stop at the end of its lane …
+    assert np.allclose(p.x_m[k], -46.0 + 10.0 * t - 0.5 * need * t * t, atol=0.6)
+    assert np.all(np.diff(np.diff(p.x_m[k])) < 0.0) and np.allclose(p.y_m[k], 0.0, atol=1e-6)
+    go = [j for j, name in enumerate(p.model) if name == "lane"]
+    assert go and p.x_m[go[0], -1] == pytest.approx(-16.0, abs=0.5)  # … or keeps its speed
+
+
+def test_a_yielding_car_is_predicted_to_stand_at_its_stop_line():
+    p = predict(give_way_road(), [(-14.0, 0.0, 0.0, 5.0)])  # 8 m out at 5 m/s: stops in 3.2 s
+    k = p.model.index("yield")
+    assert p.x_m[k, -1] == pytest.approx(-6.0, abs=0.3) and p.x_m[k].max() <= -6.0 + 0.3
+
+
+def test_a_car_too_fast_to_stop_where_its_lane_gives_way_is_expected_to_go_on():
+    # 8 m before the line at 12 m/s: stopping would need 9 m/s², no driver who means to
+    # stop leaves it that late
+    p = predict(give_way_road(), [(-14.0, 0.0, 0.0, 12.0)])
+    m = modes(p)
+    assert p.model[0] == "lane" and m.get("yield", 0.0) < 0.01
+
+
+def test_the_give_way_belief_fades_with_the_braking_stopping_would_need():
+    c = ADSConfig().prediction
+    probs = []
+    for share in (0.3, 0.6, 0.85, 1.0, 1.4):  # the braking a stop needs, over the limit
+        to_line_m = 10.0**2 / (2.0 * share * c.yield_decel_mps2)
+        m = modes(predict(give_way_road(), [(-6.0 - to_line_m, 0.0, 0.0, 10.0)]))
+        probs.append(m.get("yield", 0.0))
+    assert probs == sorted(probs, reverse=True) and probs[0] > 0.85 and probs[-1] < 0.2
+    assert 0.1 < probs[3] < 0.8  # around the limit: either is plausible
+
+
+def test_no_give_way_hypothesis_on_a_lane_with_the_right_of_way():
+    p = predict(crossing_road(), [(-30.0, 0.0, 0.0, 10.0)])
+    assert "yield" not in p.model

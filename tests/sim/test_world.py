@@ -14,7 +14,9 @@ LANE_W = 4.0
 
 
 def highway_params(**overrides):
-    """A calm highway: everyone far away and slow to act, except what a test overrides."""
+    """A calm highway: everyone far away and slow to act, except what a test overrides. The
+    world's mechanics are tested beyond the catalog's ranges (a cut-in from behind, a lead that
+    never brakes), so the values are not checked against them."""
     p = HIGHWAY.as_dict(HIGHWAY.low)
     p.update(ego_speed_mps=25.0, lead_gap_m=70.0, lead_speed_mps=25.0, lead_brake_time_s=16.0,
              lead_brake_decel_mps2=0.0, left_cutin_trigger_gap_m=2.0, right_cutin_trigger_gap_m=2.0,
@@ -22,13 +24,17 @@ def highway_params(**overrides):
              right_cutin_speed_mps=30.0, left_follow_gap_m=-60.0,
              right_follow_gap_m=-60.0, overtaker_gap_m=-80.0, overtaker_speed_mps=25.0)
     p.update(overrides)
-    return HIGHWAY.as_dict(HIGHWAY.from_dict(p))
+    assert p.keys() == set(HIGHWAY.names)
+    return p
 
 
 def crossing_params(**overrides):
+    """The middle of the intersection's space, except what a test overrides (unchecked against
+    the catalog's ranges, as for highway_params)."""
     p = CROSSING.as_dict((CROSSING.low + CROSSING.high) / 2.0)
     p.update(overrides)
-    return CROSSING.as_dict(CROSSING.from_dict(p))
+    assert p.keys() == set(CROSSING.names)
+    return p
 
 
 def run(world, seconds, accel=0.0, steer=0.0):
@@ -341,3 +347,35 @@ def test_a_crashed_npc_slides_on_along_its_heading_to_a_standstill():
     assert npc.heading == 0.1 and npc.speed == 0.0
     dx, dy = npc.position - (x0, y0)
     assert dy / dx == pytest.approx(np.tan(0.1))
+
+
+def test_a_turning_npc_stops_for_the_ego_standing_in_its_turn():
+    # the ego stands with its nose in the opposing left-turner's arc; the turner (which goes,
+    # since the ego has stopped) sees it along its arc and stops short instead of driving in
+    from evoeye.sim.intersection import _ego_crossing
+
+    left = list(NPC_MOVES).index("opp_left") + 1
+    late = {f"{n}_offset_s": CROSSING.high[CROSSING.index(f"{n}_offset_s")] for n in NPC_MOVES}
+    p = crossing_params(**{**late, "opp_left_offset_s": 0.0, "opp_left_speed_mps": 10.0})
+    world, _ = build_intersection(p, np.random.default_rng(5))
+    npc = world.npcs[left - 1]
+    s_npc, _, _ = _ego_crossing(*NPC_MOVES["opp_left"])
+    x, y, h = npc.path.pose(s_npc)
+    world.ego.position[:] = [2.0, y + 1.0]  # in its lane, its front across the turner's arc
+    world.ego.heading, world.ego.speed = -np.pi / 2, 0.0
+    scenes = run(world, 20.0, accel=0.0)
+    assert not any(s.crashed[[0, left]].any() for s in scenes)
+    assert npc.s_m < s_npc  # it never got past the ego
+
+
+def test_a_crashed_ego_stops_instead_of_rolling_through_what_it_hit():
+    p = highway_params(lead_gap_m=25.0, lead_brake_time_s=3.0, lead_brake_decel_mps2=6.5,
+                       lead_brake_duration_s=5.0)
+    world, _ = build_highway(p, np.random.default_rng(0))
+    scenes = run(world, 12.0, accel=0.0)  # an ego that never brakes runs into the lead
+    k = next(i for i, s in enumerate(scenes) if s.ego_collision)
+    v_hit = scenes[k].speed_mps[0]
+    after = [s.x_m[0] for s in scenes[k:]]
+    assert scenes[-1].speed_mps[0] == 0.0
+    from evoeye.sim.npc import CRASH_DECEL_MPS2
+    assert after[-1] - after[0] <= v_hit**2 / (2.0 * CRASH_DECEL_MPS2) + v_hit * DT + 1e-6

@@ -75,3 +75,22 @@ def test_batch_ingests_do_not_wait_for_writers_of_other_keys(root: DataRoot, add
     add_run("free", seed=5, batch="evo-a")
     with key_lock(root, "feedback", ["fusion-x"]):  # e.g. another campaign storing feedback
         assert ingest_batch(root, (HIGHWAY, "evo-a")).ingested == ["free"]
+
+
+def test_a_batch_ingest_whose_keys_share_a_stripe_does_not_wait_for_itself(
+        root: DataRoot, add_run, monkeypatch) -> None:
+    import evoeye.store.lock as lock
+
+    monkeypatch.setattr(lock, "STRIPES", 1)  # every key in one stripe: the batch's and its runs'
+    add_run("one", seed=6, batch="evo-a")
+    add_run("two", seed=7, batch="evo-a")
+    held = []
+    real = lock.WriterLock.__enter__
+
+    def enter(self):
+        assert not (self.path in held and not self.shared), f"{self.path} taken twice"
+        held.append(self.path)
+        return real(self)
+
+    monkeypatch.setattr(lock.WriterLock, "__enter__", enter)
+    assert ingest_batch(root, (HIGHWAY, "evo-a")).ingested == ["one", "two"]

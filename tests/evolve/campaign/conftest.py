@@ -23,7 +23,7 @@ def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[DataRoot, str]:
     from evoeye.monitor import train_monitor
 
     data = DataRoot.resolve(tmp_path_factory.mktemp("seeded") / "data")
-    run_batch(plan_uniform(SCENARIO, 16, 3), data)
+    run_batch(plan_uniform(SCENARIO, 16, 6), data)  # seed 6: both classes in every split
     ingest(data)
     return data, train_monitor(data, SCENARIO, seed=0, splits=SPLITS, epochs=1)
 
