@@ -31,6 +31,7 @@ from evoeye.store import SplitSpec
 from evoeye.store.feedback import read_rounds
 
 TARGET = 1.8
+TRIM_KEY = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 FULL_PROTOCOL = 2 * 5 * 20  # scenarios × methods × seeds
 
 
@@ -50,11 +51,15 @@ def timed_experiment(root: DataRoot, args: argparse.Namespace, splits: SplitSpec
 
 
 def on_dask(n: int, run) -> tuple[float, list]:
-    """`run(address)` with a LocalCluster of n one-thread worker processes."""
+    """`run(address)` with a LocalCluster of n one-thread worker processes, started as
+    docs/evolution.md advises: without Dask's MALLOC_TRIM_THRESHOLD_ (training ≈ 1.5× dearer
+    with it)."""
+    import dask
     from distributed import LocalCluster
 
-    with LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster:
+    with dask.config.set({TRIM_KEY: None}), LocalCluster(
+            n_workers=n, threads_per_worker=1, processes=True,
+            dashboard_address=None) as cluster:
         return run(cluster.scheduler_address)
 
 
