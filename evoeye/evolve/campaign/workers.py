@@ -30,6 +30,9 @@ from evoeye.lifeline import die_with_parent
 from evoeye.paths import DataRoot
 from evoeye.store.feedback import RoundMetrics
 
+# a fixed glibc malloc trim threshold (Dask's nannies set one) without an mmap threshold
+MALLOC_TRIM, MALLOC_MMAP = "MALLOC_TRIM_THRESHOLD_", "MALLOC_MMAP_THRESHOLD_"
+
 
 @dataclass(frozen=True)
 class CampaignJob:
@@ -103,6 +106,22 @@ def _local_worker(parent: int, lines: mp.Queue) -> None:
     _LINES = lines
 
 
+def _malloc_env() -> tuple[str | None, str | None]:
+    return os.environ.get(MALLOC_TRIM), os.environ.get(MALLOC_MMAP)
+
+
+def malloc_note(envs: dict[str, tuple[str | None, str | None]]) -> str | None:
+    """A note if Dask workers (address → their malloc variables) run with a fixed trim
+    threshold and no mmap threshold — Dask's default, which turns off glibc's dynamic mmap
+    threshold and makes training ≈ 1.5× dearer (docs/evolution.md); None if none does."""
+    slow = sorted(w for w, (trim, mmap) in envs.items() if trim is not None and mmap is None)
+    if not slow:
+        return None
+    return (f"note: {len(slow)} of {len(envs)} Dask workers run with "
+            f"{MALLOC_TRIM}={envs[slow[0]][0]} and no {MALLOC_MMAP}: training a monitor costs "
+            "them ≈ 1.5× the CPU; docs/evolution.md says how to start workers without it")
+
+
 @contextmanager
 def _executor(workers: int, dask_address: str | None,
               say: Callable[[str], None]) -> Iterator[Executor]:
@@ -111,6 +130,9 @@ def _executor(workers: int, dask_address: str | None,
         from distributed import Client
 
         with Client(dask_address) as client:
+            note = malloc_note(client.run(_malloc_env))
+            if note:
+                say(note)
             yield client.get_executor(pure=False)
         return
     context = pool_context()

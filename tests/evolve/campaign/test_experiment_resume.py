@@ -35,11 +35,14 @@ run_experiment(root, [{SCENARIO!r}], base, strategies={METHODS!r}, seeds=[0],
 """
 
 
-def experiment(root: DataRoot, workers: int = 1, dask_address: str | None = None) -> None:
+def experiment(root: DataRoot, workers: int = 1, dask_address: str | None = None) -> list[str]:
+    """Run the experiment; the progress lines it printed."""
+    lines: list[str] = []
     base = CampaignConfig(SCENARIO, n_round=1, epochs=1, splits=SPLITS)
     run_experiment(root, [SCENARIO], base, strategies=METHODS, seeds=[0], budget_s=BUDGET_S,
                    controls=0, workers=workers, dask_address=dask_address,
-                   progress=lambda line: None)
+                   progress=lines.append)
+    return lines
 
 
 def records(root: DataRoot) -> dict:
@@ -99,6 +102,16 @@ def test_a_dask_cluster_runs_the_campaigns_to_the_same_records(root_copy, uninte
 
     root = root_copy("dask")
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster:
-        experiment(root, dask_address=cluster.scheduler_address)
+                      dashboard_address=None) as cluster:  # Dask's default worker environment
+        lines = experiment(root, dask_address=cluster.scheduler_address)
     assert records(root) == uninterrupted
+    notes = [line for line in lines if line.startswith("note:")]
+    assert len(notes) == 1 and "2 of 2 Dask workers" in notes[0]  # told, once
+
+
+def test_a_malloc_note_only_for_workers_with_a_fixed_trim_and_no_mmap_threshold() -> None:
+    from evoeye.evolve.campaign.workers import malloc_note
+
+    assert malloc_note({"a": (None, None), "b": ("134217728", "134217728")}) is None
+    note = malloc_note({"a": ("65536", None), "b": (None, None), "c": ("65536", "1")})
+    assert note is not None and "1 of 3 Dask workers" in note and "=65536" in note
