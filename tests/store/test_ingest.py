@@ -212,3 +212,23 @@ def test_metadata_that_does_not_fit_its_logical_scenario_is_quarantined(
     other = "runs/highway-cut-in/b000/unprotected-intersection-0123456789ab.mcap"
     assert "does not match" in reasons[other]
     assert (root.quarantine / "highway-cut-in" / "a-first" / f"{genuine_id}.mcap").exists()
+
+
+def test_a_run_of_another_minor_release_is_quarantined(root: DataRoot, episode_factory,
+                                                        log_writer) -> None:
+    from evoeye import __version__
+
+    major, minor = __version__.split(".")[:2]
+    versions = {"newer": f"{int(major) + 1}.{minor}.0", "patch": f"{major}.{minor}.99",
+                "synthetic": None}  # the factory's own, not a release's version string
+    for name, version in versions.items():
+        episode = episode_factory(name, seed=11)
+        if version:
+            episode.software_version = version
+        log_writer(root, episode)
+    report = ingest(root)
+    reasons = dict(report.quarantined)
+    assert sorted(report.ingested) == ["patch", "synthetic"] and len(reasons) == 1
+    why = reasons["runs/highway-cut-in/b000/newer.mcap"]
+    assert f"written by evoeye {versions['newer']}" in why
+    assert f"{major}.{minor}" in why and "docs/warehouse.md" in why
