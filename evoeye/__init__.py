@@ -10,7 +10,9 @@ def __getattr__(name: str) -> Any:
         from importlib.metadata import PackageNotFoundError, version
 
         try:
-            return version("evoeye")
+            found = version("evoeye")
         except PackageNotFoundError:  # running from a source tree without an install
-            return "0.0.0+local"
+            found = "0.0.0+local"
+        globals()["__version__"] = found  # looked up once: ingest checks it for every log
+        return found
     raise AttributeError(f"module 'evoeye' has no attribute {name!r}")
