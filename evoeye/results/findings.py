@@ -22,6 +22,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
+from evoeye.results.config import BASELINES
 from evoeye.results.rq1 import FUSION_LABEL
 from evoeye.results.rq2 import g0_label
 from evoeye.results.tables import EFFECT, cell_key
@@ -50,8 +51,7 @@ FINDINGS: tuple[Finding, ...] = (
     Finding("rq1-baselines", "RQ1: the FusionMonitor beats every baseline",
             "best F1, AUROC and AUPRC on both scenarios", "rq1", ("test",),
             ("f1@0.05", "auprc"),
-            tuple((FUSION_LABEL, b) for b in ("ttc", "ttc-2d", "rss", "rss-2s", "aem",
-                                              "context-only"))),
+            tuple((FUSION_LABEL, b) for b in BASELINES)),
     Finding("rq3-context", "Monitor ablation: a context of L = 5 frames beats L = 1",
             "F1@0.05 +7.6 (S1), +4.0 (S2)", "ablation", ("test",), ("f1@0.05",),
             (("L=5", "L=1"),)),

@@ -122,10 +122,11 @@ def rq2(study: Study, scenario: str) -> dict:
         trained_version(study, scenario, f, seed=s, **G0_RECIPE) for s in cfg.training_seeds[:k]]
         for f in families}
     rows: dict[str, dict] = {}
+    campaigns = [Campaign(study.root, c) for c in plan]
     starts = {DEFAULT_FAMILY: g0s[0]}
-    for c in plan:
-        if c.family != DEFAULT_FAMILY:
-            starts.setdefault(c.family, Campaign(study.root, c).g0)
+    for campaign in campaigns:
+        if campaign.config.family != DEFAULT_FAMILY:
+            starts.setdefault(campaign.config.family, campaign.g0)
     for f in families:
         start = set_figures(study, judge, starts[f])
         rows[g0_label(f)] = {"versions": [[starts[f]]] * n, "figures": [start] * n}
@@ -134,9 +135,9 @@ def rq2(study: Study, scenario: str) -> dict:
                                          "unpaired": True}
     acquired = {(r["seed"], m): r for m, runs in ran.items() if isinstance(runs, list)
                 for r in runs}
-    for c in plan:
+    for campaign in campaigns:
+        c, campaign_id = campaign.config, campaign.campaign_id
         method = method_of(c)
-        campaign_id = Campaign(study.root, c).campaign_id
         versions = final_versions(study, c, campaign_id, seeds_of[c.family])
         row = rows.setdefault(method, {"campaigns": [], "versions": [], "figures": [],
                                        "acquisition": []})

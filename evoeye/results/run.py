@@ -132,7 +132,8 @@ def write_results(root: DataRoot, results: dict, name: str = "results", *,
     folder = root.reports / name
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "results.json").write_text(json.dumps(results, indent=1) + "\n", encoding="utf-8")
-    for file, text in markdown_files(results).items():
+    files = markdown_files(results)
+    for file, text in files.items():
         (folder / file).write_text(text, encoding="utf-8")
     (folder / "results.html").write_text(results_html(results, f"evoeye results — {name}"),
                                          encoding="utf-8")
@@ -141,7 +142,7 @@ def write_results(root: DataRoot, results: dict, name: str = "results", *,
         for file in DOCS_FILES:
             shutil.copyfile(folder / file, docs / file)
     if readme is not None:
-        section = findings_markdown(results["findings"], "docs/results/results.json")
+        section = files["findings.md"]
         readme.write_text(splice_readme(readme.read_text(encoding="utf-8"), section),
                           encoding="utf-8")
     return folder

@@ -11,7 +11,6 @@ from __future__ import annotations
 
 import hashlib
 from collections.abc import Callable
-from dataclasses import asdict
 from functools import cached_property
 
 from evoeye.evaluation.dataset import SplitWindows, load_split
@@ -90,10 +89,6 @@ class Study:
                                             context_len=self.context_len,
                                             horizon_s=self.config.horizon_s)
         return self._windows[key]
-
-    def describe(self) -> dict:
-        """The splits as the results JSON records them."""
-        return {"splits": asdict(self.splits)}
 
 
 def prepare_data(root: DataRoot, config: ResultsConfig, progress: Progress | None = None

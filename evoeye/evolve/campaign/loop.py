@@ -93,7 +93,7 @@ class Campaign:
         self.space = get_scenario(config.scenario)
         self.family = FAMILIES[config.family]
         self._train = train or self.family.train
-        self._assess = assess
+        self.assess = assess  # may be set after construction (e.g. from the campaign's ids)
         self._monitors: dict[str, object] = {}
         self.clock = PhaseClock()  # wall seconds per phase of this object's calls
 
@@ -348,4 +348,4 @@ class Campaign:
 
     def _metrics(self, version: str) -> RoundMetrics | None:
         with self.clock("assess"):
-            return self._assess(version) if self._assess else None
+            return self.assess(version) if self.assess else None

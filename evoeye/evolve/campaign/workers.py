@@ -68,13 +68,19 @@ def assessor(campaign: Campaign) -> Assessor:
     return _ASSESSORS[key]
 
 
+def _campaign(job: CampaignJob) -> Campaign:
+    """The job's campaign, assessed (if asked) by this process's assessor of its scenario."""
+    campaign = Campaign(DataRoot.resolve(job.root), job.config)
+    if job.assess:
+        campaign.assess = assessor(campaign)
+    return campaign
+
+
 def prepare_campaigns(jobs: Sequence[CampaignJob]) -> None:
     """Resolve every campaign's G_0 and store its round 0 (G_0's feedback on D_init and its
     assessment), one campaign after another: what the campaigns would otherwise all write."""
     for job in jobs:
-        probe = Campaign(DataRoot.resolve(job.root), job.config)
-        assess = assessor(probe) if job.assess else None
-        Campaign(probe.root, job.config, assess=assess).start()
+        _campaign(job).start()
 
 
 def no_metrics(metrics: RoundMetrics | None) -> str:
@@ -85,9 +91,7 @@ def run_campaign(job: CampaignJob, brief: Brief = no_metrics,
                  say: Callable[[str], None] | None = None) -> CampaignDone:
     """Run (or resume) one campaign to its budget; `say` each round's line as it ends (in a
     local worker, it goes to the process that started the workers)."""
-    root = DataRoot.resolve(job.root)
-    probe = Campaign(root, job.config)
-    campaign = Campaign(root, job.config, assess=assessor(probe) if job.assess else None)
+    campaign = _campaign(job)
     say = say or (_LINES.put if _LINES is not None else None)
     lines: list[str] = []
 
