@@ -124,7 +124,8 @@ class IntentPredictor:
         # give way: P(it stops at its lane's end), from the braking that stopping would need
         to_end = self.lane_len.take(lane) - s  # (n,) to the lane's end (its stop line)
         may_yield = on & self.gives_way.take(lane) & (to_end > 0.0) & (to_end <= c.yield_range_m)
-        need = v_along * v_along / (2.0 * np.maximum(to_end, 0.5))  # (n,) m/s²
+        stop_m = np.maximum(to_end, 0.5)  # (n,) where a yielding car stops, at least 0.5 m on
+        need = v_along * v_along / (2.0 * stop_m)  # (n,) m/s²
         p_yield = may_yield * c.yield_prior / (
             1.0 + np.exp(np.minimum((need - c.yield_decel_mps2) / c.yield_decel_scale_mps2, 50.0)))
         go = 1.0 - p_yield
@@ -155,7 +156,7 @@ class IntentPredictor:
         stops = mode == YIELD
         if np.count_nonzero(stops):  # brake evenly to a stop at the lane's end
             o = obs[stops]
-            v0, d_end = v_along.take(o)[:, None], np.maximum(to_end.take(o), 0.5)[:, None]
+            v0, d_end = v_along.take(o)[:, None], stop_m.take(o)[:, None]
             t_stop = 2.0 * d_end / np.maximum(v0, 1e-6)  # (r, 1)
             tt = np.minimum(t, t_stop)
             ds = v0 * tt - 0.5 * (v0 / t_stop) * tt * tt

@@ -30,9 +30,9 @@ from evoeye.ads.oracle import (
     TrueFutures,
     careful_planner,
 )
+from evoeye.boxes import box_corners, box_gaps
 from evoeye.scene import RoadMap, SceneState
 from evoeye.sim.episode import STATUS_OK, Episode, RunSpec
-from evoeye.sim.footprint import box_corners, box_gaps
 from evoeye.sim.runner import DriverFactory, SimConfig, run_episode
 
 REACTION_S = 0.75  # the careful driver reacts this long after the danger shows …

@@ -18,7 +18,7 @@ import numpy as np
 from evoeye.boxes import box_corners, box_gaps
 from evoeye.scene import SceneState
 
-__all__ = ["box_corners", "box_gaps", "ego_gaps", "min_ego_gap"]
+__all__ = ["ego_gaps", "min_ego_gap"]
 
 
 def _bbox_gap(x: np.ndarray, y: np.ndarray, h: np.ndarray, length: np.ndarray,

@@ -15,8 +15,8 @@ from __future__ import annotations
 import numpy as np
 from highway_env.road.road import Road
 
+from evoeye.boxes import box_corners, box_gaps
 from evoeye.scene import EGO_ID, RoadMap, SceneState
-from evoeye.sim.footprint import box_corners, box_gaps
 from evoeye.sim.npc import EgoVehicle, Npc
 from evoeye.sim.path import Path
 from evoeye.sim.traffic import (

@@ -7,8 +7,9 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from evoeye.boxes import box_corners, box_gaps
 from evoeye.scene import SceneState
-from evoeye.sim.footprint import box_corners, box_gaps, ego_gaps, min_ego_gap
+from evoeye.sim.footprint import ego_gaps, min_ego_gap
 
 
 def scene(*boxes: tuple[float, float, float]) -> SceneState:
