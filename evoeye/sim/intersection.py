@@ -89,8 +89,8 @@ def _network() -> tuple[RoadNetwork, RoadMap]:
         net.add_lane(f"o{k}", f"x{k}", StraightLane(
             out.end, out.end + EXTENSION_M * out.direction,
             line_types=[LineType.NONE, LineType.CONTINUOUS], speed_limit=EGO_CRUISE_MPS))
-    yielding = frozenset(pair for k in GIVE_WAY_APPROACHES
-                         for pair in ((f"e{k}", f"o{k}"), (f"o{k}", f"ir{k}")))
+    # only the lane that ends at the box gives way; its 320 m extension ends 100 m before it
+    yielding = frozenset((f"o{k}", f"ir{k}") for k in GIVE_WAY_APPROACHES)
     return net, road_map_from_network("unprotected-intersection", net, EGO_ROUTE, yielding)
 
 

@@ -115,3 +115,15 @@ def test_a_car_standing_in_a_turn_blocks_it_though_it_is_not_straight_ahead():
 def test_a_straight_path_is_left_to_the_straight_corridor():
     p = Path(np.stack((np.linspace(0.0, 200.0, 201), np.zeros(201)), axis=1))
     assert blocking(p, 20.0, [(35.0, 0.0, math.pi / 2)]) == math.inf
+
+
+def test_only_the_west_approach_lane_that_ends_at_the_box_gives_way() -> None:
+    from evoeye.sim.intersection import _network
+
+    _, road = _network()
+    giving = [ln for ln in road.lanes if ln.yields_to_route]
+    assert len(giving) == 1  # the lane that ends at the stop line, not the one before it
+    end = giving[0].points[-1]
+    route = road.route.points
+    assert np.min(np.hypot(*(route - end).T)) < 15.0  # its end is at the ego's route
+    assert end[0] < 0.0  # on the west side
