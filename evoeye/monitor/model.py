@@ -37,8 +37,9 @@ from evoeye.store.features import (
 )
 
 # The tensors FusionNet.forward takes, in order (also the ONNX input names).
-INPUTS = ("perception", "perception_mask", "prediction", "prediction_mask", "plan", "plan_mask",
-          "plan_info", "control", "context_mask")
+FRAME_INPUTS = ("perception", "perception_mask", "prediction", "prediction_mask", "plan",
+                "plan_mask", "plan_info", "control")  # encode_frames' arguments, in order
+INPUTS = (*FRAME_INPUTS, "context_mask")
 MASK_VALUE = -1e9  # attention logit of an empty slot: finite, so an empty set gives no NaN
 
 
@@ -187,7 +188,8 @@ class FusionNet(nn.Module):
         prediction: torch.Tensor, prediction_mask: torch.Tensor, plan: torch.Tensor,
         plan_mask: torch.Tensor, plan_info: torch.Tensor, control: torch.Tensor,
     ) -> torch.Tensor:
-        """Frame block: (B, L, …) module inputs → (B, L, D) frame features z_t."""
+        """Frame block: (…, n, F) module inputs → (…, D) frame features z_t, each frame on its
+        own (leading axes (B, L) for windows, (N,) for frames)."""
         z = []
         if "perception" in self.encoders:
             x = self.norm["perception"](perception)  # (B, L, n, 9)
@@ -215,6 +217,12 @@ class FusionNet(nn.Module):
         """(B, L, …) inputs (see INPUTS) → (B,) logits; sigmoid(logit) is the risk score."""
         z = self.encode_frames(perception, perception_mask, prediction, prediction_mask, plan,
                                plan_mask, plan_info, control)  # (B, L, D)
+        return self.head(z, context_mask)
+
+    def head(self, z: torch.Tensor, context_mask: torch.Tensor) -> torch.Tensor:
+        """Temporal block: (B, L, D) frame features z_t and the (B, L) context mask → (B,)
+        logits. Frames are encoded independently, so a frame shared by several windows may be
+        encoded once (FusionMonitor.score does)."""
         z = torch.where(context_mask.unsqueeze(-1), self.frame_dropout(z), 0.0)  # padded: 0
         z = torch.cat([z, context_mask.to(z.dtype).unsqueeze(-1)], dim=-1)  # (B, L, D + 1)
         h = self.temporal(z.flatten(1))  # (B, H_t)
@@ -243,7 +251,8 @@ def example_inputs(net: FusionNet, batch: int = 2) -> tuple[torch.Tensor, ...]:
                  else torch.zeros(shapes[name]) for name in INPUTS)
 
 
-__all__ = ["ABLATIONS", "INPUTS", "MODULES", "FusionConfig", "FusionNet", "example_inputs"]
+__all__ = ["ABLATIONS", "FRAME_INPUTS", "INPUTS", "MODULES", "FusionConfig", "FusionNet",
+           "example_inputs"]
 
 
 def config_from_dict(d: dict) -> FusionConfig:
