@@ -1,10 +1,10 @@
-"""The messages of a few channels, straight from an MCAP file's chunks.
+"""The messages of some or all channels, straight from an MCAP file's chunks.
 
-`mcap`'s reader builds a record object for every record of every chunk it opens; a run log
-interleaves eight channels, so reading one channel costs as much as reading all (≈ 100 ms for
-a 20 s run). Here each chunk listed in the summary is decompressed once, its CRC checked, and
-its records walked with `struct` offsets, copying only the wanted channels' payloads (≈ 10×
-faster). Any inconsistency raises ValueError; the caller names the file.
+`mcap`'s reader builds a record object for every record of every chunk it opens (≈ 100 ms for
+the ~2 700 messages of a 20 s run), however few channels are wanted. Here each chunk listed in
+the summary is decompressed once, its CRC checked, and its records walked with `struct`
+offsets, copying only the wanted channels' payloads (≈ 10× faster for one channel, ≈ 3× for
+all). Any inconsistency raises ValueError; the caller names the file.
 """
 
 from __future__ import annotations

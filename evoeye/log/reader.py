@@ -120,15 +120,12 @@ def read_run(path: str | os.PathLike, topics: Iterable[str] | None = None) -> Ru
         records = {m.name: m.metadata for m in reader.iter_metadata()}
         schema_ids = _schema_ids(reader)
         attachments = {a.name: a.data for a in reader.iter_attachments()}
-        raw: dict[str, list[tuple[int, bytes]]] = {}
-        if wanted is None:
-            for _, channel, message in reader.iter_messages(log_time_order=False):
-                raw.setdefault(channel.topic, []).append((message.log_time, message.data))
-        elif wanted:  # a few topics: walk the chunks directly (evoeye.log.chunks)
-            summary = reader.get_summary()
-            topic_of = {c.id: c.topic for c in summary.channels.values() if c.topic in wanted}
-            found = channel_messages(data, summary.chunk_indexes, topic_of)
-            raw = {topic_of[c]: pairs for c, pairs in found.items() if pairs}
+        summary = reader.get_summary()  # _schema_ids checked there is one
+        topic_of = {c.id: c.topic for c in summary.channels.values()
+                    if wanted is None or c.topic in wanted}
+        # the chunks walked directly (evoeye.log.chunks), not by mcap's per-record reader
+        found = channel_messages(data, summary.chunk_indexes, topic_of) if topic_of else {}
+        raw = {topic_of[c]: pairs for c, pairs in found.items() if pairs}
     except Exception as e:  # the mcap parser raises many kinds on corrupt input
         raise _fail(path, f"corrupt MCAP file ({type(e).__name__}: {e})") from e
     if RUN_RECORD not in records:
