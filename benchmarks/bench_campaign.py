@@ -1,6 +1,6 @@
 """A campaign's rounds, profiled: where the wall time goes, and its cost against simulation alone.
 
-One campaign (`--strategy`, default evoeye; fine-tune updates, N_round = `--n-round`) runs
+One campaign (`--strategy`, default evoeye; `--update`, default replay; N_round = `--n-round`) runs
 `--rounds` rounds on a private copy of a data root holding the scenario's initial runs and a
 G_0 (`--root`; without it, `--runs` uniform runs are simulated, ingested and a G_0 trained in a
 temporary folder first). Each round is broken into the campaign's phases
@@ -94,6 +94,10 @@ def profile(root: DataRoot, cfg: CampaignConfig, rounds: int
     return out, first
 
 
+def _pct(x: float | None) -> str:
+    return "—" if x is None else f"{100 * x:.1f}"
+
+
 def row(label: str, seconds: dict) -> str:
     cells = " | ".join(f"{seconds[p]:.2f}" for p in PHASES)
     other = seconds["total"] - sum(seconds[p] for p in PHASES)
@@ -114,7 +118,9 @@ def table(kind: str, rounds: list[dict], first: dict) -> dict:
 
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
-    ap.add_argument("--root", type=Path, help="data root with initial runs and a G_0")
+    ap.add_argument("--root", type=Path, help="data root with initial runs and a G_0, split "
+                    "as this script splits them (seed 0, train 0.5, val 0.25)")
+    ap.add_argument("--update", default="replay", help="campaign option")
     ap.add_argument("--scenario", default="highway-cut-in")
     ap.add_argument("--strategy", default="evoeye")
     ap.add_argument("--rounds", type=int, default=3)
@@ -124,20 +130,25 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=60, help="initial runs without --root")
     args = ap.parse_args()
     print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}")
-    splits = SplitSpec() if args.root else SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
+    splits = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
     with tempfile.TemporaryDirectory(prefix="bench-campaign-") as tmp:
         src = (DataRoot.existing(args.root) if args.root
                else seed_root(Path(tmp) / "seed", [args.scenario], args.runs, splits))
         root = copy_root(src, Path(tmp) / "data")
         cfg = CampaignConfig(args.scenario, strategy=args.strategy, budget_s=1e9,
                              n_round=args.n_round, splits=splits, epochs=args.epochs,
-                             patience=args.patience)
+                             patience=args.patience, update=args.update)
         rounds, first = profile(root, cfg, args.rounds)
         campaign_id = Campaign(root, cfg).campaign_id
+        quality = [(r.round, r.metrics.test.get("auprc"), r.metrics.hard.get("auprc"))
+                   for r in read_rounds(root, campaign_id) if r.metrics]
         alone_s, alone_cpu_s, n_runs = simulate_alone(root, campaign_id, args.scenario,
                                                       DataRoot.resolve(Path(tmp) / "alone"))
     print(f"\ncampaign {campaign_id}: {args.scenario}, {args.strategy}, N_round {args.n_round}, "
-          f"epochs {args.epochs or 'default'}, patience {args.patience or 'default'}")
+          f"update {args.update}, epochs {args.epochs or 'default'}, "
+          f"patience {args.patience or 'default'}")
+    print("G_r's AUPRC (Test Set / Hard Set) by round: " + ", ".join(
+        f"{r}: {_pct(t)} / {_pct(h)}" for r, t, h in quality))
     wall = table("wall", [w for w, _ in rounds], first[0])
     cpu = table("CPU", [c for _, c in rounds], first[1])
     print(f"\nsimulate + log the same {n_runs} runs alone: {alone_s:.2f} s wall, "

@@ -65,7 +65,7 @@ class ResultsConfig:
     methods: tuple[str, ...] = METHODS
     budget_s: float | None = None  # None: the simulated time of the initial training data
     n_round: int = 20
-    update: str = "finetune"
+    update: str = "replay"
     feedback: str = "raw"
     workers: int = 1  # processes simulating the data batches, then running campaigns
 

@@ -76,8 +76,10 @@ def _retrain_last_update(study: Study, cfg: CampaignConfig, previous: str, j: in
     campaign = Campaign(study.root, cfg, train=reseeded)
     state = campaign.start()
     study.say(f"  {campaign.campaign_id}: final update again, seed offset {j}")
+    # the state as the last update saw it: G_{R-1}, its round not yet stored (replay's
+    # new runs are those of no stored round)
     version, _ = campaign.update_monitor(replace(state, round=state.round - 1,
-                                                 monitor=previous))
+                                                 monitor=previous, rounds=state.rounds[:-1]))
     return version
 
 

@@ -24,9 +24,11 @@ from typing import Any
 
 from evoeye.splits import SplitSpec
 
-UPDATE_MODES = ("finetune", "retrain")
+UPDATE_MODES = ("replay", "finetune", "retrain")  # evoeye.evolve.campaign.loop says what each is
 FEEDBACK_MODES = ("raw", "prior-corrected")  # ŷ as the monitor scores it, or σ(logit − log w)
 FINETUNE_EPOCHS, FINETUNE_PATIENCE = 10, 4
+REPLAY_EPOCHS, REPLAY_PATIENCE = 3, 2  # per round: passes over the new runs and their replay
+REPLAY_RATIO = 1.0  # earlier runs replayed per new run of the round
 DEFAULT_FAMILY = "fusion"  # evoeye.monitor.families.DEFAULT_FAMILY
 DEFAULT_DELTA = 0.2  # evoeye.scenarios.DEFAULT_DELTA
 DEFAULT_HORIZON_S = 3.0  # evoeye.store.windows.DEFAULT_HORIZON_S
@@ -110,12 +112,14 @@ class CampaignConfig:
                                  "trained from scratch on the scenario, or its initial "
                                  "version).")
     n_round: int = option(20, "Runs per round (N_round).", ge=1)
-    update: str = option("finetune", "Monitor update per round: finetune (from G_r) or retrain.",
-                         names="update")
-    epochs: int | None = option(None, "Epochs per monitor update (default: 10 when "
-                                "fine-tuning, the trainer's otherwise).", ge=1)
-    patience: int | None = option(None, "Early-stopping patience per update (default: 4 when "
-                                  "fine-tuning, the trainer's otherwise).", ge=1)
+    update: str = option("replay", "Monitor update per round: replay (fine-tune G_r on the "
+                         "round's runs and as many earlier ones), finetune (on every record) or "
+                         "retrain (from scratch on every record).", names="update")
+    epochs: int | None = option(None, "Epochs per monitor update (default: 3 with replay, 10 "
+                                "fine-tuning, the trainer's when retraining).", ge=1)
+    patience: int | None = option(None, "Early-stopping patience per update (default: 2 with "
+                                  "replay, 4 fine-tuning, the trainer's when retraining).",
+                                  ge=1)
     delta: float = option(DEFAULT_DELTA, "Neighbourhood radius δ of the density-aware "
                           "strategies, a share of each parameter's range.", gt=0.0, le=1.0)
     feedback: str = option("raw", "ŷ in f_r = mean |ŷ − y|: raw monitor scores, or "
@@ -151,8 +155,9 @@ class CampaignConfig:
     def train_overrides(self) -> dict[str, int]:
         """TrainParams fields of one monitor update."""
         out = {}
-        epochs = self.epochs or (FINETUNE_EPOCHS if self.update == "finetune" else None)
-        patience = self.patience or (FINETUNE_PATIENCE if self.update == "finetune" else None)
+        default = {"finetune": (FINETUNE_EPOCHS, FINETUNE_PATIENCE),
+                   "replay": (REPLAY_EPOCHS, REPLAY_PATIENCE)}.get(self.update, (None, None))
+        epochs, patience = self.epochs or default[0], self.patience or default[1]
         if epochs:
             out["epochs"] = epochs
         if patience:

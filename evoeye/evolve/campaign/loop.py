@@ -7,11 +7,16 @@ ingests the round's runs (as converted for scoring: one conversion per log), upd
 monitor on D_r, refreshes the feedback of every record with G_{r+1} and stores the round. The
 campaign stops when no run fits in the budget left.
 
-Monitor update, `update="finetune"` (the default): G_{r+1} starts from G_r's weights and input
-normalisers and trains a few epochs on D_r — Algorithm 1, line 12 is Train(G_r, D_r), and a
-round adds only N_round runs to hundreds, so re-fitting from scratch every round would spend
-most of a campaign's wall time relearning what G_r knows. `update="retrain"` trains from scratch
-on D_r every round (slower; useful to check that fine-tuning does not drift).
+Monitor update (Algorithm 1, line 12: Train(G_r, D_r)). A round adds only N_round runs to
+hundreds, so re-fitting on all of D_r every round would spend most of a campaign's wall time
+relearning what G_r knows, and more every round as D_r grows.
+* `update="replay"` (the default): G_{r+1} starts from G_r's weights and input normalisers and
+  trains a few epochs on the round's new runs plus a seeded sample of as many earlier runs of
+  D_r (experience replay, so that what G_r learned is rehearsed, not forgotten). Its cost grows
+  with N_round, not with D_r. At least one collision run is in the sample when D_r has one.
+* `update="finetune"`: the same start, a few epochs on every run of D_r.
+* `update="retrain"`: from scratch on every run of D_r (slowest; a check that the cheaper
+  updates do not drift).
 
 State and resume. Everything a campaign knows is in the data root: run logs under
 `runs/<scenario>/<campaign id>/`, the feedback table (f_r per run and monitor version) and the
@@ -43,7 +48,7 @@ import numpy as np
 
 from evoeye.atomic import remove_stale_temps
 from evoeye.batch import simulate_and_log
-from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.config import REPLAY_RATIO, CampaignConfig
 from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
 from evoeye.evolve.campaign.state import CampaignState, records_of, run_outcome, run_seed
@@ -265,18 +270,40 @@ class Campaign:
     def update_monitor(self, state: CampaignState) -> tuple[str, float]:
         """Line 12: G_{r+1} from D_r (train) and the fixed val split; (version, wall seconds)."""
         cfg = self.config
-        ids = [str(s) for s, ok in zip(state.records.scenario_id, state.ok, strict=True) if ok]
+        ids = self.training_runs(state)
+        if not ids:  # nothing new to learn from (every run of the round failed): G_r stays
+            return state.monitor, 0.0
+        fine_tune = cfg.update != "retrain"
         t0 = time.perf_counter()
         with self.clock("train"):
             version = self._train(
                 self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
                 horizon_s=cfg.horizon_s, seed=cfg.seed * 1000 + state.round + 1,
-                splits=cfg.splits, init_from=state.monitor if cfg.update == "finetune" else None,
-                context_len=(None if cfg.update == "finetune"
-                             else self.monitor(self.g0).context_len),
+                splits=cfg.splits, init_from=state.monitor if fine_tune else None,
+                context_len=None if fine_tune else self.monitor(self.g0).context_len,
                 **cfg.train_overrides(),
             )
         return version, time.perf_counter() - t0
+
+    def training_runs(self, state: CampaignState) -> list[str]:
+        """The runs of D_r the update trains on: every ok record, or with replay the round's new
+        ok runs after a sample of as many earlier ones (seeded by campaign and round; empty when
+        the round has no ok run)."""
+        ok = state.records.scenario_id[state.ok]
+        if self.config.update != "replay":
+            return [str(s) for s in ok]
+        seen = {*self.initial["scenario_id"], *(s for r in state.rounds for s in r.scenario_ids)}
+        is_new = np.array([s not in seen for s in ok], dtype=bool)
+        new, earlier = ok[is_new], ok[~is_new]
+        if len(new) == 0:
+            return []
+        rng = np.random.default_rng([self.config.seed, state.round + 1])
+        k = min(len(earlier), int(round(REPLAY_RATIO * len(new))))
+        pick = np.sort(rng.choice(len(earlier), size=k, replace=False))
+        collided = state.records.collided[state.ok]
+        if not collided[pick].any() and not collided[is_new].any() and collided[~is_new].any():
+            pick[0:1] = rng.choice(np.flatnonzero(collided[~is_new]), size=1)  # both classes
+        return [str(s) for s in (*earlier[np.sort(pick)], *new)]
 
     @intra_op_threads()
     def finish_round(self, state: CampaignState, new_ids: list[str], version: str,

@@ -8,8 +8,15 @@ import numpy as np
 import pytest
 
 from evoeye.evolve.campaign import loop as campaign_mod
-from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.config import (
+    FINETUNE_EPOCHS,
+    FINETUNE_PATIENCE,
+    REPLAY_EPOCHS,
+    REPLAY_PATIENCE,
+    CampaignConfig,
+)
 from evoeye.evolve.campaign.loop import Campaign
+from evoeye.monitor.families import FAMILIES
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse, load_windows
 from evoeye.store.feedback import read_feedback, read_rounds
@@ -60,7 +67,11 @@ def test_config_rejects_unknown_strategy_and_update() -> None:
         CampaignConfig(SCENARIO, strategy="random-walk")
     with pytest.raises(ValueError, match="update"):
         CampaignConfig(SCENARIO, update="warm")
-    assert CampaignConfig(SCENARIO).train_overrides() == {"epochs": 10, "patience": 4}
+    assert CampaignConfig(SCENARIO).update == "replay"
+    assert CampaignConfig(SCENARIO).train_overrides() == {"epochs": REPLAY_EPOCHS,
+                                                          "patience": REPLAY_PATIENCE}
+    assert CampaignConfig(SCENARIO, update="finetune").train_overrides() == {
+        "epochs": FINETUNE_EPOCHS, "patience": FINETUNE_PATIENCE}
     assert CampaignConfig(SCENARIO, update="retrain").train_overrides() == {}
 
 
@@ -324,3 +335,55 @@ def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_cop
         assert fb[one] == pytest.approx(np.abs(risk[k] - w.label[k]).mean())
     hard = rows[1].metrics.hard
     assert hard["frames"] == assess(seeded[1]).hard["frames"] > 0
+
+
+# -- the replay update: each round trains on its runs and a seeded sample of as many earlier --
+
+def capture_training(root, cfg, log: list[list[str]]) -> Campaign:
+    """A campaign whose monitor updates are real, with the runs each one trained on logged."""
+    def train(*args, train_runs, **kwargs) -> str:
+        log.append(list(train_runs))
+        return FAMILIES["fusion"].train(*args, train_runs=train_runs, **kwargs)
+    return Campaign(root, cfg, train=train)
+
+
+def test_replay_trains_on_the_rounds_runs_and_as_many_earlier_ones(root_copy, seeded) -> None:
+    root = root_copy("replay")
+    cfg = config(seeded[1], strategy="uniform", n_round=3)
+    trained: list[list[str]] = []
+    c = capture_training(root, cfg, trained)
+    state = c.run(max_rounds=2)
+    initial = set(c.initial["scenario_id"])
+    assert len(trained) == 2 and len(initial) > 3
+    earlier = set(initial)
+    for row, ids in zip(state.rounds[1:], trained, strict=True):
+        new = [s for s, ok in zip(state.records.scenario_id, state.ok, strict=True)
+               if ok and s in row.scenario_ids]
+        assert len(new) == 3 and ids[-3:] == new  # the round's own runs, in order, last
+        replayed = ids[:-3]
+        assert len(replayed) == 3 and len(set(replayed)) == 3 and set(replayed) <= earlier
+        collided = dict(zip(state.records.scenario_id, state.records.collided, strict=True))
+        assert any(collided[s] for s in ids)  # both classes to learn from
+        earlier |= set(row.scenario_ids)
+
+    again: list[list[str]] = []  # the same campaign elsewhere draws the same samples
+    capture_training(root_copy("replay-again"), cfg, again).run(max_rounds=2)
+    assert again == trained
+
+
+def test_finetune_trains_on_every_record(root_copy, seeded) -> None:
+    trained: list[list[str]] = []
+    c = capture_training(root_copy("finetune"), config(seeded[1], strategy="uniform",
+                                                       update="finetune"), trained)
+    state = c.run(max_rounds=1)
+    ok = [s for s, good in zip(state.records.scenario_id, state.ok, strict=True) if good]
+    assert trained == [ok] and len(ok) == len(c.initial["scenario_id"]) + 2
+
+
+def test_a_round_without_an_ok_run_keeps_its_monitor(root_copy, seeded) -> None:
+    c = Campaign(root_copy("failed"), config(seeded[1], strategy="uniform"))
+    state = c.start()
+    c.acquire(state)
+    state.ok[:] = np.arange(len(state.ok)) < len(c.initial["scenario_id"])  # the round failed
+    assert c.training_runs(state) == []
+    assert c.update_monitor(state) == (state.monitor, 0.0)

@@ -117,7 +117,7 @@ def test_a_registered_family_and_strategy_are_evolved_assessed_and_reported(
     check_known("method", ["toy-evo", "corners"])
     # a campaign evolves the toy family, from its own G_0, round by round
     cfg = CampaignConfig(SCENARIO, family="toy", strategy="uniform", budget_s=1000.0,
-                         n_round=2, splits=SPLITS)
+                         n_round=2, splits=SPLITS, update="finetune")  # trained on every record
     campaign = Campaign(root, cfg)
     assert campaign.campaign_id.startswith("evo-toy-uniform-s0-")
     assert campaign.g0.startswith("toy-") and campaign.reference == seeded[1]
