@@ -79,17 +79,27 @@ class FitResult:
     time_s: float
 
 
+def _deterministic(mode: bool) -> None:
+    """torch.use_deterministic_algorithms without its import of torch._inductor (≈ 1.4 s once
+    per process, to set a compiler flag for torch.compile, which evoeye never uses)."""
+    setter = getattr(torch._C, "_set_deterministic_algorithms", None)
+    if setter is None:  # another torch: the public call
+        torch.use_deterministic_algorithms(mode)
+    else:
+        setter(mode)
+
+
 @contextmanager
 def _reproducible(seed: int, threads: int):
     """Seeded global RNG, deterministic kernels and a fixed thread count; all restored after."""
     was_deterministic = torch.are_deterministic_algorithms_enabled()
     with torch.random.fork_rng(devices=[]), intra_op_threads(threads):
         torch.manual_seed(seed)
-        torch.use_deterministic_algorithms(True)
+        _deterministic(True)
         try:
             yield
         finally:
-            torch.use_deterministic_algorithms(was_deterministic)
+            _deterministic(was_deterministic)
 
 
 def _val_score(net: FusionNet, val: Windows) -> tuple[np.ndarray, float]:

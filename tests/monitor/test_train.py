@@ -40,6 +40,14 @@ def test_training_leaves_global_torch_state_alone(tiny) -> None:
     assert not torch.are_deterministic_algorithms_enabled()
 
 
+def test_training_runs_with_deterministic_kernels_on() -> None:
+    from evoeye.monitor.train import _reproducible
+
+    with _reproducible(seed=0, threads=1):
+        assert torch.are_deterministic_algorithms_enabled()
+    assert not torch.are_deterministic_algorithms_enabled()
+
+
 def test_card_records_data_hyperparameters_metrics_and_thresholds(
     tiny, trained: str
 ) -> None:

@@ -27,7 +27,7 @@ from evoeye.splits import SplitSpec
 UPDATE_MODES = ("replay", "finetune", "retrain")  # evoeye.evolve.campaign.loop says what each is
 FEEDBACK_MODES = ("raw", "prior-corrected")  # ŷ as the monitor scores it, or σ(logit − log w)
 FINETUNE_EPOCHS, FINETUNE_PATIENCE = 10, 4
-REPLAY_EPOCHS, REPLAY_PATIENCE = 3, 2  # per round: passes over the new runs and their replay
+REPLAY_EPOCHS, REPLAY_PATIENCE = 2, 1  # per round: passes over the new runs and their replay
 REPLAY_RATIO = 1.0  # earlier runs replayed per new run of the round
 DEFAULT_FAMILY = "fusion"  # evoeye.monitor.families.DEFAULT_FAMILY
 DEFAULT_DELTA = 0.2  # evoeye.scenarios.DEFAULT_DELTA
@@ -115,9 +115,9 @@ class CampaignConfig:
     update: str = option("replay", "Monitor update per round: replay (fine-tune G_r on the "
                          "round's runs and as many earlier ones), finetune (on every record) or "
                          "retrain (from scratch on every record).", names="update")
-    epochs: int | None = option(None, "Epochs per monitor update (default: 3 with replay, 10 "
+    epochs: int | None = option(None, "Epochs per monitor update (default: 2 with replay, 10 "
                                 "fine-tuning, the trainer's when retraining).", ge=1)
-    patience: int | None = option(None, "Early-stopping patience per update (default: 2 with "
+    patience: int | None = option(None, "Early-stopping patience per update (default: 1 with "
                                   "replay, 4 fine-tuning, the trainer's when retraining).",
                                   ge=1)
     delta: float = option(DEFAULT_DELTA, "Neighbourhood radius δ of the density-aware "

@@ -11,7 +11,7 @@ Monitor update (Algorithm 1, line 12: Train(G_r, D_r)). A round adds only N_roun
 hundreds, so re-fitting on all of D_r every round would spend most of a campaign's wall time
 relearning what G_r knows, and more every round as D_r grows.
 * `update="replay"` (the default): G_{r+1} starts from G_r's weights and input normalisers and
-  trains a few epochs on the round's new runs plus a seeded sample of as many earlier runs of
+  trains at most two epochs on the round's new runs plus a seeded sample of as many earlier runs of
   D_r (experience replay, so that what G_r learned is rehearsed, not forgotten). Its cost grows
   with N_round, not with D_r. At least one collision run is in the sample when D_r has one.
 * `update="finetune"`: the same start, a few epochs on every run of D_r.
