@@ -35,7 +35,6 @@ import numpy as np
 import pyarrow as pa
 
 from evoeye.ads.messages import PLANNING_DECISIONS
-from evoeye.store import feature_kernels as kernels
 from evoeye.store.signals import ArrowSignals, Signals
 
 PERCEPTION_FEATURES = (
@@ -143,6 +142,8 @@ CONTROL_COLUMNS = ("ctrl_throttle", "ctrl_brake", "ctrl_steering_rad", "ctrl_acc
 def frame_features(source: pa.Table | Signals, spec: FeatureSpec = FEATURES) -> FrameFeatures:
     """The monitor inputs of every frame of `source`, in order: an Arrow table with
     runtime_frames columns, or any `Signals` (one frame's live messages at run time)."""
+    from evoeye.store import feature_kernels as kernels  # numba: imported on first use (≈ 0.5 s)
+
     signals = ArrowSignals(source) if isinstance(source, pa.Table | pa.RecordBatch) else source
     out = FrameFeatures.empty(len(signals), spec)
     if len(signals) == 0:
