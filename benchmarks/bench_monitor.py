@@ -9,10 +9,12 @@ written and ingested in a temporary folder), one intra-op thread:
   torch eager      FusionNet forward + sigmoid under torch.inference_mode, inputs ready
   torch traced     the same, TorchScript-traced (what FusionMonitor runs)
   FusionMonitor    `score_batch`: the traced net plus tensor → numpy (the Monitor path)
-  ONNX Runtime     the exported model, one session thread
+  ONNX Runtime     the exported model, one session thread (`onnx_session`, what
+                   RuntimeMonitor runs)
   features         one frame of ADS messages → its monitor inputs (`MessageSignals` through the
                    warehouse's feature code), alone
   RuntimeMonitor   `step(messages)`: one frame of ADS messages → features → context → score
+                   (ONNX Runtime reading the context buffers in place)
   throughput       windows / s at batch 1024: torch eager, traced and ONNX Runtime
 
 Latencies are medians (and p99) over `--calls` calls after `--warmup` calls. The monitor is
@@ -27,7 +29,6 @@ import statistics
 import tempfile
 import time
 from collections.abc import Callable
-from pathlib import Path
 
 import numpy as np
 import onnxruntime as ort
@@ -35,7 +36,7 @@ import torch
 
 from benchmarks.bench_warehouse import write_logs
 from benchmarks.machine import describe
-from evoeye.monitor.export import OUTPUT, export_onnx
+from evoeye.monitor.export import OUTPUT, onnx_session
 from evoeye.monitor.fusion import FusionMonitor, net_inputs, traced
 from evoeye.monitor.model import INPUTS, FusionConfig, FusionNet
 from evoeye.monitor.protocol import Thresholds
@@ -127,11 +128,7 @@ def measure(args: argparse.Namespace, root: DataRoot) -> None:
                  *timed(lambda: torch_net(x1, graph), args.calls, args.warmup)))
     rows.append(("FusionMonitor.score_batch, batch 1",
                  *timed(lambda: monitor.score_batch(one), args.calls, args.warmup)))
-    with tempfile.TemporaryDirectory() as tmp:
-        path = export_onnx(monitor, Path(tmp) / "monitor.onnx")
-        opts = ort.SessionOptions()
-        opts.intra_op_num_threads = opts.inter_op_num_threads = 1
-        session = ort.InferenceSession(str(path), opts, providers=["CPUExecutionProvider"])
+    session = onnx_session(monitor, threads=1)
     feed1 = {name: t.numpy() for name, t in zip(INPUTS, x1, strict=True)}
     feed_big = {name: t.numpy() for name, t in zip(INPUTS, big, strict=True)}
     rows.append(("ONNX Runtime, batch 1",

@@ -1,9 +1,10 @@
-"""Runtime signals of a frame → the fixed-size arrays a monitor consumes (pure numpy, no row loop).
+"""Runtime signals of a frame → the fixed-size arrays a monitor consumes.
 
 Everything is expressed in the ego frame of the ADS's own localization (x forward, y left,
 origin at the ego centre), so a monitor learns relative geometry, never absolute map positions.
 The signals come as `Signals` (`evoeye.store.signals`): an Arrow frames table at ingest, one
-frame's live messages at run time — one feature code for both.
+frame's live messages at run time — one feature code for both, its arithmetic compiled
+(`evoeye.store.feature_kernels`: a frame costs a few calls, N frames one loop each).
 Per frame, with n = `max_obstacles`, K = `pred_points`, P = `plan_points`:
 
     perception       (n, 9)    PERCEPTION_FEATURES of the n nearest obstacles, nearest first
@@ -28,6 +29,7 @@ K = 30 predicted points (0.1 s apart) into 10 (0.3 s apart, up to 3 s) and its 4
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
+from functools import cached_property
 
 import numpy as np
 import pyarrow as pa
@@ -62,13 +64,13 @@ class FeatureSpec:
                self.plan_stride) < 1:
             raise ValueError(f"every FeatureSpec size must be at least 1: {self}")
 
-    @property
+    @cached_property
     def pred_raw_index(self) -> np.ndarray:
-        return (np.arange(self.pred_points) + 1) * self.pred_stride - 1
+        return (np.arange(self.pred_points, dtype=np.int64) + 1) * self.pred_stride - 1
 
-    @property
+    @cached_property
     def plan_raw_index(self) -> np.ndarray:
-        return np.arange(self.plan_points) * self.plan_stride
+        return np.arange(self.plan_points, dtype=np.int64) * self.plan_stride
 
 
 FEATURES = FeatureSpec()  # the spec the warehouse's frame_features are built with
@@ -127,175 +129,38 @@ class FrameFeatures:
                 getattr(self, name)[dst : dst + hi - lo] = arr[src : src + hi - lo]
 
 
-# -- geometry -----------------------------------------------------------------------------------
-@dataclass(frozen=True)
-class _EgoPose:
-    """The ego's pose and velocity (map frame), one entry per frame — or per item (`expand`)."""
-
-    x_m: np.ndarray
-    y_m: np.ndarray
-    cos: np.ndarray
-    sin: np.ndarray
-    heading_rad: np.ndarray
-    vx_mps: np.ndarray
-    vy_mps: np.ndarray
-
-    @classmethod
-    def of(cls, signals: Signals) -> _EgoPose:
-        h = signals.scalar("loc_heading_rad")
-        v = signals.scalar("loc_speed_mps")
-        c, s = np.cos(h), np.sin(h)
-        return cls(signals.scalar("loc_x_m"), signals.scalar("loc_y_m"), c, s, h, v * c, v * s)
-
-    def expand(self, offsets: np.ndarray | None, trailing: int = 0) -> _EgoPose:
-        """The pose of each item of a list column with these offsets (None: of each frame),
-        with `trailing` axes of length 1 to broadcast against per-item values. One frame's pose
-        is a pose of floats (numpy multiplies by a float at half the cost of broadcasting)."""
-        arrays = [self.x_m, self.y_m, self.cos, self.sin, self.heading_rad, self.vx_mps,
-                  self.vy_mps]
-        if len(arrays[0]) == 1:
-            return _EgoPose(*(float(a[0]) for a in arrays))
-        if offsets is not None:
-            rows = np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
-            arrays = [a[rows] for a in arrays]
-        if trailing:
-            arrays = [a.reshape(-1, *(1,) * trailing) for a in arrays]
-        return _EgoPose(*arrays)
-
-    def rotate(self, wx: np.ndarray, wy: np.ndarray) -> tuple[np.ndarray, ...]:
-        """World vectors (wx, wy) → ego-frame (forward, left)."""
-        return self.cos * wx + self.sin * wy, -self.sin * wx + self.cos * wy
-
-    def to_ego(self, x: np.ndarray, y: np.ndarray) -> tuple[np.ndarray, ...]:
-        """World points → ego-frame points."""
-        return self.rotate(x - self.x_m, y - self.y_m)
-
-
-def _frame_of_items(offsets: np.ndarray) -> np.ndarray:
-    """(M,) the frame of each item of a list column with these offsets."""
-    if len(offsets) == 2:  # one frame (run time): no repeat needed
-        return np.zeros(offsets[1], np.int64)
-    return np.repeat(np.arange(len(offsets) - 1), np.diff(offsets))
-
-
-def _nearest_slots(
-    offsets: np.ndarray, dist: np.ndarray, n_max: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """For items grouped by frame: (item, frame, slot) of the n_max nearest per frame."""
-    frame = _frame_of_items(offsets)
-    order = np.lexsort((dist, frame))  # by frame, then distance
-    slot = np.arange(len(order)) - offsets[frame[order]]
-    keep = slot < n_max
-    return order[keep], frame[order[keep]], slot[keep]
-
-
-def _points_index(
-    offsets: np.ndarray, raw_index: np.ndarray, n_values: int
-) -> tuple[np.ndarray, np.ndarray]:
-    """Indices (rows, len(raw_index)) into n_values values picking items `raw_index` of each
-    row, the row's last item standing in past its end; and the mask of items that exist.
-    Empty rows index a valid but meaningless item: callers mask them."""
-    counts = np.diff(offsets)[:, None]
-    idx = offsets[:-1, None] + np.minimum(raw_index[None, :], np.maximum(counts - 1, 0))
-    return np.minimum(idx, max(n_values - 1, 0)), raw_index[None, :] < counts
-
-
-def _finite32(a: np.ndarray) -> np.ndarray:
-    """float32 of `a` with every non-finite value 0 (np.nan_to_num's result, without its cost)."""
-    return np.where(np.isfinite(a), a, 0.0).astype(np.float32)
-
-
-# -- per module ---------------------------------------------------------------------------------
+# -- per module (the arithmetic is in evoeye.store.feature_kernels) -----------------------------
+EGO_COLUMNS = ("loc_x_m", "loc_y_m", "loc_heading_rad", "loc_speed_mps")
 PERCEPTION_COLUMNS = ("obs_x_m", "obs_y_m", "obs_heading_rad", "obs_vx_mps", "obs_vy_mps",
                       "obs_length_m", "obs_width_m", "obs_confidence")
 PLAN_COLUMNS = ("plan_x_m", "plan_y_m", "plan_heading_rad", "plan_t_rel_s", "plan_speed_mps",
                 "plan_accel_mps2")
-
-
-def _perception(t: Signals, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
-    offsets, (x, y, h, vx, vy, length, width, confidence) = t.columns(PERCEPTION_COLUMNS)
-    pose = ego.expand(offsets)
-    feats = np.empty((len(x), len(PERCEPTION_FEATURES)))
-    feats[:, 0], feats[:, 1] = pose.to_ego(x, y)
-    dh = h - pose.heading_rad
-    feats[:, 2], feats[:, 3] = np.cos(dh), np.sin(dh)
-    feats[:, 4], feats[:, 5] = pose.rotate(vx - pose.vx_mps, vy - pose.vy_mps)
-    feats[:, 6], feats[:, 7], feats[:, 8] = length, width, confidence
-    dist = np.hypot(feats[:, 0], feats[:, 1])
-    item, frame, slot = _nearest_slots(offsets, dist, spec.max_obstacles)
-    out.perception[frame, slot] = _finite32(feats[item])
-    out.perception_mask[frame, slot] = True
-
-
-def _prediction(t: Signals, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
-    outer, inner, x = t.points("pred_x_m")  # inner: absolute into x
-    y = t.points("pred_y_m")[2]
-    if len(inner) <= 1 or len(x) == 0:
-        return
-    idx, _ = _points_index(inner, spec.pred_raw_index, len(x))  # (M, K) into x / y
-    has_points = np.diff(inner) > 0
-    dx, dy = ego.expand(outer, trailing=1).to_ego(x[idx], y[idx])
-    # one slot per obstacle, its most probable mode: the first of its contiguous rows
-    track = t.items("pred_track_id")[1]
-    first = np.ones(len(track), dtype=bool)
-    first[1:] = track[1:] != track[:-1]
-    if len(outer) > 2:  # a new frame starts a new obstacle too
-        rows = _frame_of_items(outer)
-        first[1:] |= rows[1:] != rows[:-1]
-    dist = np.where(has_points & first, np.hypot(dx[:, 0], dy[:, 0]), np.inf)
-    item, frame, slot = _nearest_slots(outer, dist, spec.max_obstacles)
-    primary = first[item]
-    item, frame, slot = item[primary], frame[primary], slot[primary]
-    out.prediction[frame, slot, :, 0] = _finite32(dx[item])
-    out.prediction[frame, slot, :, 1] = _finite32(dy[item])
-    out.prediction_mask[frame, slot] = has_points[item]
-
-
-def _plan(t: Signals, ego: _EgoPose, spec: FeatureSpec, out: FrameFeatures) -> None:
-    offsets, (x, y, h, t_rel, speed, accel) = t.columns(PLAN_COLUMNS)
-    if len(x) == 0:
-        return
-    idx, mask = _points_index(offsets, spec.plan_raw_index, len(x))  # (N, P)
-    pose = ego.expand(None, trailing=1)
-    feats = np.empty((*idx.shape, len(PLAN_FEATURES)))
-    feats[..., 1], feats[..., 2] = pose.to_ego(x[idx], y[idx])
-    dh = h[idx] - pose.heading_rad
-    feats[..., 3], feats[..., 4] = np.cos(dh), np.sin(dh)
-    feats[..., 0], feats[..., 5], feats[..., 6] = t_rel[idx], speed[idx], accel[idx]
-    has_plan = np.diff(offsets) > 0
-    out.plan[has_plan] = _finite32(feats[has_plan])
-    out.plan_mask[:] = mask
-
-
 CONTROL_COLUMNS = ("ctrl_throttle", "ctrl_brake", "ctrl_steering_rad", "ctrl_accel_cmd_mps2",
                    "loc_speed_mps", "loc_accel_mps2")  # the sources of CONTROL_FEATURES
-
-
-def _plan_info_and_control(t: Signals, out: FrameFeatures) -> None:
-    code = t.codes("plan_decision", PLANNING_DECISIONS)
-    info = np.zeros((len(t), len(PLAN_INFO_FEATURES)))
-    info[:, 0] = t.scalar("plan_target_speed_mps")
-    known = np.flatnonzero(code >= 0)
-    info[known, 1 + code[known]] = 1.0
-    out.plan_info[:] = _finite32(info)
-    control = np.empty((len(t), len(CONTROL_FEATURES)))
-    for col, name in enumerate(CONTROL_COLUMNS):
-        control[:, col] = t.scalar(name)
-    out.control[:] = _finite32(control)
 
 
 def frame_features(source: pa.Table | Signals, spec: FeatureSpec = FEATURES) -> FrameFeatures:
     """The monitor inputs of every frame of `source`, in order: an Arrow table with
     runtime_frames columns, or any `Signals` (one frame's live messages at run time)."""
+    from evoeye.store import feature_kernels as kernels  # numba: imported on first use (≈ 0.5 s)
+
     signals = ArrowSignals(source) if isinstance(source, pa.Table | pa.RecordBatch) else source
     out = FrameFeatures.empty(len(signals), spec)
     if len(signals) == 0:
         return out
-    ego = _EgoPose.of(signals)
-    _perception(signals, ego, spec, out)
-    _prediction(signals, ego, spec, out)
-    _plan(signals, ego, spec, out)
-    _plan_info_and_control(signals, out)
+    ego = tuple(signals.scalar(name) for name in EGO_COLUMNS)
+    offsets, columns = signals.columns(PERCEPTION_COLUMNS)
+    kernels.perception(ego, offsets, tuple(columns), out.perception, out.perception_mask)
+    outer, inner, x = signals.points("pred_x_m")
+    kernels.prediction(ego, outer, inner, x, signals.points("pred_y_m")[2],
+                       signals.items("pred_track_id")[1], spec.pred_raw_index, out.prediction,
+                       out.prediction_mask)
+    offsets, columns = signals.columns(PLAN_COLUMNS)
+    kernels.plan(ego, offsets, tuple(columns), spec.plan_raw_index, out.plan, out.plan_mask)
+    kernels.plan_info_and_control(
+        signals.codes("plan_decision", PLANNING_DECISIONS),
+        signals.scalar("plan_target_speed_mps"),
+        np.array([signals.scalar(name) for name in CONTROL_COLUMNS]), out.plan_info, out.control)
     return out
 
 

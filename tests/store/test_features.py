@@ -174,3 +174,29 @@ def test_live_messages_give_exactly_the_inputs_stored_at_ingest(
                 np.testing.assert_array_equal(getattr(through_arrow, name)[0], arr[i])
     assert stored.perception_mask.sum(axis=1).max() == n_obstacles
     assert not stored.plan_info[3, 1:].any() and stored.plan_info[4, 1:].sum() == 1
+
+
+def test_obstacles_at_equal_distance_keep_their_order_and_unknown_distances_come_last() -> None:
+    t = _frames(["cruise"], [[10.0, 7.0, 13.0]])  # 20 m ahead; 3 m left; 3 m right
+    x = [float("nan"), 7.0, 13.0]
+    t = t.set_column(t.schema.get_field_index("obs_x_m"), "obs_x_m", pa.array([x]))
+    t = t.set_column(t.schema.get_field_index("obs_y_m"), "obs_y_m", pa.array([[5.0] * 3]))
+    f = frame_features(t, SPEC)
+    # the NaN obstacle has no distance: it is dropped; the tie keeps the message order
+    assert f.perception[0, :, P["dy_m"]] == pytest.approx([3.0, -3.0])
+    assert f.perception_mask[0].tolist() == [True, True]
+
+
+def test_a_batch_of_frames_gives_each_frames_own_features() -> None:
+    """One definition for ingest (N frames) and run time (one): a frame's row never depends
+    on the frames beside it, non-finite inputs included."""
+    t = _frames(["yield", "cruise", "follow"], [[10.0, 7.0, 10.0], [], [7.0, float("inf")]])
+    t = t.set_column(t.schema.get_field_index("loc_speed_mps"), "loc_speed_mps",
+                     pa.array([2.0, float("nan"), 3.0]))
+    batch = frame_features(t, SPEC)
+    for i in range(len(t)):
+        alone = frame_features(t.slice(i, 1), SPEC)
+        for name, arr in batch.arrays().items():
+            np.testing.assert_array_equal(getattr(alone, name)[0], arr[i], err_msg=name)
+    assert np.isfinite(batch.perception).all() and np.isfinite(batch.control).all()
+    assert batch.control[1, 4] == 0.0  # the NaN ego speed
