@@ -76,6 +76,9 @@ def main() -> None:
     ap.add_argument("--project", type=int, help="the slice is this many campaigns of the "
                     f"full protocol ({FULL_PROTOCOL})")
     ap.add_argument("--runs", type=int, default=40, help="initial runs without --root")
+    ap.add_argument("--train-frac", type=float, default=0.5, help="split of the initial runs "
+                    "(with --root: as they were split when its G_0 was trained)")
+    ap.add_argument("--val-frac", type=float, default=0.25)
     args = ap.parse_args()
     args.scenario = args.scenario or ["highway-cut-in"]
     args.strategy = args.strategy or ["uniform", "evoeye"]
@@ -83,7 +86,7 @@ def main() -> None:
     print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}")
     print(f"{n_campaigns} campaigns: {args.scenario} × {args.strategy} × seeds {args.seeds}, "
           f"budget {args.budget_s or 'the initial data'}, N_round {args.n_round}\n")
-    splits = SplitSpec() if args.root else SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
+    splits = SplitSpec(seed=0, train_frac=args.train_frac, val_frac=args.val_frac)
     runs: dict[tuple[str, int], tuple[float, list]] = {}
     with tempfile.TemporaryDirectory(prefix="bench-experiment-") as tmp:
         src = (DataRoot.existing(args.root) if args.root
