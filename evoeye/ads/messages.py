@@ -131,4 +131,5 @@ class FrameMessages:
                 elif isinstance(value, float):
                     scalars.append(value)
         arrays.append(np.asarray(scalars))
-        return bool(np.isfinite(np.concatenate(arrays)).all())
+        values = np.concatenate(arrays)
+        return np.count_nonzero(np.isfinite(values)) == values.size

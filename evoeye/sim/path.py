@@ -76,9 +76,9 @@ class Path:
             k0 = self.index(near_s - window_m)
             k1 = min(self.index(near_s + window_m) + 1, len(self.s) - 1)
         px, py = self.x[k0:k1], self.y[k0:k1]
-        dx, dy = np.diff(self.x[k0 : k1 + 1]), np.diff(self.y[k0 : k1 + 1])
+        dx, dy = self.x[k0 + 1 : k1 + 1] - px, self.y[k0 + 1 : k1 + 1] - py
         seg2 = np.maximum(dx * dx + dy * dy, 1e-12)
-        t = np.clip(((x - px) * dx + (y - py) * dy) / seg2, 0.0, 1.0)
+        t = (((x - px) * dx + (y - py) * dy) / seg2).clip(0.0, 1.0)
         cx, cy = px + t * dx, py + t * dy
         k = int(np.argmin((cx - x) ** 2 + (cy - y) ** 2))
         s = float(self.s[k0 + k] + t[k] * math.sqrt(seg2[k]))

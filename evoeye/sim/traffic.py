@@ -10,6 +10,7 @@ the scenarios.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -54,6 +55,14 @@ class Relations:
         return float(self.bumper[i, j] if self.xi[i, j] < 0.0 else -self.bumper[i, j])
 
 
+@functools.cache
+def _not_self(n: int) -> np.ndarray:
+    """(n, n) True off the diagonal (read-only: shared by every call)."""
+    mask = ~np.eye(n, dtype=bool)
+    mask.flags.writeable = False
+    return mask
+
+
 def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """(gap, leader speed along one's heading, blocking gap) per vehicle: the nearest vehicle
     ahead in its corridor (or in its target lane, `shift_m` to the side, during a lane change)
@@ -64,7 +73,7 @@ def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray
     reach = rel.half_w + CORRIDOR_MARGIN_M
     in_lane = np.abs(rel.eta) < reach
     in_target = (shift_m != 0.0)[:, None] & (np.abs(rel.eta - shift_m[:, None]) < reach)
-    ahead = (rel.xi > 0.0) & ~np.eye(n, dtype=bool) & (in_lane | in_target)
+    ahead = (rel.xi > 0.0) & _not_self(n) & (in_lane | in_target)
     aligned = rel.cos_dh > ALIGNED_COS
     gap = np.where(ahead & aligned & (rel.xi < LOOKAHEAD_M), rel.bumper, np.inf)
     block = np.where(ahead & ~aligned & (rel.xi < BLOCKING_M), rel.bumper, np.inf).min(axis=1)
@@ -97,8 +106,8 @@ def path_block(path, s_m: float, half_len_m: float, half_wid_m: float, x: np.nda
     on_path = ex * ex + ey * ey < (half_wid_m + CORRIDOR_MARGIN_M) ** 2  # (m, K)
     on_path &= np.cos(heading[others, None] - ph[None, :]) <= ALIGNED_COS  # not a leader
     on_path[:, : int(half_len_m / path.step_m) + 1] = False  # behind its own front bumper
-    hit = on_path.any(axis=0)
-    if not hit.any():
+    hit = np.logical_or.reduce(on_path, axis=0)
+    if not np.count_nonzero(hit):
         return np.inf
     return max(float(path.s[k0 + int(hit.argmax())] - s_m) - half_len_m, 0.0)
 
@@ -113,7 +122,7 @@ def clear_to_change(rel: Relations, i: int, offset_m: float) -> bool:
     need_front = CLEAR_FRONT_M + CLEAR_FRONT_S * v_i + 2.0 * np.maximum(v_i - v_j, 0.0)
     need_rear = CLEAR_REAR_M + CLEAR_REAR_S * v_j + 2.0 * np.maximum(v_j - v_i, 0.0)
     need = np.where(rel.xi[i] >= 0.0, need_front, need_rear)
-    return not (others & in_target & (rel.bumper[i] < need)).any()
+    return not np.count_nonzero(others & in_target & (rel.bumper[i] < need))
 
 
 DECIDE_WITHIN_M = 60.0  # a crossing's order is settled once both NPCs are this close to it

@@ -56,6 +56,12 @@ class World:
         self.collision_actor = -1
         self._accel = np.zeros(len(self.vehicles))
         self._blocked_s = np.zeros(len(self.vehicles))  # how long a crossing car has blocked each
+        # every pair (i < j) and the distance within which their circumscribed circles meet
+        self._pair_i, self._pair_j = np.triu_indices(len(self.vehicles), k=1)
+        reach = 0.5 * np.hypot(self.length_m, self.width_m)  # (n,) circumscribed radius
+        self._pair_reach_m = reach[self._pair_i] + reach[self._pair_j]
+        rows = np.arange(len(self.vehicles))
+        self._others = [rows[rows != i] for i in rows]  # every row but i, per row
         assert EGO_ID == 0
 
     # -- reading -------------------------------------------------------------------------------
@@ -91,6 +97,8 @@ class World:
             seen & (block < gap), 0.0, v_lead)
         self._wait_at_crossings(gap, v_lead)
         for i, npc in enumerate(self.npcs, start=1):
+            if npc.lane_change is None:  # nothing scripted: no trigger to update
+                continue
             closing = speed[0] - speed[i] * rel.cos_dh[0, i]
             if npc.wants_lane_change(rel.gap_ahead_of(i, 0), closing) and clear_to_change(
                 rel, i, npc.lane_change.offset_m
@@ -114,12 +122,11 @@ class World:
         """Where an NPC's path curves ahead (a turn), what blocks it is looked for along the
         arc rather than straight ahead: a car standing in the turn is seen as a driver sees it."""
         half_l, half_w = 0.5 * self.length_m, 0.5 * self.width_m
-        rows = np.arange(len(self.vehicles))
         for i, npc in enumerate(self.npcs, start=1):
             if npc.crashed or npc.changing_lanes:
                 continue
             g = path_block(npc.path, npc.s_m, half_l[i], half_w[i], x, y, heading, half_l,
-                           half_w, rows[rows != i])
+                           half_w, self._others[i])
             if g < block[i]:
                 block[i] = g
 
@@ -142,19 +149,17 @@ class World:
     def _contacts(self) -> None:
         """Mark every overlapping pair of footprints as crashed; remember the ego's partner."""
         x, y, heading, _ = self._state()
-        n = len(x)
-        reach = 0.5 * np.hypot(self.length_m, self.width_m)  # (n,) circumscribed radius
-        i, j = np.triu_indices(n, k=1)
-        close = np.hypot(x[i] - x[j], y[i] - y[j]) <= reach[i] + reach[j]
-        if not close.any():
+        i, j = self._pair_i, self._pair_j
+        close = np.hypot(x[i] - x[j], y[i] - y[j]) <= self._pair_reach_m
+        if not np.count_nonzero(close):
             return
         i, j = i[close], j[close]
         corners = box_corners(x, y, heading, self.length_m, self.width_m)
         touching = box_gaps(corners[i], corners[j]) <= 0.0
-        if not touching.any():
+        if not np.count_nonzero(touching):
             return
         i, j = i[touching], j[touching]
-        if not self.crashed[0] and (i == 0).any():
+        if not self.crashed[0] and np.count_nonzero(i == 0):
             partners = j[i == 0]
             d = np.hypot(x[partners] - x[0], y[partners] - y[0])
             self.collision_actor = int(self.actor_id[partners[int(np.argmin(d))]])
