@@ -38,6 +38,8 @@ class Path:
         self.kappa = kappa  # (K,) 1/m, smoothed
         self.length_m = float(self.s[-1])
         self._profiles: dict[tuple[float, float], np.ndarray] = {}
+        # the samples as floats, for scalar lookups (a numpy call per value costs more)
+        self._samples = (self.s.tolist(), self.x.tolist(), self.y.tolist(), self.h.tolist())
 
     def index(self, s_m: float) -> int:
         """The sample at or before arc length s_m."""
@@ -57,11 +59,30 @@ class Path:
         return cls(np.concatenate(parts))
 
     # -- lookups (scalars) ----------------------------------------------------------------------
+    def _centre(self, s_m: float) -> tuple[float, float, float]:
+        """(x, y, heading) on the centre line at s_m: `np.interp` of each, value for value (its
+        arithmetic and end rules, in scalar Python, which a vehicle's every step can afford)."""
+        s, x, y, h = self._samples
+        if s_m != s_m:  # NaN
+            return s_m, s_m, s_m
+        if s_m <= s[0]:
+            return x[0], y[0], h[0]
+        if s_m >= s[-1]:
+            return x[-1], y[-1], h[-1]
+        j = min(int(s_m / self.step_m), len(s) - 2)  # s[j] ≤ s_m < s[j + 1], up to rounding
+        while s[j] > s_m:
+            j -= 1
+        while s[j + 1] <= s_m:
+            j += 1
+        if s[j] == s_m:
+            return x[j], y[j], h[j]
+        ds, u = s[j + 1] - s[j], s_m - s[j]
+        return ((x[j + 1] - x[j]) / ds * u + x[j], (y[j + 1] - y[j]) / ds * u + y[j],
+                (h[j + 1] - h[j]) / ds * u + h[j])
+
     def pose(self, s_m: float, d_m: float = 0.0) -> tuple[float, float, float]:
         """(x, y, heading) of the point d_m to the left of the centre line at arc length s_m."""
-        x = float(np.interp(s_m, self.s, self.x))
-        y = float(np.interp(s_m, self.s, self.y))
-        h = float(np.interp(s_m, self.s, self.h))
+        x, y, h = self._centre(s_m)
         if d_m:
             x -= d_m * math.sin(h)
             y += d_m * math.cos(h)

@@ -104,8 +104,10 @@ def path_block(path, s_m: float, half_len_m: float, half_wid_m: float, x: np.nda
     ex = np.maximum(np.abs(c * dx + s * dy) - half_l[others, None], 0.0)
     ey = np.maximum(np.abs(c * dy - s * dx) - half_w[others, None], 0.0)
     on_path = ex * ex + ey * ey < (half_wid_m + CORRIDOR_MARGIN_M) ** 2  # (m, K)
-    on_path &= np.cos(heading[others, None] - ph[None, :]) <= ALIGNED_COS  # not a leader
     on_path[:, : int(half_len_m / path.step_m) + 1] = False  # behind its own front bumper
+    if not np.count_nonzero(on_path):  # usually: then the headings need not be compared
+        return np.inf
+    on_path &= np.cos(heading[others, None] - ph[None, :]) <= ALIGNED_COS  # not a leader
     hit = np.logical_or.reduce(on_path, axis=0)
     if not np.count_nonzero(hit):
         return np.inf
@@ -181,9 +183,14 @@ class YieldToEgo:
     gap_s: float
     going: bool = field(default=False)
 
+    def settled(self, s: float) -> bool:
+        """Whether the NPC, at arc length s, waits for the ego no more, for good: it went, or
+        is past its stop point (an NPC never moves back along its path)."""
+        return self.going or s > self.stop_i
+
     def wait_gap(self, s: float, v: float, s_ego: float, v_ego: float) -> float | None:
         """The NPC's distance to its stop point while it waits; None when it may go."""
-        if self.going or s > self.stop_i or self.s_i - s > DECIDE_WITHIN_M:
+        if self.settled(s) or self.s_i - s > DECIDE_WITHIN_M:
             return None
         to_ego = self.s_ego - s_ego
         if to_ego < -PASSED_M:  # the ego is through

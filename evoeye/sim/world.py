@@ -138,10 +138,11 @@ class World:
         s = {i: npc.s_m for i, npc in enumerate(self.npcs, start=1)}
         v = {i: npc.speed for i, npc in enumerate(self.npcs, start=1)}
         waits = [c.wait_gap(s, v) for c in self.conflicts]
-        if self.yields:
+        live = [y for y in self.yields if not y.settled(s[y.i])]
+        if live:  # the ego's place on its route is needed (and followed) only for these
             self._ego_s = self.ego_path.project(*self.ego.position, near_s=self._ego_s)[0]
             waits += [(y.i, y.wait_gap(s[y.i], v[y.i], self._ego_s, self.ego.speed))
-                      for y in self.yields]
+                      for y in live]
         for wait in waits:
             if wait is not None and wait[1] is not None and wait[1] < gap[wait[0]]:
                 gap[wait[0]], v_lead[wait[0]] = max(wait[1], 0.0), 0.0
