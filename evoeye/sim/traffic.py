@@ -37,22 +37,26 @@ class Relations:
     speed: np.ndarray  # (n,)
 
     @classmethod
-    def of(cls, x, y, heading, speed, length, width) -> Relations:
+    def of(cls, x, y, heading, speed, half_l: np.ndarray, half_w: np.ndarray) -> Relations:
+        """half_l, half_w: (n, n) the sums of half-lengths and of half-widths (`half_sums`)."""
         dx = x[None, :] - x[:, None]
         dy = y[None, :] - y[:, None]
         c, s = np.cos(heading)[:, None], np.sin(heading)[:, None]
         xi = c * dx + s * dy
         eta = c * dy - s * dx
-        half_l = 0.5 * (length[:, None] + length[None, :])
         return cls(
             xi=xi, eta=eta, cos_dh=np.cos(heading[None, :] - heading[:, None]),
-            bumper=np.abs(xi) - half_l, half_w=0.5 * (width[:, None] + width[None, :]),
-            speed=speed,
+            bumper=np.abs(xi) - half_l, half_w=half_w, speed=speed,
         )
 
     def gap_ahead_of(self, i: int, j: int) -> float:
         """Bumper gap by which i is ahead of j along i's heading (negative when behind)."""
         return float(self.bumper[i, j] if self.xi[i, j] < 0.0 else -self.bumper[i, j])
+
+
+def half_sums(length: np.ndarray, width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n, n) sums of the half-lengths and of the half-widths of every pair (fixed per world)."""
+    return 0.5 * (length[:, None] + length[None, :]), 0.5 * (width[:, None] + width[None, :])
 
 
 @functools.cache

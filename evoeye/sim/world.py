@@ -24,6 +24,7 @@ from evoeye.sim.traffic import (
     Relations,
     YieldToEgo,
     clear_to_change,
+    half_sums,
     leaders,
     path_block,
 )
@@ -62,6 +63,7 @@ class World:
         self._pair_reach_m = reach[self._pair_i] + reach[self._pair_j]
         rows = np.arange(len(self.vehicles))
         self._others = [rows[rows != i] for i in rows]  # every row but i, per row
+        self._half_sums = half_sums(self.length_m, self.width_m)
         assert EGO_ID == 0
 
     # -- reading -------------------------------------------------------------------------------
@@ -87,7 +89,7 @@ class World:
     def step(self, accel_mps2: float, steering_rad: float, dt: float) -> None:
         """Apply the ego command, let the NPCs decide and move, integrate dt, check contacts."""
         x, y, heading, speed = self._state()
-        rel = Relations.of(x, y, heading, speed, self.length_m, self.width_m)
+        rel = Relations.of(x, y, heading, speed, *self._half_sums)
         shift = np.array([0.0] + [n.lateral_target_m() for n in self.npcs])
         gap, v_lead, block = leaders(rel, shift)
         self._block_along_paths(block, x, y, heading)
