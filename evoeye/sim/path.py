@@ -14,6 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 from highway_env.road.lane import StraightLane
+from scipy.spatial import cKDTree
 
 SAMPLE_STEP_M = 0.5
 
@@ -122,16 +123,19 @@ class Path:
 
     def first_conflict(self, other: Path, radius_m: float) -> tuple[float, float] | None:
         """(s on this path, s on `other`) where this path first comes within radius_m of the
-        other's centre line, or None if it never does."""
-        dx = self.x[:, None] - other.x[None, :]
-        dy = self.y[:, None] - other.y[None, :]
-        near = (dx * dx + dy * dy) <= radius_m * radius_m  # (K, K') on the samples
-        rows = near.any(axis=1).nonzero()[0]
-        if not len(rows):
-            return None
-        k = int(rows[0])
-        j = int(near[k].nonzero()[0][0])
-        return float(self.s[k]), float(other.s[j])
+        other's centre line, or None if it never does. The samples are compared exactly as
+        (dx² + dy² ≤ r²); a k-d tree only picks the samples that may qualify (within a hair
+        more than r), so all K × K' pairs need not be formed."""
+        pts = np.stack((self.x, self.y), axis=1)
+        dist, _ = cKDTree(np.stack((other.x, other.y), axis=1)).query(
+            pts, distance_upper_bound=radius_m * (1.0 + 1e-9) + 1e-9)
+        r2 = radius_m * radius_m
+        for k in np.isfinite(dist).nonzero()[0].tolist():  # in order along this path
+            dx, dy = self.x[k] - other.x, self.y[k] - other.y
+            near = (dx * dx + dy * dy) <= r2
+            if np.count_nonzero(near):
+                return float(self.s[k]), float(other.s[int(near.argmax())])
+        return None
 
     def stop_before(self, other: Path, s_here: float, s_there: float, radius_m: float,
                     window_m: float = 20.0) -> float:
