@@ -39,6 +39,8 @@ class Path:
         self.kappa = kappa  # (K,) 1/m, smoothed
         self.length_m = float(self.s[-1])
         self._profiles: dict[tuple[float, float], np.ndarray] = {}
+        self._dx, self._dy = self.x[1:] - self.x[:-1], self.y[1:] - self.y[:-1]  # (K-1,) segments
+        self._seg2 = np.maximum(self._dx * self._dx + self._dy * self._dy, 1e-12)
         # the samples as floats, for scalar lookups (a numpy call per value costs more)
         self._samples = (self.s.tolist(), self.x.tolist(), self.y.tolist(), self.h.tolist())
 
@@ -98,8 +100,7 @@ class Path:
             k0 = self.index(near_s - window_m)
             k1 = min(self.index(near_s + window_m) + 1, len(self.s) - 1)
         px, py = self.x[k0:k1], self.y[k0:k1]
-        dx, dy = self.x[k0 + 1 : k1 + 1] - px, self.y[k0 + 1 : k1 + 1] - py
-        seg2 = np.maximum(dx * dx + dy * dy, 1e-12)
+        dx, dy, seg2 = self._dx[k0:k1], self._dy[k0:k1], self._seg2[k0:k1]
         t = (((x - px) * dx + (y - py) * dy) / seg2).clip(0.0, 1.0)
         cx, cy = px + t * dx, py + t * dy
         k = int(np.argmin((cx - x) ** 2 + (cy - y) ** 2))
