@@ -76,8 +76,9 @@ def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray
     n = len(rel.speed)
     reach = rel.half_w + CORRIDOR_MARGIN_M
     in_lane = np.abs(rel.eta) < reach
-    in_target = (shift_m != 0.0)[:, None] & (np.abs(rel.eta - shift_m[:, None]) < reach)
-    ahead = (rel.xi > 0.0) & _not_self(n) & (in_lane | in_target)
+    if np.count_nonzero(shift_m):  # someone changes lanes: its target lane counts too
+        in_lane |= (shift_m != 0.0)[:, None] & (np.abs(rel.eta - shift_m[:, None]) < reach)
+    ahead = (rel.xi > 0.0) & _not_self(n) & in_lane
     aligned = rel.cos_dh > ALIGNED_COS
     gap = np.where(ahead & aligned & (rel.xi < LOOKAHEAD_M), rel.bumper, np.inf)
     block = np.where(ahead & ~aligned & (rel.xi < BLOCKING_M), rel.bumper, np.inf).min(axis=1)
