@@ -8,6 +8,7 @@ frame's message maps straight onto Arrow list columns in the warehouse.
 from __future__ import annotations
 
 from dataclasses import dataclass, fields
+from operator import attrgetter
 from typing import Any
 
 import numpy as np
@@ -28,6 +29,16 @@ class Message:
             names = tuple(f.name for f in fields(cls))  # type: ignore[arg-type]
             type.__setattr__(cls, "_field_names", names)
         return names
+
+    def field_values(self) -> tuple[Any, ...]:
+        """The values of the fields, in `field_names` order."""
+        cls = type(self)
+        get = cls.__dict__.get("_field_getter")
+        if get is None:
+            names = cls.field_names()
+            get = attrgetter(*names) if len(names) > 1 else lambda m: (getattr(m, names[0]),)
+            type.__setattr__(cls, "_field_getter", get)
+        return get(self)
 
 
 @dataclass(slots=True)
@@ -123,12 +134,12 @@ class FrameMessages:
         """False if any numeric field of any message is NaN or infinite (one vectorised check)."""
         arrays, scalars = [], []
         for msg in (self.localization, self.obstacles, self.predictions, self.plan, self.control):
-            for name in msg.field_names():
-                value = getattr(msg, name)
+            for value in msg.field_values():
                 if isinstance(value, np.ndarray):
                     if value.dtype.kind == "f":
                         arrays.append(value.ravel())
                 elif isinstance(value, float):
                     scalars.append(value)
         arrays.append(np.asarray(scalars))
-        return bool(np.isfinite(np.concatenate(arrays)).all())
+        values = np.concatenate(arrays)
+        return np.count_nonzero(np.isfinite(values)) == values.size

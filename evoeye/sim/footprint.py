@@ -51,16 +51,17 @@ def min_ego_gap(scenes: Sequence[SceneState], batch: int = 16) -> float:
     points are corner to corner — then exact distances in increasing order of the bound, a
     batch at a time, until the next bound is no smaller than the best exact distance. A run
     needs a handful of exact distances instead of one per frame."""
-    ego_rows, other_rows = [], []
-    for sc in scenes:
-        if sc.n > 1:
-            a = np.stack([sc.x_m, sc.y_m, sc.heading_rad, sc.length_m, sc.width_m])
-            ego_rows.append(np.repeat(a[:, :1], sc.n - 1, axis=1))
-            other_rows.append(a[:, 1:])
-    if not ego_rows:
+    scenes = [sc for sc in scenes if sc.n > 1]
+    if not scenes:
         return np.inf
-    ego = np.concatenate(ego_rows, axis=1)  # (5, pairs): x, y, heading, length, width
-    other = np.concatenate(other_rows, axis=1)
+    rows = np.stack([np.concatenate([getattr(sc, name) for sc in scenes]) for name in (
+        "x_m", "y_m", "heading_rad", "length_m", "width_m")])  # (5, actors of every scene)
+    n = np.array([sc.n for sc in scenes])
+    start = np.cumsum(n) - n  # each scene's ego row
+    is_other = np.ones(rows.shape[1], dtype=bool)
+    is_other[start] = False
+    ego = rows[:, np.repeat(start, n - 1)]  # (5, pairs): x, y, heading, length, width
+    other = rows[:, is_other]
     bound = np.maximum(_bbox_gap(*ego, *other), _bbox_gap(*other, *ego))
     order = np.argsort(bound, kind="stable")
     best = np.inf

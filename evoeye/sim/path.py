@@ -14,6 +14,7 @@ from collections.abc import Sequence
 
 import numpy as np
 from highway_env.road.lane import StraightLane
+from scipy.spatial import cKDTree
 
 SAMPLE_STEP_M = 0.5
 
@@ -38,6 +39,10 @@ class Path:
         self.kappa = kappa  # (K,) 1/m, smoothed
         self.length_m = float(self.s[-1])
         self._profiles: dict[tuple[float, float], np.ndarray] = {}
+        self._dx, self._dy = self.x[1:] - self.x[:-1], self.y[1:] - self.y[:-1]  # (K-1,) segments
+        self._seg2 = np.maximum(self._dx * self._dx + self._dy * self._dy, 1e-12)
+        # the samples as floats, for scalar lookups (a numpy call per value costs more)
+        self._samples = (self.s.tolist(), self.x.tolist(), self.y.tolist(), self.h.tolist())
 
     def index(self, s_m: float) -> int:
         """The sample at or before arc length s_m."""
@@ -57,11 +62,30 @@ class Path:
         return cls(np.concatenate(parts))
 
     # -- lookups (scalars) ----------------------------------------------------------------------
+    def _centre(self, s_m: float) -> tuple[float, float, float]:
+        """(x, y, heading) on the centre line at s_m: `np.interp` of each, value for value (its
+        arithmetic and end rules, in scalar Python, which a vehicle's every step can afford)."""
+        s, x, y, h = self._samples
+        if s_m != s_m:  # NaN
+            return s_m, s_m, s_m
+        if s_m <= s[0]:
+            return x[0], y[0], h[0]
+        if s_m >= s[-1]:
+            return x[-1], y[-1], h[-1]
+        j = min(int(s_m / self.step_m), len(s) - 2)  # s[j] ≤ s_m < s[j + 1], up to rounding
+        while s[j] > s_m:
+            j -= 1
+        while s[j + 1] <= s_m:
+            j += 1
+        if s[j] == s_m:
+            return x[j], y[j], h[j]
+        ds, u = s[j + 1] - s[j], s_m - s[j]
+        return ((x[j + 1] - x[j]) / ds * u + x[j], (y[j + 1] - y[j]) / ds * u + y[j],
+                (h[j + 1] - h[j]) / ds * u + h[j])
+
     def pose(self, s_m: float, d_m: float = 0.0) -> tuple[float, float, float]:
         """(x, y, heading) of the point d_m to the left of the centre line at arc length s_m."""
-        x = float(np.interp(s_m, self.s, self.x))
-        y = float(np.interp(s_m, self.s, self.y))
-        h = float(np.interp(s_m, self.s, self.h))
+        x, y, h = self._centre(s_m)
         if d_m:
             x -= d_m * math.sin(h)
             y += d_m * math.cos(h)
@@ -76,9 +100,8 @@ class Path:
             k0 = self.index(near_s - window_m)
             k1 = min(self.index(near_s + window_m) + 1, len(self.s) - 1)
         px, py = self.x[k0:k1], self.y[k0:k1]
-        dx, dy = np.diff(self.x[k0 : k1 + 1]), np.diff(self.y[k0 : k1 + 1])
-        seg2 = np.maximum(dx * dx + dy * dy, 1e-12)
-        t = np.clip(((x - px) * dx + (y - py) * dy) / seg2, 0.0, 1.0)
+        dx, dy, seg2 = self._dx[k0:k1], self._dy[k0:k1], self._seg2[k0:k1]
+        t = (((x - px) * dx + (y - py) * dy) / seg2).clip(0.0, 1.0)
         cx, cy = px + t * dx, py + t * dy
         k = int(np.argmin((cx - x) ** 2 + (cy - y) ** 2))
         s = float(self.s[k0 + k] + t[k] * math.sqrt(seg2[k]))
@@ -101,16 +124,19 @@ class Path:
 
     def first_conflict(self, other: Path, radius_m: float) -> tuple[float, float] | None:
         """(s on this path, s on `other`) where this path first comes within radius_m of the
-        other's centre line, or None if it never does."""
-        dx = self.x[:, None] - other.x[None, :]
-        dy = self.y[:, None] - other.y[None, :]
-        near = (dx * dx + dy * dy) <= radius_m * radius_m  # (K, K') on the samples
-        rows = near.any(axis=1).nonzero()[0]
-        if not len(rows):
-            return None
-        k = int(rows[0])
-        j = int(near[k].nonzero()[0][0])
-        return float(self.s[k]), float(other.s[j])
+        other's centre line, or None if it never does. The samples are compared exactly as
+        (dx² + dy² ≤ r²); a k-d tree only picks the samples that may qualify (within a hair
+        more than r), so all K × K' pairs need not be formed."""
+        pts = np.stack((self.x, self.y), axis=1)
+        dist, _ = cKDTree(np.stack((other.x, other.y), axis=1)).query(
+            pts, distance_upper_bound=radius_m * (1.0 + 1e-9) + 1e-9)
+        r2 = radius_m * radius_m
+        for k in np.isfinite(dist).nonzero()[0].tolist():  # in order along this path
+            dx, dy = self.x[k] - other.x, self.y[k] - other.y
+            near = (dx * dx + dy * dy) <= r2
+            if np.count_nonzero(near):
+                return float(self.s[k]), float(other.s[int(near.argmax())])
+        return None
 
     def stop_before(self, other: Path, s_here: float, s_there: float, radius_m: float,
                     window_m: float = 20.0) -> float:

@@ -72,7 +72,8 @@ def build_world(spec: RunSpec, world_rng: np.random.Generator | None = None) -> 
 
 def scene_finite(scene: SceneState) -> bool:
     """False if any actor's position, heading or speed is NaN or infinite."""
-    return bool(np.isfinite(scene.x_m + scene.y_m + scene.heading_rad + scene.speed_mps).all())
+    total = scene.x_m + scene.y_m + scene.heading_rad + scene.speed_mps
+    return np.count_nonzero(np.isfinite(total)) == total.size
 
 
 class Driver(Protocol):

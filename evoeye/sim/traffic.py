@@ -10,6 +10,7 @@ the scenarios.
 
 from __future__ import annotations
 
+import functools
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -36,22 +37,34 @@ class Relations:
     speed: np.ndarray  # (n,)
 
     @classmethod
-    def of(cls, x, y, heading, speed, length, width) -> Relations:
+    def of(cls, x, y, heading, speed, half_l: np.ndarray, half_w: np.ndarray) -> Relations:
+        """half_l, half_w: (n, n) the sums of half-lengths and of half-widths (`half_sums`)."""
         dx = x[None, :] - x[:, None]
         dy = y[None, :] - y[:, None]
         c, s = np.cos(heading)[:, None], np.sin(heading)[:, None]
         xi = c * dx + s * dy
         eta = c * dy - s * dx
-        half_l = 0.5 * (length[:, None] + length[None, :])
         return cls(
             xi=xi, eta=eta, cos_dh=np.cos(heading[None, :] - heading[:, None]),
-            bumper=np.abs(xi) - half_l, half_w=0.5 * (width[:, None] + width[None, :]),
-            speed=speed,
+            bumper=np.abs(xi) - half_l, half_w=half_w, speed=speed,
         )
 
     def gap_ahead_of(self, i: int, j: int) -> float:
         """Bumper gap by which i is ahead of j along i's heading (negative when behind)."""
         return float(self.bumper[i, j] if self.xi[i, j] < 0.0 else -self.bumper[i, j])
+
+
+def half_sums(length: np.ndarray, width: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """(n, n) sums of the half-lengths and of the half-widths of every pair (fixed per world)."""
+    return 0.5 * (length[:, None] + length[None, :]), 0.5 * (width[:, None] + width[None, :])
+
+
+@functools.cache
+def _not_self(n: int) -> np.ndarray:
+    """(n, n) True off the diagonal (read-only: shared by every call)."""
+    mask = ~np.eye(n, dtype=bool)
+    mask.flags.writeable = False
+    return mask
 
 
 def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -63,8 +76,9 @@ def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray
     n = len(rel.speed)
     reach = rel.half_w + CORRIDOR_MARGIN_M
     in_lane = np.abs(rel.eta) < reach
-    in_target = (shift_m != 0.0)[:, None] & (np.abs(rel.eta - shift_m[:, None]) < reach)
-    ahead = (rel.xi > 0.0) & ~np.eye(n, dtype=bool) & (in_lane | in_target)
+    if np.count_nonzero(shift_m):  # someone changes lanes: its target lane counts too
+        in_lane |= (shift_m != 0.0)[:, None] & (np.abs(rel.eta - shift_m[:, None]) < reach)
+    ahead = (rel.xi > 0.0) & _not_self(n) & in_lane
     aligned = rel.cos_dh > ALIGNED_COS
     gap = np.where(ahead & aligned & (rel.xi < LOOKAHEAD_M), rel.bumper, np.inf)
     block = np.where(ahead & ~aligned & (rel.xi < BLOCKING_M), rel.bumper, np.inf).min(axis=1)
@@ -95,10 +109,12 @@ def path_block(path, s_m: float, half_len_m: float, half_wid_m: float, x: np.nda
     ex = np.maximum(np.abs(c * dx + s * dy) - half_l[others, None], 0.0)
     ey = np.maximum(np.abs(c * dy - s * dx) - half_w[others, None], 0.0)
     on_path = ex * ex + ey * ey < (half_wid_m + CORRIDOR_MARGIN_M) ** 2  # (m, K)
-    on_path &= np.cos(heading[others, None] - ph[None, :]) <= ALIGNED_COS  # not a leader
     on_path[:, : int(half_len_m / path.step_m) + 1] = False  # behind its own front bumper
-    hit = on_path.any(axis=0)
-    if not hit.any():
+    if not np.count_nonzero(on_path):  # usually: then the headings need not be compared
+        return np.inf
+    on_path &= np.cos(heading[others, None] - ph[None, :]) <= ALIGNED_COS  # not a leader
+    hit = np.logical_or.reduce(on_path, axis=0)
+    if not np.count_nonzero(hit):
         return np.inf
     return max(float(path.s[k0 + int(hit.argmax())] - s_m) - half_len_m, 0.0)
 
@@ -113,7 +129,7 @@ def clear_to_change(rel: Relations, i: int, offset_m: float) -> bool:
     need_front = CLEAR_FRONT_M + CLEAR_FRONT_S * v_i + 2.0 * np.maximum(v_i - v_j, 0.0)
     need_rear = CLEAR_REAR_M + CLEAR_REAR_S * v_j + 2.0 * np.maximum(v_j - v_i, 0.0)
     need = np.where(rel.xi[i] >= 0.0, need_front, need_rear)
-    return not (others & in_target & (rel.bumper[i] < need)).any()
+    return not np.count_nonzero(others & in_target & (rel.bumper[i] < need))
 
 
 DECIDE_WITHIN_M = 60.0  # a crossing's order is settled once both NPCs are this close to it
@@ -172,9 +188,14 @@ class YieldToEgo:
     gap_s: float
     going: bool = field(default=False)
 
+    def settled(self, s: float) -> bool:
+        """Whether the NPC, at arc length s, waits for the ego no more, for good: it went, or
+        is past its stop point (an NPC never moves back along its path)."""
+        return self.going or s > self.stop_i
+
     def wait_gap(self, s: float, v: float, s_ego: float, v_ego: float) -> float | None:
         """The NPC's distance to its stop point while it waits; None when it may go."""
-        if self.going or s > self.stop_i or self.s_i - s > DECIDE_WITHIN_M:
+        if self.settled(s) or self.s_i - s > DECIDE_WITHIN_M:
             return None
         to_ego = self.s_ego - s_ego
         if to_ego < -PASSED_M:  # the ego is through

@@ -24,6 +24,7 @@ from evoeye.sim.traffic import (
     Relations,
     YieldToEgo,
     clear_to_change,
+    half_sums,
     leaders,
     path_block,
 )
@@ -56,6 +57,13 @@ class World:
         self.collision_actor = -1
         self._accel = np.zeros(len(self.vehicles))
         self._blocked_s = np.zeros(len(self.vehicles))  # how long a crossing car has blocked each
+        # every pair (i < j) and the distance within which their circumscribed circles meet
+        self._pair_i, self._pair_j = np.triu_indices(len(self.vehicles), k=1)
+        reach = 0.5 * np.hypot(self.length_m, self.width_m)  # (n,) circumscribed radius
+        self._pair_reach_m = reach[self._pair_i] + reach[self._pair_j]
+        rows = np.arange(len(self.vehicles))
+        self._others = [rows[rows != i] for i in rows]  # every row but i, per row
+        self._half_sums = half_sums(self.length_m, self.width_m)
         assert EGO_ID == 0
 
     # -- reading -------------------------------------------------------------------------------
@@ -81,7 +89,7 @@ class World:
     def step(self, accel_mps2: float, steering_rad: float, dt: float) -> None:
         """Apply the ego command, let the NPCs decide and move, integrate dt, check contacts."""
         x, y, heading, speed = self._state()
-        rel = Relations.of(x, y, heading, speed, self.length_m, self.width_m)
+        rel = Relations.of(x, y, heading, speed, *self._half_sums)
         shift = np.array([0.0] + [n.lateral_target_m() for n in self.npcs])
         gap, v_lead, block = leaders(rel, shift)
         self._block_along_paths(block, x, y, heading)
@@ -91,6 +99,8 @@ class World:
             seen & (block < gap), 0.0, v_lead)
         self._wait_at_crossings(gap, v_lead)
         for i, npc in enumerate(self.npcs, start=1):
+            if npc.lane_change is None:  # nothing scripted: no trigger to update
+                continue
             closing = speed[0] - speed[i] * rel.cos_dh[0, i]
             if npc.wants_lane_change(rel.gap_ahead_of(i, 0), closing) and clear_to_change(
                 rel, i, npc.lane_change.offset_m
@@ -114,12 +124,11 @@ class World:
         """Where an NPC's path curves ahead (a turn), what blocks it is looked for along the
         arc rather than straight ahead: a car standing in the turn is seen as a driver sees it."""
         half_l, half_w = 0.5 * self.length_m, 0.5 * self.width_m
-        rows = np.arange(len(self.vehicles))
         for i, npc in enumerate(self.npcs, start=1):
             if npc.crashed or npc.changing_lanes:
                 continue
             g = path_block(npc.path, npc.s_m, half_l[i], half_w[i], x, y, heading, half_l,
-                           half_w, rows[rows != i])
+                           half_w, self._others[i])
             if g < block[i]:
                 block[i] = g
 
@@ -131,10 +140,11 @@ class World:
         s = {i: npc.s_m for i, npc in enumerate(self.npcs, start=1)}
         v = {i: npc.speed for i, npc in enumerate(self.npcs, start=1)}
         waits = [c.wait_gap(s, v) for c in self.conflicts]
-        if self.yields:
+        live = [y for y in self.yields if not y.settled(s[y.i])]
+        if live:  # the ego's place on its route is needed (and followed) only for these
             self._ego_s = self.ego_path.project(*self.ego.position, near_s=self._ego_s)[0]
             waits += [(y.i, y.wait_gap(s[y.i], v[y.i], self._ego_s, self.ego.speed))
-                      for y in self.yields]
+                      for y in live]
         for wait in waits:
             if wait is not None and wait[1] is not None and wait[1] < gap[wait[0]]:
                 gap[wait[0]], v_lead[wait[0]] = max(wait[1], 0.0), 0.0
@@ -142,19 +152,17 @@ class World:
     def _contacts(self) -> None:
         """Mark every overlapping pair of footprints as crashed; remember the ego's partner."""
         x, y, heading, _ = self._state()
-        n = len(x)
-        reach = 0.5 * np.hypot(self.length_m, self.width_m)  # (n,) circumscribed radius
-        i, j = np.triu_indices(n, k=1)
-        close = np.hypot(x[i] - x[j], y[i] - y[j]) <= reach[i] + reach[j]
-        if not close.any():
+        i, j = self._pair_i, self._pair_j
+        close = np.hypot(x[i] - x[j], y[i] - y[j]) <= self._pair_reach_m
+        if not np.count_nonzero(close):
             return
         i, j = i[close], j[close]
         corners = box_corners(x, y, heading, self.length_m, self.width_m)
         touching = box_gaps(corners[i], corners[j]) <= 0.0
-        if not touching.any():
+        if not np.count_nonzero(touching):
             return
         i, j = i[touching], j[touching]
-        if not self.crashed[0] and (i == 0).any():
+        if not self.crashed[0] and np.count_nonzero(i == 0):
             partners = j[i == 0]
             d = np.hypot(x[partners] - x[0], y[partners] - y[0])
             self.collision_actor = int(self.actor_id[partners[int(np.argmin(d))]])

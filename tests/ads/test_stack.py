@@ -83,3 +83,19 @@ def test_cruise_speed_is_set_per_run():
     assert config.cruise_speed_mps == 12.5 and ADSConfig().cruise_speed_mps != 12.5
     frames, world, _ = run(straight_road(), (0, 0, 0, 12.5), [], 12.5, 2.0)
     assert abs(world.ego[3] - 12.5) < 0.2 and frames[-1].plan.target_speed_mps == 12.5
+
+
+def test_a_non_finite_value_in_any_message_is_caught_and_field_values_follow_field_names():
+    frames, _, _ = run(straight_road(), (0, 0, 0, 20), HIGHWAY_NPCS, 20.0, 1.0, seed=3)
+    m = frames[-1]
+    assert m.all_finite() and len(m.obstacles.x_m)
+    for msg in (m.localization, m.obstacles, m.predictions, m.plan, m.control):
+        assert msg.field_values() == tuple(getattr(msg, n) for n in msg.field_names())
+    m.obstacles.vx_mps[-1] = np.nan  # an array field
+    assert not m.all_finite()
+    m.obstacles.vx_mps[-1] = 0.0
+    m.control.steering_rad = math.inf  # a scalar field
+    assert not m.all_finite()
+    m.control.steering_rad = 0.0
+    m.predictions.y_m[0, -1] = -math.inf  # a (n, K) field
+    assert not m.all_finite()

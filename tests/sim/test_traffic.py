@@ -127,3 +127,15 @@ def test_only_the_west_approach_lane_that_ends_at_the_box_gives_way() -> None:
     route = road.route.points
     assert np.min(np.hypot(*(route - end).T)) < 15.0  # its end is at the ego's route
     assert end[0] < 0.0  # on the west side
+
+
+def test_a_turning_npc_is_settled_for_good_once_it_went_or_passed_its_stop_point():
+    rule = yield_rule()
+    assert not rule.settled(90.0)  # before its stop point, undecided: it may still wait
+    assert rule.settled(94.5)  # past its stop point: whatever the ego does
+    assert rule.wait_gap(94.5, 0.5, 299.0, 0.1) is None
+    # a long gap 50 m out: it may go, but could still stop, so the ego is judged again …
+    assert rule.wait_gap(50.0, 8.0, 150.0, 10.0) is None and not rule.settled(50.0)
+    # … 1 m before its stop point it is committed, and stays so whenever the ego comes
+    assert rule.wait_gap(93.0, 8.0, 150.0, 10.0) is None and rule.going
+    assert rule.settled(93.0) and rule.wait_gap(93.0, 8.0, 299.0, 10.0) is None
