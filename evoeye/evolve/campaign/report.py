@@ -142,13 +142,20 @@ def markdown(results: dict) -> str:
     return "\n".join(out)
 
 
+def _finite_mean(values: list[float]) -> float:
+    """The mean of the finite values; NaN (a gap in the curve) when there is none, e.g. an F1
+    whose FPR no seed's thresholds reached."""
+    a = np.asarray(values, dtype=float)
+    return float(a[np.isfinite(a)].mean()) if np.isfinite(a).any() else float("nan")
+
+
 def _curves(res: dict, split: str, col: str) -> str:
     series = []
     by_method = {s: res[s] for s in ran(res)}
     n_max = max((len(r["rounds"]) for runs in by_method.values() for r in runs), default=1)
     for strategy, runs in by_method.items():
         n = min(len(r["rounds"]) for r in runs)
-        ys = [float(np.nanmean([_value(r["rounds"][i][split][col]) for r in runs]))
+        ys = [_finite_mean([_value(r["rounds"][i][split][col]) for r in runs])
               for i in range(n)]
         series.append((strategy, [i / max(n_max - 1, 1) for i in range(n)], ys))
     return line_chart(series, title=f"{split} {col} per round", xlabel="round (0 … last)",
