@@ -22,6 +22,6 @@ CREATE OR REPLACE MACRO float32_of_bits(u) AS CAST(
 -- [9 * i + 1] the forward distance of the i-th nearest obstacle (i from 0).
 CREATE OR REPLACE MACRO float32s(b) AS list_transform(
     range(octet_length(b) // 4),
-    lambda i: float32_of_bits(('0x' || hex(b)[8 * i + 7 : 8 * i + 8] || hex(b)[8 * i + 5 : 8 * i + 6]
-                          || hex(b)[8 * i + 3 : 8 * i + 4] || hex(b)[8 * i + 1 : 8 * i + 2])
-                         ::UINTEGER));
+    lambda i: float32_of_bits(('0x'  -- the 4 bytes of value i, most significant first
+        || hex(b)[8 * i + 7 : 8 * i + 8] || hex(b)[8 * i + 5 : 8 * i + 6]
+        || hex(b)[8 * i + 3 : 8 * i + 4] || hex(b)[8 * i + 1 : 8 * i + 2])::UINTEGER));
