@@ -11,8 +11,9 @@ Windows (target ≤ 2×): the ingested parts are replicated under new scenario i
 warehouse holds ≥ `--window-frames` frames (content does not change the cost; every replica
 is an ordinary committed run). Windows end at the eligible frames only (none at or after a
 collision). Both sides produce the same arrays, (B, L, …) for every frame:
-  warehouse  load_windows(L) — SQL labels in window order, the frames' inputs decoded by Arrow
-             from the Parquet parts — then Windows.arrays(), the gather of all B windows
+  warehouse  load_windows(L) — the runs and their parts from SQL, each part's frames columns and
+             float32 inputs read by Arrow, labels in numpy, the inputs copied once in window
+             order — then Windows.arrays(), the gather of all B windows
   numpy      the per-frame inputs already in memory in (scenario, frame) order with the run
              lengths: context index and mask by numpy, then the same gather.
 Every timing is the best of `--repeat` (the machine may be shared).

@@ -131,6 +131,7 @@ class Ingester:
     def run(self, converted: Sequence[LoggedRun] = ()) -> IngestReport:
         """One pass; `converted`: runs of the logs to ingest already converted (by path)."""
         report = IngestReport()
+        self.store.check_layout()  # never a part of this layout beside older ones
         given = {self.root.relative(c.path): c for c in converted}
         if self.batch is None:
             with WriterLock(self.root.writer_lock):
@@ -228,8 +229,7 @@ class Ingester:
     def _write(self, partition: Partition, part: _PendingPart, report: IngestReport) -> None:
         frames = pa.concat_tables(part.frames)
         self.store.write("frames", partition, part.part, frames)
-        path = self.store.write("frame_features", partition, part.part,
-                                pa.concat_tables(part.features))
+        self.store.write("frame_features", partition, part.part, pa.concat_tables(part.features))
         cache = part_cache()
         if cache is not None and all(f is not None for f in part.converted):
             features = FrameFeatures.empty(frames.num_rows, FEATURES)
@@ -237,7 +237,7 @@ class Ingester:
             for one in part.converted:
                 features.fill(start, one)
                 start += len(one)
-            cache.put(path, frames, features)  # this process will not decode it
+            cache.put((partition, part.part), frames, features)  # never decoded here
         self.store.commit(partition, part.part, scenarios_table(part.rows))
         report.ingested += [r["scenario_id"] for r in part.rows]
         report.frames += frames.num_rows

@@ -2,7 +2,7 @@
 
 The same conversion the warehouse makes, without ingesting: the log's frames as ingest writes
 them (`frames_table` → `frame_features`), then eligible frames and labels as the SQL builds them
-(`eligible_frames` and `frame_labels_h`, warehouse/views/05_frame_labels.sql) and the contexts
+(`evoeye.store.labels`, the twin of warehouse/views/05_frame_labels.sql) and the contexts
 by `load_windows`' own `context_rows`, so a run's windows are bit-identical to those
 `load_windows` returns once it is ingested (tests/store/test_log_windows.py checks it). The
 evolution campaign scores each freshly simulated run this way: reading the log (not the
@@ -22,11 +22,9 @@ import pyarrow as pa
 
 from evoeye.log import read_run
 from evoeye.store.features import FEATURES, FrameFeatures, frame_features
+from evoeye.store.labels import eligible_frames, frame_labels
 from evoeye.store.records import frames_table
 from evoeye.store.windows import Windows, context_rows
-
-LABEL_EPS_S = 1e-6  # as eligible_frames / frame_labels_h: frame times sit on a float 20 Hz grid
-
 
 UNCOMMITTED = "in-memory"  # the ingest_id of a conversion not yet written to a part
 
@@ -49,24 +47,6 @@ class LoggedRun:
     @property
     def duration_s(self) -> float:
         return float(self.metadata["duration_s"])
-
-
-def eligible_frames(t_s: np.ndarray, collided: np.ndarray) -> np.ndarray:
-    """(N,) bool, as the view eligible_frames: frames strictly before the first collided frame
-    (all frames of a run without one)."""
-    hit = np.flatnonzero(collided)
-    if len(hit) == 0:
-        return np.ones(len(t_s), bool)
-    return t_s[hit[0]] - t_s > LABEL_EPS_S
-
-
-def frame_labels(t_s: np.ndarray, collided: np.ndarray, horizon_s: float) -> np.ndarray:
-    """y_t (Definition 1): 1 iff 0 < tau_col − t ≤ H, tau_col the first collided frame's time."""
-    hit = np.flatnonzero(collided)
-    if len(hit) == 0:
-        return np.zeros(len(t_s), np.int8)
-    lead = t_s[hit[0]] - t_s
-    return ((lead > LABEL_EPS_S) & (lead <= horizon_s + LABEL_EPS_S)).astype(np.int8)
 
 
 def read_logged_run(path: str | Path, context_len: int, horizon_s: float) -> LoggedRun:

@@ -18,7 +18,15 @@ import pyarrow.parquet as pq
 
 from evoeye.atomic import atomic_file, fsync_dir
 from evoeye.paths import DataRoot
-from evoeye.store.schema import PARTITION_KEYS, TABLES, canonical_schema, file_schema
+from evoeye.store.schema import (
+    LAYOUT_KEY,
+    LAYOUT_VERSION,
+    PARTITION_KEYS,
+    TABLES,
+    WarehouseLayoutError,
+    canonical_schema,
+    file_schema,
+)
 
 PART_SUFFIX = ".parquet"
 TMP_SUFFIX = ".tmp"
@@ -29,14 +37,36 @@ COMPRESSION = {"scenarios": "zstd", "frames": "zstd", "frame_features": "lz4"}
 
 def _write_options(table: str, schema: pa.Schema) -> dict:
     """Dictionaries for string columns only, statistics for scalar columns only: float
-    arrays neither repeat nor get filtered on, and both would slow writes and reads."""
-    scalar = [f.name for f in schema if not pa.types.is_list(f.type)]
+    arrays (lists, or float32 bytes) neither repeat nor get filtered on, and both would slow
+    writes and reads."""
+    scalar = [f.name for f in schema
+              if not (pa.types.is_list(f.type) or pa.types.is_fixed_size_binary(f.type))]
     strings = [f.name for f in schema if f.type in (pa.string(), pa.list_(pa.string()))]
     return {
         "compression": COMPRESSION[table],
         "use_dictionary": strings,
         "write_statistics": scalar,
     }
+
+
+def part_layout(metadata: dict[bytes, bytes] | None) -> int:
+    """The layout version a part's Parquet (schema) metadata names; 1 if none (written before
+    parts named theirs)."""
+    return int((metadata or {}).get(LAYOUT_KEY, b"1"))
+
+
+def check_part_layout(path: Path, metadata: dict[bytes, bytes] | None = None) -> None:
+    """WarehouseLayoutError naming the part, its layout and the fix, unless it is of
+    LAYOUT_VERSION; `metadata`: its schema metadata, if read already."""
+    found = part_layout(pq.read_schema(path).metadata if metadata is None else metadata)
+    if found != LAYOUT_VERSION:
+        warehouse = path.parents[len(PARTITION_KEYS) + 1]  # <root>/warehouse
+        raise WarehouseLayoutError(
+            f"{path}: a warehouse part of layout {found}; this evoeye reads layout "
+            f"{LAYOUT_VERSION} only (frame_features arrays stored as float32 bytes, "
+            "docs/warehouse.md) — re-ingest: move the folders "
+            f"{', '.join(t for t in TABLES)} out of {warehouse} and run "
+            "`evoeye ingest` on the data root again (its logs under runs/ are the source)")
 
 
 class PartStore:
@@ -58,8 +88,10 @@ class PartStore:
         folder.mkdir(parents=True, exist_ok=True)
         final = folder / f"{part}{PART_SUFFIX}"
         tmp = folder / f".{part}{PART_SUFFIX}.{os.getpid()}{TMP_SUFFIX}"
+        stamped = data.replace_schema_metadata(
+            {**(data.schema.metadata or {}), LAYOUT_KEY: str(LAYOUT_VERSION).encode()})
         with atomic_file(final, tmp) as f:
-            pq.write_table(data, f, **_write_options(table, data.schema))
+            pq.write_table(stamped, f, **_write_options(table, data.schema))
         fsync_dir(folder)
         return final
 
@@ -98,6 +130,15 @@ class PartStore:
         return {path for part in self._parts("scenarios", partition).values()
                 for path in pq.read_table(part, columns=["log_path"], partitioning=None)
                 .column("log_path").to_pylist()}
+
+    def check_layout(self) -> None:
+        """WarehouseLayoutError if the ingested tables hold parts of another layout than
+        LAYOUT_VERSION. One part per table is read: every writer checks before it adds one."""
+        for table in TABLES:
+            part = next(self.root.table_dir(table).glob(f"{self._folders(None)}/*{PART_SUFFIX}"),
+                        None)
+            if part is not None:
+                check_part_layout(part)
 
     def remove_orphans(self, partition: tuple[str, str] | None = None) -> list[Path]:
         """Delete what `orphans` lists; call only under a lock on what it covers (the writer

@@ -27,6 +27,18 @@ DERIVED_TABLES = ("attribution",)
 PARTITION_KEYS = ("logical_scenario", "batch")
 DDL_SCHEMA = "ddl"  # the DuckDB schema holding the declared, always empty, tables
 
+# How the ingested tables' parts are laid out; every part carries it in its Parquet metadata
+# (LAYOUT_KEY; parts without it are layout 1). Bump it with any change to their DDL: a
+# warehouse holds parts of one layout only (`check_layout`), so the views need not reconcile
+# schemas file by file. 1: frame_features arrays as FLOAT[] lists (evoeye <= 0.4.0);
+# 2: as little-endian float32 bytes (BLOB).
+LAYOUT_VERSION = 2
+LAYOUT_KEY = b"evoeye.warehouse_layout"
+
+
+class WarehouseLayoutError(RuntimeError):
+    """Parts of a warehouse layout this evoeye does not read (LAYOUT_VERSION)."""
+
 
 def ddl(table: str) -> str:
     """The CREATE TABLE statement of `table`."""
@@ -48,11 +60,15 @@ def create_declared_tables(con: duckdb.DuckDBPyConnection) -> None:
 
 
 def _canonical(t: pa.DataType) -> pa.DataType:
-    """`t` with list children renamed to Arrow's default, so DuckDB's and Parquet's names agree."""
+    """`t` with list children renamed to Arrow's default and every binary a plain one, so
+    DuckDB's, Parquet's and the writers' types agree."""
     if pa.types.is_list(t) or pa.types.is_large_list(t):
         return pa.list_(_canonical(t.value_type))
     if pa.types.is_large_string(t) or pa.types.is_string_view(t):
         return pa.string()
+    if pa.types.is_fixed_size_binary(t) or pa.types.is_large_binary(t) \
+            or pa.types.is_binary_view(t):
+        return pa.binary()  # a BLOB of the DDL, of a fixed width or not
     return t
 
 

@@ -1,14 +1,16 @@
 """Training windows: runtime contexts c_t (Definition 2) with labels y_t (Definition 1).
 
-`warehouse/queries/windows.sql` lists every eligible frame of the selected runs (none at or
-after a run's collision: view eligible_frames) in (scenario_id, frame) order, with its label, the
-ego's localization estimate and the row of its monitor inputs in the runs' frame_features parts;
-the L context frames follow from that order (`context_rows`). The inputs are decoded by Arrow
-straight from those Parquet parts into numpy (DuckDB never turns their float lists into rows of
-its own) and kept once per frame: a window is `features[context]`, gathered when asked for (all
-at once, or per training batch), so N frames cost N feature rows, not N·L.
+DuckDB answers which runs (`select_runs`) and which committed part holds each
+(`warehouse/queries/window_runs.sql`, in scenario_id order: the order of the windows). Arrow
+then reads each part: from its frames file the few columns a window needs (WINDOW_COLUMNS),
+from its frame_features file the monitor inputs, float32 bytes numpy views without a copy (the
+two files hold the same rows in the same order). Eligible frames (none at or after a run's
+collision) and labels follow the views' definitions in numpy (`evoeye.store.labels`), and each
+eligible frame's inputs are copied once, in window order; the L context frames follow from that
+order (`context_rows`). A window is `features[context]`, gathered when asked for (all at once,
+or per training batch), so N frames cost N feature rows, not N·L. Parts are read two at a time.
 
-Inside `cached_parts()`, every part decoded is kept (a part is written once and never changed):
+Inside `cached_parts()`, every part read is kept (a part is written once and never changed):
 a process that loads windows again and again — a campaign, whose training set grows by a
 round's runs and whose validation split never changes — decodes each part once, and a part it
 ingested from its own conversion (`evoeye.store.ingest`) never. The windows are the same, in the
@@ -18,21 +20,30 @@ same layout, with the cache or without.
 from __future__ import annotations
 
 from collections.abc import Iterator
+from concurrent.futures import ThreadPoolExecutor
 from contextlib import contextmanager
 from contextvars import ContextVar
 from dataclasses import dataclass, fields
 from pathlib import Path
 from typing import TYPE_CHECKING
 
-import duckdb
 import numpy as np
 import pyarrow as pa
 import pyarrow.parquet as pq
 
 from evoeye.paths import DataRoot
 from evoeye.store.catalog import Warehouse
-from evoeye.store.features import FEATURES, STORED_COLUMNS, FeatureSpec, FrameFeatures, unpack
-from evoeye.store.parts import PART_SUFFIX, PartStore
+from evoeye.store.features import (
+    FEATURES,
+    MIN_SLICE_ROWS,
+    STORED_COLUMNS,
+    FeatureSpec,
+    FrameFeatures,
+    unpack,
+)
+from evoeye.store.labels import eligible_frames, frame_labels
+from evoeye.store.parts import PART_SUFFIX, PartStore, check_part_layout
+from evoeye.store.schema import file_schema
 from evoeye.store.selection import Runs, select_runs
 from evoeye.store.sqlfiles import query
 
@@ -108,31 +119,89 @@ class Windows:
         )
 
 
-FEATURE_KEYS = ("scenario_id", "frame", "ingest_id")  # what windows.sql matches feature_rows on
+WINDOW_COLUMNS = ("scenario_id", "frame", "t_s", "gt_ego_collision", "loc_x_m", "loc_y_m")
+Part = tuple[tuple[str, str], str]  # ((logical scenario, batch), ingest_id): a part's name
+READERS = 2  # parts read at once (Arrow's reads and numpy's copies release the GIL)
+
+
+@dataclass(frozen=True)
+class PartRows:
+    """The WINDOW_COLUMNS of a frames part, row by row (runs as indices into `names`)."""
+
+    names: np.ndarray  # (R,) object: the part's scenario ids
+    run: np.ndarray  # (n,) int32 index into names
+    frame: np.ndarray  # (n,) int32
+    t_s: np.ndarray  # (n,) float64
+    collided: np.ndarray  # (n,) bool, gt_ego_collision
+    ego_xy_m: np.ndarray  # (n, 2) float64, localization x, y (map frame)
+
+    @classmethod
+    def empty(cls) -> PartRows:
+        return cls.of(pa.table({c: pa.array([], file_schema("frames").field(c).type)
+                                for c in WINDOW_COLUMNS}))
+
+    @classmethod
+    def of(cls, table: pa.Table) -> PartRows:
+        runs = table.column("scenario_id").combine_chunks()
+        if not pa.types.is_dictionary(runs.type):
+            runs = runs.dictionary_encode()
+        return cls(
+            np.array(runs.dictionary.to_pylist(), dtype=object),
+            runs.indices.to_numpy(zero_copy_only=False).astype(np.int32),
+            table.column("frame").to_numpy().astype(np.int32),
+            table.column("t_s").to_numpy(),
+            table.column("gt_ego_collision").to_numpy(zero_copy_only=False).astype(bool),
+            np.stack([table.column(c).to_numpy(zero_copy_only=False).astype(np.float64)
+                      for c in ("loc_x_m", "loc_y_m")], axis=1).reshape(-1, 2),
+        )
+
+
+def _read_rows(path: Path) -> PartRows:
+    """A frames part's WINDOW_COLUMNS; none if the part is missing (as the views read it)."""
+    if not path.is_file():
+        return PartRows.empty()
+    with pq.ParquetFile(path, memory_map=True, read_dictionary=["scenario_id"]) as part:
+        return PartRows.of(part.read(columns=list(WINDOW_COLUMNS), use_threads=False))
+
+
+def _read_features(path: Path) -> tuple[FrameFeatures, np.ndarray]:
+    """Every row of a frame_features part (views of Arrow's buffers), and its frame column."""
+    with pq.ParquetFile(path, memory_map=True) as file:  # a third less CPU than read_table
+        check_part_layout(path, file.schema_arrow.metadata)
+        part = file.read(columns=[*STORED_COLUMNS, "frame"], use_threads=False)
+    return unpack(part, FEATURES), part.column("frame").to_numpy()
+
+
+def _decode(path: Path) -> tuple[FrameFeatures, np.ndarray]:
+    """A frame_features part read for `cached_parts()`."""
+    return _read_features(path)
 
 
 class PartCache:
-    """frame_features parts decoded by this process, by path: their keys and their features."""
+    """Parts read by this process, by name: their frames' WINDOW_COLUMNS and their features."""
 
     def __init__(self) -> None:
-        self._keys: dict[Path, pa.Table] = {}
-        self._features: dict[Path, FrameFeatures] = {}
+        self._rows: dict[Part, PartRows] = {}
+        self._features: dict[Part, tuple[FrameFeatures, np.ndarray]] = {}
 
-    def put(self, path: Path, keys: pa.Table, features: FrameFeatures | None = None) -> None:
-        """Keep a part's key columns (FEATURE_KEYS) and, if given, its features (every row)."""
-        self._keys[Path(path)] = _plain_keys(keys)
+    def put(self, part: Part, frames: pa.Table, features: FrameFeatures | None = None) -> None:
+        """Keep a part's frames (their WINDOW_COLUMNS) and, if given, its features."""
+        self._rows[part] = PartRows.of(frames.select(list(WINDOW_COLUMNS)))
         if features is not None:
-            self._features[Path(path)] = features
+            self._features[part] = (features, self._rows[part].frame)
 
-    def keys(self, path: Path) -> pa.Table:
-        if path not in self._keys:
-            self._keys[path] = _read_keys(path)
-        return self._keys[path]
+    def rows(self, part: Part, path: Path) -> PartRows:
+        if part not in self._rows:
+            self._rows[part] = _read_rows(path)
+        return self._rows[part]
 
-    def features(self, path: Path) -> FrameFeatures:
-        if path not in self._features:
-            self._features[path] = _decode(path)
-        return self._features[path]
+    def has_features(self, part: Part) -> bool:
+        return part in self._features
+
+    def features(self, part: Part, path: Path) -> tuple[FrameFeatures, np.ndarray]:
+        if part not in self._features:
+            self._features[part] = _decode(path)
+        return self._features[part]
 
 
 _CACHE: ContextVar[PartCache | None] = ContextVar("evoeye_part_cache", default=None)
@@ -140,7 +209,7 @@ _CACHE: ContextVar[PartCache | None] = ContextVar("evoeye_part_cache", default=N
 
 @contextmanager
 def cached_parts() -> Iterator[PartCache]:
-    """Within the block, every frame_features part is decoded once (module doc)."""
+    """Within the block, every part is read once (module doc)."""
     token = _CACHE.set(PartCache())
     try:
         yield _CACHE.get()
@@ -153,100 +222,76 @@ def part_cache() -> PartCache | None:
     return _CACHE.get()
 
 
-def _decode(path: Path) -> FrameFeatures:
-    """Every row of a frame_features part."""
-    part = pq.read_table(path, columns=list(STORED_COLUMNS), partitioning=None)
-    out = FrameFeatures.empty(part.num_rows, FEATURES)
-    start = 0
-    for batch in part.to_batches():
-        out.fill(start, unpack(batch, FEATURES))
-        start += batch.num_rows
-    return out
-
-
-def _plain_keys(table: pa.Table) -> pa.Table:
-    """The FEATURE_KEYS columns of a table, with plain fields (as every part's concatenate)."""
-    return pa.table({name: table.column(name) for name in FEATURE_KEYS})
-
-
-def _read_keys(path: Path) -> pa.Table:
-    return _plain_keys(pq.read_table(path, columns=list(FEATURE_KEYS), partitioning=None))
-
-
 def context_rows(run_start: np.ndarray, context_len: int) -> tuple[np.ndarray, np.ndarray]:
     """(ctx_row, ctx_mask), both (B, L), of B rows in run order, row i of the run starting at
     row run_start[i]: rows i-L+1 … i oldest first, clamped to the run's first row, and masked
     exactly where clamped (Definition 2: c_t = (m_max(1,t-L+1), …, m_t) read element-wise)."""
-    back = np.arange(len(run_start))[:, None] - run_start[:, None] - context_len + 1 \
-        + np.arange(context_len)[None, :]  # (B, L) position in the run, negative before it
-    return run_start[:, None] + np.maximum(back, 0), back >= 0
+    back = (np.arange(len(run_start)) - run_start)[:, None] \
+        + np.arange(1 - context_len, 1)[None, :]  # (B, L) position in the run, < 0 before it
+    mask = back >= 0
+    np.maximum(back, 0, out=back)
+    back += run_start[:, None]
+    return back, mask
 
 
-def _part_paths(con: duckdb.DuckDBPyConnection, root: DataRoot) -> list[Path]:
-    """The frame_features part files holding the runs in `selected_runs` (query window_parts)
-    that exist (a run whose part is missing gets no feature rows, and load_windows says so)."""
-    store = PartStore(root)
-    paths = [store.partition_dir("frame_features", (ls, batch)) / f"{part}{PART_SUFFIX}"
-             for ls, batch, part in con.sql(query("window_parts")).fetchall()]
-    return [path for path in paths if path.is_file()]
+def _scatter(out: FrameFeatures, dst: np.ndarray, part: FrameFeatures, src: np.ndarray) -> None:
+    """out[dst] = part[src] for every array: slice copies over the stretches where both step
+    by one (a run's frames), one gather where the rows are scattered."""
+    if len(src) == 0:
+        return
+    breaks = np.flatnonzero((np.diff(src) != 1) | (np.diff(dst) != 1)) + 1
+    pairs = [(arr, getattr(out, name)) for name, arr in part.arrays().items()]
+    if len(breaks) > len(src) // MIN_SLICE_ROWS:
+        for arr, target in pairs:
+            target[dst] = arr[src]
+        return
+    for lo, hi in zip(np.r_[0, breaks], np.r_[breaks, len(src)], strict=True):
+        s, d, n = int(src[lo]), int(dst[lo]), int(hi - lo)
+        for arr, target in pairs:
+            target[d : d + n] = arr[s : s + n]
 
 
-def _feature_rows(paths: list[Path]) -> pa.Table:
-    """The keys of the rows of `paths`, in file order, numbered: relation `feature_rows`."""
-    cache = part_cache()
-    keys = [cache.keys(path) if cache else _read_keys(path) for path in paths]
-    table = pa.concat_tables(keys) if keys else pa.table(
-        {"scenario_id": pa.array([], pa.string()), "frame": pa.array([], pa.int32()),
-         "ingest_id": pa.array([], pa.string())})
-    return table.append_column("feature_row", pa.array(np.arange(table.num_rows)))
+@dataclass(frozen=True)
+class _Selected:
+    """The eligible rows of the selected runs, in window order, and where each one sits."""
+
+    part: np.ndarray  # (B,) index of the row's part
+    row: np.ndarray  # (B,) its row in that part
+    run: np.ndarray  # (B,) rank of its run in scenario_id order
+    frame: np.ndarray  # (B,) int32
+    t_s: np.ndarray  # (B,) float64
+    label: np.ndarray  # (B,) int8
+    ego_xy_m: np.ndarray  # (B, 2) float64
+
+    @property
+    def run_start(self) -> np.ndarray:
+        """(B,) the first row of each row's run."""
+        new = np.flatnonzero(np.r_[True, self.run[1:] != self.run[:-1]])[: len(self.run)]
+        return np.repeat(new, np.diff(np.append(new, len(self.run))))
 
 
-def _gather_features(paths: list[Path], source: np.ndarray, spec: FeatureSpec
-                     ) -> tuple[FrameFeatures, np.ndarray]:
-    """The feature rows `source` (positions in the concatenated rows of `paths`, as numbered by
-    `_feature_rows`) in one FrameFeatures, and where each entry of `source` went.
+def _select(parts: list[PartRows], ranks: list[dict[str, int]], horizon_s: float) -> _Selected:
+    """The eligible rows of part i's runs that `ranks[i]` ranks (scenario id → rank), in window
+    order ((rank, frame)), labelled for H."""
+    if not parts:
+        parts, ranks = [PartRows.empty()], [{}]
 
-    Arrow decodes one part at a time straight from Parquet (DuckDB never materialises the float
-    lists); the rows used are copied once, in file order, and the part is freed."""
-    order = np.argsort(source, kind="stable")
-    sorted_source = source[order]
-    features = FrameFeatures.empty(len(source), spec)
-    cache = part_cache() if spec == FEATURES else None  # it holds the warehouse's spec
-    offset = 0
-    for path in paths:
-        if cache is not None:
-            part_features = cache.features(path)
-            lo, hi = np.searchsorted(sorted_source, [offset, offset + len(part_features)])
-            features.fill(int(lo), part_features, sorted_source[lo:hi] - offset)
-            offset += len(part_features)
-            continue
-        part = pq.read_table(path, columns=list(STORED_COLUMNS), partitioning=None)
-        lo, hi = np.searchsorted(sorted_source, [offset, offset + part.num_rows])
-        if hi > lo:
-            rows = sorted_source[lo:hi] - offset
-            start = int(lo)
-            for batch in part.to_batches():
-                take = rows[(rows >= 0) & (rows < batch.num_rows)]
-                if len(take):
-                    features.fill(start, unpack(batch, spec), take)
-                    start += len(take)
-                rows = rows - batch.num_rows
-        offset += part.num_rows
-    position = np.empty(len(source), np.int64)
-    position[order] = np.arange(len(source))
-    return features, position
+    def cat(name: str) -> np.ndarray:
+        return np.concatenate([getattr(p, name) for p in parts])
 
-
-def _runs(col: pa.ChunkedArray) -> tuple[np.ndarray, np.ndarray]:
-    """A scenario_id column grouped by run → (object array, one Python str per run; (B,) the
-    first row of each row's run)."""
-    encoded = col.combine_chunks().dictionary_encode()
-    names = np.array(encoded.dictionary.to_pylist(), dtype=object)
-    code = encoded.indices.to_numpy(zero_copy_only=False)
-    new_run = np.ones(len(code), bool)
-    new_run[1:] = code[1:] != code[:-1]
-    starts = np.flatnonzero(new_run)
-    return names[code], np.repeat(starts, np.diff(np.append(starts, len(code))))
+    run = np.concatenate([np.array([*(rank.get(n, -1) for n in p.names), -1])[p.run]
+                          for p, rank in zip(parts, ranks, strict=True)])
+    at = np.flatnonzero(run >= 0)
+    key = run[at] << 32 | (cat("frame")[at].astype(np.int64) + 2**31)  # (rank, frame)
+    at = at[np.argsort(key, kind="stable")]  # window order; fast on runs already in order
+    offsets = np.cumsum([0, *(len(p.run) for p in parts)])
+    part = np.searchsorted(offsets, at, side="right") - 1
+    run, frame, t_s, collided = run[at], cat("frame")[at], cat("t_s")[at], cat("collided")[at]
+    run_start = np.flatnonzero(np.r_[True, run[1:] != run[:-1]])
+    keep = eligible_frames(t_s, collided, run_start)
+    label = frame_labels(t_s, collided, horizon_s, run_start)
+    return _Selected(part[keep], (at - offsets[part])[keep], run[keep], frame[keep], t_s[keep],
+                     label[keep], cat("ego_xy_m")[at][keep])
 
 
 def load_windows(
@@ -270,21 +315,49 @@ def load_windows(
     con = warehouse.connect()
     try:
         con.register("selected_runs", select_runs(con, runs))
-        paths = _part_paths(con, warehouse.root)
-        con.register("feature_rows", _feature_rows(paths))
-        rows = con.sql(query("windows"), params={"horizon_s": float(horizon_s)}).to_arrow_table()
+        committed = con.sql(query("window_runs")).fetchall()
     finally:
         con.close()
-    missing = rows.column("feature_row").null_count
-    if missing:
-        raise RuntimeError(f"{missing} frames of the selected runs have no frame_features")
-    features, position = _gather_features(paths, rows.column("feature_row").to_numpy(), FEATURES)
-    scenario_id, run_start = _runs(rows.column("scenario_id"))
-    ctx_row, ctx_mask = context_rows(run_start, context_len)
-    ego_xy_m = np.stack([rows.column(c).to_numpy(zero_copy_only=False).astype(np.float64)
-                         for c in ("loc_x_m", "loc_y_m")], axis=1)
-    return Windows(
-        features, position[ctx_row], ctx_mask, rows.column("label").to_numpy().astype(np.int8),
-        scenario_id, rows.column("frame").to_numpy().astype(np.int32),
-        rows.column("t_s").to_numpy(), horizon_s, FEATURES, ego_xy_m,
-    )
+    by_part: dict[Part, dict[str, int]] = {}
+    for rank, (sid, ls, batch, ingest_id) in enumerate(committed):
+        by_part.setdefault(((ls, batch), ingest_id), {})[sid] = rank
+    parts = list(by_part)
+    store, cache = PartStore(warehouse.root), part_cache()  # resolved here, not in the threads
+
+    def path(table: str, part: Part) -> Path:
+        return store.partition_dir(table, part[0]) / f"{part[1]}{PART_SUFFIX}"
+
+    def rows_of(part: Part) -> PartRows:
+        return cache.rows(part, path("frames", part)) if cache else _read_rows(
+            path("frames", part))
+
+    with ThreadPoolExecutor(READERS) as pool:
+        rows = list(pool.map(rows_of, parts))
+        sel = _select(rows, [by_part[p] for p in parts], horizon_s)
+        counts = np.bincount(sel.part, minlength=len(parts))
+        missing = sum(int(counts[i]) for i, p in enumerate(parts)
+                      if not (cache and cache.has_features(p))
+                      and not path("frame_features", p).is_file())
+        if missing:
+            raise RuntimeError(f"{missing} frames of the selected runs have no frame_features")
+        features = FrameFeatures.empty(len(sel.run), FEATURES)
+
+        grouped = np.argsort(sel.part, kind="stable")
+        bounds = np.searchsorted(sel.part[grouped], np.arange(len(parts) + 1))
+
+        def fill(i: int) -> None:
+            at = grouped[bounds[i] : bounds[i + 1]]  # its rows, in window order
+            if len(at) == 0:
+                return
+            source = path("frame_features", parts[i])
+            part_features, frame = (cache.features(parts[i], source) if cache
+                                    else _read_features(source))
+            if not np.array_equal(frame, rows[i].frame):
+                raise RuntimeError(f"{source} does not hold the rows of its frames part")
+            _scatter(features, at, part_features, sel.row[at])
+
+        list(pool.map(fill, range(len(parts))))
+    ctx_row, ctx_mask = context_rows(sel.run_start, context_len)
+    names = np.array([sid for sid, *_ in committed], dtype=object)
+    return Windows(features, ctx_row, ctx_mask, sel.label, names[sel.run], sel.frame, sel.t_s,
+                   horizon_s, FEATURES, sel.ego_xy_m)

@@ -6,6 +6,8 @@ from collections.abc import Callable
 from pathlib import Path
 
 import numpy as np
+import pyarrow as pa
+import pyarrow.parquet as pq
 import pytest
 
 from evoeye.log import write_episode
@@ -100,3 +102,24 @@ def episode_factory() -> Callable[..., Episode]:
 def log_writer() -> Callable[[DataRoot, Episode], Path]:
     """write_run, for tests that write an Episode they built."""
     return write_run
+
+
+def _as_layout_1(path: Path) -> None:
+    """Rewrite a frame_features part as evoeye <= 0.4.0 wrote it: float lists, no layout key."""
+    table = pq.read_table(path, partitioning=None)
+    columns = {}
+    for field in table.schema:
+        col = table.column(field.name)
+        if pa.types.is_fixed_size_binary(field.type):
+            values = np.frombuffer(col.combine_chunks().buffers()[1], np.float32)
+            width = field.type.byte_width // 4
+            col = pa.ListArray.from_arrays(pa.array(np.arange(len(col) + 1, dtype=np.int32)
+                                                    * width), pa.array(values))
+        columns[field.name] = col
+    pq.write_table(pa.table(columns), path)
+
+
+@pytest.fixture
+def as_layout_1() -> Callable[[Path], None]:
+    """as_layout_1(path) rewrites a frame_features part in layout 1 (float lists)."""
+    return _as_layout_1

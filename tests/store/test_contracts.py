@@ -37,8 +37,7 @@ QUERY_PARAMS = {
         "max_round": None, "collided": None, "status": "ok", "seed": 0, "train_frac": 0.5,
         "val_frac": 0.125, "test_batch": None,
     },
-    "windows": {"horizon_s": 3.0},
-    "window_parts": {},
+    "window_runs": {},
     "collision_runs": {"logical_scenario": None, "batch": None, "software_version": "other",
                        "variants": 5},
     "attribution_shares": {"logical_scenario": "highway-cut-in"},
@@ -153,9 +152,6 @@ def test_every_query_runs(name: str, filled: DataRoot) -> None:
     con = Warehouse(filled).connect()
     try:
         con.register("selected_runs", con.sql("SELECT scenario_id FROM scenarios"))
-        con.register("feature_rows", con.sql(
-            "SELECT scenario_id, frame, ingest_id, row_number() OVER () AS feature_row "
-            "FROM frame_features"))
         con.register("monitor_scores", con.sql(
             "SELECT scenario_id, frame, 'm' AS monitor_version, 0.0 AS score FROM frames"))
         params = dict(QUERY_PARAMS[name])

@@ -55,3 +55,17 @@ def test_runs_without_collision_are_all_safe(labelled: Warehouse) -> None:
         "FROM frame_labels_h(1000.0) WHERE scenario_id = 'safe'"
     ).to_pylist()[0]
     assert rows == {"n": 80, "pos": 0, "tau": None}
+
+
+@pytest.mark.parametrize("h", [0.05, 1.0, 3.0, 5.95, 6.0, 100.0])
+def test_windows_take_the_views_frames_and_labels(labelled: Warehouse, h: float) -> None:
+    """load_windows decides eligibility and labels in numpy (evoeye.store.labels): the very
+    frames and labels of the views, also where tau_col − t falls on H."""
+    from evoeye.store import load_windows
+
+    sql = labelled.sql("SELECT scenario_id, frame, t_s, label FROM frame_labels_h($h) "
+                       "ORDER BY scenario_id, frame", {"h": h}).to_pydict()
+    w = load_windows(labelled.root, context_len=1, horizon_s=h)
+    assert w.scenario_id.tolist() == sql["scenario_id"]
+    assert w.frame.tolist() == sql["frame"] and w.t_s.tolist() == sql["t_s"]
+    assert w.label.tolist() == sql["label"] and sum(sql["label"]) > 0

@@ -16,6 +16,7 @@ import pytest
 from evoeye.paths import DataRoot
 from evoeye.store import FEATURES, Warehouse, ingest, load_windows
 from evoeye.store.features import unpack
+from evoeye.store.schema import WarehouseLayoutError
 from evoeye.store.windows import context_rows
 
 RUNS = {  # scenario_id: make_episode arguments (several parts, partitions and ingests)
@@ -99,20 +100,19 @@ def test_a_subset_of_runs_sharing_parts_matches_the_reference(varied: DataRoot) 
     assert len(w.features) == len(w)  # only the selected frames' inputs are kept
 
 
-def test_parts_written_with_nullable_list_items_read_the_same(varied: DataRoot) -> None:
-    """Parts from before the lists declared their items non-null load to the same windows."""
-    before = load_windows(varied, list(RUNS), context_len=5)
-    for path in varied.table_dir("frame_features").rglob("*.parquet"):
-        table = pq.read_table(path, partitioning=None)
-        plain = pa.schema([pa.field(f.name, pa.list_(pa.float32()))
-                           if pa.types.is_list(f.type) else f for f in table.schema])
-        pq.write_table(table.cast(plain), path)
-    assert pa.types.is_list(pq.read_schema(path).field("control").type)
-    assert pq.read_schema(path).field("control").type.value_field.nullable
+def test_a_part_of_the_old_layout_anywhere_is_refused(varied: DataRoot,
+                                                      as_layout_1) -> None:
+    """Every frame_features part is checked as it is read, not only the one a connection
+    checks: one part of layout 1 among new ones is named, never read as floats."""
+    for part in sorted(varied.table_dir("frame_features").rglob("*.parquet")):
+        kept = part.read_bytes()
+        as_layout_1(part)
+        assert pa.types.is_list(pq.read_schema(part).field("control").type)
+        with pytest.raises(WarehouseLayoutError, match="layout 1; .* re-ingest"):
+            load_windows(varied, list(RUNS), context_len=5)
+        part.write_bytes(kept)
     assert_same(load_windows(varied, list(RUNS), context_len=5),
                 reference(varied, list(RUNS), 5, 3.0))
-    np.testing.assert_array_equal(load_windows(varied, list(RUNS), context_len=5).context,
-                                  before.context)
 
 
 def test_parts_of_many_row_groups_read_the_same(varied: DataRoot) -> None:
