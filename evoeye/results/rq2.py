@@ -112,11 +112,11 @@ def rq2(study: Study, scenario: str) -> dict:
                           feedback=cfg.feedback, epochs=cfg.epochs, patience=cfg.patience,
                           horizon_s=cfg.horizon_s, splits=study.splits)
     study.say(f"{scenario}: RQ2 campaigns {list(cfg.methods)} × seeds {list(cfg.campaign_seeds)}")
-    ran = run_experiment(study.root, [scenario], base, strategies=cfg.methods,
-                         seeds=cfg.campaign_seeds, budget_s=cfg.budget_s, controls=0,
-                         progress=study.say, workers=cfg.workers).get(scenario, {})
     plan = plan_experiment(study.root, [scenario], base, strategies=cfg.methods,
                            seeds=cfg.campaign_seeds, budget_s=cfg.budget_s)
+    ran = run_experiment(study.root, [scenario], base, strategies=cfg.methods,
+                         seeds=cfg.campaign_seeds, budget_s=cfg.budget_s, controls=0,
+                         progress=study.say, workers=cfg.workers, plan=plan).get(scenario, {})
     judge = Judge.of(study, scenario, g0s)
     n = len(cfg.campaign_seeds)
     families = [DEFAULT_FAMILY] + sorted({methods()[m][1] for m in cfg.methods} - {DEFAULT_FAMILY})

@@ -123,12 +123,15 @@ def run_experiment(root: DataRoot, scenarios: Sequence[str],
                    base: CampaignConfig, *, strategies: Sequence[str] = MAIN + ABLATION,
                    seeds: Sequence[int] = (0, 1, 2), budget_s: float | None = None,
                    controls: int = 3, progress: Callable[[str], None] = print,
-                   workers: int | None = None, dask_address: str | None = None) -> dict:
+                   workers: int | None = None, dask_address: str | None = None,
+                   plan: Sequence[CampaignConfig] | None = None) -> dict:
     """Run (or resume) every campaign of the plan — over `workers` local processes (default:
     one per CPU; 1: one after another here) or the Dask cluster at `dask_address` — then
-    `collect_results`, with `controls` re-seeded G_0 per scenario."""
-    plan = plan_experiment(root, scenarios, base, strategies=strategies, seeds=seeds,
-                           budget_s=budget_s)
+    `collect_results`, with `controls` re-seeded G_0 per scenario. `plan`: the
+    `plan_experiment` of the same arguments, if the caller has it already."""
+    if plan is None:
+        plan = plan_experiment(root, scenarios, base, strategies=strategies, seeds=seeds,
+                               budget_s=budget_s)
     jobs = campaign_jobs(root, plan)
     for job in jobs:
         progress(f"{job.label}: budget {job.config.budget_s:.0f} s")
