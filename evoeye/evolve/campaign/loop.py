@@ -2,10 +2,11 @@
 
 Round r+1 starts from the monitor G_r and the records D_r (D_init, then every run acquired so
 far, each with its feedback under G_r). It proposes one scenario at a time, simulates it, scores
-the new run with G_r and adds it to D_r, until N_round runs or the budget is spent; then it
-ingests the round's runs (as converted for scoring: one conversion per log), updates the
-monitor on D_r, refreshes the feedback of every record with G_{r+1} and stores the round. The
-campaign stops when no run fits in the budget left.
+the new run with G_r (converted from the Episode just logged, not read back) and adds it to D_r,
+until N_round runs or the budget is spent; then it ingests the round's runs (as converted for
+scoring: one conversion per log), updates the monitor on D_r, refreshes the feedback of every
+record with G_{r+1} and stores the round. The campaign stops when no run fits in the budget
+left.
 
 Monitor update (Algorithm 1, line 12: Train(G_r, D_r)). A round adds only N_round runs to
 hundreds, so re-fitting on all of D_r every round would spend most of a campaign's wall time
@@ -47,7 +48,7 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.atomic import remove_stale_temps
-from evoeye.batch import simulate_and_log
+from evoeye.batch import simulate_and_keep
 from evoeye.evolve.campaign.config import REPLAY_RATIO, CampaignConfig
 from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
@@ -76,7 +77,7 @@ from evoeye.store.feedback import (
 )
 from evoeye.store.feedback import write_round as store_round
 from evoeye.store.ingest import IngestReport, ingest_batch, refresh_catalog
-from evoeye.store.log_windows import LoggedRun, read_logged_run
+from evoeye.store.log_windows import LoggedRun, episode_run, read_logged_run
 from evoeye.store.windows import cached_parts
 
 
@@ -234,12 +235,14 @@ class Campaign:
                 spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
                                 batch=self.campaign_id, source=cfg.strategy,
                                 round=state.round + 1)
-                result = simulate_and_log(spec, self.root)
+                result, episode = simulate_and_keep(spec, self.root)
             if result.status == "error":
                 raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
                                    f"{result.reason}")
-            with self.clock("score"):
-                run = read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
+            with self.clock("score"):  # a log a resumed round finds on disk is read
+                run = (read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
+                       if episode is None else
+                       episode_run(episode, result.path, monitor.context_len, cfg.horizon_s))
                 fb = (windows_feedback(monitor, run.windows, cfg.feedback).feedback[0]
                       if run.ok and run.windows is not None else np.nan)
             outcome = run_outcome(run.metadata)

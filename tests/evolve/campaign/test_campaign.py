@@ -172,7 +172,7 @@ def test_killed_mid_round_resumes_to_the_same_records(root_copy, seeded, clean_r
     assert len(expected["logs"]) == 4 and len(expected["rounds"]) == 3
 
     root = root_copy("killed")
-    real = campaign_mod.simulate_and_log
+    real = campaign_mod.simulate_and_keep
     calls = {"n": 0}
 
     def dies_on_the_fourth_run(spec, where):
@@ -181,12 +181,12 @@ def test_killed_mid_round_resumes_to_the_same_records(root_copy, seeded, clean_r
             raise KeyboardInterrupt("killed mid-round")
         return real(spec, where)
 
-    monkeypatch.setattr(campaign_mod, "simulate_and_log", dies_on_the_fourth_run)
+    monkeypatch.setattr(campaign_mod, "simulate_and_keep", dies_on_the_fourth_run)
     with pytest.raises(KeyboardInterrupt):
         Campaign(root, cfg).run(max_rounds=2)
     assert len(read_rounds(root, Campaign(root, cfg).campaign_id)) == 2  # round 2 cut mid-way
-    monkeypatch.setattr(campaign_mod, "simulate_and_log", real)
-    resumed = Campaign(root, cfg)
+    monkeypatch.setattr(campaign_mod, "simulate_and_keep", real)
+    resumed = Campaign(root, cfg)  # round 2's first run is read from its log
     resumed.run(max_rounds=1)
     assert snapshot(root, resumed) == expected
 
