@@ -5,7 +5,7 @@ NaN or ±inf as null, numpy arrays as lists. `live_column` builds the Arrow colu
 values taken before JSON (`evoeye.log.episode_log`) by those rules, whole columns at a time:
 a non-finite number becomes null, then numbers take the column's type as Arrow casts a decoded
 one. A value it has no columnar rule for (a float32 array, whose JSON is its float32 digits; a
-list where an array is expected) takes the log's own way: JSON-encoded and decoded, then
+list of numbers) takes the log's own way: JSON-encoded and decoded, then
 `pa.array` — so the column equals the log's in every case, only slower in the unusual ones.
 """
 
@@ -32,14 +32,23 @@ def as_decoded(value: Any) -> Any:
 def live_column(values: Sequence[Any], typ: pa.DataType) -> pa.Array:
     """The frames column of type `typ` holding `values` (one per frame, as published)."""
     if pa.types.is_list(typ):
-        column = _list_column(values, typ)
+        column = _number_lists(values, typ)
         if column is not None:
             return column
-        return pa.array([as_decoded(v) for v in values], typ)
-    if all(v is None or isinstance(v, _SCALARS) for v in values):
+    elif all(v is None or isinstance(v, _SCALARS) for v in values):
         return pa.array([None if isinstance(v, float) and not math.isfinite(v) else v
                          for v in values], typ)
-    return pa.array([as_decoded(v) for v in values], typ)
+    return pa.array([_as_logged(v) for v in values], typ)
+
+
+def _as_logged(value: Any) -> Any:
+    """`value` as JSON decoding of its log gives it: itself where JSON keeps it (a string, an
+    integer, a finite float, a list of strings), None for a non-finite float, else decoded."""
+    if value is None or isinstance(value, _SCALARS):
+        return None if isinstance(value, float) and not math.isfinite(value) else value
+    if type(value) is list and all(type(v) is str for v in value):
+        return value
+    return as_decoded(value)
 
 
 def _leaf(typ: pa.DataType) -> tuple[pa.DataType, int]:
@@ -50,9 +59,9 @@ def _leaf(typ: pa.DataType) -> tuple[pa.DataType, int]:
     return typ, depth
 
 
-def _list_column(values: Sequence[Any], typ: pa.DataType) -> pa.Array | None:
+def _number_lists(values: Sequence[Any], typ: pa.DataType) -> pa.Array | None:
     """A list (of lists) of numbers from numpy arrays of that depth, or None when a value is
-    not such an array (strings, other dtypes, lists)."""
+    not such an array (other dtypes, lists) or the items are not numbers."""
     leaf, depth = _leaf(typ)
     kind = "f" if pa.types.is_floating(leaf) else "i" if pa.types.is_integer(leaf) else None
     if kind is None:
