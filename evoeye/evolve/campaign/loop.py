@@ -67,6 +67,7 @@ from evoeye.paths import DataRoot
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
 from evoeye.sim.runner import run_spec
 from evoeye.store import RunFilter, Warehouse
+from evoeye.store.connections import shared_connections
 from evoeye.store.feedback import (
     FeedbackRows,
     RoundMetrics,
@@ -342,8 +343,9 @@ class Campaign:
     def run(self, max_rounds: int | None = None,
             on_round: Callable[[RoundRow, CampaignState], None] | None = None) -> CampaignState:
         """Resume, then run rounds until the budget is spent (or `max_rounds` more are done).
-        Each warehouse part is decoded once for all rounds (`cached_parts`)."""
-        with cached_parts():
+        Each warehouse part is decoded once for all rounds (`cached_parts`), and the warehouse's
+        DuckDB views are installed once per state of it (`shared_connections`)."""
+        with cached_parts(), shared_connections():
             state = self.start()
             done_rounds = 0
             while not self.done(state) and (max_rounds is None or done_rounds < max_rounds):
