@@ -54,6 +54,7 @@ from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
 from evoeye.evolve.campaign.state import CampaignState, records_of, run_outcome, run_seed
 from evoeye.evolve.search.strategies import FEEDBACK_BLIND, make_strategy
+from evoeye.heap import frozen_heap
 from evoeye.log import read_run
 from evoeye.monitor.families import (
     DEFAULT_FAMILY,
@@ -343,18 +344,21 @@ class Campaign:
     def run(self, max_rounds: int | None = None,
             on_round: Callable[[RoundRow, CampaignState], None] | None = None) -> CampaignState:
         """Resume, then run rounds until the budget is spent (or `max_rounds` more are done).
-        Each warehouse part is decoded once for all rounds (`cached_parts`), and the warehouse's
-        DuckDB views are installed once per state of it (`shared_connections`)."""
+        Each warehouse part is decoded once for all rounds (`cached_parts`), the warehouse's
+        DuckDB views are installed once per state of it (`shared_connections`), and the rounds'
+        garbage collections skip what was loaded before them (`frozen_heap`)."""
         with cached_parts(), shared_connections():
             state = self.start()
             done_rounds = 0
-            while not self.done(state) and (max_rounds is None or done_rounds < max_rounds):
-                row = self.run_round(state)
-                if row is None:
-                    break
-                done_rounds += 1
-                if on_round is not None:
-                    on_round(row, state)
+            with frozen_heap():
+                while not self.done(state) and (max_rounds is None
+                                                or done_rounds < max_rounds):
+                    row = self.run_round(state)
+                    if row is None:
+                        break
+                    done_rounds += 1
+                    if on_round is not None:
+                        on_round(row, state)
         refresh_catalog(self.root)  # its views see the tables the campaign added to
         return state
 

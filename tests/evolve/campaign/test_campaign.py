@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import shutil
 
 import numpy as np
@@ -126,7 +127,9 @@ def test_budget_is_never_overspent_and_every_round_is_recorded(root_copy) -> Non
     root = root_copy("budget")
     g0 = Campaign(root, config(None)).g0  # the newest from-scratch monitor of the scenario
     c = Campaign(root, config(g0, strategy="uniform", budget_s=50.0, n_round=2))
-    state = c.run()
+    frozen: list[int] = []  # the start-up heap is left out of the rounds' collections
+    state = c.run(on_round=lambda row, state: frozen.append(gc.get_freeze_count()))
+    assert frozen and min(frozen) > 0 and gc.get_freeze_count() == 0
     assert c.done(state) and state.spent_s <= 50.0
     assert 50.0 - state.spent_s < c.config.max_run_s  # it stopped only when no run fitted
     rows = read_rounds(root, c.campaign_id)
