@@ -23,7 +23,7 @@ from evoeye.lifeline import die_with_parent
 from evoeye.log import LogError, read_run, write_episode
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import get_scenario
-from evoeye.sim.episode import STATUS_OK, RunSpec
+from evoeye.sim.episode import STATUS_OK, Episode, RunSpec
 from evoeye.sim.runner import run_episode, run_spec
 
 
@@ -61,6 +61,12 @@ class RunResult:
 
 def simulate_and_log(spec: RunSpec, root: DataRoot) -> RunResult:
     """Simulate one run and write its log, unless its log already exists. Picklable."""
+    return simulate_and_keep(spec, root)[0]
+
+
+def simulate_and_keep(spec: RunSpec, root: DataRoot) -> tuple[RunResult, Episode | None]:
+    """`simulate_and_log`, and the Episode it simulated (None when the log was on disk), for a
+    caller that converts the run in memory (`evoeye.store.log_windows.episode_run`)."""
     path = root.run_log(spec.scenario, spec.batch, spec.scenario_id)
     if path.exists():
         try:
@@ -68,7 +74,7 @@ def simulate_and_log(spec: RunSpec, root: DataRoot) -> RunResult:
             return RunResult(
                 spec.scenario_id, str(path), meta["status"], bool(meta["collided"]),
                 meta.get("reason") or "", skipped=True, sim_time_s=float(meta["duration_s"]),
-            )
+            ), None
         except LogError:
             path.unlink()  # a final-named log that does not read back: simulate it again
     episode = run_episode(spec)
@@ -76,7 +82,7 @@ def simulate_and_log(spec: RunSpec, root: DataRoot) -> RunResult:
     write_episode(episode, path)
     o = episode.outcome
     return RunResult(spec.scenario_id, str(path), o.status, o.collided, o.reason,
-                     sim_time_s=o.duration_s)
+                     sim_time_s=o.duration_s), episode
 
 
 def remove_stale_logs(specs: Sequence[RunSpec], root: DataRoot) -> list[Path]:

@@ -22,6 +22,7 @@ import numpy as np
 import torch
 from torch import nn
 
+from evoeye.monitor.adam import Adam
 from evoeye.monitor.card import thresholds_from_card
 from evoeye.monitor.families import read_version
 from evoeye.monitor.protocol import Thresholds
@@ -205,7 +206,7 @@ def _train(train: Windows, normal: np.ndarray, config: AEMConfig,
     model = AutoEncoder(x.shape[1], config.hidden, config.latent)
     if init is not None:
         model.load_state_dict(init.model.state_dict())
-    opt = torch.optim.Adam(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)
+    opt = Adam(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)
     gen = torch.Generator().manual_seed(config.seed)
     model.train()
     for _ in range(config.epochs):

@@ -13,7 +13,7 @@ import os
 from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any
+from typing import Any, ClassVar
 
 import orjson
 from mcap.reader import SeekingReader
@@ -42,6 +42,7 @@ class RunLog:
     schema_ids: dict[str, str]  # topic -> `$id` of its embedded schema, e.g. "…:localization.v1"
     requested: frozenset[str] | None = None  # the topics asked of read_run; None = all
     _decoded: dict[str, list[tuple[int, dict]]] = field(default_factory=dict, repr=False)
+    decoded: ClassVar[bool] = True  # message values as JSON decodes them (lists, None)
 
     @property
     def topics(self) -> tuple[str, ...]:

@@ -9,8 +9,9 @@ unweighted BCE is dominated by the easy safe frames; weighting the positives bal
 classes in expectation while every window is still seen exactly once per epoch (unlike
 re-sampling, which repeats a few positive windows and drops negatives). The weighting shifts the
 scores upwards, which does not matter for alarms: thresholds are calibrated on validation for a
-target FPR. Optimiser Adam; early stopping on validation AUPRC (the best epoch's weights are
-kept). Seeded: the same seed, data and thread count give the same weights (and version).
+target FPR. Optimiser Adam (`evoeye.monitor.adam`: torch's, without its compiler import); early
+stopping on validation AUPRC (the best epoch's weights are kept). Seeded: the same seed, data
+and thread count give the same weights (and version).
 
 `init_from=<version>` fine-tunes a parent: its weights, input normalisers and architecture are
 the starting point, and the card records the parent. Without it a monitor is trained from
@@ -32,6 +33,7 @@ import torch
 from torch import nn
 
 from evoeye import __version__
+from evoeye.monitor.adam import Adam
 from evoeye.monitor.calibration import calibrate_on_validation
 from evoeye.monitor.card import (
     data_summary,
@@ -126,7 +128,7 @@ def fit(net: FusionNet, train: Windows, val: Windows, params: TrainParams = Trai
                          "are unsafe")
     pos_weight = params.pos_weight or (len(train) - n_pos) / n_pos
     loss_fn = nn.BCEWithLogitsLoss(pos_weight=torch.tensor(pos_weight))
-    opt = torch.optim.Adam(net.parameters(), lr=params.lr, weight_decay=params.weight_decay)
+    opt = Adam(net.parameters(), lr=params.lr, weight_decay=params.weight_decay)
     gen = torch.Generator().manual_seed(params.seed)
     # AUPRC needs both classes in validation; without, early stopping falls back to val loss
     use_auprc = ranking_metrics(np.zeros(len(val)), val.label)["auprc"] is not None
@@ -141,7 +143,7 @@ def fit(net: FusionNet, train: Windows, val: Windows, params: TrainParams = Trai
             batch = train.batch(idx)
             logit = net(*net_inputs(batch))
             loss = loss_fn(logit, batch.label)
-            opt.zero_grad(set_to_none=True)
+            opt.zero_grad()
             loss.backward()
             nn.utils.clip_grad_norm_(net.parameters(), params.grad_clip)
             opt.step()

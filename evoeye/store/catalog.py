@@ -1,11 +1,11 @@
 """DuckDB over the warehouse Parquet: the connection every reader uses, and the catalog file.
 
 Readers never open the DuckDB file for writing and take no lock: `Warehouse.connect()` gives an
-in-memory DuckDB whose views read the Parquet parts directly; `Warehouse.read_only_sql` runs a
-user's query there with reads only and, by default, external access off except for the
-warehouse folder. The file
-`<root>/warehouse/evoeye.duckdb` holds the same views for the DuckDB CLI and other tools; only
-the ingester (under the writer lock) rewrites it.
+in-memory DuckDB whose views read the Parquet parts directly (inside `shared_connections()`, a
+cursor of one such database per warehouse state); `Warehouse.read_only_sql` runs a user's
+query there with reads only and, by default, external access off except for the warehouse
+folder. The file `<root>/warehouse/evoeye.duckdb` holds the same views for the DuckDB CLI and
+other tools; only the ingester (under the writer lock) rewrites it.
 """
 
 from __future__ import annotations
@@ -17,6 +17,7 @@ import duckdb
 import pyarrow as pa
 
 from evoeye.paths import DataRoot
+from evoeye.store.connections import connection
 from evoeye.store.parts import PartStore
 from evoeye.store.schema import (
     DDL_SCHEMA,
@@ -37,13 +38,13 @@ def _string_literal(text: str) -> str:
     return "'" + text.replace("'", "''") + "'"
 
 
-def _parquet_view_sql(table: str, table_dir: Path) -> str:
+def _parquet_view_sql(table: str, table_dir: Path, has_parts: bool) -> str:
     """The base view `<table>_parquet` over every part of `table`, or the empty declared table.
 
     The parts share one schema (a warehouse holds one layout: `PartStore.check_layout`), so
     DuckDB reads it from one file and need not union the schemas of every part each time a
     view or query is bound (that took most of a connection's time over a few dozen parts)."""
-    if not any(table_dir.glob(PART_GLOB)):
+    if not has_parts:
         source = f"{DDL_SCHEMA}.{table}"
     else:
         hive_types = ", ".join(f"{_string_literal(k)}: 'VARCHAR'" for k in PARTITION_KEYS)
@@ -58,24 +59,33 @@ def _parquet_view_sql(table: str, table_dir: Path) -> str:
     )
 
 
-def _derived_view_sql(table: str, table_dir: Path) -> str:
+def _derived_view_sql(table: str, table_dir: Path, has_parts: bool) -> str:
     """The view `<table>` over the flat parts of a derived table, or its empty declared table."""
     source = f"{DDL_SCHEMA}.{table}"
-    if any(table_dir.glob("*.parquet")):
+    if has_parts:
         source = (f"read_parquet({_string_literal(str(table_dir / '*.parquet'))}, "
                   "union_by_name = true)")
     return f"CREATE OR REPLACE VIEW {table} AS SELECT * FROM {source}"
 
 
-def install_views(con: duckdb.DuckDBPyConnection, root: DataRoot) -> None:
-    """Create the declared tables, the Parquet base views and every view script on `con`;
-    WarehouseLayoutError for a warehouse of another layout."""
+def parts_present(root: DataRoot) -> tuple[bool, ...]:
+    """Whether each table (TABLES, then DERIVED_TABLES) has a part: the views depend on nothing
+    else of the warehouse's state. WarehouseLayoutError for a warehouse of another layout."""
     PartStore(root).check_layout()
+    return (*(any(root.table_dir(t).glob(PART_GLOB)) for t in TABLES),
+            *(any(root.table_dir(t).glob("*.parquet")) for t in DERIVED_TABLES))
+
+
+def install_views(con: duckdb.DuckDBPyConnection, root: DataRoot,
+                  present: tuple[bool, ...] | None = None) -> None:
+    """Create the declared tables, the Parquet base views and every view script on `con`, for
+    the tables `present` (default: as they are now, `parts_present`)."""
+    present = parts_present(root) if present is None else present
     create_declared_tables(con)
-    for table in TABLES:
-        con.execute(_parquet_view_sql(table, root.table_dir(table)))
-    for table in DERIVED_TABLES:
-        con.execute(_derived_view_sql(table, root.table_dir(table)))
+    for table, has_parts in zip(TABLES, present[:len(TABLES)], strict=True):
+        con.execute(_parquet_view_sql(table, root.table_dir(table), has_parts))
+    for table, has_parts in zip(DERIVED_TABLES, present[len(TABLES):], strict=True):
+        con.execute(_derived_view_sql(table, root.table_dir(table), has_parts))
     for _, script in view_scripts():
         con.execute(script)
 
@@ -98,10 +108,18 @@ class Warehouse:
         self.root = root
 
     def connect(self) -> duckdb.DuckDBPyConnection:
-        """A fresh in-memory DuckDB with every warehouse view; the caller closes it."""
+        """An in-memory DuckDB with every warehouse view; the caller closes it. Inside
+        `shared_connections()`, a connection to the block's database of the warehouse in its
+        present state (`evoeye.store.connections`)."""
+        present = parts_present(self.root)
+        return connection(("views", str(self.root.path), present),
+                          lambda: self._new(present))
+
+    def _new(self, present: tuple[bool, ...]) -> duckdb.DuckDBPyConnection:
+        """A new in-memory DuckDB with the views of the tables `present`."""
         con = duckdb.connect()
         try:
-            install_views(con, self.root)
+            install_views(con, self.root, present)
         except BaseException:
             con.close()
             raise
@@ -118,8 +136,9 @@ class Warehouse:
     def read_only_sql(self, text: str, *, allow_files: bool = False) -> pa.Table:
         """Run a user's query: SELECT / EXPLAIN statements only (ReadOnlyQueryError otherwise),
         and unless `allow_files`, no file but the warehouse's own Parquet (duckdb's
-        PermissionException otherwise); the last statement's result as Arrow."""
-        con = self.connect()
+        PermissionException otherwise); the last statement's result as Arrow. Always a
+        database of its own: locking it down locks the whole database."""
+        con = self._new(parts_present(self.root))
         try:
             statements = con.extract_statements(text)
             refused = sorted({s.type.name for s in statements} - {t.name for t in

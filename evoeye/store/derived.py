@@ -27,6 +27,7 @@ import pyarrow.parquet as pq
 
 from evoeye.atomic import atomic_file, fsync_dir
 from evoeye.paths import DataRoot
+from evoeye.store.connections import connection
 from evoeye.store.schema import canonical_schema, declared_schema
 from evoeye.store.sqlfiles import query
 
@@ -94,7 +95,7 @@ def read_parts(root: DataRoot, table: str, query_name: str, *, key: str | None =
     files = part_files(root.table_dir(table), key)
     if not files:
         return declared_schema(table).empty_table()
-    con = duckdb.connect()
+    con = connection(("bare",), duckdb.connect)
     try:
         return con.sql(query(query_name), params={
             "glob": [str(f) for f in files], **params}).to_arrow_table()

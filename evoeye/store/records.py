@@ -24,6 +24,7 @@ from evoeye.log import TOPICS
 from evoeye.log.channels import CHANNELS
 from evoeye.scene import EGO_ID
 from evoeye.store.features import FEATURES, FeatureSpec, FrameFeatures, frame_features, pack
+from evoeye.store.live_columns import live_column
 from evoeye.store.schema import PARTITION_KEYS, file_schema, table_schema
 
 PREFIX_TOPIC = {
@@ -48,9 +49,12 @@ class RunRecordError(ValueError):
 
 
 class RunSource(Protocol):
-    """What the converter needs of a run log (evoeye.log.RunLog has it)."""
+    """What the converter needs of a run log: `evoeye.log.RunLog` (read from its file, message
+    values as JSON decodes them) or `evoeye.log.episode_log.EpisodeLog` (from the Episode in
+    memory, values as published: `decoded` False)."""
 
     metadata: dict[str, Any]
+    decoded: bool
 
     def messages(self, topic: str) -> list[tuple[int, dict[str, Any]]]: ...
 
@@ -93,21 +97,23 @@ def _is_array_field(topic: str, field: str) -> bool:
     return CHANNELS[topic].schema["properties"][field]["type"] == "array"
 
 
-def _column(msgs: list[dict[str, Any]], field: str, typ: pa.DataType, ego: bool) -> pa.Array:
-    if ego:  # a per-actor ground-truth array: the ego is always the first row
-        return pa.array([m[field][0] for m in msgs], type=typ)
-    return pa.array([m[field] for m in msgs], type=typ)
+def _column(msgs: list[dict[str, Any]], field: str, typ: pa.DataType, ego: bool,
+            decoded: bool) -> pa.Array:
+    # ego: a per-actor ground-truth array, whose first row is always the ego's
+    values = [m[field][0] for m in msgs] if ego else [m[field] for m in msgs]
+    return pa.array(values, type=typ) if decoded else live_column(values, typ)
 
 
 def frames_table(run: RunSource, scenario_id: str, ingest_id: str) -> pa.Table:
-    """The frames of one run as an Arrow table in the Parquet file schema (no partition keys)."""
+    """The frames of one run as an Arrow table in the Parquet file schema (no partition keys);
+    the same from a run's log and from its Episode in memory."""
     schema = file_schema("frames")
     sources = frame_column_sources()
     try:
         by_topic = _aligned_messages(run, sorted({t for t, _ in sources.values()}))
         clock = by_topic[FRAME_CLOCK]
         for i, m in enumerate(clock):
-            if not m["actor_id"] or m["actor_id"][0] != EGO_ID:
+            if m["actor_id"] is None or len(m["actor_id"]) == 0 or m["actor_id"][0] != EGO_ID:
                 raise RunRecordError(f"ground truth of frame {i} does not start with the ego")
         n = len(clock)
         columns: dict[str, pa.Array] = {
@@ -119,7 +125,7 @@ def frames_table(run: RunSource, scenario_id: str, ingest_id: str) -> pa.Table:
         for name, (topic, field) in sources.items():
             typ = schema.field(name).type
             per_actor = _is_array_field(topic, field) and not pa.types.is_list(typ)
-            columns[name] = _column(by_topic[topic], field, typ, per_actor)
+            columns[name] = _column(by_topic[topic], field, typ, per_actor, run.decoded)
     except RunRecordError:
         raise
     except KeyError as e:

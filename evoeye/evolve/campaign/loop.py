@@ -2,10 +2,11 @@
 
 Round r+1 starts from the monitor G_r and the records D_r (D_init, then every run acquired so
 far, each with its feedback under G_r). It proposes one scenario at a time, simulates it, scores
-the new run with G_r and adds it to D_r, until N_round runs or the budget is spent; then it
-ingests the round's runs (as converted for scoring: one conversion per log), updates the
-monitor on D_r, refreshes the feedback of every record with G_{r+1} and stores the round. The
-campaign stops when no run fits in the budget left.
+the new run with G_r (converted from the Episode just logged, not read back) and adds it to D_r,
+until N_round runs or the budget is spent; then it ingests the round's runs (as converted for
+scoring: one conversion per log), updates the monitor on D_r, refreshes the feedback of every
+record with G_{r+1} and stores the round. The campaign stops when no run fits in the budget
+left.
 
 Monitor update (Algorithm 1, line 12: Train(G_r, D_r)). A round adds only N_round runs to
 hundreds, so re-fitting on all of D_r every round would spend most of a campaign's wall time
@@ -47,12 +48,13 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.atomic import remove_stale_temps
-from evoeye.batch import simulate_and_log
+from evoeye.batch import simulate_and_keep
 from evoeye.evolve.campaign.config import REPLAY_RATIO, CampaignConfig
 from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
 from evoeye.evolve.campaign.state import CampaignState, records_of, run_outcome, run_seed
 from evoeye.evolve.search.strategies import FEEDBACK_BLIND, make_strategy
+from evoeye.heap import frozen_heap
 from evoeye.log import read_run
 from evoeye.monitor.families import (
     DEFAULT_FAMILY,
@@ -66,6 +68,7 @@ from evoeye.paths import DataRoot
 from evoeye.scenarios import DEFAULT_DELTA, get_scenario
 from evoeye.sim.runner import run_spec
 from evoeye.store import RunFilter, Warehouse
+from evoeye.store.connections import shared_connections
 from evoeye.store.feedback import (
     FeedbackRows,
     RoundMetrics,
@@ -76,7 +79,7 @@ from evoeye.store.feedback import (
 )
 from evoeye.store.feedback import write_round as store_round
 from evoeye.store.ingest import IngestReport, ingest_batch, refresh_catalog
-from evoeye.store.log_windows import LoggedRun, read_logged_run
+from evoeye.store.log_windows import LoggedRun, episode_run, read_logged_run
 from evoeye.store.windows import cached_parts
 
 
@@ -234,12 +237,14 @@ class Campaign:
                 spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
                                 batch=self.campaign_id, source=cfg.strategy,
                                 round=state.round + 1)
-                result = simulate_and_log(spec, self.root)
+                result, episode = simulate_and_keep(spec, self.root)
             if result.status == "error":
                 raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
                                    f"{result.reason}")
-            with self.clock("score"):
-                run = read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
+            with self.clock("score"):  # a log a resumed round finds on disk is read
+                run = (read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
+                       if episode is None else
+                       episode_run(episode, result.path, monitor.context_len, cfg.horizon_s))
                 fb = (windows_feedback(monitor, run.windows, cfg.feedback).feedback[0]
                       if run.ok and run.windows is not None else np.nan)
             outcome = run_outcome(run.metadata)
@@ -339,17 +344,21 @@ class Campaign:
     def run(self, max_rounds: int | None = None,
             on_round: Callable[[RoundRow, CampaignState], None] | None = None) -> CampaignState:
         """Resume, then run rounds until the budget is spent (or `max_rounds` more are done).
-        Each warehouse part is decoded once for all rounds (`cached_parts`)."""
-        with cached_parts():
+        Each warehouse part is decoded once for all rounds (`cached_parts`), the warehouse's
+        DuckDB views are installed once per state of it (`shared_connections`), and the rounds'
+        garbage collections skip what was loaded before them (`frozen_heap`)."""
+        with cached_parts(), shared_connections():
             state = self.start()
             done_rounds = 0
-            while not self.done(state) and (max_rounds is None or done_rounds < max_rounds):
-                row = self.run_round(state)
-                if row is None:
-                    break
-                done_rounds += 1
-                if on_round is not None:
-                    on_round(row, state)
+            with frozen_heap():
+                while not self.done(state) and (max_rounds is None
+                                                or done_rounds < max_rounds):
+                    row = self.run_round(state)
+                    if row is None:
+                        break
+                    done_rounds += 1
+                    if on_round is not None:
+                        on_round(row, state)
         refresh_catalog(self.root)  # its views see the tables the campaign added to
         return state
 

@@ -1,7 +1,8 @@
 """Where a campaign's time goes: wall and CPU seconds per phase of its rounds, for profiling.
 
     simulate  propose and simulate the round's runs, writing their logs
-    score     read each new log (the warehouse's conversion) and score it with G_r
+    score     convert each new run as the warehouse does (from its Episode in memory, or the
+              log a resumed round finds on disk) and score it with G_r
     ingest    put the round's runs into the warehouse
     train     the monitor update G_r → G_{r+1}
     refresh   every record's feedback under G_{r+1}

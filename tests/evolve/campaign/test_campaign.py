@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import gc
 import shutil
 
 import numpy as np
@@ -126,7 +127,9 @@ def test_budget_is_never_overspent_and_every_round_is_recorded(root_copy) -> Non
     root = root_copy("budget")
     g0 = Campaign(root, config(None)).g0  # the newest from-scratch monitor of the scenario
     c = Campaign(root, config(g0, strategy="uniform", budget_s=50.0, n_round=2))
-    state = c.run()
+    frozen: list[int] = []  # the start-up heap is left out of the rounds' collections
+    state = c.run(on_round=lambda row, state: frozen.append(gc.get_freeze_count()))
+    assert frozen and min(frozen) > 0 and gc.get_freeze_count() == 0
     assert c.done(state) and state.spent_s <= 50.0
     assert 50.0 - state.spent_s < c.config.max_run_s  # it stopped only when no run fitted
     rows = read_rounds(root, c.campaign_id)
@@ -172,7 +175,7 @@ def test_killed_mid_round_resumes_to_the_same_records(root_copy, seeded, clean_r
     assert len(expected["logs"]) == 4 and len(expected["rounds"]) == 3
 
     root = root_copy("killed")
-    real = campaign_mod.simulate_and_log
+    real = campaign_mod.simulate_and_keep
     calls = {"n": 0}
 
     def dies_on_the_fourth_run(spec, where):
@@ -181,12 +184,12 @@ def test_killed_mid_round_resumes_to_the_same_records(root_copy, seeded, clean_r
             raise KeyboardInterrupt("killed mid-round")
         return real(spec, where)
 
-    monkeypatch.setattr(campaign_mod, "simulate_and_log", dies_on_the_fourth_run)
+    monkeypatch.setattr(campaign_mod, "simulate_and_keep", dies_on_the_fourth_run)
     with pytest.raises(KeyboardInterrupt):
         Campaign(root, cfg).run(max_rounds=2)
     assert len(read_rounds(root, Campaign(root, cfg).campaign_id)) == 2  # round 2 cut mid-way
-    monkeypatch.setattr(campaign_mod, "simulate_and_log", real)
-    resumed = Campaign(root, cfg)
+    monkeypatch.setattr(campaign_mod, "simulate_and_keep", real)
+    resumed = Campaign(root, cfg)  # round 2's first run is read from its log
     resumed.run(max_rounds=1)
     assert snapshot(root, resumed) == expected
 
