@@ -16,7 +16,8 @@ import numpy as np
 import pyarrow as pa
 
 from evoeye.evaluation.dataset import narrow
-from evoeye.evaluation.monitors import BASELINES, check_scores, monitor_context_len
+from evoeye.evaluation.harness import score_and_calibrate
+from evoeye.evaluation.monitors import BASELINES, check_scores
 from evoeye.evolve.campaign.assess import (
     FPRS,
     HARD_SET_FPR,
@@ -26,7 +27,6 @@ from evoeye.evolve.campaign.assess import (
     metrics_dict,
     robust_hard_set,
 )
-from evoeye.monitor.calibration import calibrate_on_validation
 from evoeye.monitor.families import FAMILIES, MonitorFamily, family_of, load_calibrated
 from evoeye.monitor.protocol import Monitor
 from evoeye.monitor.threads import intra_op_threads
@@ -87,13 +87,10 @@ def test_figures(study: Study, scenario: str, monitor: Monitor) -> dict:
     @intra_op_threads()
     def evaluate() -> dict:
         study.say(f"{scenario}: evaluating {monitor.name} {monitor.version}")
-        L = monitor_context_len(monitor)
-        val, test = study.windows(scenario, "val"), study.windows(scenario, "test")
-        s_val = check_scores(monitor, monitor.score(narrow(val.windows, L)), len(val))
-        s_test = check_scores(monitor, monitor.score(narrow(test.windows, L)), len(test))
-        thr = calibrate_on_validation(s_val, val.windows, FPRS)
-        figures = metrics_dict(s_test, test.windows.label, thr)
-        figures.update({f"val_fpr@{f}": thr.realised_fpr[f] for f in FPRS})
+        test = study.windows(scenario, "test")
+        c = score_and_calibrate(monitor, study.windows(scenario, "val"), test, FPRS)
+        figures = metrics_dict(c.test, test.windows.label, c.thresholds)
+        figures.update({f"val_fpr@{f}": c.thresholds.realised_fpr[f] for f in FPRS})
         return {"test": figures}
 
     return study.ledger.remember("evaluate", inputs, evaluate)
