@@ -101,6 +101,13 @@ def metrics_dict(scores: np.ndarray, labels: np.ndarray, thresholds) -> dict:
     return out
 
 
+def reached(metrics: dict, metric: str) -> bool:
+    """Whether `metric` (a key of `metrics_dict`, e.g. "f1@0.05") was measured: False only
+    where its target FPR was unreachable; a metric of no FPR ("auroc") always was."""
+    fpr = metric.partition("@")[2]
+    return not fpr or metrics.get(f"reachable@{fpr}") is not False
+
+
 class Assessor:
     """Judges monitor versions on one scenario's Test Set and on subsets of it: the Hard Set of
     G_0 and, given the re-seeded G_0s, the robust Hard Set."""

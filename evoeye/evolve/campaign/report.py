@@ -18,6 +18,7 @@ import numpy as np
 from evoeye.evaluation.plots import interval_chart, line_chart
 from evoeye.evaluation.report import DASH, UNREACHABLE, UNREACHABLE_NOTE
 from evoeye.evaluation.stats import finite_mean, mean_ci, sample_sd
+from evoeye.evolve.campaign.assess import reached
 from evoeye.evolve.campaign.experiment import ABLATION, MAIN, methods
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.paths import DataRoot
@@ -80,9 +81,7 @@ def _cells(per_seed: Sequence[dict]) -> list[str]:
     for split in ("test", "hard"):
         for col in COLUMNS:
             ms = [m[split] for m in per_seed]
-            fpr = col.partition("@")[2]
-            ok = [m.get(f"reachable@{fpr}", True) for m in ms] if fpr else None
-            cells.append(_mean_std([_value(m[col]) for m in ms], ok))
+            cells.append(_mean_std([_value(m[col]) for m in ms], [reached(m, col) for m in ms]))
     return cells
 
 
