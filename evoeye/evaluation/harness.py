@@ -22,7 +22,7 @@ from evoeye.evaluation.metrics import Curves, FrameMetrics, frame_metrics
 from evoeye.evaluation.monitors import check_scores, monitor_context_len
 from evoeye.evaluation.scenario import Runs, ScenarioMetrics, scenario_metrics
 from evoeye.monitor.calibration import calibrate_on_validation
-from evoeye.monitor.protocol import TARGET_FPRS, Monitor
+from evoeye.monitor.protocol import TARGET_FPRS, Monitor, Thresholds
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 from evoeye.store.scores import ScoreRows, write_scores
@@ -92,24 +92,40 @@ def _store(root: DataRoot, monitor: Monitor, scenario: str, parts: list[tuple[Sp
     return write_scores(root, rows).rows
 
 
+@dataclass(frozen=True)
+class Calibrated:
+    """A monitor's scores of a val and a test split, and its thresholds calibrated on the val."""
+
+    context_len: int  # the L its windows were narrowed to
+    val: np.ndarray  # (B_val,) float64 in [0, 1]
+    test: np.ndarray  # (B_test,) float64 in [0, 1]
+    thresholds: Thresholds
+
+
+def score_and_calibrate(monitor: Monitor, val: SplitWindows, test: SplitWindows,
+                        fprs: Sequence[float] = TARGET_FPRS) -> Calibrated:
+    """Score both splits at the monitor's own L; calibrate a threshold per target FPR on val."""
+    L = monitor_context_len(monitor)
+    s_val = check_scores(monitor, monitor.score(narrow(val.windows, L)), len(val))
+    s_test = check_scores(monitor, monitor.score(narrow(test.windows, L)), len(test))
+    return Calibrated(L, s_val, s_test, calibrate_on_validation(s_val, val.windows, fprs))
+
+
 def evaluate_monitor(monitor: Monitor, val: SplitWindows, test: SplitWindows, runs: Runs, *,
                      fprs: Sequence[float] = TARGET_FPRS, ks: Sequence[int] = SCENARIO_KS,
                      latency: bool = False) -> tuple[MonitorResult, np.ndarray, np.ndarray]:
     """One monitor's results, and its raw val and test scores (for storage)."""
-    L = monitor_context_len(monitor)
-    s_val = check_scores(monitor, monitor.score(narrow(val.windows, L)), len(val))
-    s_test = check_scores(monitor, monitor.score(narrow(test.windows, L)), len(test))
-    y_test = test.windows.label
-    thr = calibrate_on_validation(s_val, val.windows, fprs)
+    c = score_and_calibrate(monitor, val, test, fprs)
+    s_test, y_test, thr = c.test, test.windows.label, c.thresholds
     result = MonitorResult(
-        monitor.name, monitor.version, L, dict(thr.by_fpr), dict(thr.realised_fpr),
+        monitor.name, monitor.version, c.context_len, dict(thr.by_fpr), dict(thr.realised_fpr),
         {f: thr.reachable(f) for f in fprs},
         frame_metrics(s_test, y_test, thr, fprs),
         {k: scenario_metrics(s_test, runs, thr, k, fprs) for k in ks},
         Curves.of(s_test, y_test),
-        measure_latency(monitor, narrow(test.windows, L)) if latency else None,
+        measure_latency(monitor, narrow(test.windows, c.context_len)) if latency else None,
     )
-    return result, s_val, s_test
+    return result, c.val, s_test
 
 
 def evaluate(

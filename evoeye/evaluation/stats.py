@@ -50,6 +50,12 @@ def _finite(values: Sequence[float] | np.ndarray) -> np.ndarray:
     return a[np.isfinite(a)]
 
 
+def finite_mean(values: Sequence[float] | np.ndarray) -> float | None:
+    """The mean of the finite values (NaN, e.g. an undefined seed, left out); None for none."""
+    a = _finite(values)
+    return float(a.mean()) if len(a) else None
+
+
 def sample_sd(values: Sequence[float] | np.ndarray) -> float | None:
     """Sample SD (ddof = 1) of the finite values; None for fewer than two."""
     a = _finite(values)

@@ -13,12 +13,13 @@ gives a user, who deploys one monitor — and only removes the last training's s
 it; an ensemble would judge a different, stronger monitor than any method produces. A campaign
 that made no round keeps its start, G_0, judged by the mean of G_0's recipe over k seeds.
 
-The sets (`units.Judge`): the Test Set (the study's test split: the held-out batch), the
-paper's Hard Set (the unsafe test frames G_0 misses, plus the safe frames of their runs) and the
-robust Hard Set (the unsafe test frames a majority of the study's re-seeded G_0s — its training
-seeds — miss, plus every safe test frame). Rows: "G_0" (the start of every campaign, one value),
-"G_0 (k seeds)" (G_0's recipe, no new data, mean of k training seeds: the issue's control), and
-likewise "<family> G_0" for a `<family>-evo` method (AEM-Evo's start: the AEM trained on D_init).
+The sets (`units.judge`: an `Assessor` given the re-seeded G_0s): the Test Set (the study's
+test split: the held-out batch), the paper's Hard Set (the unsafe test frames G_0 misses, plus
+the safe frames of their runs) and the robust Hard Set (the unsafe test frames a majority of the
+study's re-seeded G_0s — its training seeds — miss, plus every safe test frame). Rows: "G_0"
+(the start of every campaign, one value), "G_0 (k seeds)" (G_0's recipe, no new data, mean of k
+training seeds: the issue's control), and likewise "<family> G_0" for a `<family>-evo` method
+(AEM-Evo's start: the AEM trained on D_init).
 """
 
 from __future__ import annotations
@@ -35,7 +36,7 @@ from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.monitor.inputs import MODULES
 from evoeye.results.rq1 import FULL_CONTEXT_LEN
 from evoeye.results.study import Study
-from evoeye.results.units import Judge, set_figures, trained_version
+from evoeye.results.units import judge, set_figures, trained_version
 from evoeye.store.feedback import read_rounds
 
 FINAL_SEED_STRIDE = 100_000  # seed of final retraining j: the last update's seed + j × stride
@@ -117,7 +118,7 @@ def rq2(study: Study, scenario: str) -> dict:
     ran = run_experiment(study.root, [scenario], base, strategies=cfg.methods,
                          seeds=cfg.campaign_seeds, budget_s=cfg.budget_s, controls=0,
                          progress=study.say, workers=cfg.workers, plan=plan).get(scenario, {})
-    judge = Judge.of(study, scenario, g0s)
+    sets = judge(study, scenario, g0s)
     n = len(cfg.campaign_seeds)
     families = [DEFAULT_FAMILY] + sorted({methods()[m][1] for m in cfg.methods} - {DEFAULT_FAMILY})
     seeds_of = {f: g0s[:k] if f == DEFAULT_FAMILY else [
@@ -130,9 +131,9 @@ def rq2(study: Study, scenario: str) -> dict:
         if campaign.config.family != DEFAULT_FAMILY:
             starts.setdefault(campaign.config.family, campaign.g0)
     for f in families:
-        start = set_figures(study, judge, starts[f])
+        start = set_figures(study, sets, starts[f])
         rows[g0_label(f)] = {"versions": [[starts[f]]] * n, "figures": [start] * n}
-        per_seed = [set_figures(study, judge, v) for v in seeds_of[f]]
+        per_seed = [set_figures(study, sets, v) for v in seeds_of[f]]
         rows[g0_label(f, seeds=True)] = {"versions": [seeds_of[f]], "figures": per_seed,
                                          "unpaired": True}
     acquired = {(r["seed"], m): r for m, runs in ran.items() if isinstance(runs, list)
@@ -145,8 +146,7 @@ def rq2(study: Study, scenario: str) -> dict:
                                        "acquisition": []})
         row["campaigns"].append(campaign_id)
         row["versions"].append(versions)
-        row["figures"].append(mean_figures([set_figures(study, judge, v) for v in versions]))
+        row["figures"].append(mean_figures([set_figures(study, sets, v) for v in versions]))
         row["acquisition"].append(acquired.get((c.seed, method), {}).get("acquisition"))
-    labels = study.windows(scenario, "test").windows.label
     return {"campaign_seeds": list(cfg.campaign_seeds), "final_seeds": k, "g0": g0s[0],
-            "reseeded": g0s, "sets": judge.sizes(labels), "methods": rows}
+            "reseeded": g0s, "sets": sets.sizes(), "methods": rows}

@@ -20,6 +20,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from evoeye.evaluation.stats import compare_paired, mean_ci, pairs_needed
+from evoeye.evolve.campaign.assess import reached
 from evoeye.results.rq1 import FUSION_LABEL
 from evoeye.results.rq2 import G0, G0_SEEDS, g0_label
 
@@ -102,8 +103,7 @@ def values(row: dict, set_name: str, metric: str) -> np.ndarray:
 
 def unreachable(row: dict, set_name: str, metric: str) -> int:
     """Seeds of a row whose figure is undefined because its target FPR was unreachable."""
-    fpr = metric.partition("@")[2]
-    return sum(1 for f in row["figures"] if fpr and f[set_name].get(f"reachable@{fpr}") is False)
+    return sum(1 for f in row["figures"] if not reached(f[set_name], metric))
 
 
 def _row_cell(row: dict, set_name: str, metric: str) -> dict:

@@ -9,30 +9,17 @@ score with one intra-op thread, as campaigns do (`evoeye.monitor.threads`).
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
-from dataclasses import dataclass
+from collections.abc import Sequence
 
 import numpy as np
-import pyarrow as pa
 
-from evoeye.evaluation.dataset import narrow
-from evoeye.evaluation.monitors import BASELINES, check_scores, monitor_context_len
-from evoeye.evolve.campaign.assess import (
-    FPRS,
-    HARD_SET_FPR,
-    ensure_scored,
-    frame_mask,
-    hard_set,
-    metrics_dict,
-    robust_hard_set,
-)
-from evoeye.monitor.calibration import calibrate_on_validation
-from evoeye.monitor.families import FAMILIES, MonitorFamily, family_of, load_calibrated
+from evoeye.evaluation.harness import score_and_calibrate
+from evoeye.evaluation.monitors import BASELINES
+from evoeye.evolve.campaign.assess import FPRS, Assessor, metrics_dict
+from evoeye.monitor.families import FAMILIES, MonitorFamily, family_of
 from evoeye.monitor.protocol import Monitor
 from evoeye.monitor.threads import intra_op_threads
 from evoeye.results.study import Study
-from evoeye.store import Warehouse
-from evoeye.store.scores import read_scores
 
 
 def _exists(study: Study, family: MonitorFamily):
@@ -87,51 +74,20 @@ def test_figures(study: Study, scenario: str, monitor: Monitor) -> dict:
     @intra_op_threads()
     def evaluate() -> dict:
         study.say(f"{scenario}: evaluating {monitor.name} {monitor.version}")
-        L = monitor_context_len(monitor)
-        val, test = study.windows(scenario, "val"), study.windows(scenario, "test")
-        s_val = check_scores(monitor, monitor.score(narrow(val.windows, L)), len(val))
-        s_test = check_scores(monitor, monitor.score(narrow(test.windows, L)), len(test))
-        thr = calibrate_on_validation(s_val, val.windows, FPRS)
-        figures = metrics_dict(s_test, test.windows.label, thr)
-        figures.update({f"val_fpr@{f}": thr.realised_fpr[f] for f in FPRS})
+        test = study.windows(scenario, "test")
+        c = score_and_calibrate(monitor, study.windows(scenario, "val"), test, FPRS)
+        figures = metrics_dict(c.test, test.windows.label, c.thresholds)
+        figures.update({f"val_fpr@{f}": c.thresholds.realised_fpr[f] for f in FPRS})
         return {"test": figures}
 
     return study.ledger.remember("evaluate", inputs, evaluate)
 
 
-@dataclass(frozen=True)
-class Judge:
-    """RQ2's sets on one scenario's test split: the Test Set, the paper's Hard Set (G_0's misses)
-    and the robust Hard Set (misses of a majority of the re-seeded G_0s)."""
-
-    scenario: str
-    g0: str
-    reseeded: tuple[str, ...]  # the k G_0s of the robust Hard Set (G_0 first)
-    masks: Mapping[str, np.ndarray]  # set → (B,) bool over the test windows
-
-    @classmethod
-    @intra_op_threads()
-    def of(cls, study: Study, scenario: str, g0s: Sequence[str]) -> Judge:
-        """The sets of G_0 = g0s[0] and the robust set of all of `g0s`."""
-        w = study.windows(scenario, "test").windows
-        thresholds = {}
-        for version in g0s:
-            monitor = load_calibrated(study.root, version)
-            ensure_scored(study.root, monitor, scenario, narrow(w, monitor.context_len))
-            thresholds[version] = monitor.thresholds.at(HARD_SET_FPR)
-        scores = pa.concat_tables([read_scores(study.root, monitor_version=v) for v in g0s])
-        kw = {"logical_scenario": scenario, "horizon_s": study.config.horizon_s,
-              "splits": study.splits}
-        hard = hard_set(Warehouse(study.root), scores, monitor_version=g0s[0],
-                        threshold=thresholds[g0s[0]], **kw)
-        robust = robust_hard_set(Warehouse(study.root), scores, thresholds=thresholds, **kw)
-        masks = {"test": np.ones(len(w), bool), "hard": frame_mask(hard, w),
-                 "robust": frame_mask(robust, w)}
-        return cls(scenario, g0s[0], tuple(g0s), masks)
-
-    def sizes(self, labels: np.ndarray) -> dict[str, dict[str, int]]:
-        return {name: {"frames": int(m.sum()), "unsafe": int(labels[m].sum())}
-                for name, m in self.masks.items()}
+def judge(study: Study, scenario: str, g0s: Sequence[str]) -> Assessor:
+    """RQ2's sets on one scenario's test split: the Test Set, the paper's Hard Set of
+    G_0 = g0s[0] and the robust Hard Set of all of `g0s` (the re-seeded G_0s, G_0 first)."""
+    return Assessor(study.root, scenario, g0s[0], reseeded=g0s, splits=study.splits,
+                    horizon_s=study.config.horizon_s, test=study.windows(scenario, "test"))
 
 
 def set_metrics(scores: np.ndarray, labels: np.ndarray, thresholds) -> dict:
@@ -142,19 +98,10 @@ def set_metrics(scores: np.ndarray, labels: np.ndarray, thresholds) -> dict:
     return metrics_dict(scores, labels, thresholds)
 
 
-def set_figures(study: Study, judge: Judge, version: str) -> dict:
-    """A version's figures on the Test Set, the Hard Set and the robust Hard Set, at the
-    thresholds it was calibrated at when trained."""
-    inputs = {"version": version, **study.data_key(judge.scenario, "test"), "g0": judge.g0,
-              "reseeded": list(judge.reseeded)}
-
-    @intra_op_threads()
-    def assess() -> dict:
-        monitor = load_calibrated(study.root, version)
-        w = study.windows(judge.scenario, "test").windows
-        scores = check_scores(monitor, monitor.score(narrow(w, monitor.context_len)), len(w))
-        return {name: set_metrics(scores[m], w.label[m], monitor.thresholds)
-                for name, m in judge.masks.items()}
-
-    return study.ledger.remember("assess", inputs, assess,
+def set_figures(study: Study, sets: Assessor, version: str) -> dict:
+    """A version's figures on the Test Set, the Hard Set and the robust Hard Set (`judge`), at
+    the thresholds it was calibrated at when trained."""
+    inputs = {"version": version, **study.data_key(sets.scenario, "test"), "g0": sets.g0,
+              "reseeded": list(sets.reseeded)}
+    return study.ledger.remember("assess", inputs, lambda: sets.figures(version, set_metrics),
                                  valid=lambda _: _exists(study, family_of(version))(version))

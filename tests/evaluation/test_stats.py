@@ -17,6 +17,7 @@ from scipy import stats
 
 from evoeye.evaluation.stats import (
     compare_paired,
+    finite_mean,
     mean_ci,
     paired_power,
     pairs_needed,
@@ -31,6 +32,16 @@ def test_sample_sd_is_ddof_1_and_skips_undefined_values() -> None:
     assert sample_sd(values) == pytest.approx(math.sqrt(3 / 2) * np.std(values))  # 1.22× at n=3
     assert sample_sd([0.2, np.nan, 0.5, 0.3]) == pytest.approx(statistics.stdev(values))
     assert sample_sd([0.4]) is None and sample_sd([]) is None
+
+
+def test_finite_mean_skips_undefined_values_and_is_none_without_any() -> None:
+    import warnings
+
+    assert finite_mean([0.2, np.nan, 0.5, np.inf, 0.3]) == pytest.approx(1.0 / 3)
+    assert finite_mean([0.2, np.nan, 0.5]) == mean_ci([0.2, np.nan, 0.5]).mean
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # no 'Mean of empty slice'
+        assert finite_mean([np.nan, np.nan]) is None and finite_mean([]) is None
 
 
 def test_mean_ci_is_the_t_interval() -> None:

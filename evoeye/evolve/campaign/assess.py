@@ -8,19 +8,23 @@ fixed validation split when it was trained).
 
 The robust Hard Set (`robust_hard_set`, `warehouse/queries/robust_hard_set.sql`) holds the
 unsafe test frames a strict majority of k re-seeded G_0s miss, and every safe test frame: hard
-whatever G_0's training seed, and with false alarms paid on the whole Test Set.
+whatever G_0's training seed, and with false alarms paid on the whole Test Set. An `Assessor`
+given the re-seeded G_0s judges on it too (`evoeye results`); a campaign's does not.
 """
 
 from __future__ import annotations
 
+from collections.abc import Callable, Sequence
 from dataclasses import asdict
 
 import numpy as np
 import pyarrow as pa
 
-from evoeye.evaluation.dataset import SplitWindows, load_split
+from evoeye.evaluation.dataset import SplitWindows, load_split, narrow
 from evoeye.evaluation.metrics import frame_metrics
+from evoeye.evaluation.monitors import check_scores
 from evoeye.monitor.families import load_calibrated
+from evoeye.monitor.protocol import Thresholds
 from evoeye.monitor.threads import intra_op_threads
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse
@@ -31,6 +35,7 @@ from evoeye.store.windows import DEFAULT_HORIZON_S, Windows
 
 HARD_SET_FPR = 0.05
 FPRS = (0.05, 0.01)
+SetMetrics = Callable[[np.ndarray, np.ndarray, Thresholds], dict]  # (scores, labels, thr) → figures
 
 
 def _over_scores(warehouse: Warehouse, scores: pa.Table, name: str, splits: SplitSpec,
@@ -96,25 +101,44 @@ def metrics_dict(scores: np.ndarray, labels: np.ndarray, thresholds) -> dict:
     return out
 
 
+def reached(metrics: dict, metric: str) -> bool:
+    """Whether `metric` (a key of `metrics_dict`, e.g. "f1@0.05") was measured: False only
+    where its target FPR was unreachable; a metric of no FPR ("auroc") always was."""
+    fpr = metric.partition("@")[2]
+    return not fpr or metrics.get(f"reachable@{fpr}") is not False
+
+
 class Assessor:
-    """Scores monitor versions on the Test Set and the Hard Set of G_0 of one scenario."""
+    """Judges monitor versions on one scenario's Test Set and on subsets of it: the Hard Set of
+    G_0 and, given the re-seeded G_0s, the robust Hard Set."""
 
     @intra_op_threads()
     def __init__(self, root: DataRoot, scenario: str, g0: str, *,
+                 reseeded: Sequence[str] = (),
                  splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen)
-                 horizon_s: float = DEFAULT_HORIZON_S) -> None:
-        self.root = root
-        monitor = load_calibrated(self.root, g0)
-        self.test: SplitWindows = load_split(self.root, scenario, "test", splits,
-                                             context_len=monitor.context_len,
-                                             horizon_s=horizon_s)
+                 horizon_s: float = DEFAULT_HORIZON_S,
+                 test: SplitWindows | None = None) -> None:
+        """`reseeded`: the k G_0s of the robust Hard Set (G_0 first; none: no robust set).
+        `test`: the Test Set's windows at any L ≥ every judged version's (default: loaded at
+        G_0's L)."""
+        self.root, self.scenario, self.g0, self.reseeded = root, scenario, g0, tuple(reseeded)
+        g0s = {v: load_calibrated(root, v) for v in (g0, *self.reseeded)}
+        self.test: SplitWindows = test if test is not None else load_split(
+            root, scenario, "test", splits, context_len=g0s[g0].context_len, horizon_s=horizon_s)
         w = self.test.windows
-        ensure_scored(self.root, monitor, scenario, w)
-        hard = hard_set(Warehouse(self.root), read_scores(self.root, monitor_version=g0),
-                        monitor_version=g0, threshold=monitor.thresholds.at(HARD_SET_FPR),
-                        logical_scenario=scenario, horizon_s=horizon_s, splits=splits)
-        self.hard = frame_mask(hard, w)
-        self.context_len = monitor.context_len
+        for monitor in g0s.values():
+            ensure_scored(root, monitor, scenario, narrow(w, monitor.context_len))
+        thresholds = {v: m.thresholds.at(HARD_SET_FPR) for v, m in g0s.items()}
+        scores = pa.concat_tables([read_scores(root, monitor_version=v) for v in g0s])
+        kw = {"logical_scenario": scenario, "horizon_s": horizon_s, "splits": splits}
+        hard = hard_set(Warehouse(root), scores, monitor_version=g0, threshold=thresholds[g0],
+                        **kw)
+        self.masks: dict[str, np.ndarray] = {"test": np.ones(len(w), bool),  # set → (B,) bool
+                                             "hard": frame_mask(hard, w)}
+        if self.reseeded:
+            robust = robust_hard_set(Warehouse(root), scores, **kw, thresholds={
+                v: thresholds[v] for v in self.reseeded})
+            self.masks["robust"] = frame_mask(robust, w)
         self._assessed: dict[str, RoundMetrics] = {}  # a version never changes
 
     @classmethod
@@ -124,17 +148,24 @@ class Assessor:
         return cls(campaign.root, cfg.scenario, campaign.reference, splits=cfg.splits,
                    horizon_s=cfg.horizon_s)
 
+    def sizes(self) -> dict[str, dict[str, int]]:
+        """Frames and unsafe frames of every set."""
+        labels = self.test.windows.label
+        return {name: {"frames": int(m.sum()), "unsafe": int(labels[m].sum())}
+                for name, m in self.masks.items()}
+
     @intra_op_threads()
+    def figures(self, version: str, metrics: SetMetrics = metrics_dict) -> dict[str, dict]:
+        """{set: `metrics` of `version` on it}, at the version's own thresholds."""
+        monitor = load_calibrated(self.root, version)
+        w = self.test.windows
+        scores = check_scores(monitor, monitor.score(narrow(w, monitor.context_len)), len(w))
+        return {name: metrics(scores[m], w.label[m], monitor.thresholds)
+                for name, m in self.masks.items()}
+
     def __call__(self, version: str) -> RoundMetrics:
         """`version` on the Test Set and the Hard Set, at its own thresholds (once a version)."""
-        if version in self._assessed:
-            return self._assessed[version]
-        monitor = load_calibrated(self.root, version)
-        scores = monitor.score(self.test.windows)
-        labels = self.test.windows.label
-        self._assessed[version] = RoundMetrics(
-            version,
-            test=metrics_dict(scores, labels, monitor.thresholds),
-            hard=metrics_dict(scores[self.hard], labels[self.hard], monitor.thresholds),
-        )
+        if version not in self._assessed:
+            f = self.figures(version)
+            self._assessed[version] = RoundMetrics(version, test=f["test"], hard=f["hard"])
         return self._assessed[version]

@@ -16,8 +16,9 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.evaluation.plots import interval_chart, line_chart
-from evoeye.evaluation.report import UNREACHABLE, UNREACHABLE_NOTE
-from evoeye.evaluation.stats import mean_ci, sample_sd
+from evoeye.evaluation.report import DASH, UNREACHABLE, UNREACHABLE_NOTE
+from evoeye.evaluation.stats import finite_mean, mean_ci, sample_sd
+from evoeye.evolve.campaign.assess import reached
 from evoeye.evolve.campaign.experiment import ABLATION, MAIN, methods
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.paths import DataRoot
@@ -55,18 +56,21 @@ def _value(v: float | None) -> float:
 
 
 def _mean_std(values: list[float], reachable: Sequence[bool] | None = None) -> str:
-    """Mean ± sample SD (in %) of one figure over seeds; seeds whose target FPR was unreachable
-    are left out and counted ('n/r' if every seed's was)."""
+    """Mean ± sample SD (in %) of one figure's finite values over seeds ('–' if there is none);
+    seeds whose target FPR was unreachable are left out and counted ('n/r' if every seed's
+    was)."""
     a = np.asarray(values, float)
     if not len(a):
-        return "–"
+        return DASH
     ok = np.ones(len(a), bool) if reachable is None else np.asarray(reachable, bool)
     if not ok.any():
         return UNREACHABLE
     a = a[ok]
-    mean, sd = f"{100 * np.nanmean(a):.1f}", sample_sd(a)
-    # one seed has no spread to report: "± 0.0" would read as zero variance
-    cell = mean if sd is None else f"{mean} ± {100 * sd:.1f}"
+    mean, sd = finite_mean(a), sample_sd(a)
+    if mean is None:  # no seed's figure is defined, e.g. AUROC on a one-class set
+        cell = DASH
+    else:  # one seed has no spread to report: "± 0.0" would read as zero variance
+        cell = f"{100 * mean:.1f}" + ("" if sd is None else f" ± {100 * sd:.1f}")
     return cell if ok.all() else f"{cell} ({int((~ok).sum())}/{len(ok)} {UNREACHABLE})"
 
 
@@ -77,9 +81,7 @@ def _cells(per_seed: Sequence[dict]) -> list[str]:
     for split in ("test", "hard"):
         for col in COLUMNS:
             ms = [m[split] for m in per_seed]
-            fpr = col.partition("@")[2]
-            ok = [m.get(f"reachable@{fpr}", True) for m in ms] if fpr else None
-            cells.append(_mean_std([_value(m[col]) for m in ms], ok))
+            cells.append(_mean_std([_value(m[col]) for m in ms], [reached(m, col) for m in ms]))
     return cells
 
 
@@ -142,20 +144,15 @@ def markdown(results: dict) -> str:
     return "\n".join(out)
 
 
-def _finite_mean(values: list[float]) -> float:
-    """The mean of the finite values; NaN (a gap in the curve) when there is none, e.g. an F1
-    whose FPR no seed's thresholds reached."""
-    a = np.asarray(values, dtype=float)
-    return float(a[np.isfinite(a)].mean()) if np.isfinite(a).any() else float("nan")
-
-
 def _curves(res: dict, split: str, col: str) -> str:
     series = []
     by_method = {s: res[s] for s in ran(res)}
     n_max = max((len(r["rounds"]) for runs in by_method.values() for r in runs), default=1)
     for strategy, runs in by_method.items():
         n = min(len(r["rounds"]) for r in runs)
-        ys = [_finite_mean([_value(r["rounds"][i][split][col]) for r in runs])
+        # a round's point: the mean of its finite values; a gap (NaN) when none is, e.g. an
+        # F1 whose FPR no seed's thresholds reached
+        ys = [_value(finite_mean([_value(r["rounds"][i][split][col]) for r in runs]))
               for i in range(n)]
         series.append((strategy, [i / max(n_max - 1, 1) for i in range(n)], ys))
     return line_chart(series, title=f"{split} {col} per round", xlabel="round (0 … last)",

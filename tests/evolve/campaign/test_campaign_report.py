@@ -154,3 +154,52 @@ def test_a_round_in_one_line_shows_an_unreachable_f1_as_nr() -> None:
                      hard={"f1@0.05": 0.25, "reachable@0.05": True, "auprc": None})
     assert brief(m) == "test F1@0.05 n/r AUPRC 0.500 | hard F1@0.05 0.250"
     assert brief(None) == ""
+
+
+def test_a_figure_no_seed_defines_is_a_dash_without_a_warning() -> None:
+    import warnings
+
+    import numpy as np
+
+    def one_class(run: dict) -> dict:  # a Hard Set of one class: no AUROC, AUPRC for any seed
+        for r in run["rounds"]:
+            r["hard"] = {**r["hard"], "auroc": None, "auprc": None}
+        return run
+
+    res = {**RESULTS["highway-cut-in"],
+           "uniform": [one_class(_run([0.2, 0.3])), one_class(_run([0.2, 0.5]))]}
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # np.nanmean warned 'Mean of empty slice' here
+        rows = {r[0]: r for r in table_rows(res, ("uniform",))}
+        page = html({"highway-cut-in": res})
+    assert rows["uniform"][7:9] == ["–", "–"]  # hard AUROC, AUPRC: undefined, not "nan"
+    assert rows["uniform"][5] == "20.0 ± 7.1"  # hard F1@0.05 of 0.15 and 0.25: defined
+    assert "hard auprc per round" in page and "nan" not in rows["uniform"]
+    gap = acquisition_rows({"uniform": [{"acquisition": {
+        "runs": 3, "collision_share": 0.5, "near_miss_share": np.nan, "near_share": 0.0}}] * 2})
+    assert gap[0][3] == "–"  # near misses not recorded by any seed
+
+
+def _old_mean_std(values: list[float]) -> str:
+    """report._mean_std's cell (every seed reachable) before it took finite_mean: np.nanmean."""
+    import numpy as np
+
+    from evoeye.evaluation.stats import sample_sd
+
+    a = np.asarray(values, float)
+    mean, sd = f"{100 * np.nanmean(a):.1f}", sample_sd(a)
+    return mean if sd is None else f"{mean} ± {100 * sd:.1f}"
+
+
+def test_a_cell_with_a_finite_value_is_the_nanmean_one_it_was() -> None:
+    import numpy as np
+
+    from evoeye.evolve.campaign.report import _mean_std
+
+    rng = np.random.default_rng(7)
+    for n in range(1, 26):  # up to 25 seeds, some undefined (NaN), at least one defined
+        for _ in range(40):
+            values = rng.uniform(0, 1, n)
+            values[rng.uniform(size=n) < rng.uniform(0, 0.8)] = np.nan
+            values[rng.integers(n)] = rng.uniform(0, 1)
+            assert _mean_std(list(values)) == _old_mean_std(list(values)), values
