@@ -17,8 +17,15 @@ from pydantic import BaseModel, Field
 from evoeye.paths import DataRoot
 from evoeye.results.config import ResultsConfig
 from evoeye.results.markdown import findings_markdown
-from evoeye.results.run import PARTS, assemble, data_summary, write_results
-from evoeye.results.study import Study, prepare_data
+from evoeye.results.run import (
+    PARTS,
+    assemble,
+    part_study,
+    prepare_studies,
+    scenario_data,
+    write_results,
+)
+from evoeye.results.study import Study, monitor_study
 
 D = ResultsConfig()
 
@@ -33,6 +40,7 @@ class ResultsParams(BaseModel):
     campaign_seeds: int = Field(len(D.campaign_seeds), ge=2)
     final_seeds: int = Field(D.final_seeds, ge=1)
     initial_runs: int = Field(D.initial_runs, ge=0)
+    rq1_runs: int = Field(D.rq1_runs, ge=0)
     sim_seed: int = Field(D.sim_seed, ge=0)
     test_runs: int = Field(D.test_runs, ge=0)
     test_seed: int = Field(D.test_seed, ge=0)
@@ -67,13 +75,14 @@ class ResultsParams(BaseModel):
 
 @task(task_run_name="data")
 def data_task(root: DataRoot, config: ResultsConfig) -> None:
-    prepare_data(root, config, print)
+    prepare_studies(root, config, print)
 
 
 @task(task_run_name="{part}-{scenario}")
 def part_task(root: DataRoot, config: ResultsConfig, scenario: str, part: str) -> dict:
     """One part (rq1, ablation, rq2) of one logical scenario: its per-seed figures."""
-    return PARTS[part](Study(root, config, print), scenario)
+    study = Study(root, config, print)
+    return PARTS[part](part_study(study, monitor_study(study), part), scenario)
 
 
 @flow(name="evoeye-results", log_prints=True)
@@ -83,9 +92,10 @@ def results_flow(params: ResultsParams | None = None) -> dict[str, Any]:
     config, root = params.config(), DataRoot.resolve(params.root)
     data_task(root, config)
     study = Study(root, config)
+    monitors = monitor_study(study)
     scenarios = {}
     for scenario in config.scenarios:  # one after the other; a part's campaigns side by side
-        scenarios[scenario] = {"data": data_summary(study, scenario)}
+        scenarios[scenario] = scenario_data(study, monitors, scenario)
         for part in config.parts:
             scenarios[scenario][part] = part_task(root, config, scenario, part)
     results = assemble(study, scenarios)

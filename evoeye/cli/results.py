@@ -41,6 +41,11 @@ def results_command(
                     "uniform-seed<sim-seed> (0: use the warehouse's).")] = D.initial_runs,
     sim_seed: Annotated[int, typer.Option(min=0, help="Seed of the initial runs.")] =
         D.sim_seed,
+    rq1_runs: Annotated[int, typer.Option(
+        min=0, help="RQ1 and the monitor ablation train on at least this many initial runs per "
+                    "scenario: if --initial-runs is fewer (and not 0), on their own (same seed, "
+                    "same Test Set) under <root>/results/rq1-data; RQ2 keeps --initial-runs.")
+    ] = D.rq1_runs,
     test_runs: Annotated[int, typer.Option(
         min=0, help="Simulate (or resume) this many runs per scenario as the held-out Test Set "
                     "batch (0: none, or the --test-batch already there).")] = D.test_runs,
@@ -98,7 +103,8 @@ def results_command(
             scenarios=tuple(scenario or D.scenarios), parts=tuple(part or D.parts),
             training_seeds=tuple(range(training_seeds)),
             campaign_seeds=tuple(range(campaign_seeds)), final_seeds=final_seeds,
-            initial_runs=initial_runs, sim_seed=sim_seed, test_runs=test_runs,
+            initial_runs=initial_runs, sim_seed=sim_seed, rq1_runs=rq1_runs,
+            test_runs=test_runs,
             test_seed=test_seed, test_batch=test_batch, split_seed=split_seed,
             train_frac=train_frac, val_frac=val_frac, baselines=_csv(baselines),
             context_lens=tuple(context_len or D.context_lens),

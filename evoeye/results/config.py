@@ -16,11 +16,18 @@ Sizes, and why:
 * Test Set: a batch of 400 runs simulated apart at its own seed, at least 3× the paper's test
   runs (75 on S1, 132 on S2); with it, the initial runs split train : val = 0.8 : 0.2 (the
   paper's 6 h : 1.5 h), so the Test Set is that batch alone.
+* RQ1's data: RQ1 and the monitor ablation train on at least 1300 initial runs per scenario
+  (1040 train : 260 val), on a data root of their own when the study simulates fewer
+  (`evoeye.results.study.monitor_study`); RQ2 keeps the study's, its D_init. The
+  FusionMonitor learns S1's rare failures (cut-ins, early collisions) only from enough of them:
+  on a development seed its test AUPRC went 41 → 55 → 56 → 70 → 72 with 107, 209, 418, 836
+  and 1040 training runs (TTC-2D: 53), while RQ2 needs a small D_init for evolution to add to
+  and campaigns whose cost grows with it.
 """
 
 from __future__ import annotations
 
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, fields, replace
 
 SCENARIOS = ("highway-cut-in", "unprotected-intersection")  # evoeye.scenarios.SCENARIOS
 BASELINES = ("ttc", "ttc-2d", "rss", "rss-2s", "aem",
@@ -31,7 +38,9 @@ INPUTS = ("perception", "perception+prediction", "perception+prediction+planning
 METHODS = ("uniform", "avfuzzer", "evoeye", "no-feedback", "no-density",
            "aem-evo")  # evoeye.evolve.campaign.experiment MAIN + ABLATION
 PARTS = ("rq1", "ablation", "rq2")
+MONITOR_PARTS = ("rq1", "ablation")  # the parts that train on RQ1's data
 PAPER_TEST_RUNS = {"highway-cut-in": 75, "unprotected-intersection": 132}
+RQ1_RUNS = 1300  # initial runs RQ1 and the monitor ablation train on, at least (module doc)
 TEST_SHARES = (0.8, 0.2)  # train, val shares of the initial runs when a test batch is held out
 DEFAULT_SHARES = (0.5, 0.125)  # evoeye.splits.SplitSpec() (no test batch)
 
@@ -48,6 +57,7 @@ class ResultsConfig:
     # data: simulated (or resumed) first, then ingested; 0 runs: use what the warehouse holds
     initial_runs: int = 0  # round-0 runs per scenario, batch uniform-seed<sim_seed>
     sim_seed: int = 0
+    rq1_runs: int = RQ1_RUNS  # RQ1 and the ablation's initial runs, at least (`rq1_own_data`)
     test_runs: int = 400  # runs per scenario of the held-out Test Set batch
     test_seed: int = 1_000_000
     test_batch: str | None = None  # its name (default test-seed<test_seed> when test_runs > 0)
@@ -85,14 +95,18 @@ class ResultsConfig:
         unknown = set(self.parts) - set(PARTS)
         if unknown or not self.parts:
             raise ValueError(f"unknown part(s) {sorted(unknown)}; known: {list(PARTS)}")
-        for name, least in (("initial_runs", 0), ("test_runs", 0), ("n_round", 1),
-                            ("workers", 1)):
+        for name, least in (("initial_runs", 0), ("rq1_runs", 0), ("test_runs", 0),
+                            ("n_round", 1), ("workers", 1)):
             if getattr(self, name) < least:
                 raise ValueError(f"{name} must be >= {least}, got {getattr(self, name)}")
         if self.test_runs and self.test_seed == self.sim_seed:
             raise ValueError("the test batch needs its own seed: --test-seed equals --sim-seed")
         if min(self.training_seeds + self.campaign_seeds + (self.sim_seed, self.test_seed)) < 0:
             raise ValueError("seeds must be non-negative")
+        if self.rq1_own_data and not self.test_runs:
+            raise ValueError(f"RQ1's own {self.rq1_runs} initial runs need the Test Set "
+                             "simulated beside them (--test-runs > 0); or give --rq1-runs 0 to "
+                             "train RQ1 on the study's initial runs")
 
     def check_names(self) -> None:
         """ValueError naming any scenario, baseline, input set, method, update or feedback mode
@@ -120,6 +134,20 @@ class ResultsConfig:
         if self.test_batch:
             return self.test_batch
         return f"test-seed{self.test_seed}" if self.test_runs else None
+
+    @property
+    def rq1_own_data(self) -> bool:
+        """Whether RQ1 and the ablation run on initial runs of their own: they run, and the
+        study simulates fewer initial runs than `rq1_runs` (with `initial_runs` 0 every part
+        uses the warehouse's)."""
+        return (0 < self.initial_runs < self.rq1_runs
+                and bool(set(self.parts) & set(MONITOR_PARTS)))
+
+    def rq1_config(self) -> ResultsConfig:
+        """The config RQ1 and the ablation run on: this one, or with their own initial runs."""
+        if not self.rq1_own_data:
+            return self
+        return replace(self, initial_runs=self.rq1_runs, rq1_runs=0)
 
     @property
     def shares(self) -> tuple[float, float]:

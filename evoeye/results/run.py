@@ -1,6 +1,10 @@
 """`evoeye results` end to end: the data, RQ1, the monitor ablation and RQ2 of every scenario,
 then every table with its CIs, the findings, and the files.
 
+RQ1 and the monitor ablation run on `monitor_study` (the study itself, or one with more initial
+runs: `evoeye.results.study`), RQ2 on the study; each scenario's "data" holds the study's
+splits and, when RQ1 has its own, "rq1_data" RQ1's.
+
 Resumable and idempotent: the data batches resume, campaigns resume (the experiment API), and
 every training, evaluation and assessment is a ledger unit (`evoeye.results.ledger`), so a
 re-run does only what is new and writes the same results JSON. Files, under
@@ -13,18 +17,19 @@ from __future__ import annotations
 
 import json
 import shutil
+from collections import Counter
 from collections.abc import Callable
 from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from evoeye.paths import DataRoot
-from evoeye.results.config import PAPER_TEST_RUNS, ResultsConfig
+from evoeye.results.config import MONITOR_PARTS, PAPER_TEST_RUNS, ResultsConfig
 from evoeye.results.findings import check_findings
 from evoeye.results.html import results_html
 from evoeye.results.markdown import findings_markdown, part_markdown, splice_readme
 from evoeye.results.rq1 import ablation, rq1
 from evoeye.results.rq2 import rq2
-from evoeye.results.study import Progress, Study, prepare_data
+from evoeye.results.study import Progress, Study, monitor_study, prepare_data, share_logs
 from evoeye.results.tables import build_tables
 from evoeye.store import Warehouse
 
@@ -52,19 +57,46 @@ def data_summary(study: Study, scenario: str) -> dict:
             "paper_test_runs": PAPER_TEST_RUNS.get(scenario)}
 
 
+def prepare_studies(root: DataRoot, config: ResultsConfig,
+                    progress: Progress | None = None) -> tuple[Study, Study]:
+    """The study and the one RQ1 and the ablation run on (the same, or RQ1's own: its logs
+    linked from the study's first), their data prepared."""
+    study = Study(root, config, progress)
+    prepare_data(root, config, progress)
+    monitors = monitor_study(study)
+    if monitors is not study:
+        share_logs(root, monitors.root, monitors.config)
+        prepare_data(monitors.root, monitors.config, progress)
+    return study, monitors
+
+
+def part_study(study: Study, monitors: Study, part: str) -> Study:
+    """The study a part runs on: RQ1 and the ablation on `monitors`, RQ2 on `study`."""
+    return monitors if part in MONITOR_PARTS else study
+
+
+def scenario_data(study: Study, monitors: Study, scenario: str) -> dict:
+    """A scenario's "data" (the study's splits) and, if RQ1 has its own, "rq1_data"."""
+    data = {"data": data_summary(study, scenario)}
+    if monitors is not study:
+        data["rq1_data"] = data_summary(monitors, scenario)
+    return data
+
+
 def run_results(root: DataRoot, config: ResultsConfig,
                 progress: Progress | None = None) -> ResultsRun:
     """Prepare the data, run every part of every scenario, and assemble the results."""
-    study = Study(root, config, progress)
-    prepare_data(root, config, progress)
+    study, monitors = prepare_studies(root, config, progress)
     scenarios = {}
     for scenario in config.scenarios:
-        parts = {"data": data_summary(study, scenario)}
+        parts = scenario_data(study, monitors, scenario)
         for part in config.parts:
-            parts[part] = PARTS[part](study, scenario)
+            parts[part] = PARTS[part](part_study(study, monitors, part), scenario)
         scenarios[scenario] = parts
-    return ResultsRun(assemble(study, scenarios), dict(study.ledger.found),
-                      dict(study.ledger.computed))
+    ledgers = {id(s.ledger): s.ledger for s in (study, monitors)}.values()
+    return ResultsRun(assemble(study, scenarios),
+                      dict(sum((lg.found for lg in ledgers), Counter())),
+                      dict(sum((lg.computed for lg in ledgers), Counter())))
 
 
 def assemble(study: Study, scenarios: dict[str, dict]) -> dict:
@@ -76,25 +108,30 @@ def assemble(study: Study, scenarios: dict[str, dict]) -> dict:
     return json.loads(json.dumps(results, default=float))
 
 
-def _data_lines(results: dict) -> list[str]:
+def _data_lines(results: dict, key: str = "data") -> list[str]:
     out = ["| scenario | split | runs | violations | frames | unsafe frames |",
            "|---|---|---:|---:|---:|---:|"]
     for scenario, parts in results["scenarios"].items():
-        for split, s in parts["data"]["splits"].items():
+        for split, s in parts.get(key, parts["data"])["splits"].items():
             out.append(f"| {scenario} | {split} | {s['scenarios']} | {s['violations']} | "
                        f"{s['frames']:,} | {s['unsafe_frames']:,} |")
     return out
 
 
-def _intro(results: dict, what: str) -> str:
+def _intro(results: dict, what: str, data: str = "data") -> str:
+    """A part's intro: seeds, splits and the data it ran on (`data`: "data" or "rq1_data")."""
     cfg, splits = results["config"], results["splits"]
     test = (f"the held-out batch `{splits['test_batch']}`" if splits["test_batch"]
             else "the round-0 runs the split seed puts in test")
+    own = data != "data" and any(data in p for p in results["scenarios"].values())
+    runs = (f"RQ1's own {cfg['rq1_runs']} initial runs per scenario (RQ2's D_init: the "
+            f"study's round-0 train split)" if own else "the round-0 runs")
     lines = [f"Generated by `evoeye results` ({what}). Training seeds "
              f"{cfg['training_seeds']}; campaign seeds {cfg['campaign_seeds']}; each final "
              f"monitor judged by the mean over {cfg['final_seeds']} training seeds. Train and "
-             f"val: the round-0 runs (shares {splits['train_frac']} : {splits['val_frac']}, "
-             f"split seed {splits['seed']}); Test Set: {test}.", "", *_data_lines(results)]
+             f"val: {runs} (shares {splits['train_frac']} : {splits['val_frac']}, "
+             f"split seed {splits['seed']}); Test Set: {test}.", "",
+             *_data_lines(results, data)]
     return "\n".join(lines)
 
 
@@ -115,7 +152,7 @@ def markdown_files(results: dict) -> dict[str, str]:
                  + "\n".join(_set_lines(results)))
     return {
         "rq1.md": part_markdown("RQ1 and the monitor ablation",
-                                _intro(results, "RQ1 and the monitor ablation"),
+                                _intro(results, "RQ1 and the monitor ablation", "rq1_data"),
                                 results["tables"], ("rq1", "ablation")),
         "rq2.md": part_markdown("RQ2, the evolution ablation and AEM-Evo", rq2_intro,
                                 results["tables"], ("rq2", "evolution-ablation", "aem-evo")),

@@ -5,21 +5,31 @@ batch (`test-seed<test_seed>`, its own seed) are simulated or resumed (`run_batc
 on disk) and ingested (which adds only what is new). Every monitor then trains on the round-0
 train split only — runs acquired by campaigns are round >= 1 and would otherwise join it — is
 early-stopped and calibrated on the val split, and is judged on the test split.
+
+RQ1 and the monitor ablation train on at least `rq1_runs` initial runs (`ResultsConfig`). When
+the study has fewer, they run on a study of their own (`monitor_study`): the same config with
+`rq1_runs` initial runs, on a data root under `<root>/results/rq1-data/`, whose logs start as
+links to the study's — its initial runs (the first of the larger batch: `plan_uniform` draws
+the same runs for the same seed whatever their number) and its Test Set — so both judge on the
+same Test Set, while RQ2's D_init, G_0 and val split stay the study's.
 """
 
 from __future__ import annotations
 
 import hashlib
+import os
+import shutil
 from collections.abc import Callable
 from functools import cached_property
 
 from evoeye.evaluation.dataset import SplitWindows, load_split
-from evoeye.paths import DataRoot
+from evoeye.paths import LOG_SUFFIX, DataRoot
 from evoeye.results.config import ResultsConfig
 from evoeye.results.ledger import Ledger
 from evoeye.store import RunFilter, SplitSpec, Warehouse, select_runs
 
 Progress = Callable[[str], None]
+RQ1_DATA = ("results", "rq1-data")  # RQ1's own data root, under the study's root
 
 
 class EmptySplitError(ValueError):
@@ -115,3 +125,40 @@ def prepare_data(root: DataRoot, config: ResultsConfig, progress: Progress | Non
     say("ingesting new logs")
     ingest(root)
     return planned
+
+
+def monitor_study(study: Study) -> Study:
+    """The study RQ1 and the monitor ablation run on: `study`, or one with their own initial
+    runs on a data root under the study's (module doc)."""
+    config = study.config.rq1_config()
+    if config is study.config:
+        return study
+    return Study(DataRoot(study.root.path.joinpath(*RQ1_DATA)), config, study.say)
+
+
+def share_logs(source: DataRoot, target: DataRoot, config: ResultsConfig) -> int:
+    """Link (or copy, across devices) into `target` the logs of `source` that `target` needs:
+    those of its initial runs the source has, and every log of the Test Set batch, so both
+    judge on the same runs and nothing is simulated twice; the number of logs linked. Logs are
+    written once and never changed, so a link is a copy."""
+    from evoeye.batch import plan_uniform
+
+    linked = 0
+    for scenario in config.scenarios:
+        initial = f"uniform-seed{config.sim_seed}"
+        wanted = [source.run_log(scenario, initial, spec.scenario_id) for spec in
+                  plan_uniform(scenario, config.initial_runs, config.sim_seed, batch=initial)
+                  ] if config.initial_runs else []
+        if config.held_out_batch:
+            wanted += sorted(source.batch_dir(scenario, config.held_out_batch)
+                             .glob(f"*{LOG_SUFFIX}"))
+        for src in wanted:
+            dst = target.path / src.relative_to(source.path)
+            if src.is_file() and not dst.exists():
+                dst.parent.mkdir(parents=True, exist_ok=True)
+                try:
+                    os.link(src, dst)
+                except OSError:
+                    shutil.copy2(src, dst)
+                linked += 1
+    return linked

@@ -53,10 +53,27 @@ def test_the_defaults_are_the_issues_sizes() -> None:
     ({"parts": ("rq1", "rq4")}, r"unknown part\(s\) \['rq4'\]"),
     ({"test_seed": 0}, "its own seed"),
     ({"n_round": 0}, "n_round must be >= 1"),
+    ({"rq1_runs": -1}, "rq1_runs must be >= 0"),
+    ({"initial_runs": 260, "test_runs": 0}, "need the Test Set simulated beside them"),
 ])
 def test_bad_sizes_are_refused(kwargs: dict, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         ResultsConfig(**kwargs)
+
+
+def test_rq1_gets_initial_runs_of_its_own_only_when_the_study_simulates_fewer() -> None:
+    small = ResultsConfig(initial_runs=260)
+    assert small.rq1_runs == config.RQ1_RUNS and small.rq1_own_data
+    own = small.rq1_config()
+    assert (own.initial_runs, own.rq1_runs, own.rq1_own_data) == (config.RQ1_RUNS, 0, False)
+    assert own.sim_seed == small.sim_seed and own.held_out_batch == small.held_out_batch
+    assert own.shares == small.shares and own.training_seeds == small.training_seeds
+    for same in (ResultsConfig(initial_runs=config.RQ1_RUNS),  # already enough
+                 ResultsConfig(initial_runs=260, rq1_runs=0),  # asked for the study's
+                 ResultsConfig(test_runs=0, test_batch="held"),  # the warehouse's runs
+                 ResultsConfig(initial_runs=260, parts=("rq2",), test_runs=0)):  # no RQ1
+        assert not same.rq1_own_data and same.rq1_config() is same
+    assert ResultsConfig(initial_runs=260, parts=("ablation",)).rq1_own_data
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [
