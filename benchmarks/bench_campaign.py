@@ -19,6 +19,7 @@ import os
 import shutil
 import tempfile
 import time
+from collections.abc import Mapping
 from pathlib import Path
 
 from benchmarks.machine import describe
@@ -36,13 +37,16 @@ from evoeye.store.feedback import read_rounds
 TARGET = 1.5
 
 
-def seed_root(path: Path, scenarios: list[str], runs: int, splits: SplitSpec) -> DataRoot:
-    """A data root with `runs` uniform runs per scenario, ingested, and a G_0 for each."""
+def seed_root(path: Path, scenarios: list[str], runs: int | Mapping[str, int],
+              splits: SplitSpec) -> DataRoot:
+    """A data root with `runs` uniform runs per scenario (or `runs[scenario]`), ingested, and a
+    G_0 for each."""
     from evoeye.monitor import train_monitor
 
     root = DataRoot.resolve(path)
     for scenario in scenarios:
-        run_batch(plan_uniform(scenario, runs, seed=11), root, workers=1)
+        n = runs if isinstance(runs, int) else runs[scenario]
+        run_batch(plan_uniform(scenario, n, seed=11), root, workers=1)
     ingest(root)
     for scenario in scenarios:
         train_monitor(root, scenario, seed=0, splits=splits, epochs=5)

@@ -11,7 +11,9 @@ With `--project N`, the slice is taken to be N campaigns of the full protocol (2
 budget, the initial data's simulated time) and its wall time on the largest local worker count
 is scaled to the whole: the slice must hold every (scenario, method) alike (e.g. 2 seeds: 20
 campaigns, 1/10). Without `--root`, `--runs` uniform runs per scenario are simulated, ingested
-and a G_0 trained in a temporary folder first (a small stand-in for the paper's data).
+and a G_0 trained in a temporary folder first (a small stand-in for the paper's data); with
+`--paper-data`, the paper's initial data instead: its train + validation runs per scenario (S1
+107 + 25, S2 177 + 45, split 0.8 : 0.2), so that a campaign's budget is the paper's.
 """
 
 from __future__ import annotations
@@ -33,6 +35,7 @@ from evoeye.store.feedback import read_rounds
 TARGET = 1.8
 TRIM_KEY = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 FULL_PROTOCOL = 2 * 5 * 20  # scenarios × methods × seeds
+PAPER_INITIAL_RUNS = {"highway-cut-in": 107 + 25, "unprotected-intersection": 177 + 45}
 
 
 def timed_experiment(root: DataRoot, args: argparse.Namespace, splits: SplitSpec,
@@ -76,6 +79,8 @@ def main() -> None:
     ap.add_argument("--project", type=int, help="the slice is this many campaigns of the "
                     f"full protocol ({FULL_PROTOCOL})")
     ap.add_argument("--runs", type=int, default=40, help="initial runs without --root")
+    ap.add_argument("--paper-data", action="store_true", help="without --root: the paper's "
+                    "initial runs per scenario (train + val), split 0.8 : 0.2")
     ap.add_argument("--train-frac", type=float, default=0.5, help="split of the initial runs "
                     "(with --root: as they were split when its G_0 was trained)")
     ap.add_argument("--val-frac", type=float, default=0.25)
@@ -86,6 +91,8 @@ def main() -> None:
     print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}")
     print(f"{n_campaigns} campaigns: {args.scenario} × {args.strategy} × seeds {args.seeds}, "
           f"budget {args.budget_s or 'the initial data'}, N_round {args.n_round}\n")
+    if args.paper_data:
+        args.runs, args.train_frac, args.val_frac = PAPER_INITIAL_RUNS, 0.8, 0.2
     splits = SplitSpec(seed=0, train_frac=args.train_frac, val_frac=args.val_frac)
     runs: dict[tuple[str, int], tuple[float, list]] = {}
     with tempfile.TemporaryDirectory(prefix="bench-experiment-") as tmp:
