@@ -29,13 +29,13 @@ from benchmarks.machine import describe
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.experiment import run_experiment
 from evoeye.paths import DataRoot
+from evoeye.results.config import PAPER_INITIAL_RUNS
 from evoeye.store import SplitSpec
 from evoeye.store.feedback import read_rounds
 
 TARGET = 1.8
 TRIM_KEY = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 FULL_PROTOCOL = 2 * 5 * 20  # scenarios × methods × seeds
-PAPER_INITIAL_RUNS = {"highway-cut-in": 107 + 25, "unprotected-intersection": 177 + 45}
 
 
 def timed_experiment(root: DataRoot, args: argparse.Namespace, splits: SplitSpec,

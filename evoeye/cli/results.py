@@ -10,7 +10,12 @@ import typer
 from evoeye.cli.app import app
 from evoeye.cli.output import StepBar
 from evoeye.paths import DataRoot
-from evoeye.results.config import PARTS, ResultsConfig
+from evoeye.results.config import (
+    PAPER_INITIAL_RUNS,
+    PARTS,
+    ResultsConfig,
+    parse_initial_runs,
+)
 
 D = ResultsConfig()  # the defaults --help shows (config.py imports nothing heavy)
 
@@ -28,7 +33,8 @@ def results_command(
     part: Annotated[list[str] | None, typer.Option(
         "--part", help=f"Run only these parts (repeatable): {', '.join(PARTS)}.")] = None,
     training_seeds: Annotated[int, typer.Option(
-        min=2, help="Training seeds 0 … N−1 (RQ1, the ablation, the re-seeded G_0s).")] =
+        min=2, help="Training seeds 0 … N−1 (RQ1, the ablation; the first k are RQ2's "
+                    "re-seeded G_0s).")] =
         len(D.training_seeds),
     campaign_seeds: Annotated[int, typer.Option(
         min=2, help="Campaign seeds 0 … N−1, paired across the RQ2 methods.")] =
@@ -36,9 +42,12 @@ def results_command(
     final_seeds: Annotated[int, typer.Option(
         min=1, help="k: a campaign's final monitor is judged by the mean over k training "
                     "seeds of its last update.")] = D.final_seeds,
-    initial_runs: Annotated[int, typer.Option(
-        min=0, help="Simulate (or resume) this many initial runs per scenario, batch "
-                    "uniform-seed<sim-seed> (0: use the warehouse's).")] = D.initial_runs,
+    initial_runs: Annotated[list[str] | None, typer.Option(
+        help="Simulate (or resume) this many initial runs per scenario, batch "
+             "uniform-seed<sim-seed> (0: use the warehouse's): N for every scenario, "
+             "SCENARIO=N for one, or 'paper' for the paper's "
+             f"({', '.join(f'{n} on {s}' for s, n in PAPER_INITIAL_RUNS.items())}); "
+             "repeatable.  [default: 0]")] = None,
     sim_seed: Annotated[int, typer.Option(min=0, help="Seed of the initial runs.")] =
         D.sim_seed,
     rq1_runs: Annotated[int, typer.Option(
@@ -99,11 +108,12 @@ def results_command(
     from evoeye.results.run import run_results, write_results
 
     try:
+        runs = parse_initial_runs(initial_runs or [])
         config = ResultsConfig(
             scenarios=tuple(scenario or D.scenarios), parts=tuple(part or D.parts),
             training_seeds=tuple(range(training_seeds)),
             campaign_seeds=tuple(range(campaign_seeds)), final_seeds=final_seeds,
-            initial_runs=initial_runs, sim_seed=sim_seed, rq1_runs=rq1_runs,
+            initial_runs=runs, sim_seed=sim_seed, rq1_runs=rq1_runs,
             test_runs=test_runs,
             test_seed=test_seed, test_batch=test_batch, split_seed=split_seed,
             train_frac=train_frac, val_frac=val_frac, baselines=_csv(baselines),
@@ -114,7 +124,8 @@ def results_command(
         config.check_names()
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from None
-    data = DataRoot.resolve(root) if initial_runs or test_runs else DataRoot.existing(root)
+    simulates = any(map(config.runs_of, config.scenarios)) or test_runs
+    data = DataRoot.resolve(root) if simulates else DataRoot.existing(root)
     with StepBar("results") as bar:
         run = run_results(data, config, progress=bar)
     folder = write_results(data, run.results, name, docs=docs, readme=readme)

@@ -5,7 +5,7 @@ come from elsewhere are literals checked against their sources by tests/results/
 
 Sizes, and why:
 
-* Training seeds (RQ1, the monitor ablation, the k re-seeded G_0s of the robust Hard Set): 6.
+* Training seeds (RQ1, the monitor ablation; the first k are RQ2's re-seeded G_0s): 6.
   The issue asks for at least 5, but 5 pairs can never give a Wilcoxon p below 2 / 2^5 = 0.0625;
   6 can reach 0.031.
 * Campaign seeds (RQ2 and the evolution ablations, paired across methods): 20, inside the 16–25
@@ -27,6 +27,7 @@ Sizes, and why:
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, fields, replace
 
 SCENARIOS = ("highway-cut-in", "unprotected-intersection")  # evoeye.scenarios.SCENARIOS
@@ -40,9 +41,38 @@ METHODS = ("uniform", "avfuzzer", "evoeye", "no-feedback", "no-density",
 PARTS = ("rq1", "ablation", "rq2")
 MONITOR_PARTS = ("rq1", "ablation")  # the parts that train on RQ1's data
 PAPER_TEST_RUNS = {"highway-cut-in": 75, "unprotected-intersection": 132}
+# the paper's initial data: its train + validation runs per scenario (split 0.8 : 0.2)
+PAPER_INITIAL_RUNS = {"highway-cut-in": 107 + 25, "unprotected-intersection": 177 + 45}
 RQ1_RUNS = 1300  # initial runs RQ1 and the monitor ablation train on, at least (module doc)
 TEST_SHARES = (0.8, 0.2)  # train, val shares of the initial runs when a test batch is held out
 DEFAULT_SHARES = (0.5, 0.125)  # evoeye.splits.SplitSpec() (no test batch)
+
+
+def parse_initial_runs(values: list[str]) -> int | dict[str, int]:
+    """`--initial-runs` as given: "N" (every scenario), "SCENARIO=N" (that one; later wins) or
+    "paper" (the paper's per scenario, `PAPER_INITIAL_RUNS`), repeatable; ValueError naming a
+    value that is none of these."""
+    every, per = 0, {}
+    for value in values:
+        scenario, sep, count = value.rpartition("=")
+        if not sep and count == "paper":
+            per.update(PAPER_INITIAL_RUNS)
+            continue
+        try:
+            n = int(count)
+        except ValueError:
+            n = -1
+        if n < 0 or (sep and not scenario):
+            raise ValueError(f"--initial-runs {value!r}: give N, SCENARIO=N or 'paper' "
+                             "(N a whole number >= 0)")
+        if sep and scenario not in SCENARIOS:
+            raise ValueError(f"--initial-runs {value!r}: unknown scenario {scenario!r}; known: "
+                             f"{list(SCENARIOS)}")
+        if sep:
+            per[scenario] = n
+        else:
+            every, per = n, {}
+    return {**dict.fromkeys(SCENARIOS, every), **per} if per else every
 
 
 @dataclass(frozen=True)
@@ -55,7 +85,8 @@ class ResultsConfig:
     final_seeds: int = 3  # k: a final monitor is judged by the mean over k training seeds
     parts: tuple[str, ...] = PARTS
     # data: simulated (or resumed) first, then ingested; 0 runs: use what the warehouse holds
-    initial_runs: int = 0  # round-0 runs per scenario, batch uniform-seed<sim_seed>
+    # round-0 runs, batch uniform-seed<sim_seed>: one count for every scenario, or per scenario
+    initial_runs: int | Mapping[str, int] = 0
     sim_seed: int = 0
     rq1_runs: int = RQ1_RUNS  # RQ1 and the ablation's initial runs, at least (`rq1_own_data`)
     test_runs: int = 400  # runs per scenario of the held-out Test Set batch
@@ -85,6 +116,13 @@ class ResultsConfig:
             object.__setattr__(self, name, tuple(getattr(self, name)))
         if not self.scenarios:
             raise ValueError("give at least one logical scenario")
+        if isinstance(self.initial_runs, Mapping):
+            runs = dict(self.initial_runs)
+            if unknown_runs := sorted(set(runs) - set(SCENARIOS)):
+                raise ValueError(f"initial runs given for unknown scenario(s) {unknown_runs}; "
+                                 f"known: {list(SCENARIOS)}")
+            object.__setattr__(self, "initial_runs",
+                               {s: int(runs.get(s, 0)) for s in self.scenarios})
         for name in ("training_seeds", "campaign_seeds"):  # pairs need two seeds at least
             seeds = getattr(self, name)
             if len(seeds) < 2 or len(set(seeds)) != len(seeds):
@@ -95,14 +133,18 @@ class ResultsConfig:
         unknown = set(self.parts) - set(PARTS)
         if unknown or not self.parts:
             raise ValueError(f"unknown part(s) {sorted(unknown)}; known: {list(PARTS)}")
-        for name, least in (("initial_runs", 0), ("rq1_runs", 0), ("test_runs", 0),
-                            ("n_round", 1), ("workers", 1)):
+        for name, least in (("rq1_runs", 0), ("test_runs", 0), ("n_round", 1), ("workers", 1)):
             if getattr(self, name) < least:
                 raise ValueError(f"{name} must be >= {least}, got {getattr(self, name)}")
+        if bad := {s: n for s in self.scenarios if (n := self.runs_of(s)) < 0}:
+            raise ValueError(f"initial runs must be >= 0, got {bad}")
         if self.test_runs and self.test_seed == self.sim_seed:
             raise ValueError("the test batch needs its own seed: --test-seed equals --sim-seed")
         if min(self.training_seeds + self.campaign_seeds + (self.sim_seed, self.test_seed)) < 0:
             raise ValueError("seeds must be non-negative")
+        if self.rq1_own_data and not all(map(self.runs_of, self.scenarios)):
+            raise ValueError("RQ1's own initial runs start from the study's: give every "
+                             "scenario initial runs, or none (0: the warehouse's)")
         if self.rq1_own_data and not self.test_runs:
             raise ValueError(f"RQ1's own {self.rq1_runs} initial runs need the Test Set "
                              "simulated beside them (--test-runs > 0); or give --rq1-runs 0 to "
@@ -135,19 +177,31 @@ class ResultsConfig:
             return self.test_batch
         return f"test-seed{self.test_seed}" if self.test_runs else None
 
+    def runs_of(self, scenario: str) -> int:
+        """The initial runs to simulate (or resume) of a scenario (0: the warehouse's)."""
+        if isinstance(self.initial_runs, Mapping):
+            return self.initial_runs.get(scenario, 0)
+        return self.initial_runs
+
     @property
     def rq1_own_data(self) -> bool:
         """Whether RQ1 and the ablation run on initial runs of their own: they run, and the
-        study simulates fewer initial runs than `rq1_runs` (with `initial_runs` 0 every part
-        uses the warehouse's)."""
-        return (0 < self.initial_runs < self.rq1_runs
+        study simulates fewer initial runs than `rq1_runs` of some scenario (with initial runs
+        0 every part uses the warehouse's)."""
+        return (any(0 < self.runs_of(s) < self.rq1_runs for s in self.scenarios)
                 and bool(set(self.parts) & set(MONITOR_PARTS)))
 
     def rq1_config(self) -> ResultsConfig:
-        """The config RQ1 and the ablation run on: this one, or with their own initial runs."""
+        """The config RQ1 and the ablation run on: this one, or with their own initial runs
+        (at least `rq1_runs` of every scenario)."""
         if not self.rq1_own_data:
             return self
-        return replace(self, initial_runs=self.rq1_runs, rq1_runs=0)
+        if isinstance(self.initial_runs, Mapping):
+            runs: int | dict[str, int] = {s: max(n, self.rq1_runs)
+                                          for s, n in self.initial_runs.items()}
+        else:
+            runs = max(self.initial_runs, self.rq1_runs)
+        return replace(self, initial_runs=runs, rq1_runs=0)
 
     @property
     def shares(self) -> tuple[float, float]:

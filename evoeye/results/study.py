@@ -112,9 +112,8 @@ def prepare_data(root: DataRoot, config: ResultsConfig, progress: Progress | Non
     planned: dict[str, dict[str, int]] = {}
     for scenario in config.scenarios:
         batches = []
-        if config.initial_runs:
-            batches.append((f"uniform-seed{config.sim_seed}", config.initial_runs,
-                            config.sim_seed))
+        if runs := config.runs_of(scenario):
+            batches.append((f"uniform-seed{config.sim_seed}", runs, config.sim_seed))
         if config.test_runs:
             batches.append((config.held_out_batch, config.test_runs, config.test_seed))
         for batch, n, seed in batches:
@@ -146,9 +145,9 @@ def share_logs(source: DataRoot, target: DataRoot, config: ResultsConfig) -> int
     linked = 0
     for scenario in config.scenarios:
         initial = f"uniform-seed{config.sim_seed}"
+        runs = config.runs_of(scenario)
         wanted = [source.run_log(scenario, initial, spec.scenario_id) for spec in
-                  plan_uniform(scenario, config.initial_runs, config.sim_seed, batch=initial)
-                  ] if config.initial_runs else []
+                  plan_uniform(scenario, runs, config.sim_seed, batch=initial)] if runs else []
         if config.held_out_batch:
             wanted += sorted(source.batch_dir(scenario, config.held_out_batch)
                              .glob(f"*{LOG_SUFFIX}"))

@@ -85,7 +85,7 @@ def test_figures(study: Study, scenario: str, monitor: Monitor) -> dict:
 
 def judge(study: Study, scenario: str, g0s: Sequence[str]) -> Assessor:
     """RQ2's sets on one scenario's test split: the Test Set, the paper's Hard Set of
-    G_0 = g0s[0] and the robust Hard Set of all of `g0s` (the re-seeded G_0s, G_0 first)."""
+    G_0 = g0s[0] and the robust Hard Set of all of `g0s` (the k re-seeded G_0s, G_0 first)."""
     return Assessor(study.root, scenario, g0s[0], reseeded=g0s, splits=study.splits,
                     horizon_s=study.config.horizon_s, test=study.windows(scenario, "test"))
 

@@ -1,4 +1,4 @@
-"""`evoeye results` end to end on a tiny root (2 training seeds, 2 campaign seeds, one-run
+"""`evoeye results` end to end on a tiny root (3 training seeds, 2 campaign seeds, one-run
 campaigns over 2 worker processes): every table carries CIs and p-values computed from the
 per-seed figures, and a re-run redoes nothing."""
 
@@ -28,11 +28,13 @@ pytestmark = pytest.mark.slow
 RUNNER = CliRunner()
 SCENARIO = "highway-cut-in"
 METHODS = ("uniform", "evoeye", "no-feedback", "aem-evo")  # a row in every RQ2 table
+TRAINING_SEEDS, CAMPAIGN_SEEDS = 3, 2  # k = 2 final seeds: fewer than the training seeds
 
 
 def _args(root: DataRoot, docs: Path, readme: Path) -> list[str]:
     args = ["results", "--root", str(root.path), "--scenario", SCENARIO, "--training-seeds",
-            "2", "--campaign-seeds", "2", "--final-seeds", "2", "--test-runs", "0",
+            str(TRAINING_SEEDS), "--campaign-seeds", str(CAMPAIGN_SEEDS), "--final-seeds", "2",
+            "--test-runs", "0",
             "--test-batch", "held", "--epochs", "1", "--patience", "1", "--budget-s", "20",
             "--n-round", "1", "--context-len", "1", "--context-len", "5", "--inputs",
             "perception", "--inputs", "all", "--name", "tiny", "--docs", str(docs),
@@ -96,7 +98,8 @@ def test_every_table_is_made_with_a_ci_and_p_for_every_comparison(done) -> None:
         for comparison in table["comparisons"]:
             for cell in comparison["cells"].values():
                 if cell["n"]:  # a figure undefined for a seed leaves that pair out
-                    assert cell["p_value"] is not None and cell["n"] == 2
+                    pairs = TRAINING_SEEDS if table["id"] in ("rq1", "ablation") else CAMPAIGN_SEEDS
+                    assert cell["p_value"] is not None and cell["n"] == pairs
             row = f"| {comparison['a']} − {comparison['b']} |"
             assert row in text, row
     assert "p=" in text and "[95 % CI]" in text
@@ -125,8 +128,9 @@ def test_a_comparison_recomputed_with_scipy_is_the_one_in_the_table(done) -> Non
     line = next(x for x in (done.folder / "rq1.md").read_text().splitlines()
                 if x.startswith("| FusionMonitor − aem |"))
     assert line.split(" | ")[3] == expected  # F1@0.05, F1@0.01, AUROC
-    # the row's Student-t interval over the two training seeds
-    low, high = stats.t.interval(0.95, 1, loc=fusion.mean(), scale=stats.sem(fusion))
+    # the row's Student-t interval over the training seeds
+    low, high = stats.t.interval(0.95, len(fusion) - 1, loc=fusion.mean(),
+                                 scale=stats.sem(fusion))
     row = next(x for x in (done.folder / "rq1.md").read_text().splitlines()
                if x.startswith("| FusionMonitor |"))
     pct = lambda x: f"{100 * x:.1f}".replace("-", "−")  # noqa: E731
@@ -153,13 +157,17 @@ def test_each_final_monitor_is_the_mean_over_k_training_seeds(done) -> None:
             last = read_rounds(done.root, campaign)[-1]
             assert last.round == 1 and versions[0] == last.monitor_version
             assert len(set(versions)) == 2  # the last update again, with another seed
+    # the robust Hard Set's re-seeded G_0s: G_0's recipe with the first k of the 3 training
+    # seeds, which here (RQ1 on the study's data) are RQ1's FusionMonitors of those seeds
+    fusion = done.results["scenarios"][SCENARIO]["rq1"]["methods"]["FusionMonitor"]
+    assert rq2["reseeded"] == fusion["versions"][:2] and rq2["g0"] == fusion["versions"][0]
     sets = rq2["sets"]
     assert sets["test"]["frames"] > sets["robust"]["frames"] and sets["robust"]["unsafe"] > 0
     assert sets["hard"]["unsafe"] <= sets["test"]["unsafe"]
 
 
 def test_the_campaigns_ran_side_by_side_on_the_held_out_test_set(done) -> None:
-    campaigns = len(METHODS) * 2  # campaign seeds
+    campaigns = len(METHODS) * CAMPAIGN_SEEDS
     # each reported by the worker pool once it ended (a campaign run in-process is not)
     assert done.first.output.count("1 round(s) run, budget spent") == campaigns
     assert done.second.output.count("0 round(s) run, budget spent") == campaigns

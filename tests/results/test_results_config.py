@@ -9,7 +9,9 @@ import sys
 import pytest
 
 from evoeye.results import config
-from evoeye.results.config import ResultsConfig
+from evoeye.results.config import PAPER_INITIAL_RUNS, ResultsConfig, parse_initial_runs
+
+S1, S2 = config.SCENARIOS
 
 
 def test_the_literal_defaults_are_their_sources() -> None:
@@ -55,6 +57,9 @@ def test_the_defaults_are_the_issues_sizes() -> None:
     ({"n_round": 0}, "n_round must be >= 1"),
     ({"rq1_runs": -1}, "rq1_runs must be >= 0"),
     ({"initial_runs": 260, "test_runs": 0}, "need the Test Set simulated beside them"),
+    ({"initial_runs": {S1: -1}}, r"initial runs must be >= 0, got \{'highway-cut-in': -1\}"),
+    ({"initial_runs": {"roundabout": 5}}, r"unknown scenario\(s\) \['roundabout'\]"),
+    ({"initial_runs": {S1: 132}}, "give every scenario initial runs, or none"),
 ])
 def test_bad_sizes_are_refused(kwargs: dict, message: str) -> None:
     with pytest.raises(ValueError, match=message):
@@ -74,6 +79,48 @@ def test_rq1_gets_initial_runs_of_its_own_only_when_the_study_simulates_fewer() 
                  ResultsConfig(initial_runs=260, parts=("rq2",), test_runs=0)):  # no RQ1
         assert not same.rq1_own_data and same.rq1_config() is same
     assert ResultsConfig(initial_runs=260, parts=("ablation",)).rq1_own_data
+
+
+@pytest.mark.parametrize(("values", "runs"), [
+    ([], 0),
+    (["260"], 260),
+    (["paper"], PAPER_INITIAL_RUNS),
+    ([f"{S2}=222"], {S1: 0, S2: 222}),
+    (["100", f"{S2}=222"], {S1: 100, S2: 222}),
+    (["paper", f"{S1}=7"], {S1: 7, S2: PAPER_INITIAL_RUNS[S2]}),
+    ([f"{S1}=7", "50"], 50),  # a count for every scenario after a per-scenario one: it wins
+])
+def test_initial_runs_are_one_count_or_per_scenario(values: list[str], runs) -> None:
+    assert parse_initial_runs(values) == runs
+
+
+@pytest.mark.parametrize("value", ["-3", "many", "=5", f"{S1}=", f"{S1}=-1", "paper=3"])
+def test_a_bad_initial_runs_value_is_named(value: str) -> None:
+    with pytest.raises(ValueError, match=f"--initial-runs '{value}'"):
+        parse_initial_runs([value])
+
+
+def test_the_command_names_a_bad_initial_runs_value_before_it_runs(tmp_path) -> None:
+    from typer.testing import CliRunner
+
+    import evoeye.cli.results  # noqa: F401  (registers the command)
+    from evoeye.cli import app
+
+    done = CliRunner().invoke(app, ["results", "--root", str(tmp_path / "r"), "--initial-runs",
+                                    "paper", "--initial-runs", "highway=5"])
+    assert done.exit_code == 2 and "unknown scenario 'highway'" in done.output
+    assert not (tmp_path / "r").exists()  # nothing created
+
+
+def test_per_scenario_initial_runs_reach_each_scenario_and_rq1s_own_data() -> None:
+    cfg = ResultsConfig(initial_runs=PAPER_INITIAL_RUNS)
+    assert [cfg.runs_of(s) for s in config.SCENARIOS] == [132, 222] and cfg.rq1_own_data
+    assert cfg.rq1_config().initial_runs == {S1: config.RQ1_RUNS, S2: config.RQ1_RUNS}
+    mixed = ResultsConfig(initial_runs={S1: 132, S2: 2000})  # S2 has enough: it keeps its own
+    assert mixed.rq1_config().initial_runs == {S1: config.RQ1_RUNS, S2: 2000}
+    one = ResultsConfig(scenarios=(S2,), initial_runs=PAPER_INITIAL_RUNS)  # S1's is dropped
+    assert one.initial_runs == {S2: 222} and one.runs_of(S1) == 0
+    assert not ResultsConfig(initial_runs={S1: 2000, S2: 1300}).rq1_own_data
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [
