@@ -36,6 +36,7 @@ from evoeye.store.feedback import read_rounds
 TARGET = 1.8
 TRIM_KEY = "distributed.nanny.pre-spawn-environ.MALLOC_TRIM_THRESHOLD_"
 FULL_PROTOCOL = 2 * 5 * 20  # scenarios × methods × seeds
+PRELOAD = "evoeye.evolve.campaign.workers"  # what a Dask worker runs campaigns with
 
 
 def timed_experiment(root: DataRoot, args: argparse.Namespace, splits: SplitSpec,
@@ -53,16 +54,17 @@ def timed_experiment(root: DataRoot, args: argparse.Namespace, splits: SplitSpec
     return wall, rounds
 
 
-def on_dask(n: int, run) -> tuple[float, list]:
+def on_dask(n: int, run, preload: bool = True) -> tuple[float, list]:
     """`run(address)` with a LocalCluster of n one-thread worker processes, started as
     docs/evolution.md advises: without Dask's MALLOC_TRIM_THRESHOLD_ (training ≈ 1.5× dearer
-    with it)."""
+    with it) and, with `preload`, with the campaign code imported as each worker starts (as
+    the local pool's forked workers inherit it), not by its first campaign."""
     import dask
     from distributed import LocalCluster
 
     with dask.config.set({TRIM_KEY: None}), LocalCluster(
-            n_workers=n, threads_per_worker=1, processes=True,
-            dashboard_address=None) as cluster:
+            n_workers=n, threads_per_worker=1, processes=True, dashboard_address=None,
+            preload=[PRELOAD] if preload else []) as cluster:
         return run(cluster.scheduler_address)
 
 
@@ -76,6 +78,8 @@ def main() -> None:
     ap.add_argument("--n-round", type=int, default=20)
     ap.add_argument("--workers", type=int, nargs="*", default=[1, 2])
     ap.add_argument("--dask", type=int, nargs="*", default=[1, 2])
+    ap.add_argument("--no-preload", action="store_true", help="Dask workers import the "
+                    "campaign code on their first campaign, inside the timed experiment")
     ap.add_argument("--project", type=int, help="the slice is this many campaigns of the "
                     f"full protocol ({FULL_PROTOCOL})")
     ap.add_argument("--runs", type=int, default=40, help="initial runs without --root")
@@ -106,7 +110,7 @@ def main() -> None:
         for n in args.dask:
             root = copy_root(src, Path(tmp) / f"dask-{n}")
             runs["dask", n] = on_dask(n, lambda address, root=root: timed_experiment(
-                root, args, splits, dask_address=address))
+                root, args, splits, dask_address=address), preload=not args.no_preload)
             print(f"dask {n}: {runs['dask', n][0]:.1f} s "
                   f"(load average {os.getloadavg()[0]:.2f})", flush=True)
     print("\n| runner | workers | wall s | speed-up vs 1 worker | same records |")

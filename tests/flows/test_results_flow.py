@@ -50,3 +50,13 @@ def test_bad_parameters_are_refused_before_anything_runs() -> None:
         ResultsParams(baselines=["ttc", "radar"], test_runs=0)
     with pytest.raises(ValidationError):
         ResultsParams(training_seeds=1)
+    with pytest.raises((ValueError, ValidationError), match="initial runs must be >= 0"):
+        ResultsParams(initial_runs={"highway-cut-in": -1, "unprotected-intersection": 5})
+
+
+def test_initial_runs_per_scenario_reach_the_config() -> None:
+    from evoeye.results.config import PAPER_INITIAL_RUNS
+
+    assert ResultsParams(initial_runs=PAPER_INITIAL_RUNS).config().initial_runs == \
+        PAPER_INITIAL_RUNS
+    assert ResultsParams(initial_runs=40).config().runs_of("unprotected-intersection") == 40
