@@ -39,6 +39,7 @@ class ResultsParams(BaseModel):
     training_seeds: int = Field(len(D.training_seeds), ge=2)
     campaign_seeds: int = Field(len(D.campaign_seeds), ge=2)
     final_seeds: int = Field(D.final_seeds, ge=1)
+    final: str = D.final  # "update" or "retrain" (ResultsConfig)
     initial_runs: int | dict[str, int] = Field(D.initial_runs)  # every scenario, or per one
     rq1_runs: int = Field(D.rq1_runs, ge=0)
     sim_seed: int = Field(D.sim_seed, ge=0)

@@ -42,6 +42,11 @@ def results_command(
     final_seeds: Annotated[int, typer.Option(
         min=1, help="k: a campaign's final monitor is judged by the mean over k training "
                     "seeds of its last update.")] = D.final_seeds,
+    final: Annotated[str, typer.Option(
+        help="The k final monitors: 'update' (the campaign's last update again with k seeds: "
+             "what a user of the method deploys) or 'retrain' (G_0's recipe trained from "
+             "scratch on the campaign's D_R with G_0's k seeds: what the data it acquired is "
+             "worth, whatever the update rule).")] = D.final,
     initial_runs: Annotated[list[str] | None, typer.Option(
         help="Simulate (or resume) this many initial runs per scenario, batch "
              "uniform-seed<sim-seed> (0: use the warehouse's): N for every scenario, "
@@ -112,7 +117,7 @@ def results_command(
         config = ResultsConfig(
             scenarios=tuple(scenario or D.scenarios), parts=tuple(part or D.parts),
             training_seeds=tuple(range(training_seeds)),
-            campaign_seeds=tuple(range(campaign_seeds)), final_seeds=final_seeds,
+            campaign_seeds=tuple(range(campaign_seeds)), final_seeds=final_seeds, final=final,
             initial_runs=runs, sim_seed=sim_seed, rq1_runs=rq1_runs,
             test_runs=test_runs,
             test_seed=test_seed, test_batch=test_batch, split_seed=split_seed,

@@ -39,6 +39,10 @@ INPUTS = ("perception", "perception+prediction", "perception+prediction+planning
 METHODS = ("uniform", "avfuzzer", "evoeye", "no-feedback", "no-density",
            "aem-evo")  # evoeye.evolve.campaign.experiment MAIN + ABLATION
 PARTS = ("rq1", "ablation", "rq2")
+# how a campaign's k final monitors are made (evoeye.results.rq2): its last update again with
+# k seeds (what a user of the method deploys), or G_0's recipe trained from scratch on its D_R
+# with the k seeds of "G_0 (k seeds)" (what the data it acquired is worth, whatever the update)
+FINALS = ("update", "retrain")
 MONITOR_PARTS = ("rq1", "ablation")  # the parts that train on RQ1's data
 PAPER_TEST_RUNS = {"highway-cut-in": 75, "unprotected-intersection": 132}
 # the paper's initial data: its train + validation runs per scenario (split 0.8 : 0.2)
@@ -83,6 +87,7 @@ class ResultsConfig:
     training_seeds: tuple[int, ...] = (0, 1, 2, 3, 4, 5)
     campaign_seeds: tuple[int, ...] = tuple(range(20))
     final_seeds: int = 3  # k: a final monitor is judged by the mean over k training seeds
+    final: str = "update"  # FINALS: the k monitors are the last update again, or retrained
     parts: tuple[str, ...] = PARTS
     # data: simulated (or resumed) first, then ingested; 0 runs: use what the warehouse holds
     # round-0 runs, batch uniform-seed<sim_seed>: one count for every scenario, or per scenario
@@ -130,6 +135,8 @@ class ResultsConfig:
                                  f"got {seeds}")
         if self.final_seeds < 1:
             raise ValueError(f"final_seeds must be >= 1, got {self.final_seeds}")
+        if self.final not in FINALS:
+            raise ValueError(f"unknown final {self.final!r}; known: {list(FINALS)}")
         unknown = set(self.parts) - set(PARTS)
         if unknown or not self.parts:
             raise ValueError(f"unknown part(s) {sorted(unknown)}; known: {list(PARTS)}")

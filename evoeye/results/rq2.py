@@ -13,6 +13,11 @@ gives a user, who deploys one monitor — and only removes the last training's s
 it; an ensemble would judge a different, stronger monitor than any method produces. A campaign
 that made no round keeps its start, G_0, judged by the mean of G_0's recipe over k seeds.
 
+With `final="retrain"` the k monitors are instead G_0's recipe trained from scratch on the
+campaign's D_R (D_init's train runs and every run it acquired) with the k training seeds of
+"G_0 (k seeds)": a campaign and that row then differ only in their data, so the comparison
+judges what a strategy acquired apart from how the update rule used it.
+
 The sets (`units.judge`: an `Assessor` given the re-seeded G_0s): the Test Set (the study's
 test split: the held-out batch), the paper's Hard Set (the unsafe test frames G_0 misses, plus
 the safe frames of their runs) and the robust Hard Set (the unsafe test frames a majority of k
@@ -86,15 +91,35 @@ def _retrain_last_update(study: Study, cfg: CampaignConfig, previous: str, j: in
     return version
 
 
+def _retrain_on_campaign_data(study: Study, cfg: CampaignConfig, seed: int) -> str:
+    """G_0's recipe trained from scratch, with `seed`, on the campaign's D_R (its initial
+    train runs and every run it acquired that ran) and its fixed val split."""
+    campaign = Campaign(study.root, cfg)
+    state = campaign.start()
+    ids = [str(s) for s in state.records.scenario_id[state.ok]]
+    study.say(f"  {campaign.campaign_id}: G_0's recipe on its D_R ({len(ids)} runs), seed {seed}")
+    return FAMILIES[cfg.family].train(
+        study.root, cfg.scenario, train_runs=ids, val_runs=campaign.val_runs, seed=seed,
+        splits=cfg.splits, horizon_s=cfg.horizon_s, **G0_RECIPE, **study.train_overrides)
+
+
 def final_versions(study: Study, cfg: CampaignConfig, campaign_id: str,
                    start_seeds: Sequence[str]) -> list[str]:
     """The k monitors a campaign's final figure is the mean of (module doc)."""
     rounds = read_rounds(study.root, campaign_id)
     last = rounds[-1]
     k = study.config.final_seeds
-    if last.round == 0:
+    if last.round == 0:  # D_R = D_init: both kinds of final are G_0's recipe over k seeds
         return list(start_seeds[:k])
     family = FAMILIES[cfg.family]
+    if study.config.final == "retrain":
+        return [study.ledger.remember(
+            "final-retrain", {"campaign": campaign_id, "last": last.monitor_version,
+                              "seed": seed, "recipe": G0_RECIPE,
+                              "overrides": study.train_overrides},
+            lambda seed=seed: _retrain_on_campaign_data(study, cfg, seed),
+            valid=lambda v: family.version_dir(study.root, v).is_dir())
+            for seed in study.config.training_seeds[:k]]
     out = [last.monitor_version]
     for j in range(1, k):
         inputs = {"campaign": campaign_id, "final": last.monitor_version, "j": j}

@@ -205,3 +205,40 @@ def test_docs_readme_and_html_come_from_the_same_results(done) -> None:
     assert not math.isclose(cell["low"], cell["high"])
     assert f'data-interval="{100 * cell["low"]:.4g},{100 * cell["high"]:.4g}"' in html
     assert html.count("<svg") >= 2 * len(done.results["tables"])
+
+
+@pytest.fixture(scope="module")
+def retrained(done) -> SimpleNamespace:
+    """RQ2 judged again with `--final retrain`, on the same campaigns."""
+    args = [a for a in _args(done.root, done.docs, done.readme) if a not in ("--docs", "--readme",
+            str(done.docs), str(done.readme))]
+    args[args.index("--name") + 1] = "retrain"
+    run = RUNNER.invoke(app, [*args, "--part", "rq2", "--final", "retrain"])
+    assert run.exit_code == 0, run.output
+    again = RUNNER.invoke(app, [*args, "--part", "rq2", "--final", "retrain"])
+    return SimpleNamespace(run=run, again=again, results=json.loads(
+        (done.root.path / "reports" / "retrain" / "results.json").read_text()))
+
+
+def test_retrain_finals_are_g0s_recipe_on_each_campaigns_data(done, retrained) -> None:
+    rq2 = retrained.results["scenarios"][SCENARIO]["rq2"]["methods"]
+    before = done.results["scenarios"][SCENARIO]["rq2"]["methods"]
+    assert rq2["G_0 (k seeds)"] == before["G_0 (k seeds)"]  # the row it is compared with
+    g0_seeds = [load_version(done.root, v).card for v in rq2["G_0 (k seeds)"]["versions"][0]]
+    train_runs = done.results["scenarios"][SCENARIO]["data"]["splits"]["train"]["scenarios"]
+    for method in ("uniform", "evoeye", "no-feedback"):
+        row = rq2[method]
+        assert row["campaigns"] == before[method]["campaigns"]  # no campaign ran again
+        for campaign, versions, old in zip(row["campaigns"], row["versions"],
+                                           before[method]["versions"], strict=True):
+            assert not set(versions) & set(old)
+            acquired = sum(len(r.scenario_ids) for r in read_rounds(done.root, campaign))
+            for card, g0 in zip((load_version(done.root, v).card for v in versions), g0_seeds,
+                                strict=True):
+                assert card["parent"] is None  # from scratch, not from G_{R-1}
+                assert card["hyperparameters"]["seed"] == g0["hyperparameters"]["seed"]
+                assert card["data"]["train"]["runs"] == train_runs + acquired
+                assert card["data"]["val"] == g0["data"]["val"]
+    assert "final-retrain" in retrained.run.output and "nothing new" in retrained.again.output
+    intro = (done.root.path / "reports" / "retrain" / "rq2.md").read_text()
+    assert "trained from scratch on its D_R" in intro

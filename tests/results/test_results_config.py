@@ -52,6 +52,7 @@ def test_the_defaults_are_the_issues_sizes() -> None:
     ({"training_seeds": (0,)}, "at least 2 distinct training seeds"),
     ({"campaign_seeds": (1, 1)}, "at least 2 distinct campaign seeds"),
     ({"final_seeds": 0}, "final_seeds must be >= 1"),
+    ({"final": "ensemble"}, r"unknown final 'ensemble'; known: \['update', 'retrain'\]"),
     ({"parts": ("rq1", "rq4")}, r"unknown part\(s\) \['rq4'\]"),
     ({"test_seed": 0}, "its own seed"),
     ({"n_round": 0}, "n_round must be >= 1"),
