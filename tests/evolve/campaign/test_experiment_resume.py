@@ -98,12 +98,17 @@ def test_a_killed_two_worker_experiment_resumes_to_the_same_records(root_copy,
 
 
 def test_a_dask_cluster_runs_the_campaigns_to_the_same_records(root_copy, uninterrupted) -> None:
-    from distributed import LocalCluster
+    from distributed import Client, LocalCluster
 
     root = root_copy("dask")
-    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
-                      dashboard_address=None) as cluster:  # Dask's default worker environment
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,  # Dask's default
+                      dashboard_address=None,  # worker environment, and our preload
+                      preload=["evoeye.evolve.campaign.workers"]) as cluster:
+        with Client(cluster.scheduler_address) as client:  # loaded before any campaign
+            loaded = client.run(lambda: sorted({"torch", "highway_env", "duckdb"}
+                                               & set(sys.modules)))
         lines = experiment(root, dask_address=cluster.scheduler_address)
+    assert list(loaded.values()) == [["duckdb", "highway_env", "torch"]] * 2
     assert records(root) == uninterrupted
     notes = [line for line in lines if line.startswith("note:")]
     assert len(notes) == 1 and "2 of 2 Dask workers" in notes[0]  # told, once
