@@ -57,9 +57,12 @@ def finite_mean(values: Sequence[float] | np.ndarray) -> float | None:
 
 
 def sample_sd(values: Sequence[float] | np.ndarray) -> float | None:
-    """Sample SD (ddof = 1) of the finite values; None for fewer than two."""
+    """Sample SD (ddof = 1) of the finite values; None for fewer than two; exactly 0 when they
+    are all equal (np.std's rounding would leave ~1e-17 of a mean that is not exactly theirs)."""
     a = _finite(values)
-    return float(np.std(a, ddof=1)) if len(a) > 1 else None
+    if len(a) < 2:
+        return None
+    return 0.0 if np.ptp(a) == 0 else float(np.std(a, ddof=1))
 
 
 @dataclass(frozen=True)

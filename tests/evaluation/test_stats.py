@@ -32,6 +32,7 @@ def test_sample_sd_is_ddof_1_and_skips_undefined_values() -> None:
     assert sample_sd(values) == pytest.approx(math.sqrt(3 / 2) * np.std(values))  # 1.22× at n=3
     assert sample_sd([0.2, np.nan, 0.5, 0.3]) == pytest.approx(statistics.stdev(values))
     assert sample_sd([0.4]) is None and sample_sd([]) is None
+    assert sample_sd([0.1] * 6) == 0.0 and mean_ci([0.1] * 6).low == mean_ci([0.1] * 6).high
 
 
 def test_finite_mean_skips_undefined_values_and_is_none_without_any() -> None:
