@@ -66,7 +66,7 @@ def parse_initial_runs(values: list[str]) -> int | dict[str, int]:
             n = int(count)
         except ValueError:
             n = -1
-        if n < 0 or (sep and not scenario):
+        if n < 0:
             raise ValueError(f"--initial-runs {value!r}: give N, SCENARIO=N or 'paper' "
                              "(N a whole number >= 0)")
         if sep and scenario not in SCENARIOS:

@@ -33,6 +33,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 from dataclasses import replace
+from functools import cache
 
 import numpy as np
 
@@ -45,6 +46,7 @@ from evoeye.results.rq1 import FULL_CONTEXT_LEN
 from evoeye.results.study import Study
 from evoeye.results.units import judge, set_figures, trained_version
 from evoeye.store.feedback import read_rounds
+from evoeye.store.selection import RunFilter
 
 FINAL_SEED_STRIDE = 100_000  # seed of final retraining j: the last update's seed + j × stride
 # G_0's recipe: RQ1's full FusionMonitor (a family that has no modules, e.g. the AEM, ignores them)
@@ -91,16 +93,12 @@ def _retrain_last_update(study: Study, cfg: CampaignConfig, previous: str, j: in
     return version
 
 
-def _retrain_on_campaign_data(study: Study, cfg: CampaignConfig, seed: int) -> str:
-    """G_0's recipe trained from scratch, with `seed`, on the campaign's D_R (its initial
-    train runs and every run it acquired that ran) and its fixed val split."""
+def _campaign_data(study: Study, cfg: CampaignConfig) -> tuple[list[str], RunFilter]:
+    """The campaign's D_R (its initial train runs and every run it acquired that ran) and its
+    fixed val split."""
     campaign = Campaign(study.root, cfg)
     state = campaign.start()
-    ids = [str(s) for s in state.records.scenario_id[state.ok]]
-    study.say(f"  {campaign.campaign_id}: G_0's recipe on its D_R ({len(ids)} runs), seed {seed}")
-    return FAMILIES[cfg.family].train(
-        study.root, cfg.scenario, train_runs=ids, val_runs=campaign.val_runs, seed=seed,
-        splits=cfg.splits, horizon_s=cfg.horizon_s, **G0_RECIPE, **study.train_overrides)
+    return [str(s) for s in state.records.scenario_id[state.ok]], campaign.val_runs
 
 
 def final_versions(study: Study, cfg: CampaignConfig, campaign_id: str,
@@ -112,13 +110,25 @@ def final_versions(study: Study, cfg: CampaignConfig, campaign_id: str,
     if last.round == 0:  # D_R = D_init: both kinds of final are G_0's recipe over k seeds
         return list(start_seeds[:k])
     family = FAMILIES[cfg.family]
+
+    def exists(version: str) -> bool:
+        return family.version_dir(study.root, version).is_dir()
+
     if study.config.final == "retrain":
+        data = cache(lambda: _campaign_data(study, cfg))  # read once, for the k seeds
+
+        def retrain(seed: int) -> str:
+            ids, val = data()
+            study.say(f"  {campaign_id}: G_0's recipe on its D_R ({len(ids)} runs), seed {seed}")
+            return family.train(study.root, cfg.scenario, train_runs=ids, val_runs=val,
+                                seed=seed, splits=cfg.splits, horizon_s=cfg.horizon_s,
+                                **G0_RECIPE, **study.train_overrides)
+
         return [study.ledger.remember(
             "final-retrain", {"campaign": campaign_id, "last": last.monitor_version,
                               "seed": seed, "recipe": G0_RECIPE,
                               "overrides": study.train_overrides},
-            lambda seed=seed: _retrain_on_campaign_data(study, cfg, seed),
-            valid=lambda v: family.version_dir(study.root, v).is_dir())
+            lambda seed=seed: retrain(seed), valid=exists)
             for seed in study.config.training_seeds[:k]]
     out = [last.monitor_version]
     for j in range(1, k):
@@ -126,7 +136,7 @@ def final_versions(study: Study, cfg: CampaignConfig, campaign_id: str,
         out.append(study.ledger.remember(
             "final", inputs,
             lambda j=j: _retrain_last_update(study, cfg, rounds[-2].monitor_version, j),
-            valid=lambda v: family.version_dir(study.root, v).is_dir()))
+            valid=exists))
     return out
 
 
