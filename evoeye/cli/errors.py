@@ -57,6 +57,8 @@ KNOWN_ERRORS: dict[str, str] = {
     "evoeye.results.study.EmptySplitError": "simulate the data with the command (--initial-runs "
                                             "N --test-runs M), or check --test-batch and the "
                                             "shares",
+    "evoeye.results.combine.ResultsFileError": "give the results.json (or report folder) of "
+                                               "each `evoeye results` run once",
     "evoeye.store.lock.WarehouseLockedError": "wait for the other writer to finish, then run "
                                               "again",
     "evoeye.store.schema.WarehouseLayoutError": "re-ingest: move warehouse/scenarios, "

@@ -7,20 +7,29 @@ from pathlib import Path
 
 import pytest
 
+from evoeye.results.combine import combined_markdown
 from evoeye.results.findings import check_findings
 from evoeye.results.markdown import README_BEGIN, README_END, findings_markdown, splice_readme
 
 REPO = Path(__file__).resolve().parents[2]
 RESULTS = REPO / "docs" / "results" / "results.json"
+COMBINED = REPO / "docs" / "results" / "findings.json"  # `evoeye findings --out docs/results`
 
 
-def test_the_readme_section_is_generated_from_the_results_json() -> None:
-    readme = (REPO / "README.md").read_text(encoding="utf-8")
-    assert readme.count(README_BEGIN) == 1 and readme.count(README_END) == 1
+def _section() -> str:
+    """What the README's section must be: from docs/results/findings.json when the findings
+    combine several runs, else from the one run's results.json."""
+    if COMBINED.exists():
+        return combined_markdown(json.loads(COMBINED.read_text()), "docs/results/findings.json")
     findings = (json.loads(RESULTS.read_text())["findings"] if RESULTS.exists()
                 else check_findings([]))  # before the first run: every finding "not run yet"
-    section = findings_markdown(findings, "docs/results/results.json")
-    assert splice_readme(readme, section) == readme
+    return findings_markdown(findings, "docs/results/results.json")
+
+
+def test_the_readme_section_is_generated_from_the_results() -> None:
+    readme = (REPO / "README.md").read_text(encoding="utf-8")
+    assert readme.count(README_BEGIN) == 1 and readme.count(README_END) == 1
+    assert splice_readme(readme, _section()) == readme
 
 
 def test_splicing_replaces_only_the_section() -> None:

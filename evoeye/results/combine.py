@@ -1,0 +1,119 @@
+"""The paper's findings over several `evoeye results` runs: `evoeye findings`.
+
+A study too big for one session or one machine runs its parts separately — RQ1 and the
+monitor ablation on one data root, RQ2 and the evolution ablations on another — and each run
+writes its own `results.json`. `combine` takes every table from the run that has it and checks
+the findings over all of them, exactly as one run over everything would (`check_findings`).
+A table (part and scenario) present in two runs is refused by name: which of the two counts
+would be a choice, and a choice is what the findings must not depend on.
+
+The combined JSON keeps, for each run, its path, its config and the tables it gave, so every
+verdict can be traced to the run (seeds, sizes, Test Set) that produced it.
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Sequence
+from pathlib import Path
+
+from evoeye.results.findings import check_findings
+
+RESULTS_FILE = "results.json"
+
+
+class ResultsFileError(ValueError):
+    """A results file that cannot be read, or two that claim the same table."""
+
+
+def results_path(path: Path) -> Path:
+    """`path` itself, or `path/results.json` for a report folder."""
+    return path / RESULTS_FILE if path.is_dir() else path
+
+
+def load_results(path: Path) -> dict:
+    """A results JSON written by `evoeye results`, checked for what combining needs."""
+    file = results_path(path)
+    try:
+        results = json.loads(file.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise ResultsFileError(f"{file}: no such results file (give the results.json of an "
+                               "`evoeye results` run, or its report folder)") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise ResultsFileError(f"{file}: not a results JSON ({exc})") from None
+    tables = results.get("tables") if isinstance(results, dict) else None
+    if not isinstance(tables, list) or not all(
+            isinstance(t, dict) and {"id", "scenario", "comparisons"} <= t.keys()
+            for t in tables):
+        raise ResultsFileError(f"{file}: not written by `evoeye results` (no tables with an "
+                               "id, a scenario and comparisons)")
+    return results
+
+
+def _table_name(table: dict) -> str:
+    return f"{table['id']} ({table['scenario']})"
+
+
+def combine(paths: Sequence[Path]) -> dict:
+    """{"sources": [{"path", "config", "tables"}], "tables", "findings"} over the runs."""
+    if not paths:
+        raise ResultsFileError("give at least one results file")
+    sources, tables, owner = [], [], {}
+    for path in paths:
+        file = results_path(path)
+        results = load_results(file)
+        names = []
+        for table in results["tables"]:
+            key = (table["id"], table["scenario"])
+            if key in owner:
+                raise ResultsFileError(
+                    f"{file}: table {_table_name(table)} is also in {owner[key]}; give each "
+                    "part and scenario from one run only")
+            owner[key] = file
+            tables.append(table)
+            names.append(_table_name(table))
+        sources.append({"path": str(file), "config": results.get("config", {}),
+                        "tables": names})
+    return {"sources": sources, "tables": tables, "findings": check_findings(tables)}
+
+
+def source_lines(sources: list[dict]) -> list[str]:
+    """One Markdown bullet per run: its file, the tables it gave and the sizes they rest on."""
+    out = []
+    for s in sources:
+        cfg = s["config"]
+        sizes = [f"{label} {len(cfg[key])}" for key, label in (
+            ("training_seeds", "training seeds"), ("campaign_seeds", "campaign seeds"))
+            if cfg.get(key)]
+        sizes += [f"{label} {cfg[key]}" for key, label in (
+            ("sim_seed", "sim seed"), ("test_seed", "Test Set seed")) if cfg.get(key) is not None]
+        tables = ", ".join(s["tables"]) or "no tables"
+        out.append(f"* `{s['path']}`: {tables} — {', '.join(sizes)}")
+    return out
+
+
+def combined_markdown(combined: dict, source: str) -> str:
+    """findings.md of combined runs: the runs, then the findings as `evoeye results` shows them."""
+    from evoeye.results.markdown import findings_markdown
+
+    return findings_markdown(combined["findings"], source, command="evoeye findings",
+                             runs=["Each table comes from one `evoeye results` run:", "",
+                                   *source_lines(combined["sources"])])
+
+
+def write_combined(combined: dict, out: Path | None = None, readme: Path | None = None) -> str:
+    """findings.md (returned; with `out`, written there beside findings.json), and with
+    `readme`, spliced into its findings section."""
+    from evoeye.results.markdown import splice_readme
+
+    source = str(out / "findings.json") if out is not None else "the runs below"
+    text = combined_markdown(combined, source)
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+        (out / "findings.json").write_text(json.dumps(combined, indent=1) + "\n",
+                                           encoding="utf-8")
+        (out / "findings.md").write_text(text, encoding="utf-8")
+    if readme is not None:
+        readme.write_text(splice_readme(readme.read_text(encoding="utf-8"), text),
+                          encoding="utf-8")
+    return text
