@@ -184,7 +184,7 @@ def _wilcoxon(d: np.ndarray, n_resamples: int, seed: int
     else:
         method = "exact"
     p = float(stats.wilcoxon(nonzero, zero_method="wilcox", method=method).pvalue)
-    return min(p, 1.0), zeros, min(1.0, 2.0 / 2.0 ** m)
+    return min(p, 1.0), zeros, min(1.0, 2.0 ** (1 - m))
 
 
 def sd_of_differences(sd_a: float, sd_b: float, correlation: float) -> float:
@@ -204,7 +204,7 @@ def paired_power(n_pairs: int, diff: float, sd_diff: float, *, alpha: float = 0.
     if not 0.0 < alpha < 1.0 or sd_diff <= 0 or n_pairs < 2:
         raise ValueError(f"need 0 < alpha < 1, sd_diff > 0 and ≥ 2 pairs, got {alpha}, "
                          f"{sd_diff}, {n_pairs}")
-    if test == "wilcoxon" and 2.0 / 2.0**n_pairs > alpha:
+    if n_pairs < smallest_design(alpha, test):
         return 0.0  # no outcome of so few pairs reaches p ≤ alpha
     n = n_pairs * (WILCOXON_ARE if test == "wilcoxon" else 1.0)
     df = max(n - 1.0, 1e-9)

@@ -15,6 +15,7 @@ from evoeye.evaluation.report import CSS, Table
 from evoeye.results.markdown import (
     FINDINGS_RULE,
     FLOOR_NOTE,
+    METRIC_NAMES,
     UNPAIRED_NOTE,
     comparison_cells,
     comparison_intro,
@@ -37,7 +38,7 @@ def table_charts(table: dict) -> list[str]:
     charts = []
     for s in table["sets"]:
         for m in [table["metrics"][0], *(k for k in CHART_METRICS[1:] if k in table["metrics"])]:
-            key, what = cell_key(s, m), f"{SET_NAMES[s]} {m.upper()}"
+            key, what = cell_key(s, m), f"{SET_NAMES[s]} {METRIC_NAMES.get(m, m.upper())}"
             rows = [(r["method"], _pct(c["mean"]), _pct(c["low"]), _pct(c["high"]))
                     for r in table["rows"] for c in [r["cells"][key]]]
             charts.append(interval_chart(rows, title=f"{what}: mean, 95 % CI",
@@ -75,7 +76,8 @@ def results_html(results: dict, title: str = "evoeye results") -> str:
             body += [f"<h3>{escape(f['claim'])}: {escape(f['verdict'])}</h3>",
                      Table(*finding_checks(f)).html()]
     for part, name in (("rq1", "RQ1"), ("ablation", "Monitor ablation"), ("rq2", "RQ2"),
-                       ("evolution-ablation", "Evolution ablation"), ("aem-evo", "AEM-Evo")):
+                       ("evolution-ablation", "Evolution ablation"), ("aem-evo", "AEM-Evo"),
+                       ("acquisition", "What each method acquired")):
         tables = [t for t in results["tables"] if t["id"] == part]
         if tables:
             body.append(f"<h2>{escape(name)}</h2>")

@@ -67,8 +67,13 @@ def diff_cell(cell: dict) -> str:
     return text
 
 
+# what the acquisition table's metrics are (the others are named by their key: F1@0.05, AUROC)
+METRIC_NAMES = {"collision_share": "collided", "near_share": "within δ of an earlier run",
+                "feedback": "f under the monitor that chose it"}
+
+
 def column(set_name: str, metric: str, sets: list[str]) -> str:
-    label = metric.upper()  # F1@0.05, AUROC, AUPRC
+    label = METRIC_NAMES.get(metric, metric.upper())  # F1@0.05, AUROC, AUPRC
     return label if len(sets) == 1 else f"{SET_NAMES[set_name]} {label}"
 
 

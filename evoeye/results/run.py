@@ -159,7 +159,8 @@ def markdown_files(results: dict) -> dict[str, str]:
                                 _intro(results, "RQ1 and the monitor ablation", "rq1_data"),
                                 results["tables"], ("rq1", "ablation")),
         "rq2.md": part_markdown("RQ2, the evolution ablation and AEM-Evo", rq2_intro,
-                                results["tables"], ("rq2", "evolution-ablation", "aem-evo")),
+                                results["tables"], ("rq2", "evolution-ablation", "aem-evo",
+                                                     "acquisition")),
         "findings.md": findings_markdown(results["findings"], "docs/results/results.json"),
     }
 

@@ -29,7 +29,7 @@ METRICS = ("f1@0.05", "f1@0.01", "auroc", "auprc")
 ABLATION_METRICS = ("f1@0.05", "auroc", "auprc")  # the paper's ablation tables
 EFFECT = 0.05  # a difference worth detecting: 5 points (of F1, on 0 … 1)
 POWER = 0.8
-SET_NAMES = {"test": "Test", "hard": "Hard", "robust": "Robust Hard"}
+SET_NAMES = {"test": "Test", "hard": "Hard", "robust": "Robust Hard", "acquired": "Acquired"}
 FULL_VARIANTS = ("L=5", "all")  # the full FusionMonitor's label in the ablation
 
 
@@ -45,6 +45,14 @@ class TableSpec:
     rows: Callable[[list[str]], list[str]]  # the part's methods → this table's rows, in order
     comparisons: Callable[[list[str]], list[tuple[str, str]]]  # its rows → pairs (a, b)
     over: str  # what the seeds are
+    figures: Callable[[dict], list[dict]] = lambda row: row["figures"]  # per seed {set: metrics}
+
+
+def _acquired(row: dict) -> list[dict]:
+    """A campaign method's acquisition per seed as figures of the set "acquired" (a campaign
+    that acquired nothing has none; results from before it was recorded, no row)."""
+    return [{ACQUIRED: {k: a.get(k) for k in ACQUISITION_METRICS} if a else {}}
+            for a in row.get("acquisition", [])]
 
 
 def _in(order: tuple[str, ...]) -> Callable[[list[str]], list[str]]:
@@ -71,6 +79,11 @@ def _evolution(winner: str, others: tuple[str, ...]) -> Callable[[list[str]], li
 
 RQ2_MAIN = ("uniform", "avfuzzer", "evoeye")
 EVOLUTION_ABLATION = ("evoeye", "no-feedback", "no-density")
+ACQUIRED = "acquired"
+# what a campaign acquired (`evoeye.evolve.campaign.experiment`): the share of runs that
+# collided, the share within δ of an earlier record (local mutations, in effect), and the mean
+# feedback of its runs under the monitor that chose them (how wrong it was where it looked)
+ACQUISITION_METRICS = ("collision_share", "near_share", "feedback")
 
 TABLES: tuple[TableSpec, ...] = (
     TableSpec("rq1", "rq1", "RQ1: monitoring effectiveness (test frames)", ("test",), METRICS,
@@ -85,6 +98,10 @@ TABLES: tuple[TableSpec, ...] = (
     TableSpec("evolution-ablation", "rq2", "Evolution ablation", RQ2_SETS, METRICS,
               _in((G0, G0_SEEDS, *EVOLUTION_ABLATION)),
               _evolution("evoeye", ("no-feedback", "no-density")), "campaign seeds"),
+    TableSpec("acquisition", "rq2", "What each method acquired", (ACQUIRED,),
+              ACQUISITION_METRICS, _in((*RQ2_MAIN, *EVOLUTION_ABLATION[1:], "aem-evo")),
+              _evolution("evoeye", (*RQ2_MAIN[:2], *EVOLUTION_ABLATION[1:])), "campaign seeds",
+              figures=_acquired),
     TableSpec("aem-evo", "rq2", "AEM-Evo", RQ2_SETS, METRICS,
               _in((g0_label("aem"), g0_label("aem", seeds=True), "aem-evo")),
               _evolution("aem-evo", ()), "campaign seeds"),
@@ -95,20 +112,20 @@ def cell_key(set_name: str, metric: str) -> str:
     return f"{set_name}/{metric}"
 
 
-def values(row: dict, set_name: str, metric: str) -> np.ndarray:
+def values(figures: list[dict], set_name: str, metric: str) -> np.ndarray:
     """A row's figure per seed (NaN where undefined)."""
     return np.array([np.nan if f[set_name].get(metric) is None else float(f[set_name][metric])
-                     for f in row["figures"]], dtype=float)
+                     for f in figures], dtype=float)
 
 
-def unreachable(row: dict, set_name: str, metric: str) -> int:
+def unreachable(figures: list[dict], set_name: str, metric: str) -> int:
     """Seeds of a row whose figure is undefined because its target FPR was unreachable."""
-    return sum(1 for f in row["figures"] if not reached(f[set_name], metric))
+    return sum(1 for f in figures if not reached(f[set_name], metric))
 
 
-def _row_cell(row: dict, set_name: str, metric: str) -> dict:
-    v = values(row, set_name, metric)
-    n_r = unreachable(row, set_name, metric)
+def _row_cell(figures: list[dict], set_name: str, metric: str) -> dict:
+    v = values(figures, set_name, metric)
+    n_r = unreachable(figures, set_name, metric)
     return {**mean_ci(v).to_dict(), "unreachable": n_r, "undefined": int(np.isnan(v).sum()) - n_r}
 
 
@@ -129,17 +146,18 @@ def _comparison_cell(a: np.ndarray, b: np.ndarray) -> dict:
 def build_table(spec: TableSpec, scenario: str, part: dict) -> dict | None:
     """A table's rows and comparisons for one scenario (None if none of its rows ran)."""
     methods = part["methods"]
-    rows = spec.rows(list(methods))
+    figures = {m: spec.figures(methods[m]) for m in spec.rows(list(methods))}
+    rows = [m for m, f in figures.items() if f]
     if not any(not methods[m].get("unpaired") for m in rows):
         return None
-    out_rows = [{"method": m, "n": len(methods[m]["figures"]),
+    out_rows = [{"method": m, "n": len(figures[m]),
                  "unpaired": bool(methods[m].get("unpaired")),
-                 "cells": {cell_key(s, k): _row_cell(methods[m], s, k)
+                 "cells": {cell_key(s, k): _row_cell(figures[m], s, k)
                            for s in spec.sets for k in spec.metrics}} for m in rows]
     paired = [m for m in rows if not methods[m].get("unpaired")]
     comparisons = [{"a": a, "b": b,
-                    "cells": {cell_key(s, k): _comparison_cell(values(methods[a], s, k),
-                                                               values(methods[b], s, k))
+                    "cells": {cell_key(s, k): _comparison_cell(values(figures[a], s, k),
+                                                               values(figures[b], s, k))
                               for s in spec.sets for k in spec.metrics}}
                    for a, b in spec.comparisons(paired)]
     return {"id": spec.id, "scenario": scenario, "title": spec.title, "over": spec.over,

@@ -186,3 +186,17 @@ def test_power_inputs_are_checked() -> None:
     assert pairs_needed(0.05, 0.1, 0.1, 1.0) == 6  # Wilcoxon: 2/2⁵ > 0.05 ≥ 2/2⁶
     assert pairs_needed(0.05, 0.1, 0.1, 1.0, alpha=0.01) == 8  # 2/2⁷ > 0.01 ≥ 2/2⁸
     assert paired_power(6, 0.05, 1e-9) > 0.99 and paired_power(5, 0.05, 1e-9) == 0.0
+
+
+def test_designs_of_thousands_of_pairs_are_sized_not_overflowed() -> None:
+    # a noisy share (SD 0.7, e.g. 0/1 outcomes of one-run campaigns) needs ≈ 2 (z_α + z_β)² σ²/δ²
+    # ≈ 3,000 pairs to detect 5 points: past 1,023, where 2.0 ** n overflows a float
+    sd = sd_of_differences(0.7, 0.7, 0.0)
+    n = pairs_needed(0.05, 0.7, 0.7, 0.0)
+    t_n = 2 * (stats.norm.ppf(0.975) + stats.norm.ppf(0.8)) ** 2 * 0.7**2 / 0.05**2
+    assert 0.95 * t_n / 0.955 < n < 1.1 * t_n / 0.955  # the Wilcoxon ARE, 3/π
+    assert paired_power(n, 0.05, sd) >= 0.8 > paired_power(n - 1, 0.05, sd)
+    with pytest.raises(ValueError, match="more than 1000 pairs"):
+        pairs_needed(0.05, 0.7, 0.7, 0.0, max_pairs=1000)
+    big = compare_paired(np.arange(1, 1201) / 1e3, np.zeros(1200))
+    assert big.min_p == 0.0 and big.p_value < 1e-100  # 2 / 2^1200 underflows to 0, no error

@@ -80,7 +80,13 @@ def _table(results: dict, table_id: str) -> dict:
 
 def test_every_table_is_made_with_a_ci_and_p_for_every_comparison(done) -> None:
     tables = {t["id"]: t for t in done.results["tables"]}
-    assert set(tables) == {"rq1", "ablation", "rq2", "evolution-ablation", "aem-evo"}
+    assert set(tables) == {"rq1", "ablation", "rq2", "evolution-ablation", "aem-evo",
+                           "acquisition"}
+    acquired = {r["method"]: r["cells"] for r in tables["acquisition"]["rows"]}
+    assert list(acquired) == ["uniform", "evoeye", "no-feedback", "aem-evo"]
+    for cells in acquired.values():  # each campaign's runs, scored by the monitor that chose them
+        assert cells["acquired/feedback"]["n"] == CAMPAIGN_SEEDS
+        assert 0.0 <= cells["acquired/feedback"]["mean"] <= 1.0
     rq1 = tables["rq1"]
     assert [r["method"] for r in rq1["rows"]] == ["FusionMonitor", "ttc", "ttc-2d", "rss",
                                                   "rss-2s", "aem", "context-only"]

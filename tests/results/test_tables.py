@@ -134,3 +134,32 @@ def test_percentages_in_the_tables() -> None:
     assert (pct(0.3124), pct(-0.0312, signed=True), pct(0.05, signed=True)) == (
         "31.2", "−3.1", "+5.0")
     assert pct(-1e-5, signed=True) == "+0.0" and pct(None) == "–"  # no "−0.0"
+
+
+def test_the_acquisition_table_pairs_what_each_method_acquired_by_campaign_seed() -> None:
+    def acquired(collisions: list[float], feedback: list[float | None]) -> list[dict]:
+        return [{"runs": 40, "collision_share": c, "near_share": 0.1, "feedback": f}
+                for c, f in zip(collisions, feedback, strict=True)]
+
+    uniform_fb = list(0.10 + 0.01 * RNG.standard_normal(N))
+    evo_fb = [f + 0.02 + 0.005 * RNG.standard_normal() for f in uniform_fb]
+    evo_fb[3] = None  # a campaign whose runs have no stored feedback: left out, and counted
+    part = _rq2({"uniform": [0.3] * N, "evoeye": [0.3] * N}, [0.3, 0.3, 0.3])
+    part["methods"]["uniform"]["acquisition"] = acquired([0.25] * N, uniform_fb)
+    part["methods"]["evoeye"]["acquisition"] = acquired([0.2] * (N - 1) + [None], evo_fb)
+    part["methods"]["evoeye"]["acquisition"][-1] = None  # a campaign that acquired nothing
+    table = next(t for t in build_tables({"s1": {"rq2": part}}) if t["id"] == "acquisition")
+    assert [r["method"] for r in table["rows"]] == ["uniform", "evoeye"]  # no G_0 rows
+    evo = table["rows"][1]["cells"]["acquired/feedback"]
+    defined = [f for f in evo_fb[:-1] if f is not None]
+    assert evo["n"] == N - 2 and evo["undefined"] == 2
+    assert evo["mean"] == pytest.approx(np.mean(defined))
+    (cmp,) = table["comparisons"]
+    assert (cmp["a"], cmp["b"]) == ("evoeye", "uniform")
+    diff = np.array([e - u for e, u in zip(evo_fb[:-1], uniform_fb, strict=False)
+                     if e is not None])
+    cell = cmp["cells"]["acquired/feedback"]
+    assert cell["n"] == N - 2 and cell["mean_diff"] == pytest.approx(diff.mean())
+    assert cell["p_value"] == pytest.approx(stats.wilcoxon(diff).pvalue)
+    collided = cmp["cells"]["acquired/collision_share"]
+    assert collided["mean_diff"] == pytest.approx(-0.05)

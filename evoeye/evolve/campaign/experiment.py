@@ -28,7 +28,7 @@ from evoeye.evolve.search.fitness import CRITICALITY_SCALE_M
 from evoeye.evolve.search.strategies import STRATEGIES
 from evoeye.monitor.families import DEFAULT_FAMILY, evolvable_families, initial_monitor
 from evoeye.paths import DataRoot
-from evoeye.store.feedback import RoundMetrics, read_rounds
+from evoeye.store.feedback import RoundMetrics, RoundRow, feedback_of, read_rounds
 from evoeye.store.ingest import refresh_catalog
 
 MAIN = ("uniform", "avfuzzer", "evoeye")
@@ -107,7 +107,9 @@ def collect_results(root: DataRoot, plan: Sequence[CampaignConfig]) -> dict:
         res.setdefault(method, []).append({
             "campaign_id": c.campaign_id, "seed": cfg.seed, "rounds": rounds,
             "budget_s": cfg.budget_s, "simulated_s": rows[-1].simulated_s,
-            "records": rows[-1].n_records, "acquisition": acquisition(c, state),
+            "records": rows[-1].n_records,
+            "acquisition": {**acquisition(c, state),
+                            "feedback": chosen_feedback(root, rows, cfg.feedback)},
             "blind_spots": _blind_spots(c, state) if method == "evoeye" else None,
         })
     return out
@@ -223,6 +225,18 @@ def acquisition(c: Campaign, st: CampaignState) -> dict:
     miss = ~np.asarray(new.collided, bool) & (gap_m < NEAR_MISS_M)
     return {"runs": int(new.n), "collision_share": float(np.mean(new.collided)),
             "near_miss_share": float(np.mean(miss)), "near_share": float(np.mean(near))}
+
+
+def chosen_feedback(root: DataRoot, rounds: Sequence[RoundRow], mode: str) -> float | None:
+    """The mean feedback of the runs a campaign acquired, each under G_{r-1}, the monitor whose
+    errors chose it (rounds[r - 1]'s version for round r's runs): how wrong the monitor was
+    where the strategy looked. Uniform sampling gives the error of a random run; a strategy
+    that finds the monitor's blind spots scores above it. None if no round stored any."""
+    values: list[float] = []
+    for chooser, row in zip(rounds, rounds[1:], strict=False):
+        stored = feedback_of(root, chooser.monitor_version, mode)
+        values += [stored[s] for s in row.scenario_ids if s in stored]
+    return float(np.mean(values)) if values else None
 
 
 def map_axes(u: np.ndarray, feedback: np.ndarray) -> tuple[int, int]:

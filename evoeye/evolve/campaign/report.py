@@ -25,7 +25,7 @@ from evoeye.paths import DataRoot
 
 COLUMNS = ("f1@0.05", "f1@0.01", "auroc", "auprc")
 ACQUISITION_HEAD = ("method", "runs", "collisions %", "near misses (< 1 m, no collision) %",
-                    "within δ of an earlier record %")
+                    "within δ of an earlier record %", "f under the monitor that chose it %")
 
 
 def ran(res: dict) -> tuple[str, ...]:
@@ -103,9 +103,13 @@ def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
     return rows
 
 
+def _defined(x: float | None) -> float:
+    return np.nan if x is None else x
+
+
 def acquisition_rows(res: dict) -> list[list[str]]:
-    """Per strategy: acquired runs, collision, near-miss and near-record shares (mean ± sample
-    SD over seeds)."""
+    """Per strategy: acquired runs, collision, near-miss and near-record shares, and the mean
+    feedback under the monitor that chose the runs (mean ± sample SD over seeds)."""
     rows = []
     for strategy in ran(res):
         acq = [r["acquisition"] for r in res.get(strategy, []) if r.get("acquisition")]
@@ -116,7 +120,8 @@ def acquisition_rows(res: dict) -> list[list[str]]:
             rows.append([strategy, runs_s,
                          _mean_std([a["collision_share"] for a in acq]),
                          _mean_std([a.get("near_miss_share", np.nan) for a in acq]),
-                         _mean_std([a["near_share"] for a in acq])])
+                         _mean_std([a["near_share"] for a in acq]),
+                         _mean_std([_defined(a.get("feedback")) for a in acq])])
     return rows
 
 

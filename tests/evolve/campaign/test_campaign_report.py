@@ -20,7 +20,7 @@ def _m(f1: float) -> dict:
 def _run(f1s: list[float], collisions: float = 0.5) -> dict:
     return {"rounds": [{"test": _m(f), "hard": _m(f / 2)} for f in f1s],
             "acquisition": {"runs": 40, "collision_share": collisions, "near_miss_share": 0.1,
-                            "near_share": 0.25},
+                            "near_share": 0.25, "feedback": collisions / 4},
             "blind_spots": {
         "names": ["a", "b"], "u0": [0.1, 0.9], "u1": [0.5, 0.2], "feedback": [0.0, 0.4],
         "acquired": [False, True]}}
@@ -102,7 +102,8 @@ def test_report_files_hold_tables_curves_and_map(tmp_path) -> None:
 def test_acquisition_table_averages_over_seeds() -> None:
     rows = {r[0]: r for r in acquisition_rows(RESULTS["highway-cut-in"])}
     assert set(rows) == {"uniform", "evoeye"}  # strategies that did not run are left out
-    assert rows["uniform"] == ["uniform", "40 ± 0", "30.0 ± 14.1", "10.0 ± 0.0", "25.0 ± 0.0"]
+    assert rows["uniform"] == ["uniform", "40 ± 0", "30.0 ± 14.1", "10.0 ± 0.0", "25.0 ± 0.0",
+                               "7.5 ± 3.5"]
     assert "| uniform | 40 ± 0 | 30.0 ± 14.1 |" in markdown(RESULTS)
 
 
@@ -130,6 +131,33 @@ def test_acquisition_counts_runs_within_delta_of_an_earlier_record() -> None:
     assert got["collision_share"] == 1 / 3
     assert got["near_miss_share"] == 1 / 3  # 0.5 m without a collision; 4 m is no near miss
     assert got["near_share"] == 2 / 3
+
+
+def test_the_feedback_of_acquired_runs_is_read_under_the_monitor_that_chose_them(
+        tmp_path) -> None:
+    import numpy as np
+
+    from evoeye.evolve.campaign.experiment import chosen_feedback
+    from evoeye.store.feedback import FeedbackRows, RoundRow, write_feedback
+
+    root = DataRoot.resolve(tmp_path)
+
+    def rnd(r: int, version: str, ids: list[str]) -> RoundRow:
+        return RoundRow("c", "highway-cut-in", "evoeye", 0, r, version, ids, 2 * r, 10.0 * r)
+
+    def store(version: str, values: dict[str, float]) -> None:
+        write_feedback(root, FeedbackRows("highway-cut-in", version, "raw",
+                                          np.array(list(values), object),
+                                          np.array(list(values.values())),
+                                          np.ones(len(values), int)))
+
+    rounds = [rnd(0, "g0", []), rnd(1, "g1", ["a", "b"]), rnd(2, "g2", ["c", "d"])]
+    store("g0", {"a": 0.2, "b": 0.4, "init": 0.9})  # a, b were chosen under G_0
+    store("g1", {"a": 0.0, "b": 0.0, "c": 0.6})  # c under G_1; d failed (no feedback stored)
+    store("g2", {"c": 1.0, "d": 1.0})  # after they were chosen: must not count
+    assert chosen_feedback(root, rounds, "raw") == np.mean([0.2, 0.4, 0.6])
+    assert chosen_feedback(root, rounds, "prior-corrected") is None  # none stored in that mode
+    assert chosen_feedback(root, rounds[:1], "raw") is None  # no round acquired anything
 
 
 def test_map_axes_are_the_parameters_feedback_depends_on_most() -> None:
