@@ -14,7 +14,7 @@ from evoeye.cli.app import app
 def findings_command(
     results: Annotated[list[Path], typer.Argument(
         help="results.json files (or report folders) of `evoeye results` runs.",
-        show_default=False)],
+        metavar="RESULTS", show_default=False)],
     out: Annotated[Path | None, typer.Option(
         help="Write findings.md and findings.json here (e.g. docs/results).")] = None,
     readme: Annotated[Path | None, typer.Option(
