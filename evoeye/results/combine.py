@@ -82,9 +82,10 @@ def source_lines(sources: list[dict]) -> list[str]:
     out = []
     for s in sources:
         cfg = s["config"]
+        campaigns = "rq2" in cfg.get("parts", ("rq2",))  # RQ1-only runs have none
         sizes = [f"{label} {len(cfg[key])}" for key, label in (
             ("training_seeds", "training seeds"), ("campaign_seeds", "campaign seeds"))
-            if cfg.get(key)]
+            if cfg.get(key) and (campaigns or key != "campaign_seeds")]
         sizes += [f"{label} {cfg[key]}" for key, label in (
             ("sim_seed", "sim seed"), ("test_seed", "Test Set seed")) if cfg.get(key) is not None]
         tables = ", ".join(s["tables"]) or "no tables"

@@ -101,7 +101,8 @@ def test_a_bad_results_file_is_named(tmp_path: Path, text: str | None, message: 
 
 def test_the_command_writes_the_files_and_the_readme_section(tmp_path: Path) -> None:
     a = _write(tmp_path / "a", {"s1": {"rq1": _rq1(0.1)}},
-               {"training_seeds": [0, 1, 2, 3, 4, 5], "sim_seed": 60606, "test_seed": 60607})
+               {"training_seeds": [0, 1, 2, 3, 4, 5], "campaign_seeds": [0, 1], "sim_seed": 60606,
+                "test_seed": 60607, "parts": ["rq1"]})  # no campaigns ran: none shown
     b = _write(tmp_path / "b", {"s1": {"rq2": _rq2(0.1)}})
     readme = tmp_path / "README.md"
     readme.write_text(f"intro\n{README_BEGIN}\nold\n{README_END}\nrest\n", encoding="utf-8")
