@@ -28,7 +28,7 @@ from evoeye.evolve.search.fitness import CRITICALITY_SCALE_M
 from evoeye.evolve.search.strategies import STRATEGIES
 from evoeye.monitor.families import DEFAULT_FAMILY, evolvable_families, initial_monitor
 from evoeye.paths import DataRoot
-from evoeye.store.feedback import RoundMetrics, RoundRow, feedback_of, read_rounds
+from evoeye.store.feedback import RoundMetrics, RoundRow, read_rounds
 from evoeye.store.ingest import refresh_catalog
 
 MAIN = ("uniform", "avfuzzer", "evoeye")
@@ -109,7 +109,7 @@ def collect_results(root: DataRoot, plan: Sequence[CampaignConfig]) -> dict:
             "budget_s": cfg.budget_s, "simulated_s": rows[-1].simulated_s,
             "records": rows[-1].n_records,
             "acquisition": {**acquisition(c, state),
-                            "feedback": chosen_feedback(root, rows, cfg.feedback)},
+                            "feedback": chosen_feedback(c.stored_feedback, rows)},
             "blind_spots": _blind_spots(c, state) if method == "evoeye" else None,
         })
     return out
@@ -227,14 +227,16 @@ def acquisition(c: Campaign, st: CampaignState) -> dict:
             "near_miss_share": float(np.mean(miss)), "near_share": float(np.mean(near))}
 
 
-def chosen_feedback(root: DataRoot, rounds: Sequence[RoundRow], mode: str) -> float | None:
+def chosen_feedback(stored_feedback: Callable[[str], dict[str, float]],
+                    rounds: Sequence[RoundRow]) -> float | None:
     """The mean feedback of the runs a campaign acquired, each under G_{r-1}, the monitor whose
-    errors chose it (rounds[r - 1]'s version for round r's runs): how wrong the monitor was
+    errors chose it (rounds[r - 1]'s version for round r's runs; `stored_feedback`: version →
+    {run: f} in the campaign's mode, `Campaign.stored_feedback`): how wrong the monitor was
     where the strategy looked. Uniform sampling gives the error of a random run; a strategy
     that finds the monitor's blind spots scores above it. None if no round stored any."""
     values: list[float] = []
     for chooser, row in zip(rounds, rounds[1:], strict=False):
-        stored = feedback_of(root, chooser.monitor_version, mode)
+        stored = stored_feedback(chooser.monitor_version)
         values += [stored[s] for s in row.scenario_ids if s in stored]
     return float(np.mean(values)) if values else None
 

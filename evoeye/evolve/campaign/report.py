@@ -55,7 +55,7 @@ def _value(v: float | None) -> float:
     return np.nan if v is None else float(v)
 
 
-def _mean_std(values: list[float], reachable: Sequence[bool] | None = None) -> str:
+def _mean_std(values: list[float | None], reachable: Sequence[bool] | None = None) -> str:
     """Mean ± sample SD (in %) of one figure's finite values over seeds ('–' if there is none);
     seeds whose target FPR was unreachable are left out and counted ('n/r' if every seed's
     was)."""
@@ -103,10 +103,6 @@ def table_rows(res: dict, strategies: Sequence[str]) -> list[list[str]]:
     return rows
 
 
-def _defined(x: float | None) -> float:
-    return np.nan if x is None else x
-
-
 def acquisition_rows(res: dict) -> list[list[str]]:
     """Per strategy: acquired runs, collision, near-miss and near-record shares, and the mean
     feedback under the monitor that chose the runs (mean ± sample SD over seeds)."""
@@ -121,7 +117,7 @@ def acquisition_rows(res: dict) -> list[list[str]]:
                          _mean_std([a["collision_share"] for a in acq]),
                          _mean_std([a.get("near_miss_share", np.nan) for a in acq]),
                          _mean_std([a["near_share"] for a in acq]),
-                         _mean_std([_defined(a.get("feedback")) for a in acq])])
+                         _mean_std([a.get("feedback") for a in acq])])
     return rows
 
 

@@ -138,7 +138,7 @@ def test_the_feedback_of_acquired_runs_is_read_under_the_monitor_that_chose_them
     import numpy as np
 
     from evoeye.evolve.campaign.experiment import chosen_feedback
-    from evoeye.store.feedback import FeedbackRows, RoundRow, write_feedback
+    from evoeye.store.feedback import FeedbackRows, RoundRow, feedback_of, write_feedback
 
     root = DataRoot.resolve(tmp_path)
 
@@ -155,9 +155,12 @@ def test_the_feedback_of_acquired_runs_is_read_under_the_monitor_that_chose_them
     store("g0", {"a": 0.2, "b": 0.4, "init": 0.9})  # a, b were chosen under G_0
     store("g1", {"a": 0.0, "b": 0.0, "c": 0.6})  # c under G_1; d failed (no feedback stored)
     store("g2", {"c": 1.0, "d": 1.0})  # after they were chosen: must not count
-    assert chosen_feedback(root, rounds, "raw") == np.mean([0.2, 0.4, 0.6])
-    assert chosen_feedback(root, rounds, "prior-corrected") is None  # none stored in that mode
-    assert chosen_feedback(root, rounds[:1], "raw") is None  # no round acquired anything
+    def stored(mode: str):  # Campaign.stored_feedback of a campaign in `mode`
+        return lambda version: feedback_of(root, version, mode)
+
+    assert chosen_feedback(stored("raw"), rounds) == np.mean([0.2, 0.4, 0.6])
+    assert chosen_feedback(stored("prior-corrected"), rounds) is None  # none in that mode
+    assert chosen_feedback(stored("raw"), rounds[:1]) is None  # no round acquired anything
 
 
 def test_map_axes_are_the_parameters_feedback_depends_on_most() -> None:
@@ -204,8 +207,10 @@ def test_a_figure_no_seed_defines_is_a_dash_without_a_warning() -> None:
     assert rows["uniform"][5] == "20.0 ± 7.1"  # hard F1@0.05 of 0.15 and 0.25: defined
     assert "hard auprc per round" in page and "nan" not in rows["uniform"]
     gap = acquisition_rows({"uniform": [{"acquisition": {
-        "runs": 3, "collision_share": 0.5, "near_miss_share": np.nan, "near_share": 0.0}}] * 2})
+        "runs": 3, "collision_share": 0.5, "near_miss_share": np.nan, "near_share": 0.0,
+        "feedback": None}}] * 2})
     assert gap[0][3] == "–"  # near misses not recorded by any seed
+    assert gap[0][5] == "–"  # no feedback stored under the choosing monitors
 
 
 def _old_mean_std(values: list[float]) -> str:
