@@ -59,6 +59,9 @@ KNOWN_ERRORS: dict[str, str] = {
                                             "shares",
     "evoeye.results.combine.ResultsFileError": "give the results.json (or report folder) of "
                                                "each `evoeye results` run once",
+    "evoeye.results.reproduce.PlanError": "give the findings.json `evoeye findings` wrote (or "
+                                          "its folder, e.g. docs/results), and --root only "
+                                          "for its runs",
     "evoeye.store.lock.WarehouseLockedError": "wait for the other writer to finish, then run "
                                               "again",
     "evoeye.store.schema.WarehouseLayoutError": "re-ingest: move warehouse/scenarios, "

@@ -219,3 +219,11 @@ class ResultsConfig:
 
     def to_dict(self) -> dict:
         return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    @classmethod
+    def from_dict(cls, data: Mapping) -> ResultsConfig:
+        """The config a results JSON records (`to_dict`, through JSON); a field it lacks takes
+        its default, a key no field has is a ValueError naming it."""
+        if unknown := sorted(set(data) - {f.name for f in fields(cls)}):
+            raise ValueError(f"unknown config key(s) {unknown}")
+        return cls(**data)

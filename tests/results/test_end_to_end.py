@@ -248,3 +248,28 @@ def test_retrain_finals_are_g0s_recipe_on_each_campaigns_data(done, retrained) -
     assert "final-retrain" in retrained.run.output and "nothing new" in retrained.again.output
     intro = (done.root.path / "reports" / "retrain" / "rq2.md").read_text()
     assert "trained from scratch on its D_R" in intro
+
+
+def test_reproduce_regenerates_a_findings_file_from_the_runs_it_records(done, tmp_path) -> None:
+    docs, readme = tmp_path / "docs", tmp_path / "README.md"
+    docs.mkdir()
+    (docs / "tiny.json").write_bytes(done.first_json)
+    made = RUNNER.invoke(app, ["findings", str(docs / "tiny.json"), "--out", str(docs)])
+    assert made.exit_code == 0, made.output
+    (docs / "tiny.json").write_text("{}")  # stale: reproduce writes it again from the run
+    readme.write_text(f"# x\n{README_BEGIN}\nold text\n{README_END}\n")
+    before = _state(done.root)
+    run = RUNNER.invoke(app, ["reproduce", str(docs), "--root", f"tiny={done.root.path}",
+                              "--readme", str(readme)])
+    assert run.exit_code == 0, run.output
+    assert _state(done.root) == before  # every unit found done on the root that made it
+    assert (docs / "tiny.json").read_bytes() == done.first_json
+    markdown = (docs / "tiny.md").read_text()
+    assert markdown.startswith("# RQ1 and the monitor ablation")
+    assert "\n# RQ2, the evolution ablation and AEM-Evo" in markdown
+    combined = json.loads((docs / "findings.json").read_text())
+    assert [s["path"] for s in combined["sources"]] == [str(docs / "tiny.json")]
+    assert combined["sources"][0]["config"] == done.results["config"]
+    assert combined["findings"] == done.results["findings"]
+    assert "old text" not in readme.read_text()
+    assert done.results["findings"][0]["claim"] in readme.read_text()

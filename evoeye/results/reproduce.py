@@ -1,0 +1,111 @@
+"""`evoeye reproduce`: every table of docs/results again, in one command, from what it records.
+
+`evoeye findings` writes findings.json with, for each `evoeye results` run it combines, the
+run's file and its whole config (`combine`). That is the plan: `reproduce` re-runs each of those
+runs with its recorded config — on a data root of its own under a folder, or on a root named for
+it — writes its results.json and its Markdown back beside findings.json under the same names,
+and combines them again as `evoeye findings` did (findings.md, findings.json, and the README's
+findings section). Each run is resumable and idempotent (the ledger of `evoeye results`): a
+killed reproduction picks up where it stopped, and on the roots that produced the files it
+recomputes nothing and rewrites the same tables.
+"""
+
+from __future__ import annotations
+
+import json
+import shutil
+from collections.abc import Mapping
+from dataclasses import dataclass, replace
+from pathlib import Path
+
+from evoeye.paths import PLAIN_NAME, DataRoot
+from evoeye.results.combine import combine, write_combined
+from evoeye.results.config import MONITOR_PARTS, ResultsConfig
+from evoeye.results.study import Progress
+
+FINDINGS_FILE = "findings.json"
+
+
+class PlanError(ValueError):
+    """A findings file that does not say which runs produced it, or a root given for no run."""
+
+
+@dataclass(frozen=True)
+class PlannedRun:
+    """One `evoeye results` run of the plan: its name (the file stem), where its results.json
+    goes, and its config."""
+
+    name: str
+    path: Path
+    config: ResultsConfig
+
+
+def findings_path(path: Path) -> Path:
+    """`path` itself, or `path/findings.json` for a folder (e.g. docs/results)."""
+    return path / FINDINGS_FILE if path.is_dir() else path
+
+
+def read_plan(path: Path) -> list[PlannedRun]:
+    """The runs a findings.json of `evoeye findings` was combined from, each with its config;
+    PlanError naming the file and the run that cannot be re-run."""
+    file = findings_path(path)
+    try:
+        data = json.loads(file.read_text(encoding="utf-8"))
+    except FileNotFoundError:
+        raise PlanError(f"{file}: no such findings file") from None
+    except (json.JSONDecodeError, UnicodeDecodeError) as exc:
+        raise PlanError(f"{file}: not a findings JSON ({exc})") from None
+    sources = data.get("sources") if isinstance(data, dict) else None
+    if not isinstance(sources, list) or not sources:
+        raise PlanError(f"{file}: no runs recorded (write it with `evoeye findings`)")
+    plan: list[PlannedRun] = []
+    for source in sources:
+        if not isinstance(source, dict) or not isinstance(source.get("path"), str):
+            raise PlanError(f"{file}: a run without its results file: {source!r}")
+        name = Path(source["path"]).stem
+        if not PLAIN_NAME.fullmatch(name):
+            raise PlanError(f"{file}: run {source['path']!r} has no plain name")
+        if any(p.name == name for p in plan):
+            raise PlanError(f"{file}: two runs are named {name!r}")
+        try:
+            config = ResultsConfig.from_dict(source.get("config") or {})
+        except (TypeError, ValueError) as exc:
+            raise PlanError(f"{file}: run {name!r} cannot be re-run: {exc}") from None
+        plan.append(PlannedRun(name, file.parent / f"{name}.json", config))
+    return plan
+
+
+def run_markdown(results: dict) -> str:
+    """The Markdown of a run's parts: RQ1's and the monitor ablation's, RQ2's, or both."""
+    from evoeye.results.run import markdown_files
+
+    files = markdown_files(results)
+    parts = set(results["config"]["parts"])
+    chosen = [f for f, own in (("rq1.md", parts & set(MONITOR_PARTS)), ("rq2.md", "rq2" in parts))
+              if own]
+    return "\n\n".join(files[f].rstrip("\n") for f in chosen) + "\n"
+
+
+def reproduce(findings: Path, data: Path, *, roots: Mapping[str, Path] | None = None,
+              workers: int | None = None, readme: Path | None = None,
+              progress: Progress | None = None) -> str:
+    """Re-run every run of the plan in `findings` (on `roots[name]`, else `data/<name>`;
+    `workers` replaces the recorded processes), write each run's `<name>.json` and `<name>.md`
+    beside the findings file, combine them again; findings.md's text."""
+    from evoeye.results.run import run_results, write_results
+
+    plan = read_plan(findings)
+    roots = dict(roots or {})
+    if unknown := sorted(set(roots) - {run.name for run in plan}):
+        raise PlanError(f"root given for no run of {findings_path(findings)}: {unknown}; its "
+                        f"runs: {[run.name for run in plan]}")
+    for run in plan:
+        root = DataRoot.resolve(roots.get(run.name, Path(data) / run.name))
+        config = run.config if workers is None else replace(run.config, workers=workers)
+        config.check_names()
+        results = run_results(root, config, progress).results
+        folder = write_results(root, results, run.name)
+        shutil.copyfile(folder / "results.json", run.path)
+        run.path.with_suffix(".md").write_text(run_markdown(results), encoding="utf-8")
+    out = findings_path(findings).parent
+    return write_combined(combine([run.path for run in plan]), out, readme)
