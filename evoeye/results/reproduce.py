@@ -99,10 +99,16 @@ def reproduce(findings: Path, data: Path, *, roots: Mapping[str, Path] | None = 
     if unknown := sorted(set(roots) - {run.name for run in plan}):
         raise PlanError(f"root given for no run of {findings_path(findings)}: {unknown}; its "
                         f"runs: {[run.name for run in plan]}")
-    for run in plan:
+    configs = [run.config if workers is None else replace(run.config, workers=workers)
+               for run in plan]
+    for run, config in zip(plan, configs, strict=True):  # every name known before any run
+        try:
+            config.check_names()
+        except ValueError as exc:
+            raise PlanError(f"{findings_path(findings)}: run {run.name!r} cannot be re-run: "
+                            f"{exc}") from None
+    for run, config in zip(plan, configs, strict=True):
         root = DataRoot.resolve(roots.get(run.name, Path(data) / run.name))
-        config = run.config if workers is None else replace(run.config, workers=workers)
-        config.check_names()
         results = run_results(root, config, progress).results
         folder = write_results(root, results, run.name)
         shutil.copyfile(folder / "results.json", run.path)

@@ -84,3 +84,10 @@ def test_the_command_names_a_bad_plan_or_root_and_exits_as_a_user_error(tmp_path
     assert res.exit_code != 0 and "give NAME=PATH" in res.output
     res = RUNNER.invoke(app, ["reproduce", str(docs), "--root", "rq9=/x"])
     assert res.exit_code == ExitCode.USER_ERROR and "['rq9']" in res.output
+
+
+def test_a_run_naming_an_unknown_method_is_refused_before_the_first_run_starts(tmp_path) -> None:
+    docs = _findings(tmp_path / "docs", {"parts": ["rq1"]}, {"methods": ["evoeye", "magic"]})
+    with pytest.raises(PlanError, match=r"run 'rq2' cannot be re-run: unknown method"):
+        reproduce(docs, tmp_path / "data")
+    assert not (tmp_path / "data").exists()  # rq1, first in the plan, did not start
