@@ -147,8 +147,9 @@ def _set_lines(results: dict) -> list[str]:
     return out
 
 
-def markdown_files(results: dict) -> dict[str, str]:
-    """File name → Markdown: rq1.md, rq2.md, findings.md."""
+def markdown_files(results: dict, source: str = "results.json") -> dict[str, str]:
+    """File name → Markdown: rq1.md, rq2.md, findings.md (which names `source` as the file the
+    findings come from)."""
     rq2_intro = (_intro(results, "RQ2, the evolution ablation and AEM-Evo") + "\n\n"
                  "The sets RQ2 judges on (Hard: the unsafe test frames G_0 misses and the safe "
                  "frames of their runs; Robust Hard: the unsafe test frames a majority of the "
@@ -161,7 +162,7 @@ def markdown_files(results: dict) -> dict[str, str]:
         "rq2.md": part_markdown("RQ2, the evolution ablation and AEM-Evo", rq2_intro,
                                 results["tables"], ("rq2", "evolution-ablation", "aem-evo",
                                                      "acquisition")),
-        "findings.md": findings_markdown(results["findings"], "docs/results/results.json"),
+        "findings.md": findings_markdown(results["findings"], source),
     }
 
 
@@ -174,7 +175,8 @@ def write_results(root: DataRoot, results: dict, name: str = "results", *,
     folder = root.reports / name
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "results.json").write_text(json.dumps(results, indent=1) + "\n", encoding="utf-8")
-    files = markdown_files(results)
+    files = markdown_files(results, str(docs / "results.json") if docs is not None
+                           else "results.json")
     for file, text in files.items():
         (folder / file).write_text(text, encoding="utf-8")
     (folder / "results.html").write_text(results_html(results, f"evoeye results — {name}"),
