@@ -48,6 +48,9 @@ def reproduce_command(
     root: Annotated[list[str] | None, typer.Option(
         "--root", help="NAME=PATH: run NAME (e.g. rq2) on this data root (repeatable).")] =
         None,
+    only: Annotated[list[str] | None, typer.Option(
+        "--only", help="Re-run only this run of the plan (repeatable); the others' files are "
+                       "combined as they are.")] = None,
     workers: Annotated[int | None, typer.Option(
         min=1, help="Processes per run (default: each run's recorded).")] = None,
     readme: Annotated[Path | None, typer.Option(
@@ -60,6 +63,6 @@ def reproduce_command(
 
     roots = dict(map(_named_root, root or []))
     with StepBar("reproduce") as bar:
-        text = reproduce(findings, data, roots=roots, workers=workers, readme=readme,
-                         progress=bar)
+        text = reproduce(findings, data, roots=roots, only=only or (), workers=workers,
+                         readme=readme, progress=bar)
     typer.echo(text)

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import json
 import shutil
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -87,31 +87,35 @@ def run_markdown(results: dict) -> str:
 
 
 def reproduce(findings: Path, data: Path, *, roots: Mapping[str, Path] | None = None,
-              workers: int | None = None, readme: Path | None = None,
+              only: Sequence[str] = (), workers: int | None = None, readme: Path | None = None,
               progress: Progress | None = None) -> str:
-    """Re-run every run of the plan in `findings` (on `roots[name]`, else `data/<name>`;
-    `workers` replaces the recorded processes), write each run's `<name>.json` and `<name>.md`
-    beside the findings file, combine them again; findings.md's text."""
+    """Re-run the runs of the plan in `findings` — all, or those named in `only` — (on
+    `roots[name]`, else `data/<name>`; `workers` replaces the recorded processes), write each
+    one's `<name>.json` and `<name>.md` beside the findings file, and combine every run of the
+    plan again; findings.md's text. Everything that can be refused is refused before a run."""
     from evoeye.results.run import run_results, write_results
 
-    plan = read_plan(findings)
-    roots = dict(roots or {})
-    if unknown := sorted(set(roots) - {run.name for run in plan}):
-        raise PlanError(f"root given for no run of {findings_path(findings)}: {unknown}; its "
-                        f"runs: {[run.name for run in plan]}")
+    file = findings_path(findings)
+    plan = read_plan(file)
+    names = [run.name for run in plan]
+    for given, what in ((roots or {}, "root given"), (only, "--only")):
+        if unknown := sorted(set(given) - set(names)):
+            raise PlanError(f"{what} for no run of {file}: {unknown}; its runs: {names}")
+    chosen = [run for run in plan if not only or run.name in only]
+    if kept := [run.path for run in plan if run not in chosen and not run.path.is_file()]:
+        raise PlanError(f"{file}: {[str(p) for p in kept]} missing: re-run those runs too, "
+                        "or put their results there")
     configs = [run.config if workers is None else replace(run.config, workers=workers)
-               for run in plan]
-    for run, config in zip(plan, configs, strict=True):  # every name known before any run
+               for run in chosen]
+    for run, config in zip(chosen, configs, strict=True):
         try:
             config.check_names()
         except ValueError as exc:
-            raise PlanError(f"{findings_path(findings)}: run {run.name!r} cannot be re-run: "
-                            f"{exc}") from None
-    for run, config in zip(plan, configs, strict=True):
-        root = DataRoot.resolve(roots.get(run.name, Path(data) / run.name))
+            raise PlanError(f"{file}: run {run.name!r} cannot be re-run: {exc}") from None
+    for run, config in zip(chosen, configs, strict=True):
+        root = DataRoot.resolve((roots or {}).get(run.name, Path(data) / run.name))
         results = run_results(root, config, progress).results
         folder = write_results(root, results, run.name)
         shutil.copyfile(folder / "results.json", run.path)
         run.path.with_suffix(".md").write_text(run_markdown(results), encoding="utf-8")
-    out = findings_path(findings).parent
-    return write_combined(combine([run.path for run in plan]), out, readme)
+    return write_combined(combine([run.path for run in plan]), file.parent, readme)

@@ -257,22 +257,28 @@ def test_reproduce_regenerates_a_findings_file_from_the_runs_it_records(done, tm
     docs, readme = tmp_path / "docs", tmp_path / "README.md"
     docs.mkdir()
     (docs / "tiny.json").write_bytes(done.first_json)
-    made = RUNNER.invoke(app, ["findings", str(docs / "tiny.json"), "--out", str(docs)])
+    kept = {**done.results, "tables": [{**t, "scenario": "other"} for t in done.results["tables"]]}
+    (docs / "kept.json").write_text(json.dumps(kept))  # another run's, with tables of its own
+    made = RUNNER.invoke(app, ["findings", str(docs / "tiny.json"), str(docs / "kept.json"),
+                               "--out", str(docs)])
     assert made.exit_code == 0, made.output
     (docs / "tiny.json").write_text("{}")  # stale: reproduce writes it again from the run
+    kept_bytes = (docs / "kept.json").read_bytes()
     readme.write_text(f"# x\n{README_BEGIN}\nold text\n{README_END}\n")
     before = _state(done.root)
     run = RUNNER.invoke(app, ["reproduce", str(docs), "--root", f"tiny={done.root.path}",
-                              "--readme", str(readme)])
+                              "--only", "tiny", "--readme", str(readme)])
     assert run.exit_code == 0, run.output
     assert _state(done.root) == before  # every unit found done on the root that made it
     assert (docs / "tiny.json").read_bytes() == done.first_json
+    assert (docs / "kept.json").read_bytes() == kept_bytes  # not re-run (--only), combined
     markdown = (docs / "tiny.md").read_text()
     assert markdown.startswith("# RQ1 and the monitor ablation")
     assert "\n# RQ2, the evolution ablation and AEM-Evo" in markdown
     combined = json.loads((docs / "findings.json").read_text())
-    assert [s["path"] for s in combined["sources"]] == [str(docs / "tiny.json")]
+    assert [s["path"] for s in combined["sources"]] == [str(docs / "tiny.json"),
+                                                         str(docs / "kept.json")]
     assert combined["sources"][0]["config"] == done.results["config"]
-    assert combined["findings"] == done.results["findings"]
+    assert len(combined["tables"]) == 2 * len(done.results["tables"])
     assert "old text" not in readme.read_text()
     assert done.results["findings"][0]["claim"] in readme.read_text()

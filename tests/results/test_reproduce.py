@@ -73,6 +73,10 @@ def test_a_root_for_no_run_is_refused_before_anything_runs(tmp_path) -> None:
     docs = _findings(tmp_path / "docs", {}, {})
     with pytest.raises(PlanError, match=r"root given for no run .*\['rq3'\].*\['rq1', 'rq2'\]"):
         reproduce(docs, tmp_path / "data", roots={"rq3": tmp_path / "x"})
+    with pytest.raises(PlanError, match=r"--only for no run .*\['rq3'\]"):
+        reproduce(docs, tmp_path / "data", only=["rq3"])
+    with pytest.raises(PlanError, match=r"rq1.json'\] missing: re-run those runs too"):
+        reproduce(docs, tmp_path / "data", only=["rq2"])  # rq1 kept, but it has no file
     assert not (tmp_path / "data").exists() and not (tmp_path / "x").exists()
 
 
