@@ -184,8 +184,10 @@ class Campaign:
         with self.clock("state"):
             return self._start(new_ids)
 
-    def _start(self, new_ids: Sequence[str]) -> CampaignState:
-        remove_stale_temps(self.root.batch_dir(self.config.scenario, self.campaign_id))
+    @intra_op_threads()
+    def store_initial_round(self) -> list[RoundRow]:
+        """The stored rounds, round 0 (G_0's feedback on D_init, its assessment) stored first if
+        it is not yet."""
         rounds = read_rounds(self.root, self.campaign_id)
         if not rounds:
             self._store_feedback(self.g0, self.initial["scenario_id"])
@@ -194,6 +196,11 @@ class Campaign:
                            metrics=self._metrics(self.g0))
             store_round(self.root, row)
             rounds = read_rounds(self.root, self.campaign_id)
+        return rounds
+
+    def _start(self, new_ids: Sequence[str]) -> CampaignState:
+        remove_stale_temps(self.root.batch_dir(self.config.scenario, self.campaign_id))
+        rounds = self.store_initial_round()
         last = rounds[-1]
         records, ok = records_of(self.initial, self._acquired(
             [*(s for r in rounds for s in r.scenario_ids), *new_ids]))

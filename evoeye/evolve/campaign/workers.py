@@ -81,7 +81,7 @@ def prepare_campaigns(jobs: Sequence[CampaignJob]) -> None:
     """Resolve every campaign's G_0 and store its round 0 (G_0's feedback on D_init and its
     assessment), one campaign after another: what the campaigns would otherwise all write."""
     for job in jobs:
-        _campaign(job).start()
+        _campaign(job).store_initial_round()
 
 
 def no_metrics(metrics: RoundMetrics | None) -> str:
