@@ -11,8 +11,9 @@ claims; each check is one comparison on one scenario, set and metric, and gets a
   +5 points (the difference the design is sized for), and **does not reproduce** when its lower
   end is at or above +5 points; otherwise it is not shown.
 
-A finding reproduces when every check does — on every scenario that ran, with every
-comparison it names (a method or baseline left out of the run leaves it partly shown at best);
+A finding reproduces when every check does — on every scenario its part (rq1, ablation, rq2)
+ran on, with every comparison it names (a method or baseline left out of the run, e.g. RQ2 run
+on a scenario without aem-evo, leaves it partly shown at best);
 does not reproduce when one is reversed (or, for "little", does not reproduce); is partly shown
 when some reproduce and none goes against it; and is not run yet when the results have none of
 its comparisons.
@@ -25,7 +26,7 @@ from dataclasses import dataclass
 from evoeye.results.config import BASELINES
 from evoeye.results.rq1 import FUSION_LABEL
 from evoeye.results.rq2 import g0_label
-from evoeye.results.tables import EFFECT, cell_key
+from evoeye.results.tables import EFFECT, TABLES, cell_key
 
 ALPHA = 0.05
 REPRODUCES, REVERSED, NOT_SHOWN, AGAINST = "reproduces", "reversed", "not shown", \
@@ -101,11 +102,14 @@ def _overall(verdicts: list[str], missing: int) -> str:
 def check_findings(tables: list[dict]) -> list[dict]:
     """Every finding with its checks (scenario, set, metric, a, b, the comparison cell and its
     verdict) and an overall verdict."""
+    part_of = {spec.id: spec.part for spec in TABLES}
     out = []
     for f in FINDINGS:
-        checks, expected = [], 0
+        # every scenario whose part ran owes the finding its checks, with or without its table
+        # (no AEM-Evo table where the part ran without aem-evo: its checks are missing)
+        ran = {t["scenario"] for t in tables if part_of.get(t["id"]) == part_of[f.table]}
+        checks, expected = [], len(ran) * len(f.pairs) * len(f.sets) * len(f.metrics)
         for table in (t for t in tables if t["id"] == f.table):
-            expected += len(f.pairs) * len(f.sets) * len(f.metrics)
             for comparison in table["comparisons"]:
                 if (comparison["a"], comparison["b"]) not in f.pairs:
                     continue

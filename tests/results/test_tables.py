@@ -105,6 +105,22 @@ def test_rq2_pairs_by_campaign_seed_and_keeps_the_k_seed_control_unpaired() -> N
     assert findings["rq1-baselines"]["verdict"] == "not run yet"
 
 
+def test_a_finding_is_owed_its_checks_on_every_scenario_its_part_ran_on() -> None:
+    base = 0.3 + 0.03 * RNG.standard_normal(N)
+    aem_evo = 0.21 + 0.003 * RNG.standard_normal(N)  # ~1 point over AEM G_0's 0.2: little
+    with_aem = _rq2({"evoeye": list(base), "aem-evo": list(aem_evo)}, [0.25, 0.3, 0.28])
+    with_aem["methods"]["AEM G_0"] = {"figures": with_aem["methods"]["G_0"]["figures"]}
+    without = _rq2({"evoeye": list(base)}, [0.25, 0.3, 0.28])
+    one = build_tables({"s1": {"rq2": with_aem}})
+    both = build_tables({"s1": {"rq2": with_aem}, "s2": {"rq2": without}})
+    assert [t["scenario"] for t in both if t["id"] == "aem-evo"] == ["s1"]  # none on s2
+    alone = {f["id"]: f for f in check_findings(one)}["rq3-aem-evo"]
+    assert alone["verdict"] == "reproduces" and alone["missing"] == 0
+    owed = {f["id"]: f for f in check_findings(both)}["rq3-aem-evo"]
+    assert owed["checks"] == alone["checks"] and owed["missing"] == 1
+    assert owed["verdict"] == "partly"  # s2 ran RQ2 without AEM-Evo: not "reproduces"
+
+
 def _cell(diff: float, low: float, high: float, p: float) -> dict:
     return {"mean_diff": diff, "ci_low": low, "ci_high": high, "p_value": p}
 
