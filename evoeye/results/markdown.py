@@ -89,11 +89,18 @@ def _keys(table: dict) -> list[tuple[str, str]]:
     return [(s, m) for s in table["sets"] for m in table["metrics"]]
 
 
+def other_scale(table: dict, row: dict) -> bool:
+    """Whether a row's feedback is on another monitor family's score scale: a `<family>-evo`
+    method (evoeye.evolve.campaign.experiment.methods) in the acquisition table."""
+    return table["id"] == "acquisition" and row["method"].endswith("-evo")
+
+
 def row_cells(table: dict) -> tuple[list[str], list[list[str]]]:
     """Header and text cells of a table's rows (mean [CI] per set and metric)."""
     keys = _keys(table)
     header = ["method"] + [column(s, m, table["sets"]) for s, m in keys]
-    rows = [[r["method"] + (" ¹" if r["unpaired"] else "")]
+    rows = [[r["method"] + (" ¹" if r["unpaired"] else "") + (" ²" if other_scale(table, r)
+                                                               else "")]
             + [mean_cell(r["cells"][cell_key(s, m)], m, r["n"]) for s, m in keys]
             for r in table["rows"]]
     return header, rows
@@ -125,6 +132,10 @@ def comparison_intro(table: dict) -> str:
 UNPAIRED_NOTE = ("¹ G_0's recipe retrained on the initial data with k seeds, no new data "
                  "(mean [95 % CI] over those k): a reference, not paired with the campaigns.")
 
+OTHER_SCALE_NOTE = ("² its f is |score − label| under its own family's monitor: the AEM scores "
+                    "a typical window near 0.5 (e / (e + ẽ)), so its f is not comparable with "
+                    "the FusionMonitor methods'.")
+
 
 def table_markdown(table: dict) -> list[str]:
     """A table's rows, then its comparisons."""
@@ -134,6 +145,8 @@ def table_markdown(table: dict) -> list[str]:
            *_md(header, rows)]
     if any(r["unpaired"] for r in table["rows"]):
         out += ["", UNPAIRED_NOTE]
+    if any(other_scale(table, r) for r in table["rows"]):
+        out += ["", OTHER_SCALE_NOTE]
     if comps:
         out += ["", comparison_intro(table), "", *_md(comp_header, comps)]
     if any(FLOOR_MARK in cell for row in comps for cell in row):

@@ -7,7 +7,7 @@ import pytest
 from scipy import stats
 
 from evoeye.results.findings import FINDINGS, check_findings, check_verdict
-from evoeye.results.markdown import diff_cell, mean_cell, pct
+from evoeye.results.markdown import diff_cell, mean_cell, pct, table_markdown
 from evoeye.results.tables import build_table, build_tables
 
 RNG = np.random.default_rng(5)
@@ -179,3 +179,10 @@ def test_the_acquisition_table_pairs_what_each_method_acquired_by_campaign_seed(
     assert cell["p_value"] == pytest.approx(stats.wilcoxon(diff).pvalue)
     collided = cmp["cells"]["acquired/collision_share"]
     assert collided["mean_diff"] == pytest.approx(-0.05)
+    assert not any(line.startswith("²") for line in table_markdown(table))
+    part["methods"]["aem-evo"] = {**part["methods"]["uniform"]}  # an AEM-scored method
+    other = next(t for t in build_tables({"s1": {"rq2": part}}) if t["id"] == "acquisition")
+    text = table_markdown(other)
+    assert sum("| aem-evo ² |" in line for line in text) == 1
+    assert sum(line.startswith("² its f is |score − label| under its own family") for line in
+               text) == 1 and not any("| uniform ²" in line for line in text)
