@@ -390,22 +390,3 @@ def test_a_round_without_an_ok_run_keeps_its_monitor(root_copy, seeded) -> None:
     state.ok[:] = np.arange(len(state.ok)) < len(c.initial["scenario_id"])  # the round failed
     assert c.training_runs(state) == []
     assert c.update_monitor(state) == (state.monitor, 0.0)
-
-
-def test_preparing_campaigns_stores_round_0_once_without_building_their_state(
-        root_copy, seeded, monkeypatch) -> None:
-    from evoeye.evolve.campaign.workers import CampaignJob, prepare_campaigns
-
-    root = root_copy("prepare")
-    cfg = config(seeded[1], strategy="uniform", budget_s=50.0)
-    monkeypatch.setattr(Campaign, "_acquired", lambda self, ids: pytest.fail("state built"))
-    job = CampaignJob(str(root.path), cfg, "uniform seed 0")
-    prepare_campaigns([job])
-    first = read_rounds(root, Campaign(root, cfg).campaign_id)
-    assert [(r.round, r.monitor_version, r.scenario_ids) for r in first] == [(0, seeded[1], [])]
-    assert first[0].metrics is not None and first[0].metrics.test  # G_0 assessed
-    fed = read_feedback(root).num_rows
-    assert fed > 0  # G_0's feedback on D_init
-    prepare_campaigns([job])  # a prepared (or finished) campaign: nothing stored again
-    assert read_rounds(root, Campaign(root, cfg).campaign_id) == first
-    assert read_feedback(root).num_rows == fed
