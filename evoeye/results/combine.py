@@ -26,14 +26,14 @@ class ResultsFileError(ValueError):
     """A results file that cannot be read, or two that claim the same table."""
 
 
-def results_path(path: Path) -> Path:
-    """`path` itself, or `path/results.json` for a report folder."""
-    return path / RESULTS_FILE if path.is_dir() else path
+def file_in(path: Path, name: str = RESULTS_FILE) -> Path:
+    """`path` itself, or `path/<name>` for a folder (a report folder, docs/results)."""
+    return path / name if path.is_dir() else path
 
 
 def load_results(path: Path) -> dict:
     """A results JSON written by `evoeye results`, checked for what combining needs."""
-    file = results_path(path)
+    file = file_in(path)
     try:
         results = json.loads(file.read_text(encoding="utf-8"))
     except FileNotFoundError:
@@ -60,7 +60,7 @@ def combine(paths: Sequence[Path]) -> dict:
         raise ResultsFileError("give at least one results file")
     sources, tables, owner = [], [], {}
     for path in paths:
-        file = results_path(path)
+        file = file_in(path)
         results = load_results(file)
         names = []
         for table in results["tables"]:

@@ -19,7 +19,7 @@ from dataclasses import dataclass, replace
 from pathlib import Path
 
 from evoeye.paths import PLAIN_NAME, DataRoot
-from evoeye.results.combine import combine, write_combined
+from evoeye.results.combine import combine, file_in, write_combined
 from evoeye.results.config import MONITOR_PARTS, ResultsConfig
 from evoeye.results.study import Progress
 
@@ -40,15 +40,10 @@ class PlannedRun:
     config: ResultsConfig
 
 
-def findings_path(path: Path) -> Path:
-    """`path` itself, or `path/findings.json` for a folder (e.g. docs/results)."""
-    return path / FINDINGS_FILE if path.is_dir() else path
-
-
 def read_plan(path: Path) -> list[PlannedRun]:
     """The runs a findings.json of `evoeye findings` was combined from, each with its config;
     PlanError naming the file and the run that cannot be re-run."""
-    file = findings_path(path)
+    file = file_in(path, FINDINGS_FILE)
     try:
         data = json.loads(file.read_text(encoding="utf-8"))
     except FileNotFoundError:
@@ -95,7 +90,7 @@ def reproduce(findings: Path, data: Path, *, roots: Mapping[str, Path] | None = 
     plan again; findings.md's text. Everything that can be refused is refused before a run."""
     from evoeye.results.run import run_results, write_results
 
-    file = findings_path(findings)
+    file = file_in(findings, FINDINGS_FILE)
     plan = read_plan(file)
     names = [run.name for run in plan]
     for given, what in ((roots or {}, "root given"), (only, "--only")):
