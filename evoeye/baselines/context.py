@@ -103,6 +103,17 @@ class ContextOnlyMonitor:
         return cls.decode(*read_version(version_dir, MODEL_FILE, META_FILE))
 
 
+def context_classifier(config: ContextConfig = ContextConfig()  # noqa: B008
+                       ) -> HistGradientBoostingClassifier:
+    """The control's classifier, unfitted (also `evoeye audit`'s out-of-fold context check)."""
+    return HistGradientBoostingClassifier(
+        max_iter=config.max_iter, learning_rate=config.learning_rate,
+        max_leaf_nodes=config.max_leaf_nodes, min_samples_leaf=config.min_samples_leaf,
+        l2_regularization=config.l2_regularization, early_stopping=False,
+        random_state=config.seed,
+    )
+
+
 def train_context_only(train: Windows, config: ContextConfig = ContextConfig()  # noqa: B008
                        ) -> ContextOnlyMonitor:
     """Fit the control on every window of `train` (eligible frames, their labels)."""
@@ -110,12 +121,7 @@ def train_context_only(train: Windows, config: ContextConfig = ContextConfig()  
     if len(np.unique(y)) < 2:
         raise ValueError(f"the context-only control needs both classes; {int(y.sum())} of "
                          f"{len(y)} training windows are unsafe")
-    model = HistGradientBoostingClassifier(
-        max_iter=config.max_iter, learning_rate=config.learning_rate,
-        max_leaf_nodes=config.max_leaf_nodes, min_samples_leaf=config.min_samples_leaf,
-        l2_regularization=config.l2_regularization, early_stopping=False,
-        random_state=config.seed,
-    )
+    model = context_classifier(config)
     with threadpool_limits(THREADS):
         model.fit(x, y)
     data = hashlib.sha256(np.ascontiguousarray(x).tobytes() + y.tobytes()).hexdigest()

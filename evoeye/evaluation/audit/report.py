@@ -113,6 +113,15 @@ def _timing_lines(s: ScenarioAudit) -> list[str]:
                    f"unsafe, {c.runs} runs): earlier = riskier {_f(c.earlier_riskier)}, best "
                    f"direction {_f(c.best_direction)}, gradient boosting on t (out of fold, "
                    f"grouped by run) {_f(c.model)}; headline **{_f(c.headline)}**.")
+    x = s.context
+    out.append("")
+    if x is None:
+        out.append(f"Context-only AUROC: {NOT_INGESTED}.")
+    else:
+        out.append(f"Context-only control (RQ1's: gradient boosting on t, the ego's speed and "
+                   f"its x, y; out of fold, grouped by run) on the same frames: AUROC "
+                   f"**{_f(x.auroc)}**, AUPRC {_f(x.auprc)}. A monitor must beat its AUROC by "
+                   f"5 points (RQ1's bound); this batch trains it on fewer runs than RQ1 does.")
     return out
 
 
@@ -130,7 +139,7 @@ def markdown_report(audits: list[ScenarioAudit], scenario: str | None, batch: st
         lines += ["", "### Kinematics (NPCs, before the ego's first collision)", "",
                   *_kinematic_lines(s), "", *_worst_lines(s.runs), "",
                   "### Pass-through, pop-in", "", *(_other_findings(s) or ["None."]), "",
-                  "### Collision times and the clock", "", *_timing_lines(s), "",
+                  "### Collision times, the clock and the context", "", *_timing_lines(s), "",
                   "### Attribution (`evoeye explain`)", "", *_attribution_lines(s), ""]
     return "\n".join(lines)
 

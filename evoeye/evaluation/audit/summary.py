@@ -10,7 +10,9 @@ from typing import Any
 
 import numpy as np
 
+from evoeye.baselines.context import context_inputs
 from evoeye.evaluation.audit.attribution import AttributionSummary, summarise_attribution
+from evoeye.evaluation.audit.context import ContextAuroc, context_auroc
 from evoeye.evaluation.audit.runs import (
     DEFAULT_BOUNDS,
     AuditBounds,
@@ -21,7 +23,7 @@ from evoeye.evaluation.audit.runs import (
 from evoeye.evaluation.audit.timing import ClockAuroc, CollisionTimes, clock_auroc, collision_times
 from evoeye.evaluation.audit.verdicts import DEFAULT_THRESHOLDS, Thresholds, Verdict, verdicts
 from evoeye.paths import DataRoot
-from evoeye.store import Warehouse
+from evoeye.store import Warehouse, load_windows
 
 HORIZON_S = 3.0  # the label horizon H of the clock check (Definition 1)
 
@@ -34,6 +36,7 @@ class ScenarioAudit:
     runs: list[RunAudit]
     collision_times: CollisionTimes | None = None
     clock: ClockAuroc | None = None  # None: the runs are not in the warehouse
+    context: ContextAuroc | None = None  # None: the runs are not in the warehouse
     attribution: AttributionSummary | None = None  # None: no run explained
     verdicts: list[Verdict] = field(default_factory=list)
 
@@ -84,6 +87,7 @@ class ScenarioAudit:
             "collision_times": None if self.collision_times is None
             else self.collision_times.to_dict(),
             "clock_auroc": None if self.clock is None else self.clock.to_dict(),
+            "context_auroc": None if self.context is None else self.context.to_dict(),
             "attribution": None if self.attribution is None else self.attribution.to_dict(),
             "verdicts": [v.to_dict() for v in self.verdicts],
             "per_run": [r.to_dict() for r in self.runs],
@@ -96,6 +100,15 @@ def _clock(wh: Warehouse, ids: list[str]) -> ClockAuroc | None:
         return None
     return clock_auroc(frames.column("t_s").to_numpy(), frames.column("label").to_numpy(),
                        np.asarray(frames.column("scenario_id").to_pylist()))
+
+
+def _context(wh: Warehouse, ids: list[str]) -> ContextAuroc | None:
+    if not ids:
+        return None
+    windows = load_windows(wh, ids, context_len=1, horizon_s=HORIZON_S)
+    if len(windows) == 0:
+        return None
+    return context_auroc(context_inputs(windows), windows.label, windows.scenario_id)
 
 
 def _attribution(wh: Warehouse, ids: list[str]) -> AttributionSummary | None:
@@ -113,6 +126,7 @@ def audit_scenario(name: str, runs: list[RunAudit], wh: Warehouse,
     s = ScenarioAudit(name, runs)
     s.collision_times = collision_times(np.array([r.collision_time_s for r in collided]))
     s.clock = _clock(wh, [r.scenario_id for r in ok])
+    s.context = _context(wh, [r.scenario_id for r in ok])
     s.attribution = _attribution(wh, [r.scenario_id for r in collided])
     s.verdicts = verdicts(s, thresholds)
     return s

@@ -8,9 +8,11 @@ how far a monitor could get by reading the clock.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import asdict, dataclass
 
 import numpy as np
+from sklearn.base import ClassifierMixin
 from sklearn.ensemble import HistGradientBoostingClassifier
 from sklearn.model_selection import GroupKFold
 from threadpoolctl import threadpool_limits
@@ -84,28 +86,35 @@ class ClockAuroc:
         return {**asdict(self), "headline": self.headline}
 
 
-def clock_model_scores(t_s: np.ndarray, labels: np.ndarray, groups: np.ndarray,
+def out_of_fold_scores(x: np.ndarray, labels: np.ndarray, groups: np.ndarray,
+                       make_model: Callable[[], ClassifierMixin],
                        folds: int = CLOCK_FOLDS) -> np.ndarray | None:
-    """(N,) out-of-fold P(unsafe | t) from a gradient-boosted model of t alone, folds grouped by
-    run (a fold trained on one class predicts its training rate); None with fewer runs than 2
-    or a single class."""
+    """(N,) out-of-fold P(unsafe | x) of the classifier `make_model` builds, for x (N, F),
+    folds grouped by run (a fold trained on one class predicts its training rate); None with
+    fewer runs than 2 or a single class."""
     n_groups = len(np.unique(groups))
     if n_groups < 2 or labels.min() == labels.max():
         return None
-    x = t_s[:, None]  # (N, 1)
-    scores = np.empty(len(t_s))
+    scores = np.empty(len(x))
     # One OpenMP thread: on a shared machine its threads oversubscribe the cores (measured 20×
-    # slower at load 8 on 2 cores), and a 1-feature model gains nothing from them.
+    # slower at load 8 on 2 cores), and a model of a few features gains nothing from them.
     with threadpool_limits(1):
         for train, test in GroupKFold(n_splits=min(folds, n_groups)).split(x, labels, groups):
             y = labels[train]
             if y.min() == y.max():
                 scores[test] = y[0]
                 continue
-            model = HistGradientBoostingClassifier(max_iter=100, early_stopping=False,
-                                                   random_state=0)
-            scores[test] = model.fit(x[train], y).predict_proba(x[test])[:, 1]
+            scores[test] = make_model().fit(x[train], y).predict_proba(x[test])[:, 1]
     return scores
+
+
+def clock_model_scores(t_s: np.ndarray, labels: np.ndarray, groups: np.ndarray,
+                       folds: int = CLOCK_FOLDS) -> np.ndarray | None:
+    """(N,) out-of-fold P(unsafe | t) from a gradient-boosted model of t alone."""
+    return out_of_fold_scores(
+        t_s[:, None], labels, groups, folds=folds,
+        make_model=lambda: HistGradientBoostingClassifier(max_iter=100, early_stopping=False,
+                                                          random_state=0))
 
 
 def clock_auroc(t_s: np.ndarray, labels: np.ndarray, groups: np.ndarray) -> ClockAuroc:

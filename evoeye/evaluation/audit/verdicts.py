@@ -29,6 +29,9 @@ class Thresholds:
     careful_avoidable_min: float = 0.80
     careful_unavoidable_max: float = 0.20
     clock_auroc_max: float = 0.70
+    # a monitor must beat the context-only control by 5 AUROC points (RQ1), so the control
+    # must leave that much room
+    context_auroc_max: float = 0.95
     diverse_modules_min: int = 3  # modules with at least module_share_min of the credit
     module_share_min: float = 0.10
     module_share_max: float = 0.60
@@ -107,6 +110,17 @@ def _clock(s: ScenarioAudit, t: Thresholds) -> Verdict:
     return Verdict("clock-only AUROC", f"{h:.3f}", bound, h <= t.clock_auroc_max)
 
 
+def _context(s: ScenarioAudit, t: Thresholds) -> Verdict:
+    name, bound = "context-only AUROC", f"≤ {t.context_auroc_max:.2f} (room for RQ1's +5)"
+    if s.context is None:
+        return Verdict(name, NOT_INGESTED, bound, None)
+    c = s.context
+    if c.auroc is None:
+        return Verdict(name, "undefined (one label class only)", bound, None)
+    return Verdict(name, f"{c.auroc:.3f} (AUPRC {c.auprc:.3f})", bound,
+                   c.auroc <= t.context_auroc_max)
+
+
 def _diverse(s: ScenarioAudit, t: Thresholds) -> Verdict:
     bound = f"≥ {t.diverse_modules_min} modules ≥ {_pct(t.module_share_min)}, none > " \
             f"{_pct(t.module_share_max)}"
@@ -122,7 +136,8 @@ def _diverse(s: ScenarioAudit, t: Thresholds) -> Verdict:
 
 
 VERDICTS: tuple[Callable[[ScenarioAudit, Thresholds], Verdict], ...] = (
-    _collision_rate, _kinematics, _pass_through, _pop_in, _careful, _clock, _diverse,
+    _collision_rate, _kinematics, _pass_through, _pop_in, _careful, _clock, _context,
+    _diverse,
 )
 
 

@@ -47,6 +47,7 @@ def test_audit_before_and_after_ingest(batch_root: DataRoot) -> None:
     judged = {v["criterion"]: v for v in s["verdicts"]}
     assert judged["clock-only AUROC"]["passed"] is None
     assert "evoeye ingest" in judged["clock-only AUROC"]["value"]
+    assert s["context_auroc"] is None and judged["context-only AUROC"]["passed"] is None
     assert _files(batch_root.path) == before  # read-only
 
     assert RUNNER.invoke(app, ["ingest", "--root", str(batch_root.path)]).exit_code == 0
@@ -59,10 +60,17 @@ def test_audit_before_and_after_ingest(batch_root: DataRoot) -> None:
                       "WHERE collision_time_s IS NULL OR t_s < collision_time_s").to_pylist()
     clock = s["clock_auroc"]
     assert clock["frames"] == eligible[0]["n"] and clock["runs"] == 6
+    context = s["context_auroc"]  # the same pre-collision frames, RQ1's control out of fold
+    assert (context["frames"], context["unsafe_frames"]) == (clock["frames"],
+                                                             clock["unsafe_frames"])
+    verdict = {v["criterion"]: v for v in s["verdicts"]}["context-only AUROC"]
+    auroc = context["auroc"]
+    assert verdict["passed"] == (None if auroc is None else auroc <= 0.95)
     written = json.loads((batch_root.reports / f"audit-{S1}-all" / "audit.json").read_text())
     assert written == report
     md = (batch_root.reports / f"audit-{S1}-all" / "audit.md").read_text()
     assert "clock-only AUROC" in md and "not explained yet" in md
+    assert "Context-only control (RQ1's" in md
 
 
 def test_strict_fails_exactly_when_a_criterion_fails(batch_root: DataRoot) -> None:

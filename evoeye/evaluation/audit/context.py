@@ -1,0 +1,48 @@
+"""Does *where and when* the ego is give the danger away? The context-only check.
+
+The RQ1 context-only control (`evoeye.baselines.context`: gradient boosting on the time since
+start, the ego's speed and its x, y on the map, nothing a module publishes), scored out of fold
+with folds grouped by run, on the batch's pre-collision frames (labels: Definition 1, H = 3 s).
+
+Issue 10's RQ1 bound asks a monitor to beat this control by 5 AUROC points, so a batch whose
+control already scores above 0.95 leaves no room for that: the scenario script, not the ADS's
+messages, ranks its frames. On a batch of a few hundred runs the control trains on fewer runs
+than RQ1's (≥ 1 000), so this figure is a slight underestimate of RQ1's control: passing is
+necessary for the bound, not sufficient.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from evoeye.baselines.context import context_classifier
+from evoeye.evaluation.audit.timing import out_of_fold_scores
+from evoeye.evaluation.metrics import auprc, auroc
+
+
+@dataclass(frozen=True)
+class ContextAuroc:
+    """Out-of-fold AUROC and AUPRC of the context-only control; None where a class is missing."""
+
+    frames: int
+    unsafe_frames: int
+    runs: int
+    auroc: float | None
+    auprc: float | None
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def context_auroc(x: np.ndarray, labels: np.ndarray, groups: np.ndarray) -> ContextAuroc:
+    """x: (N, 4) the control's inputs (`context_inputs`), labels and run ids (N,)."""
+    labels = np.asarray(labels, np.int64)
+    scores = out_of_fold_scores(np.asarray(x, np.float64), labels, np.asarray(groups),
+                                make_model=context_classifier)
+    return ContextAuroc(
+        frames=len(labels), unsafe_frames=int(labels.sum()), runs=len(np.unique(groups)),
+        auroc=None if scores is None else auroc(scores, labels),
+        auprc=None if scores is None else auprc(scores, labels),
+    )
