@@ -9,6 +9,11 @@ control already scores above 0.95 leaves no room for that: the scenario script, 
 messages, ranks its frames. On a batch of a few hundred runs the control trains on fewer runs
 than RQ1's (≥ 1 000), so this figure is a slight underestimate of RQ1's control: passing is
 necessary for the bound, not sufficient.
+
+Beside it, the same model without the ego's speed — when and where only, the script's part.
+The speed is the ADS's own doing: where the stack drives into a conflict instead of braking,
+its speed shows that decision, so the gap between the two figures is how much of the control's
+score comes from watching the ego rather than reading the script.
 """
 
 from __future__ import annotations
@@ -17,9 +22,12 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from evoeye.baselines.context import context_classifier
+from evoeye.baselines.context import CONTEXT_INPUTS, context_classifier
 from evoeye.evaluation.audit.timing import out_of_fold_scores
 from evoeye.evaluation.metrics import auprc, auroc
+
+
+NO_SPEED = [i for i, name in enumerate(CONTEXT_INPUTS) if name != "ego_speed_mps"]
 
 
 @dataclass(frozen=True)
@@ -31,6 +39,8 @@ class ContextAuroc:
     runs: int
     auroc: float | None
     auprc: float | None
+    where_when_auroc: float | None  # the same without the ego's speed
+    where_when_auprc: float | None
 
     def to_dict(self) -> dict:
         return asdict(self)
@@ -38,11 +48,16 @@ class ContextAuroc:
 
 def context_auroc(x: np.ndarray, labels: np.ndarray, groups: np.ndarray) -> ContextAuroc:
     """x: (N, 4) the control's inputs (`context_inputs`), labels and run ids (N,)."""
-    labels = np.asarray(labels, np.int64)
-    scores = out_of_fold_scores(np.asarray(x, np.float64), labels, np.asarray(groups),
-                                make_model=context_classifier)
+    labels, groups, x = np.asarray(labels, np.int64), np.asarray(groups), np.asarray(x, float)
+    full = out_of_fold_scores(x, labels, groups, make_model=context_classifier)
+    where_when = out_of_fold_scores(x[:, NO_SPEED], labels, groups, make_model=context_classifier)
     return ContextAuroc(
         frames=len(labels), unsafe_frames=int(labels.sum()), runs=len(np.unique(groups)),
-        auroc=None if scores is None else auroc(scores, labels),
-        auprc=None if scores is None else auprc(scores, labels),
+        auroc=_metric(auroc, full, labels), auprc=_metric(auprc, full, labels),
+        where_when_auroc=_metric(auroc, where_when, labels),
+        where_when_auprc=_metric(auprc, where_when, labels),
     )
+
+
+def _metric(metric, scores: np.ndarray | None, labels: np.ndarray) -> float | None:
+    return None if scores is None else metric(scores, labels)
