@@ -29,17 +29,28 @@ from evoeye.store.features import CONTROL_FEATURES
 from evoeye.store.windows import Windows
 
 CONTEXT_INPUTS = ("t_s", "ego_speed_mps", "ego_x_m", "ego_y_m")
+WHERE_WHEN_INPUTS = ("t_s", "ego_x_m", "ego_y_m")  # the same without the ego's speed
+# the controls by name: (version prefix, inputs). The where-when control sees only the script's
+# part — when and where the ego is — not the ego's speed, which is the ADS's own doing: where the
+# stack drives into a conflict instead of braking, its speed shows it
+CONTROLS = {"context-only": ("ctx-", CONTEXT_INPUTS), "where-when": ("ww-", WHERE_WHEN_INPUTS)}
 SPEED = CONTROL_FEATURES.index("ego_speed_mps")
 MODEL_FILE, META_FILE = "model.pkl", "meta.json"
 THREADS = 1  # OpenMP threads for fit and predict (module doc)
 
 
-def context_inputs(windows: Windows) -> np.ndarray:
-    """(B, 4) float64: CONTEXT_INPUTS at the frame each window ends at."""
+def context_inputs(windows: Windows, inputs: tuple[str, ...] = CONTEXT_INPUTS) -> np.ndarray:
+    """(B, len(inputs)) float64: the named inputs (of CONTEXT_INPUTS) at the frame each window
+    ends at."""
     if windows.ego_xy_m is None:
         raise ValueError("these windows carry no ego position (load them with load_windows)")
-    speed = windows.features.control[windows.context[:, -1], SPEED]  # (B,)
-    return np.column_stack([windows.t_s, speed, windows.ego_xy_m]).astype(np.float64)
+    columns = {
+        "t_s": lambda: windows.t_s,
+        "ego_speed_mps": lambda: windows.features.control[windows.context[:, -1], SPEED],
+        "ego_x_m": lambda: windows.ego_xy_m[:, 0],
+        "ego_y_m": lambda: windows.ego_xy_m[:, 1],
+    }
+    return np.column_stack([columns[name]() for name in inputs]).astype(np.float64)
 
 
 @dataclass(frozen=True)
@@ -61,7 +72,7 @@ class ContextOnlyMonitor:
     config: ContextConfig
     model: HistGradientBoostingClassifier
     data_sha256: str  # of the training inputs and labels: same data and config, same version
-    name: str = "context-only"
+    name: str = "context-only"  # a key of CONTROLS
     context_len: int = 1  # reads only the newest frame of a window
     thresholds: Thresholds | None = None  # never calibrated when saved: evaluate calibrates
     card: dict[str, Any] = field(default_factory=dict)  # meta.json of a saved version
@@ -70,13 +81,17 @@ class ContextOnlyMonitor:
     def version(self) -> str:
         h = hashlib.sha256(json.dumps(asdict(self.config), sort_keys=True).encode())
         h.update(self.data_sha256.encode())
-        return f"ctx-{h.hexdigest()[:12]}"
+        return f"{CONTROLS[self.name][0]}{h.hexdigest()[:12]}"
+
+    @property
+    def inputs(self) -> tuple[str, ...]:
+        return CONTROLS[self.name][1]
 
     def score(self, windows: Windows) -> np.ndarray:
         if len(windows) == 0:
             return np.zeros(0)
         with threadpool_limits(THREADS):
-            return self.model.predict_proba(context_inputs(windows))[:, 1]
+            return self.model.predict_proba(context_inputs(windows, self.inputs))[:, 1]
 
     def save(self, folder: Path, meta: dict | None = None) -> Path:
         """Write `<folder>/<version>/model.pkl` and `meta.json`; the version folder."""
@@ -84,7 +99,7 @@ class ContextOnlyMonitor:
         out.mkdir(parents=True, exist_ok=True)
         blob = pickle.dumps(self.model, protocol=pickle.HIGHEST_PROTOCOL)
         (out / MODEL_FILE).write_bytes(blob)
-        info = {"version": self.version, "name": self.name, "inputs": list(CONTEXT_INPUTS),
+        info = {"version": self.version, "name": self.name, "inputs": list(self.inputs),
                 "config": asdict(self.config), "data_sha256": self.data_sha256,
                 "model_sha256": hashlib.sha256(blob).hexdigest()}
         (out / META_FILE).write_text(json.dumps({**info, **(meta or {})}, indent=2) + "\n")
@@ -94,7 +109,8 @@ class ContextOnlyMonitor:
     def decode(cls, blob: bytes, meta: dict[str, Any]) -> ContextOnlyMonitor:
         """The monitor of a checked model.pkl and its meta.json."""
         model = pickle.loads(blob)  # noqa: S301 (our own file, checked against its sha256)
-        return cls(ContextConfig(**meta["config"]), model, meta["data_sha256"], card=meta)
+        return cls(ContextConfig(**meta["config"]), model, meta["data_sha256"],
+                   name=meta.get("name", "context-only"), card=meta)
 
     @classmethod
     def load(cls, version_dir: Path) -> ContextOnlyMonitor:
@@ -114,15 +130,16 @@ def context_classifier(config: ContextConfig = ContextConfig()  # noqa: B008
     )
 
 
-def train_context_only(train: Windows, config: ContextConfig = ContextConfig()  # noqa: B008
-                       ) -> ContextOnlyMonitor:
-    """Fit the control on every window of `train` (eligible frames, their labels)."""
-    x, y = context_inputs(train), train.label.astype(np.int8)  # (B, 4), (B,)
+def train_context_only(train: Windows, config: ContextConfig = ContextConfig(),  # noqa: B008
+                       name: str = "context-only") -> ContextOnlyMonitor:
+    """Fit the control `name` (of CONTROLS) on every window of `train` (eligible frames, their
+    labels)."""
+    x, y = context_inputs(train, CONTROLS[name][1]), train.label.astype(np.int8)  # (B, F), (B,)
     if len(np.unique(y)) < 2:
-        raise ValueError(f"the context-only control needs both classes; {int(y.sum())} of "
+        raise ValueError(f"the {name} control needs both classes; {int(y.sum())} of "
                          f"{len(y)} training windows are unsafe")
     model = context_classifier(config)
     with threadpool_limits(THREADS):
         model.fit(x, y)
     data = hashlib.sha256(np.ascontiguousarray(x).tobytes() + y.tobytes()).hexdigest()
-    return ContextOnlyMonitor(config, model, data)
+    return ContextOnlyMonitor(config, model, data, name=name)

@@ -1,5 +1,5 @@
-"""The trained baselines as monitor families: the AEM (evolvable: AEM-Evo) and the context-only
-control, each kept under `<root>/baselines/<name>/<version>/` with `meta.json`.
+"""The trained baselines as monitor families: the AEM (evolvable: AEM-Evo), the context-only
+control and the where-when control (the same without the ego's speed), each kept under `<root>/baselines/<name>/<version>/` with `meta.json`.
 
 RQ1 (`fit`): trained on the train split of a logical scenario (or any RunFilter, e.g. its
 round-0 runs only) with a seed, and found again by a training key (a hash of the scenario,
@@ -12,10 +12,11 @@ round, its thresholds calibrated on the validation runs and kept in `meta.json`;
 
 from __future__ import annotations
 
+import functools
 from dataclasses import asdict, replace
 from typing import TYPE_CHECKING, Any
 
-from evoeye.monitor.families import MonitorFamily, register_family, training_key
+from evoeye.monitor.families import FAMILIES, MonitorFamily, register_family, training_key
 from evoeye.paths import DataRoot
 from evoeye.store.selection import RunFilter, Runs, SplitSpec
 from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S
@@ -101,21 +102,23 @@ def fit_context_only(root: DataRoot, scenario: str,
                      splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
                      config: ContextConfig | None = None, *,
                      horizon_s: float = DEFAULT_HORIZON_S, seed: int | None = None,
-                     runs: RunFilter | None = None) -> ContextOnlyMonitor:
-    """The context-only control of this scenario's train split (or of `runs`): loaded if
-    trained before, else trained on every (eligible) training window and saved; `seed`
-    replaces the config's."""
+                     runs: RunFilter | None = None,
+                     name: str = "context-only") -> ContextOnlyMonitor:
+    """The control `name` (context-only, where-when) of this scenario's train split (or of
+    `runs`): loaded if trained before, else trained on every (eligible) training window and
+    saved; `seed` replaces the config's."""
     from evoeye.baselines.context import ContextConfig, train_context_only
 
+    family = FAMILIES[name]
     config = _seeded(config or ContextConfig(), seed)
     runs = _train_runs(scenario, splits, runs)
     ids = _train_ids(root, runs)
-    key = training_key("context-only", scenario, asdict(splits), asdict(config), horizon_s, ids)
-    if (version := CONTEXT_ONLY.find(root, key)) is not None:
-        return CONTEXT_ONLY.load(root, version)
+    key = training_key(name, scenario, asdict(splits), asdict(config), horizon_s, ids)
+    if (version := family.find(root, key)) is not None:
+        return family.load(root, version)
     train = _train_windows(root, runs, 1, horizon_s)
-    monitor = train_context_only(train, config)
-    monitor.save(CONTEXT_ONLY.versions_dir(root),
+    monitor = train_context_only(train, config, name)
+    monitor.save(family.versions_dir(root),
                  _training_meta(key, scenario, splits, horizon_s, ids, len(train)))
     return monitor
 
@@ -168,4 +171,9 @@ AEM = register_family(MonitorFamily(
 CONTEXT_ONLY = register_family(MonitorFamily(
     "context-only", "context-only control", "ctx-", "baselines/context-only", "model.pkl",
     "meta.json", decode=_decode_context, fit=fit_context_only,
+))
+WHERE_WHEN = register_family(MonitorFamily(
+    "where-when", "where-when control (no ego speed)", "ww-", "baselines/where-when",
+    "model.pkl", "meta.json", decode=_decode_context,
+    fit=functools.partial(fit_context_only, name="where-when"),
 ))

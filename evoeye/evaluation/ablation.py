@@ -26,7 +26,8 @@ from evoeye.store import SplitSpec
 CONTEXT_LENS = (1, 3, 5, 7)
 FULL_INPUTS = "all"
 CONTROL = "context-only"  # the control row's label and baseline name
-REFERENCES = (CONTROL, "ttc", "ttc-2d", "rss", "rss-2s")  # baseline rows, by baseline name
+REFERENCES = (CONTROL, "where-when", "ttc", "ttc-2d", "rss",
+              "rss-2s")  # baseline rows, by baseline name
 
 
 def input_sets() -> dict[str, tuple[str, ...]]:

@@ -32,7 +32,7 @@ from dataclasses import dataclass, fields, replace
 
 SCENARIOS = ("highway-cut-in", "unprotected-intersection")  # evoeye.scenarios.SCENARIOS
 BASELINES = ("ttc", "ttc-2d", "rss", "rss-2s", "aem",
-             "context-only")  # evoeye.evaluation.monitors.BASELINES
+             "context-only", "where-when")  # evoeye.evaluation.monitors.BASELINES
 CONTEXT_LENS = (1, 3, 5, 7)  # evoeye.evaluation.ablation.CONTEXT_LENS
 INPUTS = ("perception", "perception+prediction", "perception+prediction+planning",
           "all")  # evoeye.monitor.inputs.ABLATIONS

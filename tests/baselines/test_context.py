@@ -8,6 +8,7 @@ import pytest
 
 from evoeye.baselines.context import (
     CONTEXT_INPUTS,
+    WHERE_WHEN_INPUTS,
     ContextOnlyMonitor,
     context_inputs,
     train_context_only,
@@ -78,3 +79,21 @@ def test_same_data_same_version_and_a_saved_model_round_trips(tmp_path) -> None:
 def test_one_class_is_refused() -> None:
     with pytest.raises(ValueError, match="both classes"):
         train_context_only(clock_windows(2, 0, lambda t, rng: np.zeros(len(t), bool)))
+
+
+def test_the_where_when_control_does_not_see_the_speed(tmp_path) -> None:
+    def fast(w: Windows) -> Windows:  # danger where the ego is fast, at any time and place
+        w.label[:] = w.features.control[:, SPEED] > 20.0
+        return w
+
+    train, test = fast(clock_windows(20, 5, scripted)), fast(clock_windows(10, 6, scripted))
+    x = context_inputs(test, WHERE_WHEN_INPUTS)
+    assert WHERE_WHEN_INPUTS == ("t_s", "ego_x_m", "ego_y_m") and x.shape == (len(test), 3)
+    np.testing.assert_array_equal(x[:, 1:], test.ego_xy_m)
+    full, where_when = train_context_only(train), train_context_only(train, name="where-when")
+    assert auroc(full.score(test), test.label) > 0.95
+    assert 0.4 <= auroc(where_when.score(test), test.label) <= 0.6
+    assert where_when.version.startswith("ww-") and where_when.inputs == WHERE_WHEN_INPUTS
+    back = ContextOnlyMonitor.load(where_when.save(tmp_path))
+    assert back.name == "where-when" and back.version == where_when.version
+    np.testing.assert_array_equal(back.score(test), where_when.score(test))

@@ -21,12 +21,12 @@ def test_paper_variants_l_rows_then_input_rows_at_l5() -> None:
 def test_small_ablation_trains_evaluates_and_tabulates(eval_root, splits) -> None:
     report = run_ablation(eval_root, ["highway-cut-in"], splits, context_lens=(1,),
                           inputs=("perception",), store_scores=False, epochs=1)
-    assert [r.label for r in report.rows] == ["L=1", "perception", "context-only", "ttc",
-                                              "ttc-2d", "rss", "rss-2s"]
+    assert [r.label for r in report.rows] == ["L=1", "perception", "context-only", "where-when",
+                                              "ttc", "ttc-2d", "rss", "rss-2s"]
     versions = [r.results["highway-cut-in"]["version"] for r in report.rows]
     assert len(set(versions[:2])) == 2 and all(v.startswith("fusion-") for v in versions[:2])
-    assert versions[2].startswith("ctx-")  # the control row
-    assert [v.split("-")[0] for v in versions[3:]] == ["ttc", "ttc2d", "rss", "rss"]
+    assert versions[2].startswith("ctx-") and versions[3].startswith("ww-")  # the controls
+    assert [v.split("-")[0] for v in versions[4:]] == ["ttc", "ttc2d", "rss", "rss"]
     assert len(set(versions)) == len(versions)
     md = report.markdown()
     for row in report.rows:

@@ -89,7 +89,8 @@ def test_every_table_is_made_with_a_ci_and_p_for_every_comparison(done) -> None:
         assert 0.0 <= cells["acquired/feedback"]["mean"] <= 1.0
     rq1 = tables["rq1"]
     assert [r["method"] for r in rq1["rows"]] == ["FusionMonitor", "ttc", "ttc-2d", "rss",
-                                                  "rss-2s", "aem", "context-only"]
+                                                  "rss-2s", "aem", "context-only",
+                                                  "where-when"]
     assert [r["method"] for r in tables["rq2"]["rows"]] == ["G_0", "G_0 (k seeds)", "uniform",
                                                             "evoeye"]
     assert {(c["a"], c["b"]) for c in tables["rq2"]["comparisons"]} == {

@@ -22,12 +22,12 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from evoeye.baselines.context import CONTEXT_INPUTS, context_classifier
+from evoeye.baselines.context import CONTEXT_INPUTS, WHERE_WHEN_INPUTS, context_classifier
 from evoeye.evaluation.audit.timing import out_of_fold_scores
 from evoeye.evaluation.metrics import auprc, auroc
 
 
-NO_SPEED = [i for i, name in enumerate(CONTEXT_INPUTS) if name != "ego_speed_mps"]
+NO_SPEED = [CONTEXT_INPUTS.index(name) for name in WHERE_WHEN_INPUTS]  # the where-when control
 
 
 @dataclass(frozen=True)
