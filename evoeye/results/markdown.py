@@ -13,6 +13,7 @@ import math
 from collections.abc import Sequence
 
 from evoeye.evaluation.report import DASH, UNREACHABLE
+from evoeye.evolve.campaign.report import OTHER_SCALE_NOTE
 from evoeye.results.findings import ALPHA
 from evoeye.results.tables import SET_NAMES, cell_key
 
@@ -132,9 +133,6 @@ def comparison_intro(table: dict) -> str:
 UNPAIRED_NOTE = ("¹ G_0's recipe retrained on the initial data with k seeds, no new data "
                  "(mean [95 % CI] over those k): a reference, not paired with the campaigns.")
 
-OTHER_SCALE_NOTE = ("² its f is |score − label| under its own family's monitor: the AEM scores "
-                    "a typical window near 0.5 (e / (e + ẽ)), so its f is not comparable with "
-                    "the FusionMonitor methods'.")
 
 
 def table_markdown(table: dict) -> list[str]:

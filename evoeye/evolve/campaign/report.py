@@ -28,6 +28,12 @@ ACQUISITION_HEAD = ("method", "runs", "collisions %", "near misses (< 1 m, no co
                     "within δ of an earlier record %", "f under the monitor that chose it %")
 
 
+OTHER_SCALE = " ²"  # marks a `<family>-evo` row: its f is on its own monitor's score scale
+OTHER_SCALE_NOTE = ("² its f is |score − label| under its own family's monitor: the AEM scores "
+                    "a typical window near 0.5 (e / (e + ẽ)), so its f is not comparable with "
+                    "the FusionMonitor methods'.")
+
+
 def ran(res: dict) -> tuple[str, ...]:
     """The methods with runs in `res`: the RQ2 ones, the ablations, then any other."""
     return tuple(m for m in dict.fromkeys(MAIN + ABLATION + tuple(methods())) if res.get(m))
@@ -113,7 +119,7 @@ def acquisition_rows(res: dict) -> list[list[str]]:
             runs = np.array([a["runs"] for a in acq], float)
             sd = sample_sd(runs)
             runs_s = f"{runs.mean():.0f}" + ("" if sd is None else f" ± {sd:.0f}")
-            rows.append([strategy, runs_s,
+            rows.append([strategy + (OTHER_SCALE if strategy.endswith("-evo") else ""), runs_s,
                          _mean_std([a["collision_share"] for a in acq]),
                          _mean_std([a.get("near_miss_share", np.nan) for a in acq]),
                          _mean_std([a["near_share"] for a in acq]),
@@ -140,8 +146,11 @@ def markdown(results: dict) -> str:
         out += [f"## {scenario} — what each strategy acquired (mean ± sample SD over seeds)",
                 "",
                 "| " + " | ".join(ACQUISITION_HEAD) + " |", "|---" * len(ACQUISITION_HEAD) + "|"]
-        out += ["| " + " | ".join(r) + " |" for r in acquisition_rows(res)]
+        acquired = acquisition_rows(res)
+        out += ["| " + " | ".join(r) + " |" for r in acquired]
         out.append("")
+        if any(r[0].endswith(OTHER_SCALE) for r in acquired):
+            out += [OTHER_SCALE_NOTE, ""]
     return "\n".join(out)
 
 
@@ -198,8 +207,11 @@ def html(results: dict) -> str:
         for title, strategies in tables(res):
             head = ["method"] + [f"{s} {c}" for s in ("Test", "Hard") for c in COLUMNS]
             body.append(f"<h3>{title}</h3>" + _html_table(head, table_rows(res, strategies)))
+        acquired = acquisition_rows(res)
         body.append("<h3>What each strategy acquired</h3>" + _html_table(
-            ACQUISITION_HEAD, acquisition_rows(res)))
+            ACQUISITION_HEAD, acquired))
+        if any(r[0].endswith(OTHER_SCALE) for r in acquired):
+            body.append(f"<p>{escape(OTHER_SCALE_NOTE)}</p>")
         for split in ("test", "hard"):
             for col in ("f1@0.05", "auprc"):
                 body += [_intervals(res, split, col), _curves(res, split, col)]

@@ -3,7 +3,10 @@ blind-spot map."""
 
 from __future__ import annotations
 
+from html import escape
+
 from evoeye.evolve.campaign.report import (
+    OTHER_SCALE_NOTE,
     acquisition_rows,
     html,
     markdown,
@@ -105,6 +108,19 @@ def test_acquisition_table_averages_over_seeds() -> None:
     assert rows["uniform"] == ["uniform", "40 ± 0", "30.0 ± 14.1", "10.0 ± 0.0", "25.0 ± 0.0",
                                "7.5 ± 3.5"]
     assert "| uniform | 40 ± 0 | 30.0 ± 14.1 |" in markdown(RESULTS)
+    assert OTHER_SCALE_NOTE not in markdown(RESULTS)  # no `<family>-evo` row, no note
+
+
+def test_a_family_evo_row_is_marked_its_feedback_on_another_scale() -> None:
+    acq = {"runs": 40, "collision_share": 0.3, "near_miss_share": 0.1, "near_share": 0.25,
+           "feedback": 0.5}
+    res = {"evoeye": [{**_run([0.1, 0.2]), "acquisition": acq}],
+           "aem-evo": [{**_run([0.1, 0.12]), "acquisition": acq}]}
+    rows = [r[0] for r in acquisition_rows(res)]
+    assert rows == ["evoeye", "aem-evo ²"]
+    md, page = markdown({"s": res}), html({"s": res})
+    assert "| aem-evo ² | 40 |" in md and OTHER_SCALE_NOTE in md
+    assert "aem-evo ²" in page and escape(OTHER_SCALE_NOTE) in page
 
 
 def test_acquisition_counts_runs_within_delta_of_an_earlier_record() -> None:
