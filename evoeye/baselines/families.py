@@ -1,5 +1,6 @@
 """The trained baselines as monitor families: the AEM (evolvable: AEM-Evo), the context-only
-control and the where-when control (the same without the ego's speed), each kept under `<root>/baselines/<name>/<version>/` with `meta.json`.
+control and the where-when control (the same without the ego's speed), each kept under
+`<root>/baselines/<name>/<version>/` with `meta.json`.
 
 RQ1 (`fit`): trained on the train split of a logical scenario (or any RunFilter, e.g. its
 round-0 runs only) with a seed, and found again by a training key (a hash of the scenario,

@@ -26,7 +26,6 @@ from evoeye.baselines.context import CONTEXT_INPUTS, WHERE_WHEN_INPUTS, context_
 from evoeye.evaluation.audit.timing import out_of_fold_scores
 from evoeye.evaluation.metrics import auprc, auroc
 
-
 NO_SPEED = [CONTEXT_INPUTS.index(name) for name in WHERE_WHEN_INPUTS]  # the where-when control
 
 
