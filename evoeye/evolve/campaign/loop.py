@@ -230,6 +230,14 @@ class Campaign:
         """No run fits in the budget left."""
         return self.remaining_s(state) < self.config.max_run_s
 
+    def finished(self) -> bool:
+        """`done` from the stored rounds alone: a campaign whose last stored round spent its
+        budget has nothing to resume, and a worker need not build its state (a state starts
+        from the stored rounds, so its spent time is the last round's `simulated_s`)."""
+        rounds = read_rounds(self.root, self.campaign_id)
+        return bool(rounds) and (self.config.budget_s - rounds[-1].simulated_s
+                                 < self.config.max_run_s)
+
     # -- one round, in the steps a flow runs as tasks ----------------------------------------------
     @intra_op_threads()
     def acquire(self, state: CampaignState) -> list[str]:

@@ -93,6 +93,8 @@ def run_campaign(job: CampaignJob, brief: Brief = no_metrics,
     """Run (or resume) one campaign to its budget; `say` each round's line as it ends (in a
     local worker, it goes to the process that started the workers)."""
     campaign = _campaign(job)
+    if campaign.finished():  # a cached re-run: nothing to resume, no state to build
+        return CampaignDone(job.label, campaign.campaign_id, 0, ())
     say = say or (_LINES.put if _LINES is not None else None)
     lines: list[str] = []
 

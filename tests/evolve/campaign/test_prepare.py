@@ -6,7 +6,7 @@ import pytest
 
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.loop import Campaign
-from evoeye.evolve.campaign.workers import CampaignJob, prepare_campaigns
+from evoeye.evolve.campaign.workers import CampaignJob, prepare_campaigns, run_campaign
 from evoeye.store import SplitSpec
 from evoeye.store.feedback import read_feedback, read_rounds
 
@@ -30,3 +30,24 @@ def test_preparing_campaigns_stores_round_0_once_without_building_their_state(
     prepare_campaigns([job])  # a prepared (or finished) campaign: nothing stored again
     assert read_rounds(root, Campaign(root, cfg).campaign_id) == first
     assert read_feedback(root).num_rows == fed
+
+
+def test_a_finished_campaign_is_not_resumed_by_its_worker(root_copy, seeded,
+                                                          monkeypatch) -> None:
+    root = root_copy("finished")
+    cfg = CampaignConfig(scenario=SCENARIO, strategy="uniform", budget_s=50.0, seed=0,
+                         monitor=seeded[1], n_round=2, epochs=1, splits=SPLITS)
+    job = CampaignJob(str(root.path), cfg, "uniform seed 0")
+    campaign = Campaign(root, cfg)
+    assert not campaign.finished()  # nothing stored yet
+    prepare_campaigns([job])
+    assert not campaign.finished()  # round 0 spent nothing
+    done = run_campaign(job)
+    rounds = read_rounds(root, campaign.campaign_id)
+    assert done.rounds == len(rounds) - 1 > 0
+    state = Campaign(root, cfg).start()
+    assert campaign.done(state) and campaign.finished()  # the same verdict, without a state
+    assert state.spent_s == pytest.approx(rounds[-1].simulated_s)
+    monkeypatch.setattr(Campaign, "_acquired", lambda self, ids: pytest.fail("state built"))
+    again = run_campaign(job)
+    assert again.rounds == 0 and read_rounds(root, campaign.campaign_id) == rounds
