@@ -162,7 +162,7 @@ def rq2(study: Study, scenario: str) -> dict:
         trained_version(study, scenario, f, seed=s, **G0_RECIPE) for s in cfg.training_seeds[:k]]
         for f in families}
     rows: dict[str, dict] = {}
-    campaigns = [Campaign(study.root, c) for c in plan]
+    campaigns = Campaign.of_plan(study.root, plan)
     starts = {DEFAULT_FAMILY: g0s[0]}
     for campaign in campaigns:
         if campaign.config.family != DEFAULT_FAMILY:

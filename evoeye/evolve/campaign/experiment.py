@@ -28,8 +28,10 @@ from evoeye.evolve.search.fitness import CRITICALITY_SCALE_M
 from evoeye.evolve.search.strategies import STRATEGIES
 from evoeye.monitor.families import DEFAULT_FAMILY, evolvable_families, initial_monitor
 from evoeye.paths import DataRoot
+from evoeye.store.connections import shared_connections
 from evoeye.store.feedback import RoundMetrics, RoundRow, read_rounds
 from evoeye.store.ingest import refresh_catalog
+from evoeye.store.windows import cached_parts
 
 MAIN = ("uniform", "avfuzzer", "evoeye")
 ABLATION = ("no-feedback", "no-density", "aem-evo")
@@ -93,26 +95,33 @@ def collect_results(root: DataRoot, plan: Sequence[CampaignConfig]) -> dict:
     """{scenario: {"initial": G_0's metrics, "g0", strategy: [per-seed runs]}} from the stored
     rounds of the plan's campaigns (round 0 holds G_0's assessment)."""
     out: dict = {}
-    for cfg in plan:
-        c = Campaign(root, cfg)
-        rows = read_rounds(root, c.campaign_id)
-        if not rows:
-            continue  # not started yet
-        rounds = [r.metrics.as_dict() if r.metrics else None for r in rows]
-        res = out.setdefault(cfg.scenario, {"g0": c.reference})
-        res.setdefault("initial" if cfg.family == DEFAULT_FAMILY else f"{cfg.family}-initial",
-                       rounds[0])
-        state = c.start()
-        method = method_of(cfg)
-        res.setdefault(method, []).append({
-            "campaign_id": c.campaign_id, "seed": cfg.seed, "rounds": rounds,
-            "budget_s": cfg.budget_s, "simulated_s": rows[-1].simulated_s,
-            "records": rows[-1].n_records,
-            "acquisition": {**acquisition(c, state),
-                            "feedback": chosen_feedback(c.stored_feedback, rows)},
-            "blind_spots": _blind_spots(c, state) if method == "evoeye" else None,
-        })
+    with cached_parts(), shared_connections():  # one database and one decode per part, for all
+        for c in Campaign.of_plan(root, plan):
+            _collect(root, c, out)
     return out
+
+
+def _collect(root: DataRoot, c: Campaign, out: dict) -> None:
+    """Add one campaign's stored rounds, acquisition and blind spots to `out` (nothing for a
+    campaign not started yet)."""
+    cfg = c.config
+    rows = read_rounds(root, c.campaign_id)
+    if not rows:
+        return
+    rounds = [r.metrics.as_dict() if r.metrics else None for r in rows]
+    res = out.setdefault(cfg.scenario, {"g0": c.reference})
+    res.setdefault("initial" if cfg.family == DEFAULT_FAMILY else f"{cfg.family}-initial",
+                   rounds[0])
+    state = c.start()
+    method = method_of(cfg)
+    res.setdefault(method, []).append({
+        "campaign_id": c.campaign_id, "seed": cfg.seed, "rounds": rounds,
+        "budget_s": cfg.budget_s, "simulated_s": rows[-1].simulated_s,
+        "records": rows[-1].n_records,
+        "acquisition": {**acquisition(c, state),
+                        "feedback": chosen_feedback(c.stored_feedback, rows)},
+        "blind_spots": _blind_spots(c, state) if method == "evoeye" else None,
+    })
 
 
 def campaign_jobs(root: DataRoot, plan: Sequence[CampaignConfig]) -> list[CampaignJob]:

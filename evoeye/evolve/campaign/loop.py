@@ -95,9 +95,12 @@ class Campaign:
     """One campaign over a data root: `start()` (or resume), then `run_round` until `done`."""
 
     def __init__(self, root: DataRoot, config: CampaignConfig, *,
-                 train: Trainer | None = None, assess: Assessor | None = None) -> None:
+                 train: Trainer | None = None, assess: Assessor | None = None,
+                 initial: dict[str, np.ndarray] | None = None) -> None:
         self.root = root
         self.config = config
+        if initial is not None:  # D_init already read, e.g. for another campaign (`campaigns`)
+            self.__dict__["initial"] = initial
         self.space = get_scenario(config.scenario)
         self.family = FAMILIES[config.family]
         self._train = train or self.family.train
@@ -117,6 +120,18 @@ class Campaign:
                               f"{self.root.warehouse}: simulate and ingest them first")
         return {k: np.asarray(v, dtype=object if k == "scenario_id" else None)
                 for k, v in t.items()}
+
+    @classmethod
+    def of_plan(cls, root: DataRoot, plan: Sequence[CampaignConfig]) -> list[Campaign]:
+        """A campaign per config, D_init read once per scenario and split (it is the same for
+        every campaign that shares them; a read of it is a warehouse query)."""
+        out: list[Campaign] = []
+        read: dict[tuple, dict[str, np.ndarray]] = {}
+        for cfg in plan:
+            key = (cfg.scenario, cfg.splits)
+            out.append(cls(root, cfg, initial=read.get(key)))
+            read.setdefault(key, out[-1].initial)
+        return out
 
     @cached_property
     def g0(self) -> str:

@@ -51,3 +51,27 @@ def test_a_finished_campaign_is_not_resumed_by_its_worker(root_copy, seeded,
     monkeypatch.setattr(Campaign, "_acquired", lambda self, ids: pytest.fail("state built"))
     again = run_campaign(job)
     assert again.rounds == 0 and read_rounds(root, campaign.campaign_id) == rounds
+
+
+def test_the_campaigns_of_a_plan_read_d_init_once(root_copy, seeded, monkeypatch) -> None:
+    from evoeye.store import Warehouse
+
+    root = root_copy("of-plan")
+    plan = [CampaignConfig(scenario=SCENARIO, strategy=s, budget_s=50.0, seed=seed,
+                           monitor=seeded[1], n_round=2, epochs=1, splits=SPLITS)
+            for s in ("uniform", "evoeye") for seed in (0, 1)]
+    alone = [Campaign(root, cfg) for cfg in plan]
+    expected = [(c.campaign_id, list(c.initial["scenario_id"])) for c in alone]
+    reads: list[str] = []
+    query = Warehouse.query
+    monkeypatch.setattr(Warehouse, "query",
+                        lambda self, name, **kw: reads.append(name) or query(self, name, **kw))
+    shared = Campaign.of_plan(root, plan)
+    assert [(c.campaign_id, list(c.initial["scenario_id"])) for c in shared] == expected
+    assert reads.count("initial_records") == 1
+    other = CampaignConfig(scenario=SCENARIO, strategy="uniform", budget_s=50.0, seed=0,
+                           monitor=seeded[1], n_round=2, epochs=1,
+                           splits=SplitSpec(seed=1, train_frac=0.5, val_frac=0.25))
+    mixed = Campaign.of_plan(root, [plan[0], other])  # another split: read again
+    assert reads.count("initial_records") == 3
+    assert mixed[1].campaign_id != mixed[0].campaign_id == expected[0][0]
