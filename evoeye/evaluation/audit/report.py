@@ -2,15 +2,17 @@
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from pathlib import Path
 from typing import Any
 
 import orjson
 
 from evoeye.evaluation.audit.attribution import CAUSES, MODULES
+from evoeye.evaluation.audit.context import ContextAuroc
 from evoeye.evaluation.audit.runs import RunAudit
 from evoeye.evaluation.audit.summary import ScenarioAudit
-from evoeye.evaluation.audit.timing import histogram_lines
+from evoeye.evaluation.audit.timing import ClockAuroc, histogram_lines
 from evoeye.evaluation.audit.verdicts import NOT_EXPLAINED, NOT_INGESTED
 from evoeye.paths import DataRoot
 
@@ -94,6 +96,26 @@ def _attribution_lines(s: ScenarioAudit) -> list[str]:
     ]
 
 
+def _or_not_ingested(name: str, value: Any, line: Callable[[Any], str]) -> str:
+    return f"{name}: {NOT_INGESTED}." if value is None else line(value)
+
+
+def _clock_line(c: ClockAuroc) -> str:
+    return (f"Clock-only AUROC on {c.frames:,} pre-collision frames ({c.unsafe_frames:,} "
+            f"unsafe, {c.runs} runs): earlier = riskier {_f(c.earlier_riskier)}, best "
+            f"direction {_f(c.best_direction)}, gradient boosting on t (out of fold, "
+            f"grouped by run) {_f(c.model)}; headline **{_f(c.headline)}**.")
+
+
+def _context_line(x: ContextAuroc) -> str:
+    return (f"Context-only control (RQ1's: gradient boosting on t, the ego's speed and its x, "
+            f"y; out of fold, grouped by run) on the same frames: AUROC **{_f(x.auroc)}**, "
+            f"AUPRC {_f(x.auprc)}; without the ego's speed (when and where only, the script's "
+            f"part) AUROC {_f(x.where_when_auroc)}, AUPRC {_f(x.where_when_auprc)}. A monitor "
+            f"must beat the control's AUROC by 5 points (RQ1's bound); this batch trains it on "
+            f"fewer runs than RQ1 does.")
+
+
 def _timing_lines(s: ScenarioAudit) -> list[str]:
     out = []
     ct = s.collision_times
@@ -104,26 +126,8 @@ def _timing_lines(s: ScenarioAudit) -> list[str]:
         out += [f"{ct.n} collisions; quantiles (s): {q}. Fullest {ct.bin_s:g} s bin: "
                 f"{ct.top_bin_start_s:g}–{ct.top_bin_start_s + ct.bin_s:g} s with "
                 f"{100 * ct.top_bin_share:.1f} %.", "", "```", *histogram_lines(ct), "```"]
-    c = s.clock
-    out.append("")
-    if c is None:
-        out.append(f"Clock-only AUROC: {NOT_INGESTED}.")
-    else:
-        out.append(f"Clock-only AUROC on {c.frames:,} pre-collision frames ({c.unsafe_frames:,} "
-                   f"unsafe, {c.runs} runs): earlier = riskier {_f(c.earlier_riskier)}, best "
-                   f"direction {_f(c.best_direction)}, gradient boosting on t (out of fold, "
-                   f"grouped by run) {_f(c.model)}; headline **{_f(c.headline)}**.")
-    x = s.context
-    out.append("")
-    if x is None:
-        out.append(f"Context-only AUROC: {NOT_INGESTED}.")
-    else:
-        out.append(f"Context-only control (RQ1's: gradient boosting on t, the ego's speed and "
-                   f"its x, y; out of fold, grouped by run) on the same frames: AUROC "
-                   f"**{_f(x.auroc)}**, AUPRC {_f(x.auprc)}; without the ego's speed (when and "
-                   f"where only, the script's part) AUROC {_f(x.where_when_auroc)}, AUPRC "
-                   f"{_f(x.where_when_auprc)}. A monitor must beat the control's AUROC by 5 "
-                   f"points (RQ1's bound); this batch trains it on fewer runs than RQ1 does.")
+    out += ["", _or_not_ingested("Clock-only AUROC", s.clock, _clock_line),
+            "", _or_not_ingested("Context-only AUROC", s.context, _context_line)]
     return out
 
 
