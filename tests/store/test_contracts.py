@@ -52,7 +52,6 @@ QUERY_PARAMS = {
     "initial_split_stats": {"logical_scenario": "highway-cut-in", "horizon_s": 3.0, "seed": 0,
                             "train_frac": 0.5, "val_frac": 0.125, "test_batch": None},
     "audit_attribution": {"scenario_ids": ["c-0", "c-1"]},
-    "audit_clock_frames": {"scenario_ids": ["c-0", "c-1"], "horizon_s": 3.0},
     "initial_records": {"scenario": "highway-cut-in", "seed": 0, "train_frac": 1.0,
                         "val_frac": 0.0, "test_batch": "b1"},
     "run_outcomes": {"logical_scenario": "highway-cut-in"},

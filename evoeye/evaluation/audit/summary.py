@@ -23,7 +23,7 @@ from evoeye.evaluation.audit.runs import (
 from evoeye.evaluation.audit.timing import ClockAuroc, CollisionTimes, clock_auroc, collision_times
 from evoeye.evaluation.audit.verdicts import DEFAULT_THRESHOLDS, Thresholds, Verdict, verdicts
 from evoeye.paths import DataRoot
-from evoeye.store import Warehouse, load_windows
+from evoeye.store import Warehouse, Windows, load_windows
 
 HORIZON_S = 3.0  # the label horizon H of the clock check (Definition 1)
 
@@ -94,21 +94,21 @@ class ScenarioAudit:
         }
 
 
-def _clock(wh: Warehouse, ids: list[str]) -> ClockAuroc | None:
-    frames = wh.query("audit_clock_frames", scenario_ids=ids, horizon_s=HORIZON_S)
-    if frames.num_rows == 0:
-        return None
-    return clock_auroc(frames.column("t_s").to_numpy(), frames.column("label").to_numpy(),
-                       np.asarray(frames.column("scenario_id").to_pylist()))
-
-
-def _context(wh: Warehouse, ids: list[str]) -> ContextAuroc | None:
+def _frames(wh: Warehouse, ids: list[str]) -> Windows | None:
+    """The runs' pre-collision frames (one L = 1 window each) with their labels at HORIZON_S,
+    read once for the clock and the context checks; None when none is ingested."""
     if not ids:
         return None
     windows = load_windows(wh, ids, context_len=1, horizon_s=HORIZON_S)
-    if len(windows) == 0:
-        return None
-    return context_auroc(context_inputs(windows), windows.label, windows.scenario_id)
+    return windows if len(windows) else None
+
+
+def _clock(w: Windows | None) -> ClockAuroc | None:
+    return None if w is None else clock_auroc(w.t_s, w.label, w.scenario_id)
+
+
+def _context(w: Windows | None) -> ContextAuroc | None:
+    return None if w is None else context_auroc(context_inputs(w), w.label, w.scenario_id)
 
 
 def _attribution(wh: Warehouse, ids: list[str]) -> AttributionSummary | None:
@@ -125,8 +125,8 @@ def audit_scenario(name: str, runs: list[RunAudit], wh: Warehouse,
     collided = [r for r in ok if r.collided]
     s = ScenarioAudit(name, runs)
     s.collision_times = collision_times(np.array([r.collision_time_s for r in collided]))
-    s.clock = _clock(wh, [r.scenario_id for r in ok])
-    s.context = _context(wh, [r.scenario_id for r in ok])
+    frames = _frames(wh, [r.scenario_id for r in ok])
+    s.clock, s.context = _clock(frames), _context(frames)
     s.attribution = _attribution(wh, [r.scenario_id for r in collided])
     s.verdicts = verdicts(s, thresholds)
     return s
