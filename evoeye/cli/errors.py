@@ -52,8 +52,8 @@ KNOWN_ERRORS: dict[str, str] = {
                                                 "trains it again",
     "evoeye.monitor.families.NoMonitorError": "train one first: `evoeye train --scenario NAME`, "
                                               "or name it with --monitor",
-    "evoeye.evolve.campaign.loop.NoInitialDataError": "simulate and ingest the scenario's initial "
-                                                 "runs: `evoeye simulate …`, `evoeye ingest`",
+    "evoeye.evolve.campaign.state.NoInitialDataError": "simulate and ingest the scenario's initial "
+                                                  "runs: `evoeye simulate …`, `evoeye ingest`",
     "evoeye.results.study.EmptySplitError": "simulate the data with the command (--initial-runs "
                                             "N --test-runs M), or check --test-batch and the "
                                             "shares",

@@ -38,7 +38,13 @@ from functools import cache
 import numpy as np
 
 from evoeye.evolve.campaign.config import CampaignConfig
-from evoeye.evolve.campaign.experiment import method_of, methods, plan_experiment, run_experiment
+from evoeye.evolve.campaign.experiment import (
+    campaigns_of,
+    method_of,
+    methods,
+    plan_experiment,
+    run_experiment,
+)
 from evoeye.evolve.campaign.loop import Campaign
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.monitor.inputs import MODULES
@@ -162,7 +168,7 @@ def rq2(study: Study, scenario: str) -> dict:
         trained_version(study, scenario, f, seed=s, **G0_RECIPE) for s in cfg.training_seeds[:k]]
         for f in families}
     rows: dict[str, dict] = {}
-    campaigns = Campaign.of_plan(study.root, plan)
+    campaigns = campaigns_of(study.root, plan)
     starts = {DEFAULT_FAMILY: g0s[0]}
     for campaign in campaigns:
         if campaign.config.family != DEFAULT_FAMILY:

@@ -22,7 +22,7 @@ from evoeye.evaluation.report import UNREACHABLE
 from evoeye.evolve.campaign.assess import Assessor
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.loop import Campaign
-from evoeye.evolve.campaign.state import CampaignState
+from evoeye.evolve.campaign.state import CampaignState, read_initial
 from evoeye.evolve.campaign.workers import CampaignJob, assessor, run_campaigns
 from evoeye.evolve.search.fitness import CRITICALITY_SCALE_M
 from evoeye.evolve.search.strategies import STRATEGIES
@@ -96,16 +96,27 @@ def collect_results(root: DataRoot, plan: Sequence[CampaignConfig]) -> dict:
     rounds of the plan's campaigns (round 0 holds G_0's assessment)."""
     out: dict = {}
     with cached_parts(), shared_connections():  # one database and one decode per part, for all
-        for c in Campaign.of_plan(root, plan):
-            _collect(root, c, out)
+        for c in campaigns_of(root, plan):
+            _collect(c, out)
     return out
 
 
-def _collect(root: DataRoot, c: Campaign, out: dict) -> None:
+def campaigns_of(root: DataRoot, plan: Sequence[CampaignConfig]) -> list[Campaign]:
+    """A campaign per config of the plan, D_init read once per scenario and split (it is the
+    same for every campaign that shares them)."""
+    read: dict[tuple, dict[str, np.ndarray]] = {}
+    for cfg in plan:
+        key = (cfg.scenario, cfg.splits)
+        if key not in read:
+            read[key] = read_initial(root, cfg.scenario, cfg.splits)
+    return [Campaign(root, cfg, initial=read[(cfg.scenario, cfg.splits)]) for cfg in plan]
+
+
+def _collect(c: Campaign, out: dict) -> None:
     """Add one campaign's stored rounds, acquisition and blind spots to `out` (nothing for a
     campaign not started yet)."""
     cfg = c.config
-    rows = read_rounds(root, c.campaign_id)
+    rows = read_rounds(c.root, c.campaign_id)
     if not rows:
         return
     rounds = [r.metrics.as_dict() if r.metrics else None for r in rows]

@@ -52,7 +52,13 @@ from evoeye.batch import simulate_and_keep
 from evoeye.evolve.campaign.config import REPLAY_RATIO, CampaignConfig
 from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
-from evoeye.evolve.campaign.state import CampaignState, records_of, run_outcome, run_seed
+from evoeye.evolve.campaign.state import (
+    CampaignState,
+    read_initial,
+    records_of,
+    run_outcome,
+    run_seed,
+)
 from evoeye.evolve.search.strategies import FEEDBACK_BLIND, make_strategy
 from evoeye.heap import frozen_heap
 from evoeye.log import read_run
@@ -82,11 +88,6 @@ from evoeye.store.ingest import IngestReport, ingest_batch, refresh_catalog
 from evoeye.store.log_windows import LoggedRun, episode_run, read_logged_run
 from evoeye.store.windows import cached_parts
 
-
-class NoInitialDataError(LookupError):
-    """A campaign needs the scenario's initial (round 0) runs in the warehouse."""
-
-
 Trainer = Callable[..., str]  # train_monitor's signature
 Assessor = Callable[[str], RoundMetrics]  # monitor version → metrics, stored with the round
 
@@ -99,7 +100,7 @@ class Campaign:
                  initial: dict[str, np.ndarray] | None = None) -> None:
         self.root = root
         self.config = config
-        if initial is not None:  # D_init already read, e.g. for another campaign (`campaigns`)
+        if initial is not None:  # D_init already read, e.g. for another campaign (`campaigns_of`)
             self.__dict__["initial"] = initial
         self.space = get_scenario(config.scenario)
         self.family = FAMILIES[config.family]
@@ -112,26 +113,7 @@ class Campaign:
     @cached_property
     def initial(self) -> dict[str, np.ndarray]:
         """D_init: the train split of the scenario's round-0 runs, by scenario id."""
-        cfg = self.config
-        t = Warehouse(self.root).query("initial_records", scenario=cfg.scenario,
-                                       **asdict(cfg.splits)).to_pydict()
-        if not t["scenario_id"]:
-            raise NoInitialDataError(f"no initial (round 0) training runs of {cfg.scenario!r} in "
-                              f"{self.root.warehouse}: simulate and ingest them first")
-        return {k: np.asarray(v, dtype=object if k == "scenario_id" else None)
-                for k, v in t.items()}
-
-    @classmethod
-    def of_plan(cls, root: DataRoot, plan: Sequence[CampaignConfig]) -> list[Campaign]:
-        """A campaign per config, D_init read once per scenario and split (it is the same for
-        every campaign that shares them; a read of it is a warehouse query)."""
-        out: list[Campaign] = []
-        read: dict[tuple, dict[str, np.ndarray]] = {}
-        for cfg in plan:
-            key = (cfg.scenario, cfg.splits)
-            out.append(cls(root, cfg, initial=read.get(key)))
-            read.setdefault(key, out[-1].initial)
-        return out
+        return read_initial(self.root, self.config.scenario, self.config.splits)
 
     @cached_property
     def g0(self) -> str:

@@ -1,9 +1,9 @@
-"""A campaign's state between rounds: D_r with its outcomes, G_r, and the run seeds."""
+"""A campaign's state between rounds: D_init, D_r with its outcomes, G_r, and the run seeds."""
 
 from __future__ import annotations
 
 from collections.abc import Iterable
-from dataclasses import dataclass
+from dataclasses import asdict, dataclass
 from typing import Any
 
 import numpy as np
@@ -11,7 +11,25 @@ import numpy as np
 from evoeye.evolve.search.fitness import criticality
 from evoeye.evolve.search.protocol import Strategy
 from evoeye.evolve.search.records import Records
+from evoeye.paths import DataRoot
+from evoeye.store import Warehouse
 from evoeye.store.feedback import RoundRow
+from evoeye.store.selection import SplitSpec
+
+
+class NoInitialDataError(LookupError):
+    """A campaign needs the scenario's initial (round 0) runs in the warehouse."""
+
+
+def read_initial(root: DataRoot, scenario: str, splits: SplitSpec) -> dict[str, np.ndarray]:
+    """D_init: the train split of the scenario's round-0 runs, columns by name (a warehouse
+    query; the same for every campaign of the scenario and split)."""
+    t = Warehouse(root).query("initial_records", scenario=scenario, **asdict(splits)).to_pydict()
+    if not t["scenario_id"]:
+        raise NoInitialDataError(f"no initial (round 0) training runs of {scenario!r} in "
+                                 f"{root.warehouse}: simulate and ingest them first")
+    return {k: np.asarray(v, dtype=object if k == "scenario_id" else None)
+            for k, v in t.items()}
 
 
 @dataclass

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.experiment import campaigns_of
 from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.campaign.workers import CampaignJob, prepare_campaigns, run_campaign
 from evoeye.store import SplitSpec
@@ -66,12 +67,12 @@ def test_the_campaigns_of_a_plan_read_d_init_once(root_copy, seeded, monkeypatch
     query = Warehouse.query
     monkeypatch.setattr(Warehouse, "query",
                         lambda self, name, **kw: reads.append(name) or query(self, name, **kw))
-    shared = Campaign.of_plan(root, plan)
+    shared = campaigns_of(root, plan)
     assert [(c.campaign_id, list(c.initial["scenario_id"])) for c in shared] == expected
     assert reads.count("initial_records") == 1
     other = CampaignConfig(scenario=SCENARIO, strategy="uniform", budget_s=50.0, seed=0,
                            monitor=seeded[1], n_round=2, epochs=1,
                            splits=SplitSpec(seed=1, train_frac=0.5, val_frac=0.25))
-    mixed = Campaign.of_plan(root, [plan[0], other])  # another split: read again
+    mixed = campaigns_of(root, [plan[0], other])  # another split: read again
     assert reads.count("initial_records") == 3
     assert mixed[1].campaign_id != mixed[0].campaign_id == expected[0][0]
