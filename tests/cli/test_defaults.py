@@ -25,3 +25,15 @@ def test_help_defaults_equal_their_sources() -> None:
     }
     shown = {name: getattr(defaults, name) for name in pairs}
     assert shown == pairs
+
+
+def test_every_known_error_names_an_exception_class_that_exists() -> None:
+    import importlib
+
+    from evoeye.cli.errors import KNOWN_ERRORS
+
+    for name in KNOWN_ERRORS:  # keyed by qualified name: a moved class loses its hint silently
+        module, cls = name.rsplit(".", 1)
+        found = getattr(importlib.import_module(module), cls, None)
+        assert isinstance(found, type) and issubclass(found, Exception), name
+        assert f"{found.__module__}.{found.__qualname__}" == name  # defined there, not imported
