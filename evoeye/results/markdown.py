@@ -13,7 +13,7 @@ import math
 from collections.abc import Sequence
 
 from evoeye.evaluation.report import DASH, UNREACHABLE
-from evoeye.evolve.campaign.report import OTHER_SCALE_NOTE
+from evoeye.evolve.campaign.report import OTHER_SCALE, OTHER_SCALE_NOTE, other_scale
 from evoeye.results.findings import ALPHA
 from evoeye.results.tables import SET_NAMES, cell_key
 
@@ -90,18 +90,17 @@ def _keys(table: dict) -> list[tuple[str, str]]:
     return [(s, m) for s in table["sets"] for m in table["metrics"]]
 
 
-def other_scale(table: dict, row: dict) -> bool:
-    """Whether a row's feedback is on another monitor family's score scale: a `<family>-evo`
-    method (evoeye.evolve.campaign.experiment.methods) in the acquisition table."""
-    return table["id"] == "acquisition" and row["method"].endswith("-evo")
+def marked_other_scale(table: dict, row: dict) -> bool:
+    """Whether a row of the acquisition table has its feedback on another family's scale."""
+    return table["id"] == "acquisition" and other_scale(row["method"])
 
 
 def row_cells(table: dict) -> tuple[list[str], list[list[str]]]:
     """Header and text cells of a table's rows (mean [CI] per set and metric)."""
     keys = _keys(table)
     header = ["method"] + [column(s, m, table["sets"]) for s, m in keys]
-    rows = [[r["method"] + (" ¹" if r["unpaired"] else "") + (" ²" if other_scale(table, r)
-                                                               else "")]
+    rows = [[r["method"] + (" ¹" if r["unpaired"] else "")
+             + (OTHER_SCALE if marked_other_scale(table, r) else "")]
             + [mean_cell(r["cells"][cell_key(s, m)], m, r["n"]) for s, m in keys]
             for r in table["rows"]]
     return header, rows
@@ -134,7 +133,6 @@ UNPAIRED_NOTE = ("¹ G_0's recipe retrained on the initial data with k seeds, no
                  "(mean [95 % CI] over those k): a reference, not paired with the campaigns.")
 
 
-
 def table_markdown(table: dict) -> list[str]:
     """A table's rows, then its comparisons."""
     header, rows = row_cells(table)
@@ -143,7 +141,7 @@ def table_markdown(table: dict) -> list[str]:
            *_md(header, rows)]
     if any(r["unpaired"] for r in table["rows"]):
         out += ["", UNPAIRED_NOTE]
-    if any(other_scale(table, r) for r in table["rows"]):
+    if any(marked_other_scale(table, r) for r in table["rows"]):
         out += ["", OTHER_SCALE_NOTE]
     if comps:
         out += ["", comparison_intro(table), "", *_md(comp_header, comps)]

@@ -56,6 +56,12 @@ def own_initial(method: str) -> tuple[str, str] | None:
     return f"{label} ({label}-Evo's G_0)", f"{family}-initial"
 
 
+def other_scale(method: str) -> bool:
+    """Whether a method's feedback is on another family's score scale: it evolves another
+    family's monitor (a `<family>-evo`, `own_initial`)."""
+    return own_initial(method) is not None
+
+
 def _value(v: float | None) -> float:
     """A metric as a float; None (undefined, e.g. AUPRC with one class) becomes NaN."""
     return np.nan if v is None else float(v)
@@ -119,7 +125,7 @@ def acquisition_rows(res: dict) -> list[list[str]]:
             runs = np.array([a["runs"] for a in acq], float)
             sd = sample_sd(runs)
             runs_s = f"{runs.mean():.0f}" + ("" if sd is None else f" ± {sd:.0f}")
-            rows.append([strategy + (OTHER_SCALE if strategy.endswith("-evo") else ""), runs_s,
+            rows.append([strategy + (OTHER_SCALE if other_scale(strategy) else ""), runs_s,
                          _mean_std([a["collision_share"] for a in acq]),
                          _mean_std([a.get("near_miss_share", np.nan) for a in acq]),
                          _mean_std([a["near_share"] for a in acq]),
