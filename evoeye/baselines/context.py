@@ -44,13 +44,9 @@ def context_inputs(windows: Windows, inputs: tuple[str, ...] = CONTEXT_INPUTS) -
     ends at."""
     if windows.ego_xy_m is None:
         raise ValueError("these windows carry no ego position (load them with load_windows)")
-    columns = {
-        "t_s": lambda: windows.t_s,
-        "ego_speed_mps": lambda: windows.features.control[windows.context[:, -1], SPEED],
-        "ego_x_m": lambda: windows.ego_xy_m[:, 0],
-        "ego_y_m": lambda: windows.ego_xy_m[:, 1],
-    }
-    return np.column_stack([columns[name]() for name in inputs]).astype(np.float64)
+    speed = windows.features.control[windows.context[:, -1], SPEED]  # (B,)
+    every = np.column_stack([windows.t_s, speed, windows.ego_xy_m]).astype(np.float64)
+    return every[:, [CONTEXT_INPUTS.index(name) for name in inputs]]
 
 
 @dataclass(frozen=True)
