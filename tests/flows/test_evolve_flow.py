@@ -1,4 +1,4 @@
-"""The evolution flow through Prefect: rounds are `round-<r>` flow runs; the nightly deployment."""
+"""The evolution flow through Prefect: a flow run per round (`round-<r>-…`); the deployment."""
 
 from __future__ import annotations
 
@@ -68,11 +68,20 @@ def test_evolution_flow_runs_each_round_as_a_flow_run(prefect_server, seeded) ->
     assert [r.round for r in rows] == [0, 1, 2]
     assert [len(r.scenario_ids) for r in rows] == [0, 3, 3]
     assert all(r.metrics.hard["frames"] >= 0 for r in rows)  # every G_r assessed
+    names = [f"round-{r}-{SCENARIO}-evoeye-s0" for r in (1, 2)]
     with get_client(sync_client=True) as client:
         runs = client.read_flow_runs(flow_run_filter=FlowRunFilter(
-            name=FlowRunFilterName(any_=["round-1", "round-2"])))
-    assert sorted(r.name for r in runs) == ["round-1", "round-2"]
+            name=FlowRunFilterName(any_=names)))
+        campaign = client.read_flow_runs(flow_run_filter=FlowRunFilter(
+            name=FlowRunFilterName(any_=[f"evolve-{SCENARIO}-evoeye-s0"])))
+        (artifact, *_) = [a for a in client.read_artifacts() if a.key == "evoeye-evolve"]
+    assert sorted(r.name for r in runs) == names and len(campaign) == 1
     assert all(r.state.is_completed() for r in runs)
+    # the campaign's artifact: its rounds with each G_r's figures in %, and what changed
+    assert f"# Evolution: {SCENARIO}, evoeye, seed 0" in artifact.data
+    assert "| Round | New runs | Sim s | Monitor | Test F1@.05 % |" in artifact.data
+    assert f"| 2 | 3 | {rows[2].simulated_s:.0f} | {rows[2].monitor_version} |" in artifact.data
+    assert "2 round(s) added 6 runs" in artifact.data and "Hard-Set F1@0.05" in artifact.data
     # a second flow run with a higher max resumes the same campaign at round 3
     out2 = evolution_flow(params.model_copy(update={"max_rounds": 1}))
     assert out2["campaign_id"] == out["campaign_id"] and out2["round"] == 3

@@ -18,11 +18,12 @@ import numpy as np
 from evoeye.evaluation.plots import interval_chart, line_chart
 from evoeye.evaluation.report import CSS
 from evoeye.evaluation.stats import finite_mean, mean_ci, sample_sd
-from evoeye.evaluation.table import DASH, UNREACHABLE, UNREACHABLE_NOTE, Table
+from evoeye.evaluation.table import DASH, UNREACHABLE, UNREACHABLE_NOTE, Table, pct
 from evoeye.evolve.campaign.assess import reached
 from evoeye.evolve.campaign.experiment import ABLATION, MAIN, methods
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.paths import DataRoot
+from evoeye.store.feedback import RoundRow
 
 COLUMNS = ("f1@0.05", "f1@0.01", "auroc", "auprc")
 ACQUISITION_HEAD = ("Method", "Runs", "Collisions %", "Near misses %", "Within δ %", "f %")
@@ -247,3 +248,53 @@ def write_experiment_report(root: DataRoot, results: dict,
     (folder / "rq2.json").write_text(json.dumps(results, indent=1, default=float),
                                      encoding="utf-8")
     return folder
+
+
+def _rate(split: dict | None, key: str) -> str:
+    """A round's rate in % ('–' if not assessed, 'n/r' where its target FPR was unreachable)."""
+    if split is None:
+        return DASH
+    return pct(split[key]) if reached(split, key) else UNREACHABLE
+
+
+def rounds_table(rows: Sequence[RoundRow]) -> Table:
+    """A campaign round by round: new runs, simulated time so far, and its monitor G_r on the
+    Test Set and on G_0's Hard Set (%)."""
+    out = []
+    for r in rows:
+        m = r.metrics
+        out.append([str(r.round), str(len(r.scenario_ids)), f"{r.simulated_s:.0f}",
+                    r.monitor_version, _rate(m and m.test, "f1@0.05"),
+                    _rate(m and m.test, "auprc"), _rate(m and m.hard, "f1@0.05")])
+    return Table(["Round", "New runs", "Sim s", "Monitor", "Test F1@.05 %", "Test AUPRC %",
+                  "Hard F1@.05 %"], out)
+
+
+def rounds_markdown(rows: Sequence[RoundRow]) -> str:
+    """A campaign's artifact: what it is, the rounds table, and what the last round changed."""
+    if not rows:
+        return "# Evolution\n\nNo round stored yet."
+    first = rows[0]
+    head = (f"# Evolution: {first.logical_scenario}, {first.strategy}, seed {first.seed}\n\n"
+            f"Campaign `{first.campaign_id}`: {len(rows) - 1} round(s) after G_0.")
+    return "\n\n".join([head, rounds_table(rows).markdown(), change_words(rows)])
+
+
+def change_words(rows: Sequence[RoundRow]) -> str:
+    """What evolution changed, G_0 to the last round's monitor, in words (with the sizes the
+    figures rest on)."""
+    if len(rows) < 2:
+        return "No acquisition round yet: the monitor is still G_0."
+    g0, last = rows[0], rows[-1]
+    new = sum(len(r.scenario_ids) for r in rows[1:])
+    text = (f"{len(rows) - 1} round(s) added {new} runs ({last.simulated_s - g0.simulated_s:.0f}"
+            f" s simulated) and replaced G_0 {g0.monitor_version} by {last.monitor_version}")
+    a, b = g0.metrics, last.metrics
+    if a is None or b is None:
+        return text + " (not assessed: run with --assess to see its effect)."
+    return (f"{text}: Test-Set F1@0.05 {_rate(a.test, 'f1@0.05')} → {_rate(b.test, 'f1@0.05')} "
+            f"%, Hard-Set F1@0.05 {_rate(a.hard, 'f1@0.05')} → {_rate(b.hard, 'f1@0.05')} % "
+            f"(the Hard Set: the {a.hard.get('unsafe', 0)} unsafe test frames G_0 missed and "
+            f"the safe frames of their runs, {a.hard.get('frames', 0)} in all). One campaign "
+            "seed, frame-level figures: a change this size can come from retraining alone; "
+            "`evoeye experiment` compares methods over seeds, with a re-seeded G_0 as control.")
