@@ -4,11 +4,13 @@ Markdown artifact (in the form of docs/reports.md)."""
 from __future__ import annotations
 
 from collections.abc import Callable
-from typing import Any
+from typing import TYPE_CHECKING, Any
 
-from evoeye.batch import BatchSummary
 from evoeye.evaluation.table import Table, pct
-from evoeye.paths import DataRoot
+
+if TYPE_CHECKING:
+    from evoeye.batch import BatchSummary
+    from evoeye.paths import DataRoot
 
 
 def named(describe: Callable[[Any], str]) -> Callable[[], str]:

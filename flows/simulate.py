@@ -5,7 +5,8 @@ On this machine the batch runs in one task on the command line's own process poo
 skipped, a broken run reported and the others kept), so the flow costs what the command costs
 plus one Prefect API. With `dask_address` every run is its own task on the Dask cluster
 (prefect-dask), for batches one machine cannot carry. Either way the batch is idempotent: a
-crashed flow run is simply run again, and skips the logs it finished.
+crashed flow run is simply run again, and skips the logs it finished. With `ingest` the new
+logs then go into the warehouse, as the ingest flow puts them (a subflow run).
 """
 
 from __future__ import annotations
@@ -19,6 +20,7 @@ from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import SCENARIOS
 from evoeye.sim.episode import RunSpec
 from flows.api import shared_with_workers
+from flows.ingest import IngestParams, ingest_flow
 from flows.published import batch_markdown, named, publish
 from flows.runners import task_runner
 
@@ -35,6 +37,7 @@ class SimulateParams(BaseModel):
     workers: int = Field(2, ge=1, le=64)
     dask_address: str | None = None
     batch: str | None = None  # default uniform-seed<seed>
+    ingest: bool = False  # then ingest the new logs, as the ingest flow does (a subflow run)
 
     def model_post_init(self, __context) -> None:
         if self.scenario not in SCENARIOS:
@@ -104,6 +107,8 @@ def simulate_batch_flow(params: SimulateParams) -> list[RunResult]:
             logger.warning("%s %s: %s", r.status, r.scenario_id, r.reason)
     publish("evoeye-simulate", batch_markdown(params.scenario, summary, root),
             f"{params.scenario}, batch {params.batch_name}")
+    if params.ingest:
+        ingest_flow(IngestParams(root=str(root.path)))
     return summary.results
 
 

@@ -48,3 +48,15 @@ def test_bad_parameters_are_refused_before_anything_runs():
         SimulateParams(scenario="roundabout")
     with pytest.raises(ValidationError, match="n"):
         SimulateParams(n=0)
+
+
+def test_simulate_flow_can_ingest_its_batch(prefect_server, tmp_path):
+    from evoeye.paths import DataRoot
+    from evoeye.store import Warehouse
+
+    params = SimulateParams(scenario="highway-cut-in", n=2, seed=5, root=str(tmp_path),
+                            workers=1, ingest=True)
+    results = simulate_batch_flow(params)
+    ids = Warehouse(DataRoot.resolve(tmp_path)).sql(
+        "SELECT scenario_id FROM scenarios ORDER BY scenario_id").column("scenario_id")
+    assert ids.to_pylist() == sorted(r.scenario_id for r in results)
