@@ -19,7 +19,7 @@ from typing import Any
 
 from prefect import flow, get_run_logger, task
 from prefect.cache_policies import NONE
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from evoeye.evolve.campaign.config import CampaignConfig, config_from, option_values
 from evoeye.evolve.campaign.loop import Campaign
@@ -39,6 +39,12 @@ class CampaignRun(KnownNames):
 
     def config(self) -> CampaignConfig:
         return config_from(self.model_dump())
+
+    @model_validator(mode="after")
+    def _some_budget(self) -> CampaignRun:
+        if getattr(self, "budget_s", 1.0) <= 0:
+            raise ValueError("budget_s must be greater than 0: no run fits in no simulated time")
+        return self
 
     def run_name(self) -> str:
         return f"evolve-{self.scenario}-{self.strategy}-s{self.seed}"

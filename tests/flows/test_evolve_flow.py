@@ -85,3 +85,8 @@ def test_evolution_flow_runs_each_round_as_a_flow_run(prefect_server, seeded) ->
     # a second flow run with a higher max resumes the same campaign at round 3
     out2 = evolution_flow(params.model_copy(update={"max_rounds": 1}))
     assert out2["campaign_id"] == out["campaign_id"] and out2["round"] == 3
+
+
+def test_a_campaign_with_no_budget_is_refused_before_anything_runs() -> None:
+    with pytest.raises(ValueError, match="budget_s must be greater than 0"):
+        EvolveParams(scenario=SCENARIO, budget_s=0)
