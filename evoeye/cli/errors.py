@@ -45,11 +45,10 @@ KNOWN_ERRORS: dict[str, str] = {
                                      "`evoeye ingest`, or point --root / EVOEYE_HOME at it",
     "evoeye.paths.BadNameError": "use letters, digits, '.', '_' and '-' only",
     "evoeye.scenarios.space.ScenarioError": "",
-    "evoeye.monitor.families.MonitorLoadError": "list the versions (`ls <root>/monitors "
-                                                "<root>/baselines/*`), or train one: `evoeye "
-                                                "train --scenario NAME`; a damaged baseline "
-                                                "folder can be removed, `evoeye evaluate` "
-                                                "trains it again",
+    "evoeye.monitor.families.MonitorLoadError": "list the versions with `evoeye monitors`, "
+                                                "or train one: `evoeye train --scenario "
+                                                "NAME`; a damaged baseline folder can be "
+                                                "removed, `evoeye evaluate` trains it again",
     "evoeye.monitor.families.NoMonitorError": "train one first: `evoeye train --scenario NAME`, "
                                               "or name it with --monitor",
     "evoeye.evolve.campaign.state.NoInitialDataError": "simulate and ingest the scenario's initial "
