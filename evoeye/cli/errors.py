@@ -19,12 +19,14 @@ class ExitCode(IntEnum):
     USER_ERROR = 2  # bad option or input, missing root, unknown monitor, …; nothing was done
     PARTIAL = 3  # the command finished, but some runs failed or some logs were quarantined
     CHECK_FAILED = 4  # `evoeye audit --strict`: a realism bound is not met
+    INTERRUPTED = 130  # Ctrl-C (128 + SIGINT): what was finished is kept, a re-run resumes
 
 
 EXIT_CODES_HELP = (
     "Exit codes: 0 ok · 2 user error (bad option or input; one line and a hint, "
     "--debug for the traceback) · 3 partly done (some runs failed or some logs were "
-    "quarantined) · 4 a checked bound failed (audit --strict) · 1 internal error."
+    "quarantined) · 4 a checked bound failed (audit --strict) · 130 interrupted (Ctrl-C; "
+    "a re-run resumes) · 1 internal error."
 )
 
 
