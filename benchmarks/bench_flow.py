@@ -10,8 +10,10 @@ fresh data root, then ingests them, as two commands in fresh interpreters:
   flow-tmp   `flow` with no PREFECT_API_URL: the command starts a temporary server first
 
 CPU time is the commands' and their children's (workers, a temporary server), plus for `flow`
-and `flows` what the running server spent answering them; on a shared machine it is the figure
-to compare (wall time is shown beside it). Paths are interleaved, `--repeat` times; medians.
+and `flows` what the running server spent answering them: its CPU during the commands minus
+what it spends idle (its background services, measured while the `cli` path runs) over the
+same wall time. On a shared machine CPU is the figure to compare (wall time is shown beside
+it). Paths are interleaved, `--repeat` times; medians.
 """
 
 from __future__ import annotations
@@ -95,13 +97,13 @@ def prefect_server(home: Path):
 
 
 def measure(argvs: list[list[str]], env: dict[str, str],
-            server_cpu: Callable[[], float]) -> tuple[float, float]:
-    """(wall s, CPU s) of the commands in turn, the server's share of CPU included."""
+            server_cpu: Callable[[], float]) -> tuple[float, float, float]:
+    """(wall s, CPU s, the server's CPU s meanwhile) of the commands in turn."""
     t0, c0, s0 = time.perf_counter(), _children_cpu_s(), server_cpu()
     for argv in argvs:
         subprocess.run(argv, check=True, env=env, stdout=subprocess.DEVNULL,
                        stderr=subprocess.DEVNULL)
-    return time.perf_counter() - t0, _children_cpu_s() - c0 + server_cpu() - s0
+    return time.perf_counter() - t0, _children_cpu_s() - c0, server_cpu() - s0
 
 
 def main() -> None:
@@ -116,6 +118,7 @@ def main() -> None:
     base = {k: v for k, v in os.environ.items() if k != "PREFECT_API_URL"}
     base.update(PREFECT_HOME=str(work / "prefect-home"), PREFECT_SERVER_ANALYTICS_ENABLED="false")
     times: dict[str, list[tuple[float, float]]] = {p: [] for p in PATHS}
+    idle: list[float] = []  # the server's CPU s per wall s while no flow uses it
     load = []
     try:
         with prefect_server(work / "server-home") as (url, server):
@@ -123,9 +126,13 @@ def main() -> None:
                 for path in times:
                     root = work / f"{path}-{i}"
                     env = {**base, "PREFECT_API_URL": url} if path in SERVED else base
-                    cpu = (lambda: _tree_cpu_s(server)) if path in SERVED else (lambda: 0.0)
                     argvs = commands(path, root, args.scenario, args.n, args.workers)
-                    times[path].append(measure(argvs, env, cpu))
+                    wall, cpu, served = measure(argvs, env, lambda: _tree_cpu_s(server))
+                    if path == "cli":
+                        idle.append(served / wall)
+                    elif path in SERVED:  # what answering this path cost the server
+                        cpu += max(0.0, served - statistics.median(idle) * wall)
+                    times[path].append((wall, cpu))
                     load.append(os.getloadavg()[0])
                     shutil.rmtree(root, ignore_errors=True)
     finally:
