@@ -61,6 +61,7 @@ def test_too_few_collisions_are_said_so_in_the_summary(tmp_path) -> None:
 
 def test_a_monitor_is_shipped_per_scenario_and_installs_into_a_root(tmp_path) -> None:
     from evoeye.monitor.families import load_version
+    from evoeye.results import demo_monitors
     from evoeye.scenarios import SCENARIOS
 
     versions = packaged_versions()
@@ -72,6 +73,10 @@ def test_a_monitor_is_shipped_per_scenario_and_installs_into_a_root(tmp_path) ->
         params = card["selection"]["train"]["params"]
         assert (params["train_frac"], params["val_frac"]) == (0.8, 0.2)  # demo_monitors.SPLITS
         assert card["data"]["train"]["runs"] >= 300 and card["parent"] is None
+        shipped = card["shipped"]  # which runs trained it: not the demo's (seed, batch)
+        assert (shipped["batch"], shipped["simulation_seed"]) == (demo_monitors.BATCH,
+                                                                 demo_monitors.SEED)
+        assert card["hyperparameters"]["seed"] == shipped["training_seed"] == 0
         assert sum(p.stat().st_size for p in (PACKAGED / version).iterdir()) < 400_000
         assert install(root, version) == version == install(root, version)
         monitor = load_version(root, version)  # the weights match the card's sha256
