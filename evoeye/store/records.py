@@ -23,7 +23,7 @@ import pyarrow.compute as pc
 
 from evoeye.ads.messages import FrameMessages
 from evoeye.log import TOPICS
-from evoeye.log.channels import CHANNELS, OPTIONAL_TOPICS
+from evoeye.log.channels import AGES_TOPIC, CHANNELS, OPTIONAL_TOPICS
 from evoeye.log.records import SIMULATOR_LABELS
 from evoeye.scene import EGO_ID
 from evoeye.store.features import FEATURES, FeatureSpec, FrameFeatures, frame_features, pack
@@ -36,7 +36,7 @@ PREFIX_TOPIC = {
     "pred_": TOPICS.predictions,
     "plan_": TOPICS.plan,
     "ctrl_": TOPICS.control,
-    "age_": TOPICS.ages,
+    "age_": AGES_TOPIC,
     "gt_": TOPICS.ground_truth,
 }
 # Where a column name is not prefix + field name (the column says what the field means).
