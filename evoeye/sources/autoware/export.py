@@ -320,7 +320,7 @@ def export_run(log: str | Path, out_dir: str | Path, *, mapping: Mapping | None 
     An existing folder of that name is replaced."""
     import shutil
 
-    from rosbags.rosbag2 import StoragePlugin, Writer
+    from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
 
     mapping = mapping or Mapping()
     meta, messages = bag_messages(Path(log), mapping, RATES[rates], collision)
@@ -330,6 +330,7 @@ def export_run(log: str | Path, out_dir: str | Path, *, mapping: Mapping | None 
     tmp = partial / dest.name
     store = typestore()
     writer = Writer(tmp, version=9, storage_plugin=StoragePlugin.MCAP)
+    writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)  # zstd chunks
     writer.set_custom_data(RUN_KEY, orjson.dumps({k: meta[k] for k in IDENTITY}).decode())
     with writer:
         conns: dict[str, Any] = {}
