@@ -36,10 +36,10 @@ def watch_command(
 ) -> None:
     """Score each frame of a recording as it is written: risk and alarms as JSON lines on
     stdout and in a risk MCAP (Foxglove: plot /monitor/risk.score). No ROS needed."""
+    from evoeye.log.records import UNLABELLED
     from evoeye.monitor.registry import load_monitor
     from evoeye.monitor.runtime import RuntimeMonitor
     from evoeye.monitor.watch import Watch
-    from evoeye.log.records import UNLABELLED
     from evoeye.sources.autoware.follow import follow
     from evoeye.sources.autoware.frames import FrameAssembler, SourceError
 

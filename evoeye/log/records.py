@@ -17,7 +17,6 @@ from evoeye.scenarios import SCENARIOS
 from evoeye.scene import Lane, RoadMap
 from evoeye.sim.episode import Episode
 
-
 SIMULATOR_LABELS = "simulator"  # label_source of a run evoeye simulated: its own ground truth
 UNLABELLED = "none"  # label_source of a recording without ground truth (schemas/mcap/run.v1.json)
 
