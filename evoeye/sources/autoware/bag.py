@@ -62,7 +62,7 @@ def bag_digest(path: Path) -> str:
 
 def _custom_data(reader: Any) -> dict[str, str]:
     for sub in reader.readers:
-        metadata = getattr(sub, "metadata", None)
+        metadata = getattr(getattr(sub, "storage", None), "metadata", None)
         custom = getattr(metadata, "custom", None)
         if custom:
             return dict(custom)

@@ -314,24 +314,23 @@ def bag_messages(log: Path, mapping: Mapping, rates: Rates, collision: bool = Fa
     return meta, [(t, topic, msgtype, msg) for t, _, topic, msgtype, msg in out]
 
 
-def export_run(log: str | Path, out_dir: str | Path, *, mapping: Mapping | None = None,
-               rates: str = "realistic", collision: bool = False) -> Path:
-    """Write the run log as the rosbag2 folder `<out_dir>/<scenario id>/` (MCAP); its path.
-    An existing folder of that name is replaced."""
+def write_bag(dest: str | Path, messages: list[tuple[int, str, str, Any]],
+              custom: dict[str, str] | None = None, *, store: Any = None) -> Path:
+    """Write [(log ns, topic, type, message)] as the rosbag2 MCAP folder `dest` (replaced if
+    it exists; written beside it first, so a killed export leaves no half bag under its name)."""
     import shutil
 
     from rosbags.rosbag2 import CompressionFormat, CompressionMode, StoragePlugin, Writer
 
-    mapping = mapping or Mapping()
-    meta, messages = bag_messages(Path(log), mapping, RATES[rates], collision)
-    dest = Path(out_dir) / str(meta["scenario_id"])
+    dest = Path(dest)
     partial = dest.with_name(f".{dest.name}.partial")  # the bag folder is named in its files
     shutil.rmtree(partial, ignore_errors=True)
     tmp = partial / dest.name
-    store = typestore()
+    store = store or typestore()
     writer = Writer(tmp, version=9, storage_plugin=StoragePlugin.MCAP)
     writer.set_compression(CompressionMode.STORAGE, CompressionFormat.ZSTD)  # zstd chunks
-    writer.set_custom_data(RUN_KEY, orjson.dumps({k: meta[k] for k in IDENTITY}).decode())
+    for key, value in (custom or {}).items():
+        writer.set_custom_data(key, value)
     with writer:
         conns: dict[str, Any] = {}
         for t_ns, topic, msgtype, msg in messages:
@@ -342,3 +341,12 @@ def export_run(log: str | Path, out_dir: str | Path, *, mapping: Mapping | None 
     tmp.rename(dest)
     partial.rmdir()
     return dest
+
+
+def export_run(log: str | Path, out_dir: str | Path, *, mapping: Mapping | None = None,
+               rates: str = "realistic", collision: bool = False) -> Path:
+    """Write the run log as the rosbag2 folder `<out_dir>/<scenario id>/` (MCAP); its path.
+    An existing folder of that name is replaced."""
+    meta, messages = bag_messages(Path(log), mapping or Mapping(), RATES[rates], collision)
+    identity = orjson.dumps({k: meta[k] for k in IDENTITY}).decode()
+    return write_bag(Path(out_dir) / str(meta["scenario_id"]), messages, {RUN_KEY: identity})
