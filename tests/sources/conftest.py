@@ -2,7 +2,7 @@
 
 The round trip needs real runs: the ground-truth label is recomputed from the true footprints,
 which only a simulated run keeps consistent with its own collision flag. 8 s each (the
-colliding one collides at ≈ 6.8 s), simulated once per session. A bag is a list of
+colliding one collides at ≈ 6.8 s), simulated once per session (in one xdist worker). A bag is a list of
 (log ns, topic, type, message) until `write_bag` writes it, so a test can spoil one first.
 """
 
@@ -25,6 +25,14 @@ from evoeye.store import ingest
 
 SCENARIO = "highway-cut-in"
 DURATION_S = 8.0
+SOURCES_DIR = Path(__file__).resolve().parent
+
+
+def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+    """One xdist group (`-n 2 --dist loadgroup`): the runs are simulated in one worker only."""
+    for item in items:
+        if SOURCES_DIR in Path(str(item.fspath)).resolve().parents:
+            item.add_marker(pytest.mark.xdist_group("autoware"))
 
 
 @dataclass
@@ -73,7 +81,13 @@ def messages(sim_runs: SimRuns):
     return get
 
 
-def bag_at(path: Path, msgs, identity: dict | None = None) -> Path:
+@pytest.fixture(scope="session")
+def bag_at():
+    """bag_at(path, msgs, identity=None): write messages as a bag folder (module doc)."""
+    return _bag_at
+
+
+def _bag_at(path: Path, msgs, identity: dict | None = None) -> Path:
     """Write `msgs` as a bag folder at `path` (with the run identity, if given)."""
     import orjson
 

@@ -89,14 +89,35 @@ def _check_topics(reader: Any, mapping: Mapping, path: Path) -> list[Any]:
     return wanted
 
 
+def _identity(path: Path, custom: dict[str, str]) -> dict[str, Any]:
+    """The run identity an exported bag carries; {} for any other bag."""
+    if RUN_KEY not in custom:
+        return {}
+    try:
+        return {k: orjson.loads(custom[RUN_KEY])[k] for k in IDENTITY}
+    except (orjson.JSONDecodeError, KeyError, TypeError) as e:
+        raise BagError(f"{path}: custom data {RUN_KEY}: malformed ({e})") from None
+
+
+def bag_run_id(path: str | Path) -> tuple[str, str]:
+    """(logical scenario, scenario id) the bag imports as, without decoding a message."""
+    from rosbags.highlevel import AnyReader
+
+    path = Path(path)
+    try:
+        with AnyReader([path], default_typestore=typestore()) as reader:
+            identity = _identity(path, _custom_data(reader))
+    except BagError:
+        raise
+    except Exception as e:  # as read_bag: a bag rosbags cannot open
+        raise BagError(f"{path}: (bag): unreadable bag ({type(e).__name__}: {e})") from None
+    return (identity.get("logical_scenario", EXTERNAL_SCENARIO),
+            identity.get("scenario_id", f"autoware_{bag_digest(path)[:16]}"))
+
+
 def _metadata(path: Path, custom: dict[str, str], assembler: FrameAssembler,
               frames: list[Frame], source: str) -> dict[str, Any]:
-    identity: dict[str, Any] = {}
-    if RUN_KEY in custom:
-        try:
-            identity = {k: orjson.loads(custom[RUN_KEY])[k] for k in IDENTITY}
-        except (orjson.JSONDecodeError, KeyError, TypeError) as e:
-            raise BagError(f"{path}: custom data {RUN_KEY}: malformed ({e})") from None
+    identity = _identity(path, custom)
     truth = assembler.truth
     first = next((f for f in frames if f.messages["/sim/ground_truth"]["ego_collision"]), None)
     dt_s = 1.0 / assembler.mapping.rate_hz

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from evoeye.log.writer import write_run
 from evoeye.paths import DataRoot, check_batch_name
-from evoeye.sources.autoware.bag import BagError, read_bag
+from evoeye.sources.autoware.bag import BagError, bag_run_id, read_bag
 from evoeye.sources.autoware.config import Mapping
 from evoeye.store.ingest import IngestReport, ingest_batch, refresh_catalog
 
@@ -30,7 +30,8 @@ class ImportReport:
     logs: list[Path] = field(default_factory=list)  # run logs written (or found) per bag
     failed: list[str] = field(default_factory=list)  # one line each: bag, topic, problem
     notes: list[str] = field(default_factory=list)
-    labels: dict[str, str] = field(default_factory=dict)  # scenario id → label source
+    labels: dict[str, str] = field(default_factory=dict)  # scenario id → label source, of
+    # the bags converted this time (not those whose run log was there already)
     ingest: list[IngestReport] = field(default_factory=list)
 
 
@@ -58,19 +59,19 @@ def import_bags(root: DataRoot, paths: Sequence[Path], *, mapping: Mapping | Non
         if on_bag is not None:
             on_bag(bag)
         try:
-            run = read_bag(bag, mapping)
+            scenario, sid = bag_run_id(bag)
+            log = root.run_log(scenario, batch, sid)
+            if not log.exists():  # converted before: its log is the run
+                run = read_bag(bag, mapping)
+                log.parent.mkdir(parents=True, exist_ok=True)
+                write_run(dict(run.metadata, batch=batch), run.messages(), log)
+                report.notes += run.notes
+                report.labels[sid] = run.metadata["label_source"]
         except BagError as e:
             report.failed.append(str(e))
             continue
-        meta = dict(run.metadata, batch=batch)
-        log = root.run_log(meta["logical_scenario"], batch, meta["scenario_id"])
-        if not log.exists():
-            log.parent.mkdir(parents=True, exist_ok=True)
-            write_run(meta, run.messages(), log)
         report.logs.append(log)
-        report.notes += run.notes
-        report.labels[meta["scenario_id"]] = meta["label_source"]
-        partitions.add((meta["logical_scenario"], batch))
+        partitions.add((scenario, batch))
     for partition in sorted(partitions):
         report.ingest.append(ingest_batch(root, partition))
     if partitions:
