@@ -2,8 +2,8 @@
 
 The round trip needs real runs: the ground-truth label is recomputed from the true footprints,
 which only a simulated run keeps consistent with its own collision flag. 8 s each (the
-colliding one collides at ≈ 6.8 s), simulated once per session (in one xdist worker). A bag is a list of
-(log ns, topic, type, message) until `write_bag` writes it, so a test can spoil one first.
+colliding one collides at ≈ 6.8 s), simulated once per session (in one xdist worker). A bag is
+a list of (log ns, topic, type, message) until `write_bag` writes it, so a test can spoil one.
 """
 
 from __future__ import annotations
@@ -70,7 +70,7 @@ def sim_runs(tmp_path_factory: pytest.TempPathFactory) -> SimRuns:
 
 @pytest.fixture(scope="session")
 def messages(sim_runs: SimRuns):
-    """bag messages of a run: messages(scenario_id, rates) → (metadata, [(ns, topic, type, msg)])."""
+    """messages(scenario_id, rates) → (metadata, [(ns, topic, type, msg)]) of a run's bag."""
     cache: dict = {}
 
     def get(sid: str, rates: str = "lossless"):

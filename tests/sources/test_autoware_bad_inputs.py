@@ -13,6 +13,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+
 from evoeye.paths import DataRoot
 from evoeye.sources.autoware.bag import BagError, read_bag
 from evoeye.sources.autoware.config import Topics
