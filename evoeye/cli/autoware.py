@@ -60,7 +60,7 @@ def import_autoware(
             report.failed.append(f"{log}: {reason}")
     for sid, source in sorted(report.labels.items()):
         console.print(f"{sid}: labels from {source}")
-    console.print(f"{len(report.logs)} bags converted, {ingested} runs ingested, {skipped} "
+    console.print(f"{len(report.labels)} bags converted, {ingested} runs ingested, {skipped} "
                   f"already in the warehouse (batch {batch})")
     if report.failed:
         for line in report.failed:
