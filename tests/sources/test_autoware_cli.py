@@ -52,7 +52,8 @@ def test_a_mapping_file_overrides_topics_vehicle_and_clock(tmp_path: Path) -> No
     mapping = tmp_path / "map.toml"
     mapping.write_text('[topics]\nodometry = "/odom"\ncollision = ""\n'
                        '[planning_factors]\n"/f/stop" = "yield"\n'
-                       '[vehicle]\nlength_m = 4.0\nrear_overhang_m = 0.5\n[clock]\nmax_gap_s = 1.0\n')
+                       '[vehicle]\nlength_m = 4.0\nrear_overhang_m = 0.5\n'
+                       '[clock]\nmax_gap_s = 1.0\n')
     m = load_mapping(mapping)
     assert m.topics.odometry == "/odom" and m.topics.collision == ""
     assert m.roles()["/odom"] == "odometry" and "" not in m.roles()
