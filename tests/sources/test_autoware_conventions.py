@@ -64,7 +64,8 @@ def test_a_held_prediction_is_resampled_at_the_frame_s_times() -> None:
     rows = predictions([PredictedObject(3, 4.0, 2.0, (path,))], 0.05, (0.0, 0.0))
     # 50 ms old: the frame's point k (k+1)·0.1 s ahead is the path's at (k+1)·0.1 + 0.05 s
     assert rows["x_m"][0][:3] == pytest.approx([1.5, 2.5, 3.5])
-    assert len(rows["x_m"][0]) == 29  # the last grid time (3.0 s) is past the path's end
+    # the grid it covered fresh stays whole: its last point 50 ms on along the last segment
+    assert len(rows["x_m"][0]) == 30 and rows["x_m"][0][-1] == pytest.approx(30.5)
 
 
 def test_a_held_trajectory_is_resampled_at_the_frame_s_times() -> None:
@@ -76,7 +77,7 @@ def test_a_held_trajectory_is_resampled_at_the_frame_s_times() -> None:
     plan = plan_points(traj, 0.1, (0.0, 0.0))
     assert plan["t_rel_s"][:2] == pytest.approx([0.0, 0.1])
     assert plan["x_m"][:2] == pytest.approx([2.0, 4.0])  # 0.1 s old: 2 m further on
-    assert len(plan["t_rel_s"]) == 40
+    assert len(plan["t_rel_s"]) == 41 and plan["x_m"][-1] == pytest.approx(82.0)
 
 
 def _shift(msg, dx: float, dy: float) -> None:

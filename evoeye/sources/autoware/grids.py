@@ -5,8 +5,10 @@ so a foreign stack's points must first sit where evoeye's ADS puts its own: pred
 at the frame time + (k+1)·0.1 s (k < 30), plan point j at the frame time + j·0.1 s (j ≤ 40).
 A held message is `age_s` old at the frame, so its point for frame time + τ is the one at τ +
 age_s after its own stamp. Positions and speeds are linear in time between points, headings
-too (unwrapped). A grid time past the message's last point is left out (a shorter prediction or
-plan, as evoeye's ADS may send one too); a grid time before its first point takes the first.
+too (unwrapped). The grid a message covered when it was fresh stays covered while it is held:
+up to `age_s` past its last point, values go on along its last segment (a 4 s plan held 50 ms
+still gives 41 points, as evoeye's ADS always sends — a point short would change the plan mask
+the monitor was trained on). A grid time further out is left out (a shorter prediction or plan).
 """
 
 from __future__ import annotations
@@ -29,8 +31,19 @@ TIME_SLACK_S = 1e-6  # a grid time this close past the last point still takes it
 
 
 def _within(grid_s: np.ndarray, times_s: np.ndarray, age_s: float) -> np.ndarray:
-    """The grid times whose source time (grid + age) is not past the last point."""
-    return grid_s[grid_s + age_s <= times_s[-1] + TIME_SLACK_S] if len(times_s) else grid_s[:0]
+    """The grid times the message covered when fresh: not past its last point (module doc)."""
+    return grid_s[grid_s <= times_s[-1] + TIME_SLACK_S] if len(times_s) else grid_s[:0]
+
+
+def _at(at: np.ndarray, times_s: np.ndarray, values: np.ndarray) -> np.ndarray:
+    """`values` (one per time) at the times `at`, linear, and along the last segment past the
+    last time."""
+    out = np.interp(at, times_s, values)
+    past = at > times_s[-1]
+    if past.any() and len(times_s) > 1:
+        slope = (values[-1] - values[-2]) / (times_s[-1] - times_s[-2])
+        out[past] = values[-1] + slope * (at[past] - times_s[-1])
+    return out
 
 
 def predictions(objects: list[PredictedObject], age_s: float,
@@ -49,8 +62,8 @@ def predictions(objects: list[PredictedObject], age_s: float,
             cols["mode_prob"].append(path.confidence)
             cols["length_m"].append(obj.length_m)
             cols["width_m"].append(obj.width_m)
-            cols["x_m"].append((np.interp(at, path.t_s, path.xy_m[:, 0]) - origin[0]).tolist())
-            cols["y_m"].append((np.interp(at, path.t_s, path.xy_m[:, 1]) - origin[1]).tolist())
+            cols["x_m"].append((_at(at, path.t_s, path.xy_m[:, 0]) - origin[0]).tolist())
+            cols["y_m"].append((_at(at, path.t_s, path.xy_m[:, 1]) - origin[1]).tolist())
     return {"dt_s": PRED_DT_S, **cols}
 
 
@@ -60,13 +73,13 @@ def plan_points(traj: Trajectory, age_s: float, origin: tuple[float, float]) -> 
     at = grid + age_s
 
     def at_grid(values: np.ndarray) -> list[float]:
-        return np.interp(at, traj.t_s, values).tolist()
+        return _at(at, traj.t_s, values).tolist()
 
-    h = np.interp(at, traj.t_s, traj.heading_rad)
+    h = _at(at, traj.t_s, traj.heading_rad)
     return {
         "t_rel_s": grid.tolist(),
-        "x_m": (np.interp(at, traj.t_s, traj.x_m) - origin[0]).tolist(),
-        "y_m": (np.interp(at, traj.t_s, traj.y_m) - origin[1]).tolist(),
+        "x_m": (_at(at, traj.t_s, traj.x_m) - origin[0]).tolist(),
+        "y_m": (_at(at, traj.t_s, traj.y_m) - origin[1]).tolist(),
         "heading_rad": np.arctan2(np.sin(h), np.cos(h)).tolist(),
         "speed_mps": at_grid(traj.speed_mps),
         "accel_mps2": at_grid(traj.accel_mps2),
