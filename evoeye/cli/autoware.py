@@ -22,7 +22,7 @@ MappingOpt = Annotated[Path | None, typer.Option(
     help="TOML file overriding the default topics, vehicle and clock (docs/autoware.md).")]
 
 
-def _mapping(path: Path | None):  # noqa: ANN202 - the type lives in a heavy module
+def load_mapping_option(path: Path | None):  # noqa: ANN202 - the type lives in a heavy module
     from evoeye.sources.autoware.config import MappingError, load_mapping
 
     try:
@@ -48,7 +48,7 @@ def import_autoware(
     from evoeye.sources.autoware.importer import import_bags
 
     data = DataRoot.resolve(root)
-    report = import_bags(data, paths, mapping=_mapping(mapping), batch=batch,
+    report = import_bags(data, paths, mapping=load_mapping_option(mapping), batch=batch,
                          on_bag=lambda p: err().print(f"reading {p}"))
     console = out()
     for note in report.notes:
@@ -94,7 +94,7 @@ def export_autoware(
     if not logs:
         raise UserError("no run log to export", "simulate some first: `evoeye simulate …`")
     output.mkdir(parents=True, exist_ok=True)
-    chosen = _mapping(mapping)
+    chosen = load_mapping_option(mapping)
     for log in logs:
         bag = export_run(log, output, mapping=chosen, rates=rates)
         out().print(f"wrote {bag}")

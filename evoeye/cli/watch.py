@@ -9,7 +9,7 @@ from typing import Annotated
 import typer
 
 from evoeye.cli.app import app
-from evoeye.cli.autoware import MappingOpt, _mapping
+from evoeye.cli.autoware import MappingOpt, load_mapping_option
 from evoeye.cli.defaults import TARGET_FPRS
 from evoeye.cli.errors import UserError
 from evoeye.cli.monitor import MonitorOpt, RootOpt
@@ -44,7 +44,7 @@ def watch_command(
     from evoeye.sources.autoware.frames import FrameAssembler, SourceError
 
     data = DataRoot.existing(root)
-    chosen = _mapping(mapping)
+    chosen = load_mapping_option(mapping)
     fusion = load_monitor(data, monitor)
     if output is None:
         data.replays.mkdir(parents=True, exist_ok=True)

@@ -99,6 +99,9 @@ def test_realistic_rates_stay_within_the_documented_tolerances(sim_runs, importe
     a, b = (w.arrays(np.flatnonzero(np.isin(k, common)))
             for w, k in zip((native, back), keys, strict=True))
     assert np.array_equal(a["label"], b["label"])
+    # a held plan still covers the whole grid: the plan mask a monitor was trained on (always
+    # full for evoeye's ADS) does not change
+    assert np.array_equal(a["plan_mask"], b["plan_mask"])
     for name, bound in REALISTIC_TOLERANCE.items():
         diff = np.abs(a[name].astype(np.float64) - b[name])  # (b, 1, …)
         if f"{name}_mask" in a:  # slots filled in both frames: the same obstacle or point
