@@ -66,11 +66,11 @@ def test_lossless_import_gives_the_native_features_and_labels(sim_runs, imported
 def test_lossless_import_keeps_the_outcome_and_names_the_label_source(sim_runs,
                                                                       imported) -> None:
     sql = ("SELECT scenario_id, logical_scenario, collided, collision_time_s, other_actor, "
-           "label_source FROM scenarios ORDER BY scenario_id")
+           "label_source, ads_profile FROM scenarios ORDER BY scenario_id")
     native = _rows(sim_runs.root, sql)
     back = _rows(imported["lossless"], sql)
     for n, b in zip(native, back, strict=True):
-        assert n[:3] == b[:3] and n[4] == b[4]
+        assert n[:3] == b[:3] and n[4] == b[4] and n[6] == b[6] == "default"
         assert n[3] == pytest.approx(b[3], abs=1e-6) if n[3] is not None else b[3] is None
         assert n[5] == "simulator"
         assert b[5] == "ground_truth_objects:/simulation/ground_truth/objects"
