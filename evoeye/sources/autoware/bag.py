@@ -4,9 +4,9 @@ Only the mapped topics are decoded (point clouds and images never are). The bag'
 decode it when it embeds them (MCAP); otherwise ROS 2 Humble's types and the vendored Autoware
 ones do (`typestore`). A bag that evoeye exported carries its run's identity (rosbag2
 custom data `evoeye.run`: scenario id, logical scenario, parameters, seed, round, ADS profile):
-it comes back under that id. Any other bag is a run of logical scenario `external`, its id from its bytes, so
-the same bag imported twice is the same run. Labels come from the bag's ground truth alone
-(`labels.py`), never from that record.
+it comes back under that id. Any other bag is a run of logical scenario `external`, its id
+from its bytes, so the same bag imported twice is the same run. Labels come from the bag's
+ground truth alone (`labels.py`), never from that record.
 """
 
 from __future__ import annotations
