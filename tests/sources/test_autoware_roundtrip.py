@@ -95,10 +95,11 @@ def test_message_ages_are_null_natively_zero_lossless_and_rate_bound_realistic(
 @pytest.fixture(scope="module")
 def realistic(sim_runs, imported) -> tuple[dict, dict]:
     """The native and realistic-rate windows (one frame each) of the frames both have."""
-    a, b, left_out = matched_windows(sim_runs.root, imported["realistic"], sorted(sim_runs.logs),
-                                     context_len=1)
-    assert left_out <= 2  # the last frame of a run closes only at the end
-    return a, b
+    m = matched_windows(sim_runs.root, imported["realistic"], sorted(sim_runs.logs),
+                        context_len=1)
+    assert m.left_out <= 2  # the last frame of a run closes only at the end
+    assert sorted(set(m.scenario_id)) == sorted(sim_runs.logs)
+    return m.native, m.imported
 
 
 def test_realistic_rates_stay_within_the_documented_tolerances(realistic) -> None:
