@@ -23,6 +23,7 @@ from evoeye.store.schema import (
     DDL_SCHEMA,
     DERIVED_TABLES,
     PARTITION_KEYS,
+    READ_BY_NAME,
     TABLES,
     create_declared_tables,
 )
@@ -60,12 +61,14 @@ def _parquet_view_sql(table: str, table_dir: Path, has_parts: bool) -> str:
 
 
 def _derived_view_sql(table: str, table_dir: Path, has_parts: bool) -> str:
-    """The view `<table>` over the flat parts of a derived table, or its empty declared table."""
+    """The base view `<table>_parquet` over the flat parts of a derived table, with every
+    column the DDL declares (NULL where an older part lacks it), or its empty declared table."""
     source = f"{DDL_SCHEMA}.{table}"
     if has_parts:
-        source = (f"read_parquet({_string_literal(str(table_dir / '*.parquet'))}, "
-                  "union_by_name = true)")
-    return f"CREATE OR REPLACE VIEW {table} AS SELECT * FROM {source}"
+        by_name = ", union_by_name = true" if table in READ_BY_NAME else ""
+        source = (f"(SELECT * FROM read_parquet({_string_literal(str(table_dir / '*.parquet'))}"
+                  f"{by_name}) UNION ALL BY NAME SELECT * FROM {source})")
+    return f"CREATE OR REPLACE VIEW {table}_parquet AS SELECT * FROM {source}"
 
 
 def parts_present(root: DataRoot) -> tuple[bool, ...]:

@@ -20,9 +20,12 @@ VIEWS_DIR = PROJECT_DIR / "warehouse" / "views"
 QUERIES_DIR = PROJECT_DIR / "warehouse" / "queries"
 
 TABLES = ("scenarios", "frames", "frame_features")
-# Tables later stages append to, as flat parts under warehouse/<table>/ (no partitions), that
-# every connection sees as a view of the same name (`attribution`: evoeye explain).
-DERIVED_TABLES = ("attribution",)
+# Tables later stages append to, as flat parts under warehouse/<table>/ (no partitions): explain,
+# evaluate and the evolution campaign. Every connection sees each as the base view
+# `<table>_parquet` and the view `<table>` (warehouse/views/00_derived_tables.sql).
+DERIVED_TABLES = ("attribution", "monitor_scores", "feedback", "campaign_rounds")
+# Derived tables whose older parts lack a column the DDL has now: read by column name.
+READ_BY_NAME = ("attribution", "feedback")
 # Hive partition keys, in folder order: they are columns of the views, not of the files.
 PARTITION_KEYS = ("logical_scenario", "batch")
 DDL_SCHEMA = "ddl"  # the DuckDB schema holding the declared, always empty, tables
