@@ -104,8 +104,8 @@ def combined_markdown(combined: dict, source: str) -> str:
 
 def write_combined(combined: dict, out: Path | None = None, readme: Path | None = None) -> str:
     """findings.md (returned; with `out`, written there beside findings.json), and with
-    `readme`, spliced into its findings section."""
-    from evoeye.results.markdown import splice_readme
+    `readme`, its summary spliced into the README's findings section."""
+    from evoeye.results.readme import write_readme_section
 
     source = str(out / "findings.json") if out is not None else "the runs below"
     text = combined_markdown(combined, source)
@@ -115,6 +115,7 @@ def write_combined(combined: dict, out: Path | None = None, readme: Path | None 
                                            encoding="utf-8")
         (out / "findings.md").write_text(text, encoding="utf-8")
     if readme is not None:
-        readme.write_text(splice_readme(readme.read_text(encoding="utf-8"), text),
-                          encoding="utf-8")
+        write_readme_section(readme, combined["findings"], source,
+                             None if out is None else out / "findings.md",
+                             command="evoeye findings")
     return text
