@@ -1,12 +1,18 @@
-"""The README's findings section: each of the paper's findings and its verdict, with a link to
-findings.md, where every comparison behind a verdict is shown with its CI and p."""
+"""The README's findings section — each of the paper's findings and its verdict, with a link to
+findings.md, where every comparison behind a verdict is shown with its CI and p — and its
+figure, RQ1's Test F1@0.05 per method with its CI (FIGURE, written beside findings.md)."""
 
 from __future__ import annotations
 
 import os
 from pathlib import Path
 
+from evoeye.evaluation.plots import interval_chart, standalone
 from evoeye.results.markdown import FINDINGS_RULE, findings_summary, splice_readme
+from evoeye.results.tables import cell_key
+
+FIGURE = "rq1-f1.svg"
+FIGURE_KEY = cell_key("test", "f1@0.05")
 
 
 def readme_section(findings: list[dict], source: str, *, command: str = "evoeye results",
@@ -31,3 +37,28 @@ def write_readme_section(readme: Path, findings: list[dict], source: str,
     section = readme_section(findings, source, command=command, details=details)
     readme.write_text(splice_readme(readme.read_text(encoding="utf-8"), section),
                       encoding="utf-8")
+
+
+def rq1_figure(tables: list[dict]) -> str | None:
+    """The SVG of every RQ1 table's Test F1@0.05: each method's mean over the training seeds
+    with its 95 % t CI, one row per scenario and method; None without an RQ1 table."""
+    rq1 = [t for t in tables if t["id"] == "rq1"]
+    if not rq1:
+        return None
+    seeds = sorted({c["n"] for t in rq1 for r in t["rows"] for c in [r["cells"][FIGURE_KEY]]})
+    rows = [(f"{t['scenario']}: {r['method']}", *(None if c[k] is None else 100 * c[k]
+                                                   for k in ("mean", "low", "high")))
+            for t in rq1 for r in t["rows"] for c in [r["cells"][FIGURE_KEY]]]
+    return standalone(interval_chart(rows, title=f"RQ1, Test F1@0.05: mean, 95 % CI over "
+                                                 f"{'/'.join(map(str, seeds))} training seeds",
+                                     xlabel="F1 at a 5 % false-positive rate (%)"))
+
+
+def write_figure(tables: list[dict], folder: Path) -> Path | None:
+    """Write FIGURE into `folder` (if there is an RQ1 table); its path."""
+    svg = rq1_figure(tables)
+    if svg is None:
+        return None
+    folder.mkdir(parents=True, exist_ok=True)
+    (folder / FIGURE).write_text(svg, encoding="utf-8")
+    return folder / FIGURE

@@ -27,7 +27,7 @@ from evoeye.results.config import MONITOR_PARTS, PAPER_TEST_RUNS, ResultsConfig
 from evoeye.results.findings import check_findings
 from evoeye.results.html import results_html
 from evoeye.results.markdown import findings_markdown, part_markdown
-from evoeye.results.readme import write_readme_section
+from evoeye.results.readme import write_figure, write_readme_section
 from evoeye.results.rq1 import ablation, rq1
 from evoeye.results.rq2 import rq2
 from evoeye.results.study import Progress, Study, monitor_study, prepare_data, share_logs
@@ -186,6 +186,7 @@ def write_results(root: DataRoot, results: dict, name: str = "results", *,
         docs.mkdir(parents=True, exist_ok=True)
         for file in DOCS_FILES:
             shutil.copyfile(folder / file, docs / file)
+        write_figure(results["tables"], docs)
     if readme is not None:
         write_readme_section(readme, results["findings"], source,
                              (docs if docs is not None else folder) / "findings.md")

@@ -10,7 +10,7 @@ import pytest
 
 from evoeye.results.findings import check_findings
 from evoeye.results.markdown import README_BEGIN, README_END, splice_readme
-from evoeye.results.readme import readme_section, write_readme_section
+from evoeye.results.readme import FIGURE, readme_section, rq1_figure, write_readme_section
 
 REPO = Path(__file__).resolve().parents[2]
 RESULTS = REPO / "docs" / "results" / "results.json"
@@ -34,6 +34,14 @@ def test_the_readme_section_is_generated_from_the_results() -> None:
     readme = (REPO / "README.md").read_text(encoding="utf-8")
     assert readme.count(README_BEGIN) == 1 and readme.count(README_END) == 1
     assert splice_readme(readme, _section()) == readme
+
+
+def test_the_figure_is_drawn_from_the_same_results() -> None:
+    source = COMBINED if COMBINED.exists() else RESULTS
+    figure = REPO / "docs" / "results" / FIGURE
+    tables = json.loads(source.read_text())["tables"]
+    assert figure.read_text(encoding="utf-8") == rq1_figure(tables)
+    assert f"(docs/results/{FIGURE})" in (REPO / "README.md").read_text(encoding="utf-8")
 
 
 def test_splicing_replaces_only_the_section() -> None:
