@@ -23,11 +23,10 @@ from evoeye.store.schema import (
     DDL_SCHEMA,
     DERIVED_TABLES,
     PARTITION_KEYS,
-    READ_BY_NAME,
     TABLES,
     create_declared_tables,
 )
-from evoeye.store.sqlfiles import query, view_scripts
+from evoeye.store.sqlfiles import parts_macros, query, view_scripts
 
 READ_ONLY_STATEMENTS = frozenset({duckdb.StatementType.SELECT, duckdb.StatementType.EXPLAIN})
 PART_GLOB = "/".join(["*"] * len(PARTITION_KEYS) + ["*.parquet"])  # */*/*.parquet
@@ -61,14 +60,12 @@ def _parquet_view_sql(table: str, table_dir: Path, has_parts: bool) -> str:
 
 
 def _derived_view_sql(table: str, table_dir: Path, has_parts: bool) -> str:
-    """The base view `<table>_parquet` over the flat parts of a derived table, with every
-    column the DDL declares (NULL where an older part lacks it), or its empty declared table."""
+    """The view `<table>` over every flat part of a derived table, read by its macro
+    `<table>_parts` (warehouse/parts.sql), or its empty declared table."""
     source = f"{DDL_SCHEMA}.{table}"
     if has_parts:
-        by_name = ", union_by_name = true" if table in READ_BY_NAME else ""
-        source = (f"(SELECT * FROM read_parquet({_string_literal(str(table_dir / '*.parquet'))}"
-                  f"{by_name}) UNION ALL BY NAME SELECT * FROM {source})")
-    return f"CREATE OR REPLACE VIEW {table}_parquet AS SELECT * FROM {source}"
+        source = f"{table}_parts({_string_literal(str(table_dir / '*.parquet'))})"
+    return f"CREATE OR REPLACE VIEW {table} AS SELECT * FROM {source}"
 
 
 def parts_present(root: DataRoot) -> tuple[bool, ...]:
@@ -81,12 +78,14 @@ def parts_present(root: DataRoot) -> tuple[bool, ...]:
 
 def install_views(con: duckdb.DuckDBPyConnection, root: DataRoot,
                   present: tuple[bool, ...] | None = None) -> None:
-    """Create the declared tables, the Parquet base views and every view script on `con`, for
-    the tables `present` (default: as they are now, `parts_present`)."""
+    """Create the declared tables, the Parquet base views, the derived tables' macros and views
+    and every view script on `con`, for the tables `present` (default: as they are now,
+    `parts_present`)."""
     present = parts_present(root) if present is None else present
     create_declared_tables(con)
     for table, has_parts in zip(TABLES, present[:len(TABLES)], strict=True):
         con.execute(_parquet_view_sql(table, root.table_dir(table), has_parts))
+    con.execute(parts_macros())
     for table, has_parts in zip(DERIVED_TABLES, present[len(TABLES):], strict=True):
         con.execute(_derived_view_sql(table, root.table_dir(table), has_parts))
     for _, script in view_scripts():
