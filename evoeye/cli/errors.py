@@ -54,9 +54,9 @@ KNOWN_ERRORS: dict[str, str] = {
                                               "or name it with --monitor",
     "evoeye.evolve.campaign.state.NoInitialDataError": "simulate and ingest the scenario's initial "
                                                   "runs: `evoeye simulate …`, `evoeye ingest`",
-    "evoeye.evaluation.audit.runs.NoLogsError": "audit a batch the root holds (above), or all "
-                                                "of them: `evoeye audit` without --scenario "
-                                                "and --batch",
+    "evoeye.evaluation.audit.runs.NoLogsError": "name a batch the root holds (above), or "
+                                                "leave out --scenario and --batch to audit "
+                                                "them all; `evoeye simulate …` makes runs",
     "evoeye.results.study.EmptySplitError": "simulate the data with the command (--initial-runs "
                                             "N --test-runs M), or check --test-batch and the "
                                             "shares",
