@@ -10,6 +10,7 @@ import re
 import runpy
 import shlex
 import sys
+import warnings
 from functools import cache
 from pathlib import Path
 
@@ -129,7 +130,10 @@ def module_options(module: str) -> set[str]:
     stdout, argv, path = io.StringIO(), sys.argv, sys.path
     sys.argv, sys.path = [module, "--help"], [str(REPO), *sys.path]  # benchmarks/ is no package
     try:
-        with contextlib.redirect_stdout(stdout), pytest.raises(SystemExit) as done:
+        with contextlib.redirect_stdout(stdout), pytest.raises(SystemExit) as done, \
+                warnings.catch_warnings():
+            # another test may have imported the module: runpy warns, and runs it all the same
+            warnings.filterwarnings("ignore", "'.*' found in sys.modules", RuntimeWarning)
             runpy.run_module(module, run_name="__main__", alter_sys=True)
     finally:
         sys.argv, sys.path = argv, path
