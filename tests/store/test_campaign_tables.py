@@ -64,7 +64,8 @@ def test_feedback_written_before_the_mode_column_reads_as_now(root: DataRoot) ->
         ("prior-corrected", "r-1", 0.3), ("prior-corrected", "r-2", 0.4), ("raw", "r-1", 0.1),
         ("raw", "r-2", 0.8)]
     columns = "monitor_version, feedback_mode, scenario_id, feedback"  # the view reads as they do
-    assert Warehouse(root).sql(f"SELECT {columns} FROM feedback ORDER BY ALL").to_pylist() == \
+    view = Warehouse(root).read_only_sql(f"SELECT {columns} FROM feedback ORDER BY ALL")
+    assert view.to_pylist() == \
         read_feedback(root).select(columns.split(", ")).sort_by(
             [(c, "ascending") for c in columns.split(", ")]).to_pylist()
 

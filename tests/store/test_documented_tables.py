@@ -46,13 +46,15 @@ def documented() -> dict[str, list[str] | None]:
     return names
 
 
-def installed(con: duckdb.DuckDBPyConnection) -> tuple[set[str], dict[str, list[str]]]:
-    """The views of a warehouse connection, and its table macros with their parameters."""
-    views = {v for (v,) in con.sql("SELECT view_name FROM duckdb_views() "
-                                   "WHERE NOT internal AND schema_name = 'main'").fetchall()}
-    macros = dict(con.sql("SELECT function_name, parameters FROM duckdb_functions() "
-                          "WHERE function_type = 'table_macro' AND NOT internal").fetchall())
-    return views, macros
+def installed(wh: Warehouse) -> tuple[set[str], dict[str, list[str]]]:
+    """The views a user's query sees (`evoeye sql`), and the table macros with their
+    parameters."""
+    views = wh.read_only_sql("SELECT view_name FROM duckdb_views() "
+                             "WHERE NOT internal AND schema_name = 'main'").column(0)
+    macros = wh.read_only_sql("SELECT function_name, parameters FROM duckdb_functions() "
+                              "WHERE function_type = 'table_macro' AND NOT internal")
+    return set(views.to_pylist()), dict(zip(*(c.to_pylist() for c in macros.columns),
+                                            strict=True))
 
 
 def _count(con: duckdb.DuckDBPyConnection, relation: str) -> int:
@@ -82,7 +84,7 @@ def full(root: DataRoot, add_run: Callable[..., Path]) -> DataRoot:
 
 def test_the_doc_names_every_view_and_table_macro_and_nothing_else(root: DataRoot) -> None:
     names = documented()
-    views, macros = installed(Warehouse(root).connect())
+    views, macros = installed(Warehouse(root))
     assert {n for n, args in names.items() if args is None} == views
     assert {n: args for n, args in names.items() if args is not None} == macros
     assert set(DERIVED_TABLES) <= views
@@ -112,7 +114,7 @@ def test_every_documented_relation_answers_evoeye_sql_and_duckdb(full: DataRoot)
 
 def test_the_derived_views_have_the_declared_columns(full: DataRoot) -> None:
     for table in DERIVED_TABLES:
-        assert Warehouse(full).sql(f"SELECT * FROM {table}").schema.names == \
+        assert Warehouse(full).read_only_sql(f"SELECT * FROM {table}").schema.names == \
             declared_schema(table).names, table
     rows = Warehouse(full).sql("SELECT cause, share FROM run_attribution ORDER BY cause")
     assert rows.to_pylist() == [{"cause": m, "share": 0.25}
