@@ -97,8 +97,11 @@ def resolve(words: list[str]) -> tuple[click.Command, list[str]] | None:
     (`evoeye COMMAND …`). AssertionError naming an unknown command or group option."""
     command, rest = root_command(), words[1:]
     while hasattr(command, "commands"):  # a group: typer's, not necessarily click's class
-        at = next((i for i, w in enumerate(rest) if not OPTION.match(w)), len(rest))
-        unknown = [w for w in rest[:at] if w not in _options(command)]
+        at, unknown = 0, []
+        while at < len(rest) and OPTION.match(rest[at]):  # the group's own options, values
+            param = next((p for p in command.params if rest[at] in p.opts), None)
+            unknown += [] if param or rest[at] == "--help" else [rest[at]]
+            at += 2 if param is not None and not getattr(param, "is_flag", True) else 1
         assert not unknown, f"no option {unknown} before the command in {words}"
         if at == len(rest) or PLACEHOLDER.match(rest[at]):
             return None
