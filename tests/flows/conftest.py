@@ -25,7 +25,9 @@ SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
 FLOWS_DIR = Path(__file__).resolve().parent
 
 
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if not config.pluginmanager.hasplugin("xdist"):  # `-p no:xdist`: no groups to form
+        return
     for item in items:
         if FLOWS_DIR in Path(str(item.fspath)).resolve().parents:
             item.add_marker(pytest.mark.xdist_group("prefect"))
