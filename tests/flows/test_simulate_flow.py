@@ -10,7 +10,8 @@ from evoeye.log import read_run
 from flows.simulate import SimulateParams, simulate_batch_flow
 
 
-def test_simulate_flow_writes_one_log_per_run_and_reruns_skip(prefect_server, tmp_path):
+def test_simulate_flow_writes_one_log_per_run_and_reruns_skip(tmp_path, latest_artifact,
+                                                              flow_run_names):
     params = SimulateParams(scenario="unprotected-intersection", n=2, seed=4,
                             root=str(tmp_path), workers=2)
     results = simulate_batch_flow(params)
@@ -20,17 +21,11 @@ def test_simulate_flow_writes_one_log_per_run_and_reruns_skip(prefect_server, tm
     again = simulate_batch_flow(params)
     assert all(r.skipped for r in again)
     assert sorted(r.path for r in again) == sorted(r.path for r in results)
-    from prefect.client.orchestration import get_client
-    from prefect.client.schemas.filters import FlowRunFilter, FlowRunFilterName
-
     name = "simulate-unprotected-intersection-uniform-seed4-n2"
-    with get_client(sync_client=True) as client:
-        runs = client.read_flow_runs(flow_run_filter=FlowRunFilter(
-            name=FlowRunFilterName(any_=[name])))
-        (artifact, *_) = [a for a in client.read_artifacts() if a.key == "evoeye-simulate"]
-    assert len(runs) == 2  # the run and the re-run
-    assert "# Simulated: unprotected-intersection" in artifact.data
-    assert "| Runs | Collisions | Failed | Skipped |" in artifact.data
+    assert flow_run_names(name) == [name, name]  # the run and the re-run
+    artifact = latest_artifact("evoeye-simulate")  # the re-run's
+    assert "# Simulated: unprotected-intersection" in artifact
+    assert "| Runs | Collisions | Failed | Skipped |" in artifact
 
 
 def test_simulate_flow_on_a_two_worker_dask_cluster(prefect_server, tmp_path):

@@ -49,7 +49,7 @@ def test_the_summary_answers_how_many_how_early_and_how_many_false_alarms(tmp_pa
     assert "Verdict: FusionMonitor warns of more collisions than TTC" in text
     assert ("Evolution: 1 round(s) added 4 runs (62 s simulated) and replaced G_0 fusion-a by "
             "fusion-b: Test-Set F1@0.05 60.0 → 62.0 %, Hard-Set F1@0.05 0.0 → 25.0 %") in text
-    assert "Which figure is which" in text
+    assert "Which figure is which" in text and "Fewer than" not in text  # 14 collisions
     assert [w for w, _ in result.paths()][-1] == "this summary"
 
 
@@ -57,6 +57,7 @@ def test_too_few_collisions_are_said_so_in_the_summary(tmp_path) -> None:
     result = demo.DemoResult(DataRoot.resolve(tmp_path), [_report(2, 2)], {})
     text = demo.summary_text(result)
     assert "2 test collisions: too few to compare" in text and "Evolution:" not in text
+    assert f"Fewer than {demo.MIN_COLLISIONS} test collisions in a scenario" in text
 
 
 def test_a_monitor_is_shipped_per_scenario_and_installs_into_a_root(tmp_path) -> None:
