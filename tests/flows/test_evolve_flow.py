@@ -55,10 +55,17 @@ def test_nightly_deployment_has_cron_and_parameter_schema() -> None:
 
 
 def test_evolution_flow_runs_each_round_as_a_flow_run(seeded, latest_artifact) -> None:
+    from datetime import UTC, datetime
+
     from prefect.client.orchestration import get_client
-    from prefect.client.schemas.filters import FlowRunFilter, FlowRunFilterName
+    from prefect.client.schemas.filters import (
+        FlowRunFilter,
+        FlowRunFilterName,
+        FlowRunFilterStartTime,
+    )
 
     root, g0 = seeded
+    started = datetime.now(UTC)  # other tests (the demo flow's) run rounds of this name too
     params = EvolveParams(root=str(root.path), scenario=SCENARIO, strategy="evoeye", budget_s=1000,
                           monitor=g0, n_round=3, epochs=1, max_rounds=2, train_frac=0.5,
                           val_frac=0.25, assess=True)
@@ -69,11 +76,12 @@ def test_evolution_flow_runs_each_round_as_a_flow_run(seeded, latest_artifact) -
     assert [len(r.scenario_ids) for r in rows] == [0, 3, 3]
     assert all(r.metrics.hard["frames"] >= 0 for r in rows)  # every G_r assessed
     names = [f"round-{r}-{SCENARIO}-evoeye-s0" for r in (1, 2)]
+    since = FlowRunFilterStartTime(after_=started)
     with get_client(sync_client=True) as client:
         runs = client.read_flow_runs(flow_run_filter=FlowRunFilter(
-            name=FlowRunFilterName(any_=names)))
+            name=FlowRunFilterName(any_=names), start_time=since))
         campaign = client.read_flow_runs(flow_run_filter=FlowRunFilter(
-            name=FlowRunFilterName(any_=[f"evolve-{SCENARIO}-evoeye-s0"])))
+            name=FlowRunFilterName(any_=[f"evolve-{SCENARIO}-evoeye-s0"]), start_time=since))
     assert sorted(r.name for r in runs) == names and len(campaign) == 1
     assert all(r.state.is_completed() for r in runs)
     # the campaign's artifact (the newest: other tests' flows publish theirs on the same server):
