@@ -3,7 +3,8 @@
 A run's log path is a function of (logical scenario, batch, scenario id), and logs are written
 atomically, so a batch can be killed at any point and re-run: finished runs are skipped, an
 unfinished one (a `.tmp` file) is simulated again, and the `.tmp` files of writers that are gone
-are removed first. Workers die with the parent process that started them.
+are removed first. Workers die with the parent process that started them; Ctrl-C stops them at
+once, and the runs in progress leave no file behind (`BatchInterrupted`).
 """
 
 from __future__ import annotations
@@ -20,7 +21,7 @@ import numpy as np
 
 from evoeye.ads.profiles import DEFAULT_PROFILE
 from evoeye.atomic import remove_stale_temps
-from evoeye.lifeline import die_with_parent
+from evoeye.lifeline import stop_workers, stoppable, stoppable_worker
 from evoeye.log import LogError, read_run, write_episode
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import get_scenario
@@ -130,27 +131,59 @@ def pool_context() -> mp.context.BaseContext:
     return mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
 
 
+class BatchInterrupted(KeyboardInterrupt):
+    """Ctrl-C during a batch: the workers were stopped, no log is half-written, and `summary`
+    holds the runs that finished (their logs are kept; a re-run skips them)."""
+
+    def __init__(self, summary: BatchSummary, on_disk: int, planned: int) -> None:
+        self.summary, self.on_disk, self.planned = summary, on_disk, planned
+        super().__init__(
+            f"{on_disk} of the batch's {planned} run logs are on disk, {summary.skipped} of "
+            "them from before; the runs in progress were dropped, no log is half-written. Run "
+            f"the same command again to simulate the other {planned - on_disk}.")
+
+
 def run_batch(
     specs: Sequence[RunSpec], root: DataRoot, *, workers: int = 1,
     progress: Callable[[Iterable], Iterable] | None = None,
 ) -> BatchSummary:
-    """Run every spec (in `workers` processes); one broken run never stops the others."""
+    """Run every spec (in `workers` processes); one broken run never stops the others. Ctrl-C
+    stops the workers at once and raises BatchInterrupted with what finished."""
     if workers < 1:
         raise ValueError(f"--workers must be at least 1, got {workers}")
     t0 = time.perf_counter()
     summary = BatchSummary(stale_removed=remove_stale_logs(specs, root))
     wrap = progress or (lambda it: it)
-    if workers == 1:
-        for spec in wrap(specs):
-            summary.results.append(_guarded(spec, root))
-    else:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=pool_context(),
-                                 initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
-            futures: dict[Future, RunSpec] = {
-                pool.submit(simulate_and_log, s, root): s for s in specs
-            }
-            for fut in wrap(as_completed(futures)):
-                summary.results.append(_result(fut, futures[fut], root))
+    try:
+        if workers == 1:
+            for spec in wrap(specs):
+                summary.results.append(_guarded(spec, root))
+        else:
+            _in_pool(specs, root, workers, wrap, summary)
+    except KeyboardInterrupt:
+        on_disk = sum(root.run_log(s.scenario, s.batch, s.scenario_id).exists() for s in specs)
+        raise BatchInterrupted(_finish(summary, t0), on_disk, len(specs)) from None
+    return _finish(summary, t0)
+
+
+def _in_pool(specs: Sequence[RunSpec], root: DataRoot, workers: int,
+             wrap: Callable[[Iterable], Iterable], summary: BatchSummary) -> None:
+    pool = ProcessPoolExecutor(max_workers=workers, mp_context=pool_context(),
+                               initializer=stoppable_worker, initargs=(os.getpid(),))
+    try:
+        futures: dict[Future, RunSpec] = {
+            pool.submit(stoppable, simulate_and_log, s, root): s for s in specs
+        }
+        for fut in wrap(as_completed(futures)):
+            summary.results.append(_result(fut, futures[fut], root))
+    except KeyboardInterrupt:
+        stop_workers(pool)
+        raise
+    finally:
+        pool.shutdown(wait=True)
+
+
+def _finish(summary: BatchSummary, t0: float) -> BatchSummary:
     summary.results.sort(key=lambda r: r.scenario_id)
     summary.wall_s = time.perf_counter() - t0
     return summary

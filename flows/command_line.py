@@ -20,10 +20,13 @@ from typing import Any
 
 from pydantic import BaseModel, ValidationError
 
+from flows.api import one_api_server
+
 API_NOTE = (
-    "Prefect: with no PREFECT_API_URL a flow run first starts a temporary API server (≈ 15-20 s, "
-    "longer on a busy machine; timeout PREFECT_SERVER_EPHEMERAL_STARTUP_TIMEOUT_SECONDS). To skip "
-    "that, run `prefect server start` once and set PREFECT_API_URL=http://127.0.0.1:4200/api."
+    "Prefect: with no PREFECT_API_URL a flow run first starts one temporary API server, shared "
+    "by its worker processes (≈ 5-20 s, longer on a busy machine; timeout "
+    "PREFECT_SERVER_EPHEMERAL_STARTUP_TIMEOUT_SECONDS). To skip that, run `prefect server "
+    "start` once and set PREFECT_API_URL=http://127.0.0.1:4200/api."
 )
 
 
@@ -47,7 +50,7 @@ def say_what_we_wait_for() -> None:
     """Tell the user, before a flow runs, that a temporary Prefect server starts first."""
     if not os.environ.get("PREFECT_API_URL"):
         timeout = os.environ.get("PREFECT_SERVER_EPHEMERAL_STARTUP_TIMEOUT_SECONDS", "20")
-        print(f"starting Prefect's temporary API server first (≈ 15-20 s, up to {timeout} s on a "
+        print(f"starting Prefect's temporary API server first (≈ 5-20 s, up to {timeout} s on a "
               "busy machine); set PREFECT_API_URL to use a running `prefect server start` "
               "instead", file=sys.stderr, flush=True)
 
@@ -86,6 +89,7 @@ def run_from_command_line(params: type[BaseModel], run: Callable[[Any], Any],
     except (ValidationError, ValueError) as exc:
         ap.error(str(exc))
     say_what_we_wait_for()
-    result = run(chosen)
+    with one_api_server():  # one for the flow run and every worker process it starts
+        result = run(chosen)
     print(json.dumps(result, default=_plain, indent=2))
     return result

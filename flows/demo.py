@@ -1,9 +1,10 @@
-"""The main job, small, as one Prefect flow: `python -m flows.demo` (what `make demo` runs).
+"""The demo as one Prefect flow run: `python -m flows.demo` (what `make demo` runs).
 
-simulate both logical scenarios → ingest → train the FusionMonitor and evaluate it against the
-TTC / TTC-2D / RSS / AEM baselines and the context-only control (RQ1 report) → one evolution
-round of BlindSpotEvolver. With no Prefect API configured, Prefect starts a temporary local
-server for the run; simulation fans out over local processes.
+The steps of `evoeye.results.demo`, each a flow or task run: simulate fresh runs of both logical
+scenarios and ingest them; measure the FusionMonitor shipped with evoeye against the rule-based
+baselines on their test runs; one evolution round per scenario from the shipped monitor; then
+the report and the plain-words summary, printed at the end and published as an artifact. With
+no PREFECT_API_URL one temporary API server serves the whole run.
 """
 
 from __future__ import annotations
@@ -11,68 +12,84 @@ from __future__ import annotations
 import argparse
 from typing import Any
 
-from prefect import flow
+from prefect import flow, task
+from prefect.cache_policies import NONE
 from pydantic import BaseModel, Field
 
 from evoeye.paths import DataRoot
+from evoeye.results import demo as steps
 from evoeye.scenarios import SCENARIOS
+from evoeye.store.feedback import read_rounds
+from flows.api import one_api_server
 from flows.command_line import API_NOTE, say_what_we_wait_for
-from flows.evaluate import EvaluateParams, evaluate_flow
 from flows.evolve import EvolveParams, evolution_flow
 from flows.ingest import IngestParams, ingest_flow
+from flows.published import named, publish
 from flows.simulate import SimulateParams, simulate_batch_flow
-
-EVOLVE_SCENARIO = "unprotected-intersection"
 
 
 class DemoParams(BaseModel):
     """Sizes of the demo (defaults: a few minutes on 2 cores)."""
 
     root: str | None = None
-    n: int = Field(40, ge=8, le=10_000)  # runs per logical scenario
+    n: int | None = Field(None, ge=8, le=10_000)  # runs per scenario (default steps.RUNS)
     seed: int = Field(0, ge=0)
     workers: int = Field(2, ge=1, le=64)
-    evolve_runs: int = Field(4, ge=1, le=100)  # runs in the one evolution round
+    evolve_runs: int = Field(steps.EVOLVE_RUNS, ge=1, le=100)  # runs of each evolution round
+
+    def run_name(self) -> str:
+        return f"demo-{DataRoot.resolve(self.root).path.name}"
 
 
-@flow(name="evoeye-demo", log_prints=True)
+@task(cache_policy=NONE, task_run_name="evaluate-{scenario}")
+def evaluate_shipped(root: DataRoot, scenario: str) -> dict:
+    """The shipped monitor against the rule-based baselines on the scenario's test runs."""
+    return steps.evaluate_shipped(root, scenario)
+
+
+@flow(name="evoeye-demo", log_prints=True, flow_run_name=named(DemoParams.run_name))
 def demo_flow(params: DemoParams) -> dict[str, Any]:
-    """The whole pipeline once, end to end; returns where the results are."""
+    """The demo end to end; its summary, and where the results are."""
     data = DataRoot.resolve(params.root)
     root = str(data.path)  # the sub-flows' parameters: plain, as a user would give them
     for scenario in SCENARIOS:
-        simulate_batch_flow(SimulateParams(scenario=scenario, n=params.n, seed=params.seed,
-                                           root=root, workers=params.workers, batch="demo"))
+        simulate_batch_flow(SimulateParams(scenario=scenario, n=params.n or steps.RUNS[scenario],
+                                           seed=params.seed, root=root, workers=params.workers,
+                                           batch=steps.BATCH))
     ingest_flow(IngestParams(root=root))
-    rq1 = evaluate_flow(EvaluateParams(root=root, train_fusion=True, report_name="demo"))
-    evolution = evolution_flow(EvolveParams(
-        root=root, scenario=EVOLVE_SCENARIO, strategy="evoeye", n_round=params.evolve_runs,
-        budget_s=20.0 * params.evolve_runs, max_rounds=1, epochs=2, assess=True,
-    ))
-    return {"runs": str(data.runs), "warehouse": str(data.warehouse),
-            "monitors": str(data.monitors), "rq1": rq1, "evolution": evolution,
-            "campaign_rounds": str(data.table_dir("campaign_rounds"))}
+    result = steps.DemoResult(data, [evaluate_shipped(data, s) for s in SCENARIOS])
+    for scenario in SCENARIOS:
+        cfg = steps.campaign_config(data, scenario, params.evolve_runs)
+        out = evolution_flow(EvolveParams.of(cfg, root, max_rounds=1, assess=True))
+        result.rounds[scenario] = read_rounds(data, out["campaign_id"])
+    steps.write_summary(result)
+    text = steps.summary_text(result)
+    publish("evoeye-demo", f"```\n{text}\n```", str(result.report_dir))
+    return {"summary": text, "paths": [(what, str(path)) for what, path in result.paths()]}
 
 
 def main() -> None:
     ap = argparse.ArgumentParser(prog="python -m flows.demo", description=__doc__,
                                  epilog=API_NOTE)
     ap.add_argument("--root", default=None)
-    ap.add_argument("--n", type=int, default=40)
+    ap.add_argument("--n", type=int, default=None,
+                    help="runs per logical scenario (default: 120 highway-cut-in, 60 "
+                         "unprotected-intersection)")
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--evolve-runs", type=int, default=steps.EVOLVE_RUNS)
     args = ap.parse_args()
     try:
-        params = DemoParams(root=args.root, n=args.n, workers=args.workers)
+        params = DemoParams(root=args.root, n=args.n, workers=args.workers,
+                            evolve_runs=args.evolve_runs)
     except ValueError as exc:  # pydantic's ValidationError: one line per field, no traceback
         ap.error(" ".join(str(exc).split()))
     say_what_we_wait_for()
-    result = demo_flow(params)
-    print("\nevoeye demo finished. Results:")
-    print(f"  MCAP logs (Foxglove / Lichtblick): {result['runs']}")
-    print(f"  warehouse (Parquet + DuckDB):      {result['warehouse']}")
-    print(f"  trained monitors and cards:        {result['monitors']}")
-    print(f"  RQ1 report (Markdown + HTML):      {result['rq1']['report_dir']}")
-    print(f"  evolution round state:             {result['campaign_rounds']}")
+    with one_api_server():
+        result = demo_flow(params)
+    print("\n" + result["summary"])
+    print("\nWhere the results are:")
+    for what, path in result["paths"]:
+        print(f"  {what}: {path}")
 
 
 if __name__ == "__main__":

@@ -1,7 +1,8 @@
-"""Flow: the RQ1 evaluation (a thin wrapper): one task per logical scenario, then the report.
+"""Flow: the evaluation (paper RQ1; a thin wrapper): one task per logical scenario, then the
+report.
 
 Writing monitor_scores takes the warehouse writer lock, so a task is retried only while another
-writer holds it; the report is published as a Markdown artifact.
+writer holds it; the report (its headline first) is published as a Markdown artifact.
 """
 
 from __future__ import annotations
@@ -9,7 +10,6 @@ from __future__ import annotations
 from typing import Any
 
 from prefect import flow, get_run_logger, task
-from prefect.artifacts import create_markdown_artifact
 from pydantic import BaseModel, Field
 
 from evoeye.evaluation.monitors import BASELINES
@@ -17,6 +17,7 @@ from evoeye.evaluation.report import markdown_report, write_report
 from evoeye.evaluation.rq1 import rq1, warehouse_scenarios
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
+from flows.published import named, publish
 from flows.runners import retry_while_locked
 
 
@@ -39,6 +40,9 @@ class EvaluateParams(BaseModel):
     def splits(self) -> SplitSpec:
         return SplitSpec(self.split_seed, self.train_frac, self.val_frac, self.test_batch)
 
+    def run_name(self) -> str:
+        return f"evaluate-{'-'.join(self.scenarios) or 'all'}"
+
     def model_post_init(self, __context) -> None:
         self.splits  # noqa: B018  (validates the fractions)
         unknown = [b for b in self.baselines if b not in BASELINES]
@@ -56,7 +60,8 @@ def evaluate_scenario(root: DataRoot, scenario: str, params: EvaluateParams) -> 
     return report.to_dict()
 
 
-@flow(name="evoeye-evaluate", log_prints=True)
+@flow(name="evoeye-evaluate", log_prints=True,
+      flow_run_name=named(lambda p: (p or EvaluateParams()).run_name()))
 def evaluate_flow(params: EvaluateParams | None = None) -> dict[str, Any]:
     """Evaluate every scenario, write the report, publish the RQ1 table as an artifact."""
     params = params or EvaluateParams()
@@ -65,10 +70,8 @@ def evaluate_flow(params: EvaluateParams | None = None) -> dict[str, Any]:
     # one after the other: each task writes monitor_scores under the single writer lock
     reports = [evaluate_scenario(root, s, params) for s in scenarios]
     files = write_report(root, reports, params.report_name)
-    markdown = markdown_report(reports)
-    create_markdown_artifact(markdown=markdown, key="evoeye-rq1",
-                             description=f"RQ1 report, {files.html}")
-    get_run_logger().info("RQ1 report for %s: %s", ", ".join(scenarios), files.html)
+    publish("evoeye-rq1", markdown_report(reports), f"evaluation report, {files.html}")
+    get_run_logger().info("evaluation report for %s: %s", ", ".join(scenarios), files.html)
     return {"reports": reports, "report_dir": str(files.folder)}
 
 

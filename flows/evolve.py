@@ -1,13 +1,15 @@
-"""Flow: an evolution campaign; every acquisition round is its own (sub)flow run `round-<r>`.
+"""Flow: an evolution campaign; every acquisition round is its own (sub)flow run.
 
-A round flow run runs propose → simulate → score → ingest (task `acquire`, which ingests its
-runs from the conversion it scored them with), `ingest` (any of the campaign's logs an
-interrupted `acquire` left out, and the DuckDB catalog file), `train` and `score` (feedback
-refresh and the round's commit). The tasks pass only the parameters and run ids: each
-rebuilds the campaign's state from the data root (`Campaign.start`, with the round's new run
-ids), where `acquire` left the new logs and their feedback. Because the state lives in the
-warehouse, a round flow run that crashed is simply run again by the next flow run (e.g.
-tomorrow night's), with nothing lost or repeated.
+Each flow run is named after its campaign (`evolve-<scenario>-<strategy>-s<seed>`, its rounds
+`round-<r>-…`) and publishes the campaign's rounds, with each monitor's figures where
+assessed, as a Markdown artifact. A round flow run runs propose → simulate → score → ingest
+(task `acquire`, which ingests its runs from the conversion it scored them with), `ingest` (any
+of the campaign's logs an interrupted `acquire` left out, and the DuckDB catalog file), `train`
+and `score` (feedback refresh and the round's commit). The tasks pass only the parameters and
+run ids: each rebuilds the campaign's state from the data root (`Campaign.start`, with the
+round's new run ids), where `acquire` left the new logs and their feedback. Because the state
+lives in the warehouse, a round flow run that crashed is simply run again by the next flow run
+(e.g. tomorrow night's), with nothing lost or repeated.
 """
 
 from __future__ import annotations
@@ -17,12 +19,15 @@ from typing import Any
 
 from prefect import flow, get_run_logger, task
 from prefect.cache_policies import NONE
-from pydantic import Field
+from pydantic import Field, model_validator
 
 from evoeye.evolve.campaign.config import CampaignConfig, config_from, option_values
 from evoeye.evolve.campaign.loop import Campaign
+from evoeye.evolve.campaign.report import rounds_markdown
 from evoeye.paths import DataRoot
+from evoeye.store.feedback import read_rounds
 from flows.campaign_params import KnownNames, campaign_model
+from flows.published import named, publish
 
 
 class CampaignRun(KnownNames):
@@ -34,6 +39,15 @@ class CampaignRun(KnownNames):
 
     def config(self) -> CampaignConfig:
         return config_from(self.model_dump())
+
+    @model_validator(mode="after")
+    def _some_budget(self) -> CampaignRun:
+        if getattr(self, "budget_s", 1.0) <= 0:
+            raise ValueError("budget_s must be greater than 0: no run fits in no simulated time")
+        return self
+
+    def run_name(self) -> str:
+        return f"evolve-{self.scenario}-{self.strategy}-s{self.seed}"
 
     @classmethod
     def of(cls, config: CampaignConfig, root: str | None = None, **options: Any) -> CampaignRun:
@@ -89,6 +103,12 @@ def score(params: CampaignRun, new_ids: list[str], version: str,
             "metrics": row.metrics.as_dict() if row.metrics else None}
 
 
+def publish_rounds(campaign: Campaign, key: str) -> None:
+    """The campaign's rounds so far (with G_r's figures where assessed) as artifact `key`."""
+    publish(key, rounds_markdown(read_rounds(campaign.root, campaign.campaign_id)),
+            f"campaign {campaign.campaign_id}")
+
+
 @flow(name="evoeye-evolve-round", log_prints=True)
 def round_flow(params: EvolveParams) -> dict[str, Any] | None:
     """One acquisition round of the campaign `params` names, from its stored state."""
@@ -102,10 +122,12 @@ def round_flow(params: EvolveParams) -> dict[str, Any] | None:
     out = score(params, new_ids, version, train_s)
     logger.info("round %d: %d new runs, monitor %s, %.1f / %.1f s simulated", out["round"],
                 len(new_ids), version, out["simulated_s"], params.budget_s)
+    publish_rounds(make_campaign(params), "evoeye-evolve-round")
     return out
 
 
-@flow(name="evoeye-evolve", log_prints=True)
+@flow(name="evoeye-evolve", log_prints=True,
+      flow_run_name=named(lambda p: (p or EvolveParams()).run_name()))
 def evolution_flow(params: EvolveParams | None = None) -> dict[str, Any]:
     """Run rounds (each a `round-<r>` flow run) until the budget is spent or max_rounds."""
     params = params or EvolveParams()
@@ -114,12 +136,13 @@ def evolution_flow(params: EvolveParams | None = None) -> dict[str, Any]:
     rounds: list[dict[str, Any]] = []
     while not campaign.done(state) and (params.max_rounds is None
                                         or len(rounds) < params.max_rounds):
-        name = f"round-{state.round + 1}"
+        name = f"round-{state.round + 1}-{params.scenario}-{params.strategy}-s{params.seed}"
         out = round_flow.with_options(flow_run_name=name)(params)
         if out is None:
             break
         rounds.append(out)
         state = campaign.start()
+    publish_rounds(campaign, "evoeye-evolve")
     return {"campaign_id": campaign.campaign_id, "rounds": rounds, "round": state.round,
             "monitor": state.monitor, "simulated_s": state.spent_s,
             "done": campaign.done(state), "root": str(campaign.root.path)}

@@ -13,7 +13,6 @@ from __future__ import annotations
 from typing import Any
 
 from prefect import flow, get_run_logger, task
-from prefect.artifacts import create_markdown_artifact
 from prefect.cache_policies import NONE
 from pydantic import Field
 
@@ -38,7 +37,9 @@ from evoeye.evolve.campaign.workers import (
 from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
 from evoeye.store.ingest import refresh_catalog
+from flows.api import shared_with_workers
 from flows.campaign_params import KnownNames, campaign_model
+from flows.published import named, publish
 from flows.runners import task_runner
 
 # options the experiment sets per campaign; the others apply to all of its campaigns
@@ -59,6 +60,10 @@ class ExperimentRun(KnownNames):
     report_name: str | None = None
     workers: int = Field(2, ge=1, le=64)  # local processes running campaigns side by side
     dask_address: str | None = None  # or the Dask scheduler whose workers run them
+
+    def run_name(self) -> str:
+        return (f"experiment-{'-'.join(self.scenarios)}-{len(self.strategies)}-methods-"
+                f"r{self.repetitions}")
 
     def base(self) -> CampaignConfig:
         """The options every campaign shares (the first scenario's, whose G_0 `monitor` is)."""
@@ -83,7 +88,8 @@ def campaigns_flow(jobs: list[CampaignJob], names: list[str]) -> list[CampaignDo
     return [f.result() for f in futures]
 
 
-@flow(name="evoeye-experiment", log_prints=True)
+@flow(name="evoeye-experiment", log_prints=True,
+      flow_run_name=named(lambda p: (p or ExperimentParams()).run_name()))
 def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
     """Run (or resume) every campaign, then write and publish the RQ2 report."""
     params = params or ExperimentParams()
@@ -92,14 +98,15 @@ def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
                            seeds=range(params.repetitions), budget_s=params.budget_s)
     jobs = campaign_jobs(root, plan)
     prepare_campaigns(jobs)
-    campaigns_flow.with_options(task_runner=task_runner(params.workers, params.dask_address))(
-        jobs, [f"{c.scenario}-{method_of(c)}-s{c.seed}" for c in plan])
+    runner = task_runner(params.workers, params.dask_address)
+    with shared_with_workers():
+        campaigns_flow.with_options(task_runner=runner)(
+            jobs, [f"{c.scenario}-{method_of(c)}-s{c.seed}" for c in plan])
     refresh_catalog(root)
     results = add_controls(root, plan, collect_results(root, plan), params.controls)
     folder = write_experiment_report(root, results, params.report_name)
-    create_markdown_artifact(markdown=markdown(results), key="evoeye-rq2",
-                             description=f"RQ2 report, {folder / 'rq2.html'}")
-    get_run_logger().info("RQ2 report: %s", folder / "rq2.html")
+    publish("evoeye-rq2", markdown(results), f"experiment report, {folder / 'rq2.html'}")
+    get_run_logger().info("experiment report: %s", folder / "rq2.html")
     return {"report_dir": str(folder), "campaigns": len(plan), "results": results}
 
 

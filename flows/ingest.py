@@ -15,6 +15,7 @@ from pydantic import BaseModel, Field
 from evoeye.paths import DataRoot
 from evoeye.store import ingest
 from evoeye.store.ingest import DEFAULT_RUNS_PER_PART
+from flows.published import ingest_markdown, named, publish
 from flows.runners import retry_while_locked
 
 
@@ -24,6 +25,9 @@ class IngestParams(BaseModel):
     root: str | None = None  # default: $EVOEYE_HOME or ./evoeye-data
     runs_per_part: int = Field(DEFAULT_RUNS_PER_PART, ge=1, le=10_000)
 
+    def run_name(self) -> str:
+        return f"ingest-{DataRoot.resolve(self.root).path.name}"
+
 
 @task(retries=5, retry_delay_seconds=10, retry_condition_fn=retry_while_locked)
 def ingest_logs(root: DataRoot, runs_per_part: int) -> dict[str, Any]:
@@ -31,7 +35,8 @@ def ingest_logs(root: DataRoot, runs_per_part: int) -> dict[str, Any]:
     return asdict(ingest(root, runs_per_part=runs_per_part))
 
 
-@flow(name="evoeye-ingest", log_prints=True)
+@flow(name="evoeye-ingest", log_prints=True,
+      flow_run_name=named(lambda p: (p or IngestParams()).run_name()))
 def ingest_flow(params: IngestParams | None = None) -> dict[str, Any]:
     """Ingest the runs of `params.root`; the report names every quarantined log."""
     params = params or IngestParams()
@@ -44,6 +49,7 @@ def ingest_flow(params: IngestParams | None = None) -> dict[str, Any]:
         logger.warning("quarantined %s: %s", log, reason)
     if report["catalog_error"]:
         logger.warning("views not refreshed: %s", report["catalog_error"])
+    publish("evoeye-ingest", ingest_markdown(report, root), str(root.warehouse))
     return report
 
 

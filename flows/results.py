@@ -11,7 +11,6 @@ from pathlib import Path
 from typing import Any
 
 from prefect import flow, get_run_logger, task
-from prefect.artifacts import create_markdown_artifact
 from pydantic import BaseModel, Field
 
 from evoeye.paths import DataRoot
@@ -26,6 +25,7 @@ from evoeye.results.run import (
     write_results,
 )
 from evoeye.results.study import Study, monitor_study
+from flows.published import named, publish
 
 D = ResultsConfig()
 
@@ -64,6 +64,9 @@ class ResultsParams(BaseModel):
     docs: str | None = None  # also copy the tables here (docs/results)
     readme: str | None = None  # also rewrite this README's findings section
 
+    def run_name(self) -> str:
+        return f"results-{self.report_name}-{'-'.join(self.parts)}"
+
     def config(self) -> ResultsConfig:
         values = self.model_dump(exclude={"root", "report_name", "docs", "readme"})
         values["training_seeds"] = tuple(range(self.training_seeds))
@@ -86,7 +89,8 @@ def part_task(root: DataRoot, config: ResultsConfig, scenario: str, part: str) -
     return PARTS[part](part_study(study, monitor_study(study), part), scenario)
 
 
-@flow(name="evoeye-results", log_prints=True)
+@flow(name="evoeye-results", log_prints=True,
+      flow_run_name=named(lambda p: (p or ResultsParams()).run_name()))
 def results_flow(params: ResultsParams | None = None) -> dict[str, Any]:
     """Run every part of every scenario, write the files, publish the findings."""
     params = params or ResultsParams()
@@ -103,8 +107,8 @@ def results_flow(params: ResultsParams | None = None) -> dict[str, Any]:
     folder = write_results(root, results, params.report_name,
                            docs=Path(params.docs) if params.docs else None,
                            readme=Path(params.readme) if params.readme else None)
-    create_markdown_artifact(markdown=findings_markdown(results["findings"], "this run"),
-                             key="evoeye-results", description=f"{folder / 'results.html'}")
+    publish("evoeye-results", findings_markdown(results["findings"], "this run"),
+            str(folder / "results.html"))
     get_run_logger().info("results: %s", folder / "results.html")
     return {"report_dir": str(folder), "findings": [(f["id"], f["verdict"])
                                                     for f in results["findings"]]}

@@ -1,15 +1,30 @@
-"""Flow: simulate a batch of one logical scenario; one task per run, tasks pass file paths."""
+"""Flow: simulate a batch of one logical scenario, as `evoeye simulate` does; a flow run per batch.
+
+On this machine the batch runs in one task on the command line's own process pool
+(`evoeye.batch.run_batch`: forked workers with highway-env already imported, finished logs
+skipped, a broken run reported and the others kept), so the flow costs what the command costs
+plus one Prefect API. With `dask_address` every run is its own task on the Dask cluster
+(prefect-dask), for batches one machine cannot carry. Either way the batch is idempotent: a
+crashed flow run is simply run again, and skips the logs it finished. With `ingest` the new
+logs then go into the warehouse, as the ingest flow puts them (a subflow run).
+"""
 
 from __future__ import annotations
 
 from prefect import flow, get_run_logger, task
+from prefect.cache_policies import NONE
 from pydantic import BaseModel, Field
 
-from evoeye.batch import RunResult, plan_uniform, simulate_and_log
+from evoeye.batch import BatchSummary, RunResult, plan_uniform, run_batch, simulate_and_log
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import SCENARIOS
 from evoeye.sim.episode import RunSpec
+from flows.api import shared_with_workers
+from flows.ingest import IngestParams, ingest_flow
+from flows.published import batch_markdown, named, publish
 from flows.runners import task_runner
+
+PROGRESS_EVERY = 10  # runs between two progress lines in the flow run's log
 
 
 class SimulateParams(BaseModel):
@@ -21,7 +36,8 @@ class SimulateParams(BaseModel):
     root: str | None = None
     workers: int = Field(2, ge=1, le=64)
     dask_address: str | None = None
-    batch: str | None = None
+    batch: str | None = None  # default uniform-seed<seed>
+    ingest: bool = False  # then ingest the new logs, as the ingest flow does (a subflow run)
 
     def model_post_init(self, __context) -> None:
         if self.scenario not in SCENARIOS:
@@ -30,36 +46,70 @@ class SimulateParams(BaseModel):
         if self.batch is not None:
             check_batch_name(self.batch)  # a plain name: logs never leave the data root
 
+    @property
+    def batch_name(self) -> str:
+        return self.batch or f"uniform-seed{self.seed}"
 
-@task(retries=1, retry_delay_seconds=1, task_run_name="run-{spec.scenario_id}")
+    def run_name(self) -> str:
+        return f"simulate-{self.scenario}-{self.batch_name}-n{self.n}"
+
+
+@task(retries=1, retry_delay_seconds=1, cache_policy=NONE, task_run_name="batch-{name}")
+def simulate_locally(specs: list[RunSpec], root: DataRoot, workers: int,
+                     name: str) -> BatchSummary:
+    """The whole batch on `workers` local processes, its progress in the task run's log."""
+    logger = get_run_logger()
+    done = 0
+
+    def progress(results):
+        nonlocal done
+        for r in results:
+            done += 1
+            if done % PROGRESS_EVERY == 0 or done == len(specs):
+                logger.info("%d / %d runs", done, len(specs))
+            yield r
+
+    return run_batch(specs, root, workers=workers, progress=progress)
+
+
+@task(retries=1, retry_delay_seconds=1, cache_policy=NONE,
+      task_run_name="run-{spec.scenario_id}")
 def simulate_run(spec: RunSpec, root: DataRoot) -> RunResult:
     """Simulate and log one run (skipped if its log exists): the result names the log file."""
     return simulate_and_log(spec, root)
 
 
+@flow(name="evoeye-simulate-dask", log_prints=True)
+def fan_out_flow(specs: list[RunSpec], root: DataRoot) -> list[RunResult]:
+    """Every spec a task on the flow's task runner (the Dask cluster simulate_flow picks)."""
+    futures = [simulate_run.submit(s, root) for s in specs]
+    return sorted((f.result() for f in futures), key=lambda r: r.scenario_id)
+
+
+@flow(name="evoeye-simulate", log_prints=True, flow_run_name=named(SimulateParams.run_name))
 def simulate_batch_flow(params: SimulateParams) -> list[RunResult]:
-    """Fan the batch out over the chosen task runner and collect the per-run results."""
+    """Simulate the batch; the results name each log (`path`) and its outcome."""
     root = DataRoot.resolve(params.root)
     specs = plan_uniform(params.scenario, params.n, params.seed, batch=params.batch)
-    runner_flow = simulate_flow.with_options(
-        task_runner=task_runner(params.workers, params.dask_address)
-    )
-    return runner_flow(specs=specs, root=root)
-
-
-@flow(name="evoeye-simulate", log_prints=True)
-def simulate_flow(specs: list[RunSpec], root: DataRoot) -> list[RunResult]:
-    """Simulate every spec; the results name each log (`path`) and its outcome."""
-    futures = [simulate_run.submit(s, root) for s in specs]
-    results = [f.result() for f in futures]
+    root.runs.mkdir(parents=True, exist_ok=True)
+    if params.dask_address:
+        runner = task_runner(params.workers, params.dask_address)
+        with shared_with_workers():
+            summary = BatchSummary(fan_out_flow.with_options(task_runner=runner)(specs, root))
+    else:
+        summary = simulate_locally(specs, root, params.workers, params.batch_name)
     logger = get_run_logger()
-    collided = sum(r.collided for r in results)
-    failed = [r for r in results if r.status != "ok"]
-    logger.info("%d runs, %d collisions, %d failed; logs under %s",
-                len(results), collided, len(failed), root.runs)
-    for r in failed:
-        logger.warning("%s %s: %s", r.status, r.scenario_id, r.reason)
-    return results
+    logger.info("%d runs, %d collisions, %d failed; logs under %s", summary.runs,
+                summary.collisions, summary.failures, root.batch_dir(params.scenario,
+                                                                      params.batch_name))
+    for r in summary.results:
+        if r.status != "ok":
+            logger.warning("%s %s: %s", r.status, r.scenario_id, r.reason)
+    publish("evoeye-simulate", batch_markdown(params.scenario, summary, root),
+            f"{params.scenario}, batch {params.batch_name}")
+    if params.ingest:
+        ingest_flow(IngestParams(root=str(root.path)))
+    return summary.results
 
 
 if __name__ == "__main__":

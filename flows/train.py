@@ -10,9 +10,11 @@ from typing import Any
 from prefect import flow, get_run_logger, task
 from pydantic import BaseModel, Field, field_validator
 
+from evoeye.evaluation.table import pct
 from evoeye.monitor.inputs import parse_modules
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
+from flows.published import named, publish, train_markdown
 
 
 class TrainFlowParams(BaseModel):
@@ -39,6 +41,10 @@ class TrainFlowParams(BaseModel):
         parse_modules(value)  # raises ValueError naming the choices
         return value
 
+    def run_name(self) -> str:
+        start = f"from-{self.init_from}" if self.init_from else f"seed{self.seed}"
+        return f"train-{self.scenario or 'sql'}-{start}"
+
 
 @task(task_run_name="train-{params.scenario}")
 def train_version(params: TrainFlowParams, root: DataRoot) -> str:
@@ -55,7 +61,8 @@ def train_version(params: TrainFlowParams, root: DataRoot) -> str:
     )
 
 
-@flow(name="evoeye-train", log_prints=True)
+@flow(name="evoeye-train", log_prints=True,
+      flow_run_name=named(lambda p: (p or TrainFlowParams()).run_name()))
 def train_flow(params: TrainFlowParams | None = None) -> dict[str, Any]:
     """Train a monitor version; its id, card path and validation metrics."""
     from evoeye.monitor.registry import CARD_FILE, read_card, version_dir
@@ -66,9 +73,10 @@ def train_flow(params: TrainFlowParams | None = None) -> dict[str, Any]:
     card = read_card(root, version)
     val = card["metrics"]["val"]
     get_run_logger().info(
-        "%s: val AUROC %s, AUPRC %s, F1@FPR0.05 %.3f (best epoch %d, %.1f s)", version,
-        val["auroc"], val["auprc"], val["fpr_0.05"]["f1"], card["training"]["best_epoch"],
-        card["training"]["time_s"])
+        "%s: val AUROC %s %%, AUPRC %s %%, F1@0.05 %s %% (best epoch %d, %.1f s)", version,
+        pct(val["auroc"]), pct(val["auprc"]), pct(val["fpr_0.05"]["f1"]),
+        card["training"]["best_epoch"], card["training"]["time_s"])
+    publish("evoeye-train", train_markdown(version, card), str(version_dir(root, version)))
     return {"version": version, "card": str(version_dir(root, version) / CARD_FILE),
             "parent": card["parent"], "metrics": val, "thresholds": card["thresholds"]}
 

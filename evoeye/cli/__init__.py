@@ -8,8 +8,8 @@ from importlib import import_module
 from evoeye.cli.app import app
 
 COMMAND_MODULES = (
-    "simulate", "warehouse", "monitor", "evaluate", "evolve", "demo", "audit", "explain",
-    "results", "findings", "autoware", "watch",
+    "simulate", "warehouse", "monitor", "monitors", "evaluate", "evolve", "demo", "audit",
+    "explain", "results", "findings", "autoware", "watch",
 )
 
 for _name in COMMAND_MODULES:

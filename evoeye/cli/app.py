@@ -47,6 +47,16 @@ def report_user_error(exc: BaseException) -> bool:
     return True
 
 
+def report_interrupt(exc: KeyboardInterrupt) -> None:
+    """One line on stderr: what an interrupted command kept (its own words, if it has some)."""
+    from rich.console import Console
+    from rich.markup import escape
+
+    kept = str(exc) or ("every file is written whole or not at all: run the same command "
+                        "again to resume")
+    Console(stderr=True, soft_wrap=True).print(f"[yellow]interrupted:[/] {escape(kept)}")
+
+
 class EvoeyeGroup(TyperGroup):
     """The root command group: turns known user errors into one line and an exit code."""
 
@@ -55,6 +65,9 @@ class EvoeyeGroup(TyperGroup):
             return super().invoke(ctx)
         except (typer.Exit, typer.Abort, TyperException):  # exits and usage errors: as they are
             raise
+        except KeyboardInterrupt as exc:  # Ctrl-C: say what was kept, exit 130
+            report_interrupt(exc)
+            raise typer.Exit(ExitCode.INTERRUPTED) from None
         except Exception as exc:
             if debugging(ctx) or not report_user_error(exc):
                 raise

@@ -19,12 +19,14 @@ class ExitCode(IntEnum):
     USER_ERROR = 2  # bad option or input, missing root, unknown monitor, …; nothing was done
     PARTIAL = 3  # the command finished, but some runs failed or some logs were quarantined
     CHECK_FAILED = 4  # `evoeye audit --strict`: a realism bound is not met
+    INTERRUPTED = 130  # Ctrl-C (128 + SIGINT): what was finished is kept, a re-run resumes
 
 
 EXIT_CODES_HELP = (
     "Exit codes: 0 ok · 2 user error (bad option or input; one line and a hint, "
     "--debug for the traceback) · 3 partly done (some runs failed or some logs were "
-    "quarantined) · 4 a checked bound failed (audit --strict) · 1 internal error."
+    "quarantined) · 4 a checked bound failed (audit --strict) · 130 interrupted (Ctrl-C; "
+    "a re-run resumes) · 1 internal error."
 )
 
 
@@ -45,11 +47,10 @@ KNOWN_ERRORS: dict[str, str] = {
                                      "`evoeye ingest`, or point --root / EVOEYE_HOME at it",
     "evoeye.paths.BadNameError": "use letters, digits, '.', '_' and '-' only",
     "evoeye.scenarios.space.ScenarioError": "",
-    "evoeye.monitor.families.MonitorLoadError": "list the versions (`ls <root>/monitors "
-                                                "<root>/baselines/*`), or train one: `evoeye "
-                                                "train --scenario NAME`; a damaged baseline "
-                                                "folder can be removed, `evoeye evaluate` "
-                                                "trains it again",
+    "evoeye.monitor.families.MonitorLoadError": "list the versions with `evoeye monitors`, "
+                                                "or train one: `evoeye train --scenario "
+                                                "NAME`; a damaged baseline folder can be "
+                                                "removed, `evoeye evaluate` trains it again",
     "evoeye.monitor.families.NoMonitorError": "train one first: `evoeye train --scenario NAME`, "
                                               "or name it with --monitor",
     "evoeye.evolve.campaign.state.NoInitialDataError": "simulate and ingest the scenario's initial "

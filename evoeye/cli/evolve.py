@@ -81,6 +81,9 @@ def evolve_command(
     from evoeye.evolve.campaign.loop import Campaign
 
     cfg = _config(options)
+    if cfg.budget_s <= 0:
+        raise typer.BadParameter(f"{cfg.budget_s:g} s leaves no run to simulate: give the "
+                                 "simulated seconds the campaign may use", param_hint="--budget-s")
     data = DataRoot.existing(root)
     probe = Campaign(data, cfg)
     assess = Assessor.of(probe)

@@ -32,7 +32,7 @@ def runs_table(done: list[Explained]) -> Table:
     """One row per run: each oracle's verdict, the careful driver's, and the cause shares."""
     t = table("explain (✓ avoids the collision, ✗ still collides)",
               ["run", "t_col s", *(o.removeprefix("oracle_") for o in ORACLES),
-               "careful (brakes at)", "cause share"], left=("run", "cause share"))
+               "careful (brakes at)", "cause share %"], left=("run", "cause share %"))
     for e in done:
         if e.explanation is None:
             t.add_row(e.spec.scenario_id, "", *[""] * len(ORACLES), "",
@@ -44,8 +44,8 @@ def runs_table(done: list[Explained]) -> Table:
         careful = by["careful_driver"]
         react = f" @{careful.react_s:.2f} s" if careful.react_s is not None else ""
         behind = " (struck from behind)" if careful.struck_from_behind else ""
-        causes = (" ".join(f"{c} {1 / len(avoiding):.2f}" for c in avoiding)
-                  if avoiding else "compound 1.00")
+        causes = (" ".join(f"{c} {100 / len(avoiding):.0f}" for c in avoiding)
+                  if avoiding else "compound 100")
         t.add_row(ex.spec.scenario_id, f"{ex.collision_time_s:.2f}",
                   *(_verdict(by[o].collided) for o in ORACLES),
                   _verdict(careful.collided) + react + behind, causes)

@@ -143,9 +143,9 @@ def replay_command(
     if trained and trained != logged:
         err().print(f"[yellow]warning:[/] {monitor} was trained on {trained}, the log is of "
                     f"{logged}: its risk there is not calibrated")
-    first = "none" if report.first_alarm_t_s is None else f"t = {report.first_alarm_t_s:.2f} s"
     out().print(f"{report.frames} frames, {report.alarm_frames} alarm frames (threshold "
-                f"{report.threshold:.4f}), first alarm: {first}")
+                f"{report.threshold:.4f}, target FPR {fpr:g}, {consecutive} consecutive)")
+    out().print(report.words())
     out().print(f"wrote {report.out}")
 
 
@@ -164,7 +164,8 @@ def export_command(
     output: Annotated[Path | None, typer.Option("--out", help="ONNX file to write.")] = None,
     root: RootOpt = None,
 ) -> None:
-    """Export a monitor version to ONNX (dynamic batch axis; output: risk in [0, 1])."""
+    """Export a monitor version to ONNX (dynamic batch axis; output: risk in [0, 1]); the
+    file's metadata_props hold the version, the alarm thresholds and the input spec."""
     if ctx.invoked_subcommand is not None:
         return
     if monitor is None or output is None:
@@ -174,4 +175,5 @@ def export_command(
     from evoeye.monitor.registry import load_monitor
 
     path = export_onnx(load_monitor(DataRoot.existing(root), monitor), output)
-    out().print(f"wrote {path} (inputs: see `evoeye.monitor.model.INPUTS`)")
+    out().print(f"wrote {path}: inputs, thresholds and version in its metadata_props "
+                "(evoeye.*)")

@@ -8,20 +8,26 @@ rather than truncating when a terminal is too narrow.
 from __future__ import annotations
 
 import sys
+from typing import TYPE_CHECKING
 
-from rich.console import Console
-from rich.table import Table
+if TYPE_CHECKING:  # rich's console and table modules load on first output, not for `--help`
+    from rich.console import Console
+    from rich.table import Table
 
 PIPE_WIDTH = 4096  # characters; wider than any table evoeye prints
 
 
 def out() -> Console:
     """A stdout console sized at call time (a terminal's width, else PIPE_WIDTH)."""
+    from rich.console import Console
+
     console = Console()
     return console if console.is_terminal else Console(width=PIPE_WIDTH)
 
 
 def err() -> Console:
+    from rich.console import Console
+
     return Console(stderr=True)
 
 
@@ -29,6 +35,8 @@ def table(title: str | None, columns: list[str], *, left: tuple[str, ...] = (),
           show_header: bool = True) -> Table:
     """A table whose cells fold instead of being cut; `left` columns are left-justified, the
     rest right-justified (numbers)."""
+    from rich.table import Table
+
     t = Table(title=title, show_header=show_header)
     for col in columns:
         t.add_column(col, justify="left" if col in left else "right", overflow="fold")

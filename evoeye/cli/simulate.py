@@ -6,7 +6,6 @@ from pathlib import Path
 from typing import TYPE_CHECKING, Annotated
 
 import typer
-from rich.table import Table
 
 from evoeye.cli.app import app, exit_with
 from evoeye.cli.defaults import ADS_PROFILE_NAMES, SCENARIO_NAMES
@@ -15,6 +14,8 @@ from evoeye.cli.output import err, out, table
 from evoeye.paths import BadNameError, DataRoot, check_batch_name
 
 if TYPE_CHECKING:
+    from rich.table import Table
+
     from evoeye.batch import BatchSummary
 
 RootOpt = Annotated[

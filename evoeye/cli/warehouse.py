@@ -183,7 +183,7 @@ def attribution_table(rows: list[dict[str, Any]]) -> Table:
 
     shares = report.attribution_table(rows)
     t = table("root causes of collisions (evoeye explain), %", shares.header,
-              left=tuple(shares.header[:2]))
+              left=(shares.header[0],))
     for row in shares.rows:
         t.add_row(*row)
     return t

@@ -1,29 +1,31 @@
 """Evaluation: the paper's metrics, scenario-level detection, lead time, reports.
 
-Thresholds come from `evoeye.monitor.calibration` (one calibration for every monitor)."""
+Thresholds come from `evoeye.monitor.calibration` (one calibration for every monitor). Imported
+on first use, so that a module of the package (a report's `table`) loads without the rest.
+"""
 
-from evoeye.evaluation.harness import EvaluationReport, MonitorResult, evaluate
-from evoeye.evaluation.metrics import PRF, FrameMetrics, frame_metrics, prf
-from evoeye.evaluation.monitors import BASELINES, baseline_monitors, load_monitors, train_fusion
-from evoeye.evaluation.report import markdown_report, write_report
-from evoeye.evaluation.scenario import LeadTimes, Runs, ScenarioMetrics, scenario_metrics
+from evoeye.lazy import lazy_attributes
 
-__all__ = [
-    "BASELINES",
-    "PRF",
-    "EvaluationReport",
-    "FrameMetrics",
-    "LeadTimes",
-    "MonitorResult",
-    "Runs",
-    "ScenarioMetrics",
-    "baseline_monitors",
-    "evaluate",
-    "frame_metrics",
-    "load_monitors",
-    "markdown_report",
-    "prf",
-    "scenario_metrics",
-    "train_fusion",
-    "write_report",
-]
+_LAZY = {
+    "EvaluationReport": "evoeye.evaluation.harness",
+    "MonitorResult": "evoeye.evaluation.harness",
+    "evaluate": "evoeye.evaluation.harness",
+    "PRF": "evoeye.evaluation.metrics",
+    "FrameMetrics": "evoeye.evaluation.metrics",
+    "frame_metrics": "evoeye.evaluation.metrics",
+    "prf": "evoeye.evaluation.metrics",
+    "BASELINES": "evoeye.evaluation.monitors",
+    "baseline_monitors": "evoeye.evaluation.monitors",
+    "load_monitors": "evoeye.evaluation.monitors",
+    "train_fusion": "evoeye.evaluation.monitors",
+    "markdown_report": "evoeye.evaluation.report",
+    "write_report": "evoeye.evaluation.report",
+    "LeadTimes": "evoeye.evaluation.scenario",
+    "Runs": "evoeye.evaluation.scenario",
+    "ScenarioMetrics": "evoeye.evaluation.scenario",
+    "scenario_metrics": "evoeye.evaluation.scenario",
+}
+
+__getattr__ = lazy_attributes(__name__, _LAZY)
+
+__all__ = list(_LAZY)

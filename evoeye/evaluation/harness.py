@@ -72,12 +72,14 @@ class EvaluationReport:
     ks: tuple[int, ...]
     dataset: dict[str, dict[str, int]]  # split → scenarios / violations / frames / unsafe
     monitors: list[MonitorResult] = field(default_factory=list)
+    frame_period_s: float | None = None  # time between two test frames of a run
 
     def to_dict(self) -> dict:
         return {
             "logical_scenario": self.logical_scenario, "splits": asdict(self.splits),
             "horizon_s": self.horizon_s, "fprs": list(self.fprs), "ks": list(self.ks),
             "dataset": self.dataset, "monitors": [m.to_dict() for m in self.monitors],
+            "frame_period_s": self.frame_period_s,
         }
 
 
@@ -153,7 +155,8 @@ def evaluate(
     runs = Runs.of(test.windows.scenario_id, test.windows.frame, test.windows.t_s,
                    test.collision_time_s)
     report = EvaluationReport(scenario, splits, horizon_s, tuple(fprs), tuple(ks),
-                              {"val": val.stats(), "test": test.stats()})
+                              {"val": val.stats(), "test": test.stats()},
+                              frame_period_s=runs.frame_period_s or None)
     for monitor in monitors:
         result, s_val, s_test = evaluate_monitor(monitor, val, test, runs, fprs=fprs, ks=ks,
                                                  latency=latency)

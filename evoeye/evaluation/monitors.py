@@ -28,6 +28,7 @@ BASELINES: dict[str, BaselineBuilder] = {
     # the trained baselines: every registered family with an RQ1 fit (aem, context-only)
     **{name: family.fit for name, family in FAMILIES.items() if family.fit is not None},
 }
+RULES = tuple(name for name in BASELINES if name not in FAMILIES)  # no data, no training
 
 
 def baseline_monitors(root: DataRoot, scenario: str,

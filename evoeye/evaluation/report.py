@@ -1,8 +1,10 @@
-"""The RQ1 report: Markdown tables and a self-contained HTML page, from evaluation dicts.
+"""The evaluation report: Markdown and a self-contained HTML page, from evaluation dicts.
 
 Everything renders from `EvaluationReport.to_dict()` (what `--json` prints), so the Markdown,
-the HTML and the JSON cannot disagree. Rates are shown as percentages with one decimal, as in
-the paper's Table "Monitoring effectiveness"; lead times in seconds.
+the HTML and the JSON cannot disagree. The conventions are docs/reports.md's: the headline
+first (`evoeye.evaluation.headline`: collisions warned of, lead time, false alarms per hour,
+each with its interval over runs), then the paper's RQ1 tables, narrow enough for the Prefect
+artifact view; rates in % with one decimal, times in seconds.
 """
 
 from __future__ import annotations
@@ -13,105 +15,56 @@ from datetime import UTC, datetime
 from html import escape
 from pathlib import Path
 
+from evoeye.evaluation.headline import headline_table, label, point_note, summary
 from evoeye.evaluation.plots import line_chart, strip_chart
+from evoeye.evaluation.table import (
+    DASH,
+    UNREACHABLE,
+    UNREACHABLE_NOTE,
+    Table,
+    any_unreachable,
+    pct,
+    rate,
+)
 from evoeye.paths import DataRoot
 
-DASH = "–"
-UNREACHABLE = "n/r"  # the operating point's target FPR was unreachable on validation
-UNREACHABLE_NOTE = ("n/r: the target FPR is unreachable for this monitor: more than that share "
-                    "of the validation negatives tie at its top score, so no threshold meets "
-                    "the target with any alarm (its rates there are not measured).")
+
+def _short(fpr: str) -> str:
+    """A target FPR as a column suffix: "0.05" → "@.05"."""
+    return "@" + fpr.removeprefix("0")
 
 
-def pct(x: float | None) -> str:
-    """A rate as a percentage with one decimal ('–' if undefined)."""
-    return DASH if x is None else f"{100 * x:.1f}"
-
-
-def rate(point: dict, key: str) -> str:
-    """A rate of one operating point (`PRF.to_dict()`) in %, 'n/r' where its target FPR was
-    unreachable."""
-    return pct(point[key]) if point.get("reachable", True) else UNREACHABLE
-
-
-def any_unreachable(reports: list[dict]) -> bool:
-    """Whether some monitor of these reports has a target FPR it could not reach."""
-    return any(not ok for r in reports for m in r["monitors"]
-               for ok in m.get("reachable", {}).values())
-
-
-def secs(x: float | None) -> str:
-    return DASH if x is None else f"{x:.2f}"
-
-
-@dataclass
-class Table:
-    """Header and rows of text cells; section rows have a single cell."""
-
-    header: list[str]
-    rows: list[list[str]]
-
-    def markdown(self) -> str:
-        lines = ["| " + " | ".join(self.header) + " |",
-                 "|" + "|".join(["---"] + ["---:"] * (len(self.header) - 1)) + "|"]
-        for row in self.rows:
-            cells = row if len(row) > 1 else [f"**{row[0]}**"] + [""] * (len(self.header) - 1)
-            lines.append("| " + " | ".join(cells) + " |")
-        return "\n".join(lines)
-
-    def html(self) -> str:
-        head = "".join(f"<th>{escape(h)}</th>" for h in self.header)
-        body = []
-        for row in self.rows:
-            if len(row) == 1:
-                body.append(f'<tr class="sec"><td colspan="{len(self.header)}">'
-                            f"{escape(row[0])}</td></tr>")
-            else:
-                body.append("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in row) + "</tr>")
-        return f"<table><thead><tr>{head}</tr></thead><tbody>{''.join(body)}</tbody></table>"
-
-
-def rq1_table(report: dict) -> Table:
-    """The paper's RQ1 table for one logical scenario (plus warned violations and lead time)."""
+def rq1_tables(report: dict) -> list[tuple[str, Table]]:
+    """The paper's RQ1 figures of one logical scenario, one narrow table per level: per frame,
+    then per run for each K (P / R / F1 at each target FPR's threshold, AUROC, AUPRC)."""
     fprs = [str(f) for f in report["fprs"]]
-    main = fprs[0]
-    header = ["Method"]
-    for f in fprs:
-        header += [f"P@{f}", f"R@{f}", f"F1@{f}"]
-    header += ["AUROC", "AUPRC", f"Warned@{main}", f"Lead@{main} (s)"]
-    rows: list[list[str]] = [["Frame-level"]]
-    for m in report["monitors"]:
-        fr = m["frame"]
-        cells = [m["name"]]
-        for f in fprs:
-            cells += [rate(fr["at_fpr"][f], k) for k in ("precision", "recall", "f1")]
-        rows.append(cells + [pct(fr["auroc"]), pct(fr["auprc"]), DASH, DASH])
+    header = ["Monitor"] + [f"{x}{_short(f)}" for f in fprs for x in ("P", "R", "F1")]
+    header += ["AUROC", "AUPRC"]
+
+    def row(m: dict, level: dict) -> list[str]:
+        return ([label(m["name"])]
+                + [rate(level["at_fpr"][f], x) for f in fprs for x in ("precision", "recall",
+                                                                         "f1")]
+                + [pct(level["auroc"]), pct(level["auprc"])])
+
+    out = [("Per frame", Table(header, [row(m, m["frame"]) for m in report["monitors"]]))]
     for k in report["ks"]:
-        rows.append([f"Scenario-level (K={k})"])
-        for m in report["monitors"]:
-            sc = m["scenario"][str(k)]
-            cells = [m["name"]]
-            for f in fprs:
-                cells += [rate(sc["at_fpr"][f], k) for k in ("precision", "recall", "f1")]
-            lt = sc["lead_time"][main]
-            warned = ([f"{lt['detected']}/{lt['violations']}", secs(lt["median_s"])]
-                      if sc["at_fpr"][main].get("reachable", True) else [UNREACHABLE] * 2)
-            cells += [pct(sc["auroc"]), pct(sc["auprc"]), *warned]
-            rows.append(cells)
-    return Table(header, rows)
+        warning = "1 alarm frame" if k == 1 else f"{k} consecutive alarm frames"
+        out.append((f"Per run, a warning = {warning}",
+                    Table(header, [row(m, m["scenario"][str(k)]) for m in report["monitors"]])))
+    return out
 
 
 def dataset_table(reports: list[dict]) -> Table:
     rows = []
     for r in reports:
+        rows.append([r["logical_scenario"]])
         for split, s in r["dataset"].items():
             v = s["violations"] / s["scenarios"] if s["scenarios"] else None
             u = s["unsafe_frames"] / s["frames"] if s["frames"] else None
-            rows.append([r["logical_scenario"], split, str(s["scenarios"]),
-                         f"{s['violations']} ({pct(v)}%)", str(s["frames"]),
-                         f"{s['unsafe_frames']} ({pct(u)}%)"])
-    return Table(["Logical scenario", "Split", "Scenarios", "Violations", "Frames", "Unsafe"],
-                 rows)
+            rows.append([split, str(s["scenarios"]), f"{s['violations']} ({pct(v)} %)",
+                         str(s["frames"]), f"{s['unsafe_frames']} ({pct(u)} %)"])
+    return Table(["Split", "Runs", "Collisions", "Frames", "Unsafe frames"], rows)
 
 
 def _calibrated(m: dict, fpr: str) -> list[str]:
@@ -122,23 +75,20 @@ def _calibrated(m: dict, fpr: str) -> list[str]:
 
 
 def monitors_table(reports: list[dict]) -> Table:
-    """Versions, thresholds with the FPR they realise on validation next to the target, and
-    CPU cost."""
+    """Versions, thresholds with the FPR they realise on validation (%), and CPU latency."""
     fprs = [str(f) for f in reports[0]["fprs"]] if reports else []
-    header = ["Logical scenario", "Method", "Version", "L"]
+    header = ["Monitor", "Version", "L"]
     for f in fprs:
-        header += [f"thr@{f}", f"val FPR % (target {pct(float(f))})"]
-    header += ["Latency b=1 (ms)", "Throughput b=1024 (/s)"]
+        header += [f"thr{_short(f)}", f"val FPR{_short(f)} %"]
+    header += ["ms/frame"]
     rows = []
     for r in reports:
+        rows.append([r["logical_scenario"]])
         for m in r["monitors"]:
             lat = m["latency"]
-            rows.append(
-                [r["logical_scenario"], m["name"], m["version"], str(m["context_len"])]
-                + [c for f in fprs for c in _calibrated(m, f)]
-                + ([f"{lat['latency_ms_median']:.3f}", f"{lat['throughput_per_s']:,.0f}"]
-                   if lat else [DASH, DASH])
-            )
+            rows.append([label(m["name"]), m["version"], str(m["context_len"])]
+                        + [c for f in fprs for c in _calibrated(m, f)]
+                        + [f"{lat['latency_ms_median']:.3f}" if lat else DASH])
     return Table(header, rows)
 
 
@@ -153,12 +103,14 @@ def attribution_table(rows: list[dict]) -> Table:
     for r in rows:
         g = groups.setdefault((r["logical_scenario"], r["software_version"]), dict(r))
         g[r["cause"]] = r["share"]
-    out = []
+    out: list[list[str]] = []
     for (ls, version), g in groups.items():
+        if not out or out[-1] != [ls]:
+            out.append([ls])
         careful = g["careful_avoided"] / g["careful_runs"] if g["careful_runs"] else None
-        out.append([ls, version, str(g["runs"]), *(pct(g.get(c, 0.0)) for c in CAUSES),
-                    f"{g['careful_avoided']}/{g['careful_runs']} ({pct(careful)}%)"])
-    return Table(["Logical scenario", "Version", "Runs", *CAUSES, "Careful driver avoids"], out)
+        out.append([version, str(g["runs"]), *(pct(g.get(c, 0.0)) for c in CAUSES),
+                    f"{g['careful_avoided']}/{g['careful_runs']} ({pct(careful)} %)"])
+    return Table(["ADS version", "Runs", *CAUSES, "Careful driver avoids"], out)
 
 
 def _attribution_rows(reports: list[dict]) -> list[dict]:
@@ -170,16 +122,37 @@ ATTRIBUTION_NOTE = ("Collision runs re-simulated with one module replaced by an 
                     "'compound' when none does. Shares in %.")
 
 
+TITLE = "Monitoring effectiveness (RQ1)"
+DETAILS_NOTE = ("Rates in %. Every monitor's thresholds are calibrated on validation for each "
+                "target FPR and applied unchanged to test; P / R / F1{at} are precision, "
+                "recall and F1 at the threshold for that target FPR. Frames at or after a "
+                "collision are not scored.")
+HEADLINE_NOTE = ("Warned: collision runs warned of before the collision, of all. Lead: median "
+                 "time from the warning to the collision. False al./h: warnings in "
+                 "collision-free runs per hour of their driving. Safe runs al.: collision-free "
+                 "runs with at least one warning. In parentheses: 95 % intervals over runs "
+                 "(n = 1: one run, no interval; ≤: no false alarm, the upper bound).")
+
+
+def _details_note(reports: list[dict]) -> str:
+    fprs = [str(f) for f in reports[0]["fprs"]] if reports else []
+    return DETAILS_NOTE.format(at=" " + ", ".join(_short(f) for f in fprs) if fprs else "")
+
+
 def markdown_report(reports: list[dict]) -> str:
-    """RQ1 for every logical scenario evaluated, with the dataset and the monitors used."""
-    parts = ["# RQ1: monitoring effectiveness", "",
-             "Rates in %, thresholds calibrated on validation for each target FPR and applied "
-             "unchanged to test. Warned: violation runs warned before the collision / all; "
-             "Lead: median warning lead time of those runs.", ""]
+    """The headline per logical scenario, then the paper's RQ1 tables, the dataset, the
+    monitors and the root causes."""
+    parts = [f"# {TITLE}", "", point_note(reports), "", HEADLINE_NOTE, ""]
     if any_unreachable(reports):
         parts += [UNREACHABLE_NOTE, ""]
     for r in reports:
-        parts += [f"## {r['logical_scenario']}", "", rq1_table(r).markdown(), ""]
+        parts += [f"## {r['logical_scenario']}", "", *summary(r), "",
+                  headline_table(r).markdown(), ""]
+    parts += ["## Details (paper Table \"Monitoring effectiveness\")", "",
+              _details_note(reports), ""]
+    for r in reports:
+        for title, table in rq1_tables(r):
+            parts += [f"### {r['logical_scenario']}: {title.lower()}", "", table.markdown(), ""]
     parts += ["## Dataset", "", dataset_table(reports).markdown(), "",
               "## Monitors", "", monitors_table(reports).markdown(), ""]
     if causes := _attribution_rows(reports):
@@ -202,10 +175,10 @@ svg .t{font-size:13px;font-weight:600} svg .s{font-size:11px}
 """
 
 
-def _scenario_html(r: dict) -> str:
+def _charts(r: dict) -> str:
     ms = r["monitors"]
-    roc = [(m["name"], m["curves"]["roc_fpr"], m["curves"]["roc_tpr"]) for m in ms]
-    pr = [(m["name"], m["curves"]["pr_recall"], m["curves"]["pr_precision"]) for m in ms]
+    roc = [(label(m["name"]), m["curves"]["roc_fpr"], m["curves"]["roc_tpr"]) for m in ms]
+    pr = [(label(m["name"]), m["curves"]["pr_recall"], m["curves"]["pr_precision"]) for m in ms]
     charts = [
         line_chart(roc, title="ROC (test frames)", xlabel="false-positive rate",
                    ylabel="true-positive rate", diagonal=True),
@@ -214,23 +187,35 @@ def _scenario_html(r: dict) -> str:
     ]
     for k in r["ks"]:
         for f in (str(x) for x in r["fprs"]):
-            rows = [(m["name"], m["scenario"][str(k)]["lead_time"][f]["values_s"]) for m in ms]
+            rows = [(label(m["name"]), m["scenario"][str(k)]["lead_time"][f]["values_s"])
+                    for m in ms]
             charts.append(strip_chart(rows, title=f"Warning lead time, K={k}, FPR {f}",
                                       xlabel="lead time before the collision (s)"))
-    return (f"<h2>{escape(r['logical_scenario'])}</h2>" + rq1_table(r).html()
-            + '<div class="charts">' + "".join(charts) + "</div>")
+    return '<div class="charts">' + "".join(charts) + "</div>"
 
 
-def html_report(reports: list[dict], title: str = "evoeye RQ1 report") -> str:
+def _headline_html(r: dict) -> str:
+    lines = "".join(f"<li>{escape(line.strip())}</li>" for line in summary(r)[1:])
+    return (f"<h2>{escape(r['logical_scenario'])}</h2><p>{escape(summary(r)[0])}</p>"
+            f"<ul>{lines}</ul>" + headline_table(r).html())
+
+
+def html_report(reports: list[dict], title: str = f"evoeye: {TITLE}") -> str:
     """One self-contained HTML page: inline CSS and SVG, no scripts, no external resources."""
     stamp = f"{datetime.now(UTC):%Y-%m-%d %H:%M} UTC"
     body = [f"<h1>{escape(title)}</h1>",
-            f'<p class="note">Generated {stamp}. Rates in %. Thresholds calibrated on '
-            "validation frames, applied unchanged to test; frames at or after a collision are "
-            "not scored. A run warns at its first K consecutive alarms before the collision.</p>"]
+            f'<p class="note">Generated {stamp}. {escape(point_note(reports))}</p>',
+            f'<p class="note">{escape(HEADLINE_NOTE)}</p>']
     if any_unreachable(reports):
         body.append(f'<p class="note">{escape(UNREACHABLE_NOTE)}</p>')
-    body += [_scenario_html(r) for r in reports]
+    body += [_headline_html(r) for r in reports]
+    body += ['<h2>Details (paper Table "Monitoring effectiveness")</h2>',
+             f'<p class="note">{escape(_details_note(reports))}</p>']
+    for r in reports:
+        for name, table in rq1_tables(r):
+            body += [f"<h3>{escape(r['logical_scenario'])}: {escape(name.lower())}</h3>",
+                     table.html()]
+        body.append(_charts(r))
     body += ["<h2>Dataset</h2>", dataset_table(reports).html(),
              "<h2>Monitors</h2>", monitors_table(reports).html()]
     if causes := _attribution_rows(reports):
@@ -260,6 +245,6 @@ def write_report(root: DataRoot, reports: list[dict],
     folder.mkdir(parents=True, exist_ok=True)
     files = ReportFiles(folder, folder / "rq1.md", folder / "report.html", folder / "report.json")
     files.markdown.write_text(markdown_report(reports), encoding="utf-8")
-    files.html.write_text(html_report(reports, f"evoeye RQ1 report — {name}"), encoding="utf-8")
+    files.html.write_text(html_report(reports, f"evoeye: {TITLE} — {name}"), encoding="utf-8")
     files.json.write_text(json.dumps(reports, indent=1) + "\n", encoding="utf-8")
     return files

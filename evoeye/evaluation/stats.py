@@ -1,4 +1,5 @@
-"""How sure a figure over seeds is: sample SDs, confidence intervals, paired tests and power.
+"""How sure a figure is: over seeds (sample SDs, intervals, paired tests, power) and over runs
+(the intervals of a report's headline, at the end of the module; docs/reports.md).
 
 Every method of an experiment runs on the same campaign seeds, so two methods are compared pair
 by pair (seed by seed). The choices, and why:
@@ -246,3 +247,97 @@ def pairs_needed(diff: float, sd_a: float, sd_b: float, correlation: float, *,
         else:
             lo = mid + 1
     return lo
+
+
+# ---- intervals over runs (the report's headline; docs/reports.md) ---------------------------
+# Collisions and false alarms happen per run and frames within a run are strongly correlated,
+# so every headline interval resamples or counts runs, never frames.
+
+
+@dataclass(frozen=True)
+class Estimate:
+    """A figure with its confidence interval (None where too few runs define one)."""
+
+    value: float | None
+    low: float | None
+    high: float | None
+    n: int  # the runs it rests on
+    method: str | None  # "wilson", "bootstrap", "poisson-zero" or None (no interval)
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+def proportion_ci(successes: int, n: int, confidence: float = CONFIDENCE) -> Estimate:
+    """successes / n with its Wilson score interval (`scipy.stats.binomtest`): unlike a bootstrap
+    it is not degenerate at 0 or n successes, and it covers well at the handful of collision
+    runs a scenario may have."""
+    _check_confidence(confidence)
+    if n == 0:
+        return Estimate(None, None, None, 0, None)
+    ci = stats.binomtest(successes, n).proportion_ci(confidence_level=confidence,
+                                                     method="wilson")
+    return Estimate(successes / n, float(ci.low), float(ci.high), n, "wilson")
+
+
+def _percentile_ci(data: tuple[np.ndarray, ...], statistic, confidence: float,
+                   n_resamples: int, seed: int) -> tuple[float, float]:
+    ci = stats.bootstrap(data, statistic, paired=True, vectorized=True,
+                         confidence_level=confidence, n_resamples=n_resamples,
+                         method="percentile", rng=np.random.default_rng(seed)
+                         ).confidence_interval
+    return float(ci.low), float(ci.high)
+
+
+def rate_ci(events: Sequence[int] | np.ndarray, exposure: Sequence[float] | np.ndarray, *,
+            confidence: float = CONFIDENCE, n_resamples: int = N_RESAMPLES,
+            seed: int = 0) -> Estimate:
+    """Σ events / Σ exposure over runs (e.g. false alarms per hour of safe driving) with a
+    percentile bootstrap interval resampling whole runs, which keeps a run's bursts of alarms
+    together. With no event at all the bootstrap is degenerate; the interval is then [0, the
+    one-sided Poisson bound −ln(1 − confidence) / Σ exposure]."""
+    _check_confidence(confidence)
+    e, x = np.asarray(events, float).reshape(-1), np.asarray(exposure, float).reshape(-1)
+    if e.shape != x.shape:
+        raise ValueError(f"one exposure per run: {len(e)} event counts, {len(x)} exposures")
+    total = float(x.sum())
+    if len(e) == 0 or total <= 0:
+        return Estimate(None, None, None, len(e), None)
+    value = float(e.sum()) / total
+    if e.sum() == 0:
+        bound = float(stats.chi2.ppf(confidence, 2) / 2) / total
+        return Estimate(0.0, 0.0, bound, len(e), "poisson-zero")
+    if len(e) < 2:
+        return Estimate(value, None, None, 1, None)
+    low, high = _percentile_ci((e, x), lambda a, b, axis=-1: a.sum(axis) / b.sum(axis),
+                               confidence, n_resamples, seed)
+    return Estimate(value, low, high, len(e), "bootstrap")
+
+
+def median_ci(values: Sequence[float] | np.ndarray, *, confidence: float = CONFIDENCE,
+              n_resamples: int = N_RESAMPLES, seed: int = 0) -> Estimate:
+    """The median of per-run values (e.g. lead times) with a percentile bootstrap interval
+    (None below two values)."""
+    _check_confidence(confidence)
+    a = _finite(values)
+    if len(a) == 0:
+        return Estimate(None, None, None, 0, None)
+    if len(a) < 2:
+        return Estimate(float(a[0]), None, None, 1, None)
+    if np.ptp(a) == 0:  # every resample has the same median
+        return Estimate(float(a[0]), float(a[0]), float(a[0]), len(a), "bootstrap")
+    low, high = _percentile_ci((a,), lambda v, axis=-1: np.median(v, axis=axis), confidence,
+                               n_resamples, seed)
+    return Estimate(float(np.median(a)), low, high, len(a), "bootstrap")
+
+
+def paired_warnings_p(a: Sequence[bool] | np.ndarray, b: Sequence[bool] | np.ndarray) -> float:
+    """Two-sided exact McNemar p of two monitors warned (or not) on the same runs: the binomial
+    test of the runs only one of them warned of (1.0 when there are none)."""
+    a, b = np.asarray(a, bool), np.asarray(b, bool)
+    if a.shape != b.shape:
+        raise ValueError(f"paired runs need one flag each: {a.shape} against {b.shape}")
+    only_a, only_b = int((a & ~b).sum()), int((b & ~a).sum())
+    if only_a + only_b == 0:
+        return 1.0
+    return float(stats.binomtest(only_a, only_a + only_b, 0.5).pvalue)

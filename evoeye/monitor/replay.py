@@ -60,13 +60,42 @@ ALARM_BOX_COLOR = {**CRASHED_COLOR, "a": 0.35}
 
 @dataclass(frozen=True)
 class ReplayReport:
-    """Where the copy went and what the monitor said."""
+    """Where the copy went, what the monitor said, and when the run collided."""
 
     out: Path
     frames: int
     alarm_frames: int
     first_alarm_t_s: float | None
     threshold: float
+    collision_t_s: float | None = None  # the run's first collision (None: it never collided)
+
+    @property
+    def warning_t_s(self) -> float | None:
+        """The first alarm before the collision (any first alarm in a run without one)."""
+        t = self.first_alarm_t_s
+        if t is None or (self.collision_t_s is not None and t >= self.collision_t_s):
+            return None
+        return t
+
+    @property
+    def lead_s(self) -> float | None:
+        """How long before the collision the monitor warned (None: no collision or no
+        warning before it)."""
+        if self.collision_t_s is None or self.warning_t_s is None:
+            return None
+        return self.collision_t_s - self.warning_t_s
+
+    def words(self) -> str:
+        """The run's outcome and the monitor's warning in one sentence."""
+        if self.collision_t_s is None:
+            said = ("no alarm" if self.first_alarm_t_s is None
+                    else f"a false alarm at t = {self.first_alarm_t_s:.2f} s")
+            return f"no collision; {said}"
+        hit = f"collision at t = {self.collision_t_s:.2f} s"
+        if self.lead_s is None:
+            return f"{hit}; no alarm before it (missed)"
+        return (f"{hit}; first alarm at t = {self.warning_t_s:.2f} s, {self.lead_s:.2f} s "
+                "before it")
 
 
 def log_frames(path: str | os.PathLike) -> list[FrameMessages]:
@@ -176,6 +205,8 @@ def replay(log: str | os.PathLike, monitor: FusionMonitor, out: str | os.PathLik
     if out.resolve() == log.resolve():
         raise ValueError(f"the replay must not overwrite its source log {log}")
     frames = log_frames(log)
+    meta = read_run(log, topics=()).metadata
+    collision_t = meta.get("collision_time_s") if meta.get("collided") else None
     runtime = RuntimeMonitor(monitor, fpr=fpr, consecutive=consecutive)
     states = runtime.run(frames)
     added: list[tuple[int, str, bytes]] = []
@@ -187,4 +218,4 @@ def replay(log: str | os.PathLike, monitor: FusionMonitor, out: str | os.PathLik
         _write_copy(log.read_bytes(), f, added)
     alarm_t = [s.t_s for s in states if s.alarm]
     return ReplayReport(out, len(states), len(alarm_t), alarm_t[0] if alarm_t else None,
-                        runtime.threshold)
+                        runtime.threshold, None if collision_t is None else float(collision_t))

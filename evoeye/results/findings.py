@@ -49,7 +49,7 @@ class Finding:
 
 
 FINDINGS: tuple[Finding, ...] = (
-    Finding("rq1-baselines", "RQ1: the FusionMonitor beats every baseline",
+    Finding("rq1-baselines", "The FusionMonitor beats every baseline (RQ1)",
             "best F1, AUROC and AUPRC on both scenarios", "rq1", ("test",),
             ("f1@0.05", "auprc"),
             tuple((FUSION_LABEL, b) for b in BASELINES)),
@@ -59,7 +59,7 @@ FINDINGS: tuple[Finding, ...] = (
     Finding("rq3-inputs", "Monitor ablation: all module inputs beat perception only",
             "F1@0.05 +1.8 (S1), +5.8 (S2)", "ablation", ("test",), ("f1@0.05",),
             (("L=5", "perception"),)),
-    Finding("rq2-hard", "RQ2: EvoEye beats Uniform and AV-Fuzzer on the Hard Set",
+    Finding("rq2-hard", "EvoEye beats Uniform and AV-Fuzzer on the Hard Set (RQ2)",
             "Hard F1 +10.5–13.2 (S1), +5.7–8.5 (S2) over the strongest baseline", "rq2",
             ("hard", "robust"), ("f1@0.05",), (("evoeye", "uniform"), ("evoeye", "avfuzzer"))),
     Finding("rq3-feedback", "Evolution ablation: feedback helps (EvoEye beats w/o feedback)",

@@ -75,7 +75,8 @@ def results_html(results: dict, title: str = "evoeye results") -> str:
         if f["checks"]:
             body += [f"<h3>{escape(f['claim'])}: {escape(f['verdict'])}</h3>",
                      Table(*finding_checks(f)).html()]
-    for part, name in (("rq1", "RQ1"), ("ablation", "Monitor ablation"), ("rq2", "RQ2"),
+    for part, name in (("rq1", "Monitoring effectiveness (RQ1)"), ("ablation", "Monitor ablation"),
+                       ("rq2", "Self-evolution under the same budget (RQ2)"),
                        ("evolution-ablation", "Evolution ablation"), ("aem-evo", "AEM-Evo"),
                        ("acquisition", "What each method acquired")):
         tables = [t for t in results["tables"] if t["id"] == part]

@@ -157,10 +157,11 @@ def markdown_files(results: dict, source: str = "results.json") -> dict[str, str
                  "re-seeded G_0s miss and every safe test frame):\n\n"
                  + "\n".join(_set_lines(results)))
     return {
-        "rq1.md": part_markdown("RQ1 and the monitor ablation",
+        "rq1.md": part_markdown("Monitoring effectiveness (RQ1) and the monitor ablation",
                                 _intro(results, "RQ1 and the monitor ablation", "rq1_data"),
                                 results["tables"], ("rq1", "ablation")),
-        "rq2.md": part_markdown("RQ2, the evolution ablation and AEM-Evo", rq2_intro,
+        "rq2.md": part_markdown("Self-evolution (RQ2), the evolution ablation and AEM-Evo",
+                                rq2_intro,
                                 results["tables"], ("rq2", "evolution-ablation", "aem-evo",
                                                      "acquisition")),
         "findings.md": findings_markdown(results["findings"], source),

@@ -86,13 +86,13 @@ ACQUIRED = "acquired"
 ACQUISITION_METRICS = ("collision_share", "near_share", "feedback")
 
 TABLES: tuple[TableSpec, ...] = (
-    TableSpec("rq1", "rq1", "RQ1: monitoring effectiveness (test frames)", ("test",), METRICS,
+    TableSpec("rq1", "rq1", "Monitoring effectiveness, test frames (RQ1)", ("test",), METRICS,
               lambda have: list(have), _against(lambda rows: FUSION_LABEL), "training seeds"),
     TableSpec("ablation", "ablation", "Monitor ablation (test frames)", ("test",),
               ABLATION_METRICS, lambda have: list(have),
               _against(lambda rows: next((v for v in FULL_VARIANTS if v in rows), None)),
               "training seeds"),
-    TableSpec("rq2", "rq2", "RQ2: self-evolution under the same budget", RQ2_SETS, METRICS,
+    TableSpec("rq2", "rq2", "Self-evolution under the same budget (RQ2)", RQ2_SETS, METRICS,
               _in((G0, G0_SEEDS, *RQ2_MAIN)), _evolution("evoeye", ("uniform", "avfuzzer")),
               "campaign seeds"),
     TableSpec("evolution-ablation", "rq2", "Evolution ablation", RQ2_SETS, METRICS,

@@ -74,3 +74,33 @@ def test_sigkill_on_the_parent_ends_its_workers_and_a_rerun_cleans_up(tmp_path) 
     assert rerun.returncode == 0, rerun.stdout + rerun.stderr
     assert not list(batch.glob("*.tmp")) and len(list(batch.glob("*.mcap"))) >= 3
     assert "removed the unfinished log" in rerun.stdout
+
+
+def test_ctrl_c_stops_the_workers_says_what_was_kept_and_a_rerun_resumes(tmp_path) -> None:
+    root = tmp_path / "data"
+    batch = DataRoot.resolve(root).batch_dir("highway-cut-in", "uniform-seed0")
+    parent = subprocess.Popen(_simulate(root, 40, 2), stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True, start_new_session=True)
+    workers: list[int] = []
+    try:
+        assert _poll(lambda: len(list(batch.glob("*.mcap"))) >= 2, 300.0), "no run finished"
+        workers = _children(parent.pid)
+        os.killpg(parent.pid, signal.SIGINT)  # as a terminal's Ctrl-C: the whole group
+        _, err = parent.communicate(timeout=60)
+    finally:
+        parent.kill()
+        for w in workers:
+            if _alive(w):
+                os.kill(w, signal.SIGKILL)
+    assert parent.returncode == 130, err
+    assert len(workers) >= 2 and not any(_alive(w) for w in workers)  # nothing writes on
+    assert "Traceback" not in err and "interrupted:" in err
+    kept = len(list(batch.glob("*.mcap")))
+    assert f"{kept} of the batch's 40 run logs are on disk" in " ".join(err.split())
+    assert not list(batch.glob("*.tmp"))  # the runs in progress left nothing behind
+    rerun = subprocess.run(_simulate(root, 40, 2), capture_output=True, text=True, timeout=600)
+    assert rerun.returncode == 0, rerun.stdout + rerun.stderr
+    assert len(list(batch.glob("*.mcap"))) == 40
+    row = next(line for line in rerun.stdout.splitlines() if "highway-cut-in" in line
+               and "│" in line)
+    assert [c.strip() for c in row.split("│")][5] == str(kept)  # skipped: the kept ones

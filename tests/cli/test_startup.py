@@ -50,3 +50,11 @@ def test_help_imports_no_heavy_module(command: list[str]) -> None:
     loaded = _modules_after(*command, "--help")
     assert "typer" in loaded  # the probe did run the app
     assert not loaded & set(HEAVY), sorted(loaded & set(HEAVY))
+
+
+def test_the_root_help_renders_without_richs_console_or_tables() -> None:
+    probe = PROBE.replace('m.split(".")[0]', "m")  # full module names
+    done = subprocess.run([sys.executable, "-c", probe, "--help"], capture_output=True,
+                          text=True, check=True)
+    loaded = set(json.loads(done.stdout.strip().splitlines()[-1]))
+    assert "typer" in loaded and not loaded & {"rich.console", "rich.table"}

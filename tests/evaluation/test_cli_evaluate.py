@@ -20,22 +20,31 @@ def _args(root, splits, *extra: str) -> list[str]:
             "--train-frac", str(splits.train_frac), "--val-frac", str(splits.val_frac), *extra]
 
 
+LABELS = {"TTC": "ttc", "RSS": "rss"}
+SECTIONS = {"per frame": "frame", "per run, a warning = 1 alarm frame": "1",
+            "per run, a warning = 3 consecutive alarm frames": "3"}
+
+
 def _markdown_rows(text: str) -> dict[tuple[str, str], list[str]]:
-    """(section, method) → cells of the RQ1 table rows in `text`."""
+    """(section, monitor) → cells of the table rows in `text`; the headline's section is
+    "headline", the RQ1 tables' "frame", "1" and "3"."""
     rows, section = {}, None
     for line in text.splitlines():
-        if not line.startswith("| ") or line.startswith("| Method"):
-            continue
-        cells = [c.strip() for c in line.strip("|").split("|")]
-        if cells[0].startswith("**"):
-            section = cells[0].strip("*")
-        elif section is not None and cells[0] in ("ttc", "rss"):
-            rows[(section, cells[0])] = cells[1:]
+        if line.startswith("## highway-cut-in"):
+            section = "headline"
+        elif line.startswith("### highway-cut-in: "):
+            section = SECTIONS[line.split(": ", 1)[1]]
+        elif line.startswith("#"):
+            section = None
+        elif line.startswith("| ") and section is not None:
+            cells = [c.strip() for c in line.strip("|").split("|")]
+            if cells[0] in LABELS:
+                rows[(section, LABELS[cells[0]])] = cells[1:]
     return rows
 
 
 def _expected(monitor: dict, section: str) -> list[str]:
-    block = monitor["frame"] if section == "Frame-level" else monitor["scenario"][section[-2]]
+    block = monitor["frame"] if section == "frame" else monitor["scenario"][section]
     cells = []
     for f in ("0.05", "0.01"):
         cells += [rate(block["at_fpr"][f], k) for k in ("precision", "recall", "f1")]
@@ -53,16 +62,16 @@ def test_json_and_markdown_carry_the_same_numbers(eval_root, splits) -> None:
     assert "report: " in as_md.stdout and "cli-md/report.html" in as_md.stdout
     assert "evaluate: 100%" in as_md.stderr and "2/2 [" in as_md.stderr  # the progress bar
     assert "step/s]" in as_md.stderr or "s/step]" in as_md.stderr
+    assert as_md.stdout.index("## highway-cut-in") < as_md.stdout.index("## Details")
     rows = _markdown_rows(as_md.stdout)
-    sections = ["Frame-level", "Scenario-level (K=1)", "Scenario-level (K=3)"]
-    assert set(rows) == {(s, m) for s in sections for m in ("ttc", "rss")}
+    assert set(rows) == {(s, m) for s in ("headline", *SECTIONS.values()) for m in LABELS.values()}
     for monitor in report["monitors"]:
-        for section in sections:
-            assert rows[(section, monitor["name"])][:8] == _expected(monitor, section)
-        lead = monitor["scenario"]["1"]["lead_time"]["0.05"]
-        warned = rows[("Scenario-level (K=1)", monitor["name"])][8]
-        reached = monitor["scenario"]["1"]["at_fpr"]["0.05"]["reachable"]
-        assert warned == (f"{lead['detected']}/{lead['violations']}" if reached else "n/r")
+        for section in SECTIONS.values():
+            assert rows[(section, monitor["name"])] == _expected(monitor, section)
+        lead = monitor["scenario"]["3"]["lead_time"]["0.05"]  # the headline: K = 3, FPR 0.05
+        warned = rows[("headline", monitor["name"])][0]
+        reached = monitor["scenario"]["3"]["at_fpr"]["0.05"]["reachable"]
+        assert warned == (f"{lead['detected']} of {lead['violations']}" if reached else "n/r")
 
 
 @pytest.mark.parametrize(("extra", "message"), [

@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import re
 from pathlib import Path
 
 import pytest
@@ -67,6 +68,9 @@ def test_explain_one_log_reads_its_spec_and_stores_nothing(batch: DataRoot) -> N
     out = invoke("explain", str(Path(batch.path) / run["log_path"]))
     assert run["scenario_id"] in out
     assert out.count("✓") + out.count("✗") >= len(VARIANTS)
+    assert "cause share %" in out  # shares in whole percent, not fractions
+    assert re.search(r"\b(perception|prediction|planning|control|compound) (50|100|33|25)\b",
+                     out)
     assert read_attribution(batch).num_rows == before
     safe = Warehouse(batch).sql("SELECT log_path FROM scenarios WHERE NOT collided LIMIT 1")
     out = invoke("explain", str(Path(batch.path) / safe.column("log_path")[0].as_py()))

@@ -16,6 +16,7 @@ from evoeye.baselines.aem import AEMConfig
 from evoeye.baselines.families import AEM, fit_aem
 from evoeye.evaluation import evaluate
 from evoeye.evaluation.dataset import load_split
+from evoeye.evaluation.headline import label
 from evoeye.evaluation.monitors import baseline_monitors
 from evoeye.evaluation.report import html_report, markdown_report, write_report
 from evoeye.evaluation.rq1 import rq1_report
@@ -89,7 +90,7 @@ def test_html_report_is_self_contained_with_every_monitors_curves(report, eval_r
     html = html_report([d])
     assert not re.search(r"https?://|\bsrc=|<script|<link|url\(|@import", html)
     for m in d["monitors"]:
-        assert html.count(f'data-series="{m["name"]}"') == 2  # ROC and PR
+        assert html.count(f'data-series="{label(m["name"])}"') == 2  # ROC and PR
     assert "ROC" in html and "Precision-recall" in html and "Warning lead time" in html
     files = write_report(eval_root, [d], "t-html")
     assert files.html.read_text().startswith("<!DOCTYPE html>")
@@ -108,9 +109,9 @@ def test_the_report_shows_root_cause_shares_once_runs_are_explained(report, eval
     files = rq1_report(eval_root, [report], "t-causes")
     md = files.markdown.read_text()
     assert "## Root causes (evoeye explain)" in md
-    row = next(line for line in md.splitlines() if line.startswith(f"| {SCENARIO} | v |"))
-    assert row.split(" | ")[2:8] == ["1", "0.0", "100.0", "0.0", "0.0", "0.0"]
-    assert "0/1 (0.0%)" in row  # the careful driver collided too
+    row = next(line for line in md.splitlines() if line.startswith("| v |"))
+    assert row.split(" | ")[1:7] == ["1", "0.0", "100.0", "0.0", "0.0", "0.0"]
+    assert "0/1 (0.0 %)" in row  # the careful driver collided too
     assert "Root causes" in files.html.read_text()
     assert json.loads(files.json.read_text())[0]["attribution"][0]["runs"] == 1
 
@@ -180,16 +181,39 @@ def test_an_unreachable_fpr_is_reported_as_such_never_as_zero(eval_root, splits)
         point = level["at_fpr"]["0.05"]
         assert point["reachable"] is False and point["f1"] is None and point["recall"] is None
     md = markdown_report([d])
-    row = next(x for x in md.splitlines() if x.startswith("| saturated |"))
-    assert row.count("| n/r ") == 6 and "| 0.0 |" not in row  # P, R, F1 at both FPRs
+    headline, per_frame, *_ = (x for x in md.splitlines() if x.startswith("| saturated |"))
+    assert headline.count("| n/r ") == 5  # warned, recall, lead, false alarms, safe runs
+    assert per_frame.count("| n/r ") == 6 and "| 0.0 |" not in per_frame  # P, R, F1 × 2 FPRs
     assert "n/r: the target FPR is unreachable" in md
-    assert "0.0 n/r" in next(x for x in md.splitlines() if x.startswith(f"| {SCENARIO} | sat"))
+    assert "0.0 n/r" in next(x for x in md.splitlines() if x.startswith("| saturated | sat"))
     assert "n/r" in html_report([d])
 
 
 def test_the_realised_fpr_sits_next_to_its_target(report) -> None:
     md = markdown_report([report.to_dict()])
-    assert "val FPR % (target 5.0)" in md and "val FPR % (target 1.0)" in md
+    assert "| thr@.05 | val FPR@.05 % | thr@.01 | val FPR@.01 % |" in md
     ttc = report.monitors[0]
-    line = next(x for x in md.splitlines() if x.startswith(f"| {SCENARIO} | ttc |"))
+    line = next(x for x in md.splitlines() if x.startswith(f"| TTC | {ttc.version} |"))
     assert f"| {100 * ttc.val_fpr[0.05]:.1f} |" in line
+
+
+def test_every_report_table_fits_the_artifact_view(report) -> None:
+    from evoeye.evaluation.headline import headline_table
+    from evoeye.evaluation.report import dataset_table, monitors_table, rq1_tables
+
+    d = report.to_dict()
+    tables = [headline_table(d), dataset_table([d]), monitors_table([d]),
+              *(t for _, t in rq1_tables(d))]
+    for table in tables:
+        assert table.fits(), (table.header, table.width_chars())
+
+
+def test_the_headline_counts_match_the_run_level_figures(report) -> None:
+    d = report.to_dict()
+    for m in d["monitors"]:
+        sc = m["scenario"]["3"]
+        at, lead, fa = sc["at_fpr"]["0.05"], sc["lead_time"]["0.05"], sc["false_alarms"]["0.05"]
+        assert lead["detected"] == at["tp"] and lead["violations"] == at["tp"] + at["fn"]
+        assert fa["alarmed_runs"] == at["fp"] and fa["safe_runs"] == at["fp"] + at["tn"]
+        assert fa["events"] >= fa["alarmed_runs"]
+        assert fa["safe_h"] > 0 and d["frame_period_s"] == pytest.approx(0.05)

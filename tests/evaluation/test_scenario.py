@@ -72,3 +72,28 @@ def test_run_scores_rank_runs_as_their_warnings_do() -> None:
     # held-for-3 scores: s1 0.9, s2 0.1, v1 0.1 (before the collision), v2 0.9
     # -> (v, s) pairs: v1<s1 0, v1=s2 .5, v2=s1 .5, v2>s2 1
     assert m.auroc == pytest.approx(0.5)
+
+
+def test_false_alarms_count_every_warning_of_the_safe_runs_per_hour() -> None:
+    runs, score = frames(seed=2)
+    hours = 2 * N_FRAMES / RATE_HZ / 3600  # s1 and s2, every frame eligible
+    k3 = scenario_metrics(score, runs, THRESHOLDS, k=3).false_alarms[0.05]
+    assert (k3.events, k3.safe_runs, k3.alarmed_runs) == (1, 2, 1)  # s1's 0-2; s2 never 3
+    assert k3.safe_h == pytest.approx(hours)
+    assert k3.per_h.value == pytest.approx(1 / hours)
+    k1 = scenario_metrics(score, runs, THRESHOLDS, k=1).false_alarms[0.05]
+    assert (k1.events, k1.alarmed_runs) == (4, 2)  # s1: 0-2 once; s2: 4, 6 and 13-14
+    assert k1.per_run == [1, 3]
+    quiet = scenario_metrics(score, runs, THRESHOLDS, k=1).false_alarms[0.01]
+    assert quiet.events == 0 and quiet.per_h.value == 0.0
+    assert quiet.per_h.high == pytest.approx(-np.log(0.05) / hours)  # the Poisson bound
+
+
+def test_lead_times_name_the_runs_warned_of_and_carry_intervals() -> None:
+    runs, score = frames()
+    lead = scenario_metrics(score, runs, THRESHOLDS, k=1).lead_time[0.05]
+    assert lead.warned_ids == ["v1", "v2"]
+    assert (lead.recall.value, lead.recall.n) == (1.0, 2)
+    assert lead.recall.low < 0.5 < lead.recall.high == 1.0  # 2 of 2 says little
+    d = lead.to_dict()
+    assert d["median"]["value"] == pytest.approx(0.375) and d["recall"]["method"] == "wilson"

@@ -19,8 +19,12 @@ from evoeye.evaluation.stats import (
     compare_paired,
     finite_mean,
     mean_ci,
+    median_ci,
     paired_power,
+    paired_warnings_p,
     pairs_needed,
+    proportion_ci,
+    rate_ci,
     sample_sd,
     sd_of_differences,
 )
@@ -200,3 +204,51 @@ def test_designs_of_thousands_of_pairs_are_sized_not_overflowed() -> None:
         pairs_needed(0.05, 0.7, 0.7, 0.0, max_pairs=1000)
     big = compare_paired(np.arange(1, 1201) / 1e3, np.zeros(1200))
     assert big.min_p == 0.0 and big.p_value < 1e-100  # 2 / 2^1200 underflows to 0, no error
+
+
+def test_a_share_of_runs_has_the_wilson_interval_even_at_none_or_all() -> None:
+    e = proportion_ci(6, 8)
+    assert (e.value, e.n, e.method) == (0.75, 8, "wilson")
+    z = stats.norm.ppf(0.975)  # Wilson's formula by hand
+    centre = (0.75 + z**2 / 16) / (1 + z**2 / 8)
+    half = z / (1 + z**2 / 8) * math.sqrt(0.75 * 0.25 / 8 + z**2 / 256)
+    assert (e.low, e.high) == pytest.approx((centre - half, centre + half))
+    none, every = proportion_ci(0, 2), proportion_ci(2, 2)
+    assert none.low == 0.0 and none.high > 0.5 and every.high == 1.0 and every.low < 0.5
+    assert proportion_ci(0, 0).value is None
+
+
+def test_a_rate_over_runs_resamples_runs_and_bounds_a_zero_count() -> None:
+    rng = np.random.default_rng(3)
+    events, hours = rng.poisson(2.0, 40), rng.uniform(0.01, 0.02, 40)
+    e = rate_ci(events, hours)
+    assert e.value == pytest.approx(events.sum() / hours.sum()) and e.method == "bootstrap"
+    assert e.low < e.value < e.high
+    bursty = rate_ci(np.r_[np.zeros(39), events.sum()], hours)  # the same count in one run
+    assert bursty.value == pytest.approx(e.value) and bursty.high - bursty.low > 2 * (
+        e.high - e.low)  # runs are the unit: one bursty run is far less sure
+    zero = rate_ci(np.zeros(5), np.full(5, 0.5))
+    assert (zero.value, zero.low) == (0.0, 0.0)
+    assert zero.high == pytest.approx(-math.log(0.05) / 2.5) and zero.method == "poisson-zero"
+    assert rate_ci([], []).value is None
+    with pytest.raises(ValueError, match="one exposure per run"):
+        rate_ci([1, 2], [0.1])
+
+
+def test_a_median_over_runs_has_a_bootstrap_interval_from_two_runs_on() -> None:
+    e = median_ci([1.0, 2.0, 3.0, 4.0, 10.0])
+    assert e.value == 3.0 and 1.0 <= e.low <= 3.0 <= e.high <= 10.0
+    one = median_ci([2.5])
+    assert (one.value, one.low, one.high, one.n) == (2.5, None, None, 1)
+    assert median_ci([]).value is None
+    assert median_ci([1.0, 2.0, 3.0]) == median_ci([1.0, 2.0, 3.0])  # seeded
+
+
+def test_paired_warnings_compare_only_the_runs_one_monitor_alone_warned_of() -> None:
+    a = [True] * 12 + [False] * 3
+    b = [False] * 10 + [True] * 2 + [False] * 3
+    assert paired_warnings_p(a, b) == pytest.approx(stats.binomtest(10, 10).pvalue)  # 0.002
+    assert paired_warnings_p(a, a) == 1.0
+    assert paired_warnings_p([True, False], [False, True]) == 1.0
+    with pytest.raises(ValueError, match="one flag each"):
+        paired_warnings_p([True], [True, False])

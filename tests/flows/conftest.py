@@ -25,7 +25,9 @@ SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
 FLOWS_DIR = Path(__file__).resolve().parent
 
 
-def pytest_collection_modifyitems(items: list[pytest.Item]) -> None:
+def pytest_collection_modifyitems(config: pytest.Config, items: list[pytest.Item]) -> None:
+    if not config.pluginmanager.hasplugin("xdist"):  # `-p no:xdist`: no groups to form
+        return
     for item in items:
         if FLOWS_DIR in Path(str(item.fspath)).resolve().parents:
             item.add_marker(pytest.mark.xdist_group("prefect"))
@@ -49,3 +51,36 @@ def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[DataRoot, str]:
     run_batch(plan_uniform(SCENARIO, 16, 3), root)
     ingest(root)
     return root, train_monitor(root, SCENARIO, seed=0, splits=SPLITS, epochs=1)
+
+
+def _latest_artifact(key: str) -> str:
+    """The Markdown of the newest artifact `key` on the test server."""
+    from prefect.client.orchestration import get_client
+
+    with get_client(sync_client=True) as client:
+        found = [a for a in client.read_artifacts() if a.key == key]
+    assert found, f"no artifact {key!r}"
+    return max(found, key=lambda a: a.created).data
+
+
+def _flow_run_names(*names: str) -> list[str]:
+    """The names of the flow runs on the test server called one of `names`."""
+    from prefect.client.orchestration import get_client
+    from prefect.client.schemas.filters import FlowRunFilter, FlowRunFilterName
+
+    with get_client(sync_client=True) as client:
+        runs = client.read_flow_runs(flow_run_filter=FlowRunFilter(
+            name=FlowRunFilterName(any_=list(names))))
+    return sorted(r.name for r in runs)
+
+
+@pytest.fixture
+def latest_artifact(prefect_server):
+    """`latest_artifact(key)`: the Markdown of the newest artifact `key`."""
+    return _latest_artifact
+
+
+@pytest.fixture
+def flow_run_names(prefect_server):
+    """`flow_run_names(*names)`: the flow runs called one of `names`, sorted."""
+    return _flow_run_names

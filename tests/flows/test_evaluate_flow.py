@@ -71,7 +71,8 @@ def test_evaluate_flow_writes_the_report_and_an_artifact(prefect_server: None,
     with get_client(sync_client=True) as client:
         artifacts = client.read_artifacts()
     (artifact,) = [a for a in artifacts if a.key == "evoeye-rq1"]
-    assert "| ttc |" in artifact.data and "Scenario-level (K=3)" in artifact.data
+    assert artifact.data.startswith("# Monitoring effectiveness (RQ1)")
+    assert "| TTC |" in artifact.data and "a warning = 3 consecutive alarm frames" in artifact.data
 
 
 def test_unknown_baselines_are_refused_before_anything_runs() -> None:

@@ -1,4 +1,4 @@
-"""The evolution flow through Prefect: rounds are `round-<r>` flow runs; the nightly deployment."""
+"""The evolution flow through Prefect: a flow run per round (`round-<r>-…`); the deployment."""
 
 from __future__ import annotations
 
@@ -54,11 +54,18 @@ def test_nightly_deployment_has_cron_and_parameter_schema() -> None:
     assert d.concurrency_limit == 1
 
 
-def test_evolution_flow_runs_each_round_as_a_flow_run(prefect_server, seeded) -> None:
+def test_evolution_flow_runs_each_round_as_a_flow_run(seeded, latest_artifact) -> None:
+    from datetime import UTC, datetime
+
     from prefect.client.orchestration import get_client
-    from prefect.client.schemas.filters import FlowRunFilter, FlowRunFilterName
+    from prefect.client.schemas.filters import (
+        FlowRunFilter,
+        FlowRunFilterName,
+        FlowRunFilterStartTime,
+    )
 
     root, g0 = seeded
+    started = datetime.now(UTC)  # other tests (the demo flow's) run rounds of this name too
     params = EvolveParams(root=str(root.path), scenario=SCENARIO, strategy="evoeye", budget_s=1000,
                           monitor=g0, n_round=3, epochs=1, max_rounds=2, train_frac=0.5,
                           val_frac=0.25, assess=True)
@@ -68,11 +75,27 @@ def test_evolution_flow_runs_each_round_as_a_flow_run(prefect_server, seeded) ->
     assert [r.round for r in rows] == [0, 1, 2]
     assert [len(r.scenario_ids) for r in rows] == [0, 3, 3]
     assert all(r.metrics.hard["frames"] >= 0 for r in rows)  # every G_r assessed
+    names = [f"round-{r}-{SCENARIO}-evoeye-s0" for r in (1, 2)]
+    since = FlowRunFilterStartTime(after_=started)
     with get_client(sync_client=True) as client:
         runs = client.read_flow_runs(flow_run_filter=FlowRunFilter(
-            name=FlowRunFilterName(any_=["round-1", "round-2"])))
-    assert sorted(r.name for r in runs) == ["round-1", "round-2"]
+            name=FlowRunFilterName(any_=names), start_time=since))
+        campaign = client.read_flow_runs(flow_run_filter=FlowRunFilter(
+            name=FlowRunFilterName(any_=[f"evolve-{SCENARIO}-evoeye-s0"]), start_time=since))
+    assert sorted(r.name for r in runs) == names and len(campaign) == 1
     assert all(r.state.is_completed() for r in runs)
+    # the campaign's artifact (the newest: other tests' flows publish theirs on the same server):
+    # its rounds with each G_r's figures in %, and what changed
+    artifact = latest_artifact("evoeye-evolve")
+    assert f"# Evolution: {SCENARIO}, evoeye, seed 0" in artifact
+    assert "| Round | New runs | Sim s | Monitor | Test F1@.05 % |" in artifact
+    assert f"| 2 | 3 | {rows[2].simulated_s:.0f} | {rows[2].monitor_version} |" in artifact
+    assert "2 round(s) added 6 runs" in artifact and "Hard-Set F1@0.05" in artifact
     # a second flow run with a higher max resumes the same campaign at round 3
     out2 = evolution_flow(params.model_copy(update={"max_rounds": 1}))
     assert out2["campaign_id"] == out["campaign_id"] and out2["round"] == 3
+
+
+def test_a_campaign_with_no_budget_is_refused_before_anything_runs() -> None:
+    with pytest.raises(ValueError, match="budget_s must be greater than 0"):
+        EvolveParams(scenario=SCENARIO, budget_s=0)

@@ -27,7 +27,7 @@ def root_with_logs(tmp_path: Path) -> DataRoot:
 
 
 def test_ingest_flow_ingests_quarantines_and_is_idempotent(
-    prefect_server: None, root_with_logs: DataRoot
+    prefect_server: None, root_with_logs: DataRoot, latest_artifact, flow_run_names
 ) -> None:
     params = IngestParams(root=str(root_with_logs.path), runs_per_part=1)
     report = ingest_flow(params)
@@ -37,6 +37,10 @@ def test_ingest_flow_ingests_quarantines_and_is_idempotent(
         "SELECT count(*) AS runs, sum(n_frames) AS frames FROM scenarios"
     ).to_pylist()[0]
     assert counts == {"runs": 2, "frames": 20}
+
+    md = latest_artifact("evoeye-ingest")
+    assert "| 2 | 20 | 0 | 1 |" in md and "quarantined `runs/highway-cut-in/b000/broken.mcap`" in md
+    assert flow_run_names(f"ingest-{root_with_logs.path.name}")
 
     again = ingest_flow(params)
     assert again["ingested"] == [] and again["skipped"] == 2 and again["quarantined"] == []

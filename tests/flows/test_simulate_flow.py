@@ -10,7 +10,8 @@ from evoeye.log import read_run
 from flows.simulate import SimulateParams, simulate_batch_flow
 
 
-def test_simulate_flow_writes_one_log_per_run_and_reruns_skip(prefect_server, tmp_path):
+def test_simulate_flow_writes_one_log_per_run_and_reruns_skip(tmp_path, latest_artifact,
+                                                              flow_run_names):
     params = SimulateParams(scenario="unprotected-intersection", n=2, seed=4,
                             root=str(tmp_path), workers=2)
     results = simulate_batch_flow(params)
@@ -20,6 +21,11 @@ def test_simulate_flow_writes_one_log_per_run_and_reruns_skip(prefect_server, tm
     again = simulate_batch_flow(params)
     assert all(r.skipped for r in again)
     assert sorted(r.path for r in again) == sorted(r.path for r in results)
+    name = "simulate-unprotected-intersection-uniform-seed4-n2"
+    assert flow_run_names(name) == [name, name]  # the run and the re-run
+    artifact = latest_artifact("evoeye-simulate")  # the re-run's
+    assert "# Simulated: unprotected-intersection" in artifact
+    assert "| Runs | Collisions | Failed | Skipped |" in artifact
 
 
 def test_simulate_flow_on_a_two_worker_dask_cluster(prefect_server, tmp_path):
@@ -37,3 +43,15 @@ def test_bad_parameters_are_refused_before_anything_runs():
         SimulateParams(scenario="roundabout")
     with pytest.raises(ValidationError, match="n"):
         SimulateParams(n=0)
+
+
+def test_simulate_flow_can_ingest_its_batch(prefect_server, tmp_path):
+    from evoeye.paths import DataRoot
+    from evoeye.store import Warehouse
+
+    params = SimulateParams(scenario="highway-cut-in", n=2, seed=5, root=str(tmp_path),
+                            workers=1, ingest=True)
+    results = simulate_batch_flow(params)
+    ids = Warehouse(DataRoot.resolve(tmp_path)).sql(
+        "SELECT scenario_id FROM scenarios ORDER BY scenario_id").column("scenario_id")
+    assert ids.to_pylist() == sorted(r.scenario_id for r in results)

@@ -41,13 +41,17 @@ def _runs(seeds: tuple[int, ...]) -> str:
     return f"SELECT scenario_id FROM scenarios WHERE scenario_id IN ({ids})"
 
 
-def test_train_flow_saves_a_version_and_fine_tunes_it(prefect_server, root: DataRoot) -> None:
+def test_train_flow_saves_a_version_and_fine_tunes_it(prefect_server, root: DataRoot,
+                                                     latest_artifact, flow_run_names) -> None:
     params = TrainFlowParams(root=str(root.path), train_sql=_runs((0, 1, 2, 3)),
                              val_sql=_runs((4, 5)), horizon_s=0.5, epochs=2, context_len=3)
     out = train_flow(params)
     assert out["version"].startswith("fusion-") and out["parent"] is None
     assert Path(out["card"]).is_file() and set(out["thresholds"]) == {"0.05", "0.01"}
     assert 0.0 <= out["metrics"]["auroc"] <= 1.0
+    md = latest_artifact("evoeye-train")
+    assert md.startswith(f"# Trained {out['version']}") and "| Target FPR | Threshold |" in md
+    assert flow_run_names("train-highway-cut-in-seed0")
     child = train_flow(params.model_copy(update={"init_from": out["version"], "epochs": 1,
                                                  "context_len": None}))
     assert child["parent"] == out["version"] and child["version"] != out["version"]

@@ -27,3 +27,24 @@ def test_onnx_runtime_and_torch_give_the_same_scores(tiny, trained, tmp_path) ->
         assert risk.shape == (len(index),)
         np.testing.assert_allclose(risk, expected[index], rtol=0, atol=1e-5)
     assert expected.std() > 0.05  # real, varied scores, not a constant
+
+
+def test_the_file_says_which_version_it_is_its_thresholds_and_its_inputs(tiny, trained,
+                                                                         tmp_path) -> None:
+    import json
+
+    monitor = load_monitor(tiny.root, trained)
+    path = export_onnx(monitor, tmp_path / "model.onnx")
+    props = {p.key: p.value for p in onnx.load(str(path)).metadata_props}
+    assert props["evoeye.version"] == trained
+    assert props["evoeye.logical_scenario"] == monitor.card["logical_scenario"]
+    assert props["evoeye.context_len"] == "5"
+    thresholds = json.loads(props["evoeye.thresholds"])
+    assert thresholds == {f"{f:g}": t for f, t in monitor.thresholds.by_fpr.items()}
+    spec = json.loads(props["evoeye.inputs"])
+    session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
+    for given in session.get_inputs():  # the spec matches the graph, input by input
+        assert spec[given.name]["shape"][1:] == given.shape[1:]
+        assert spec[given.name]["dtype"] == ("bool" if given.type == "tensor(bool)"
+                                             else "float32")
+    assert spec[OUTPUT]["range"] == [0.0, 1.0]

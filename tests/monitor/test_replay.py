@@ -112,6 +112,7 @@ def test_cli_replay_and_export(tiny, trained, tmp_path) -> None:
                                  "--root", str(tiny.root.path), "--out", str(out)])
     assert result.exit_code == 0, result.output
     assert "40 frames" in result.output and out.exists()
+    assert "collision at t = " in result.output  # the val run collides
     result = runner.invoke(app, ["export", "--monitor", trained, "--root", str(tiny.root.path),
                                  "--out", str(tmp_path / "m.onnx")])
     assert result.exit_code == 0, result.output
@@ -147,3 +148,32 @@ def test_cli_replay_writes_to_replays_and_warns_on_another_scenario(tiny, traine
                                  "--root", str(tiny.root.path)])
     assert result.exit_code == 0, result.output
     assert "warning:" in result.output and "trained on unprotected-intersection" in result.output
+
+
+def test_the_report_knows_when_the_run_collided_and_how_early_it_warned(tiny, replayed) -> None:
+    sid, report = replayed
+    meta = read_run(tiny.logs[sid], topics=()).metadata
+    assert meta["collided"] and report.collision_t_s == pytest.approx(meta["collision_time_s"])
+    if report.warning_t_s is not None:
+        assert report.lead_s == pytest.approx(report.collision_t_s - report.warning_t_s)
+        assert report.words().endswith(f"{report.lead_s:.2f} s before it")
+    else:
+        assert report.words().endswith("no alarm before it (missed)")
+
+
+@pytest.mark.parametrize(("first_alarm", "collision", "words"), [
+    (1.5, 4.0, "collision at t = 4.00 s; first alarm at t = 1.50 s, 2.50 s before it"),
+    (4.2, 4.0, "collision at t = 4.00 s; no alarm before it (missed)"),
+    (None, 4.0, "collision at t = 4.00 s; no alarm before it (missed)"),
+    (3.0, None, "no collision; a false alarm at t = 3.00 s"),
+    (None, None, "no collision; no alarm"),
+])
+def test_the_outcome_in_words(first_alarm, collision, words) -> None:
+    from evoeye.monitor.replay import ReplayReport
+
+    report = ReplayReport(Path("x"), 100, 3, first_alarm, 0.5, collision)
+    assert report.words() == words
+    if "before it" in words and "missed" not in words:
+        assert report.lead_s == pytest.approx(collision - first_alarm)
+    else:
+        assert report.lead_s is None

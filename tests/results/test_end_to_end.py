@@ -274,8 +274,8 @@ def test_reproduce_regenerates_a_findings_file_from_the_runs_it_records(done, tm
     assert (docs / "tiny.json").read_bytes() == done.first_json
     assert (docs / "kept.json").read_bytes() == kept_bytes  # not re-run (--only), combined
     markdown = (docs / "tiny.md").read_text()
-    assert markdown.startswith("# RQ1 and the monitor ablation")
-    assert "\n# RQ2, the evolution ablation and AEM-Evo" in markdown
+    assert markdown.startswith("# Monitoring effectiveness (RQ1) and the monitor ablation")
+    assert "\n# Self-evolution (RQ2), the evolution ablation and AEM-Evo" in markdown
     combined = json.loads((docs / "findings.json").read_text())
     assert [s["path"] for s in combined["sources"]] == [str(docs / "tiny.json"),
                                                          str(docs / "kept.json")]

@@ -18,7 +18,7 @@ from dataclasses import replace
 import numpy as np
 from scipy.stats import spearmanr
 
-from evoeye.evaluation.report import UNREACHABLE
+from evoeye.evaluation.table import UNREACHABLE, pct
 from evoeye.evolve.campaign.assess import Assessor
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.loop import Campaign
@@ -213,17 +213,18 @@ def reseeded_controls(root: DataRoot, cfg: CampaignConfig, k: int,
 
 
 def brief(metrics: RoundMetrics | None) -> str:
-    """A round's metrics in one line ('' if it was not assessed)."""
+    """A round's metrics in one line, in % ('' if it was not assessed)."""
     if metrics is None:
         return ""
     t, h = metrics.test, metrics.hard
-    return (f"test F1@0.05 {_f1(t)} AUPRC {t['auprc'] or 0:.3f} | "
+    return (f"test F1@0.05 {_f1(t)}, AUPRC {pct(t['auprc'])} % | "
             f"hard F1@0.05 {_f1(h)}")
 
 
 def _f1(split: dict) -> str:
-    """F1 at the first target FPR, or n/r where that target was unreachable (its F1 is None)."""
-    return UNREACHABLE if split["f1@0.05"] is None else f"{split['f1@0.05']:.3f}"
+    """F1 at the first target FPR in %, or n/r where that target was unreachable (its F1 is
+    None)."""
+    return UNREACHABLE if split["f1@0.05"] is None else f"{pct(split['f1@0.05'])} %"
 
 
 NEAR_MISS_M = 1.0  # a collision-free run whose footprints came this close is a near miss

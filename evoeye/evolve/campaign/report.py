@@ -16,16 +16,22 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.evaluation.plots import interval_chart, line_chart
-from evoeye.evaluation.report import DASH, UNREACHABLE, UNREACHABLE_NOTE
+from evoeye.evaluation.report import CSS
 from evoeye.evaluation.stats import finite_mean, mean_ci, sample_sd
+from evoeye.evaluation.table import DASH, UNREACHABLE, UNREACHABLE_NOTE, Table, pct
 from evoeye.evolve.campaign.assess import reached
 from evoeye.evolve.campaign.experiment import ABLATION, MAIN, methods
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.paths import DataRoot
+from evoeye.store.feedback import RoundRow
 
 COLUMNS = ("f1@0.05", "f1@0.01", "auroc", "auprc")
-ACQUISITION_HEAD = ("method", "runs", "collisions %", "near misses (< 1 m, no collision) %",
-                    "within δ of an earlier record %", "f under the monitor that chose it %")
+ACQUISITION_HEAD = ("Method", "Runs", "Collisions %", "Near misses %", "Within δ %", "f %")
+ACQUISITION_NOTE = ("Near misses: collision-free runs whose footprints came within 1 m. Within "
+                    "δ: runs within δ (Chebyshev, normalised) of an earlier record. f: mean "
+                    "feedback |ŷ − y| under the monitor that chose the run, in %.")
+SETS = (("Test", "the Test Set"), ("Hard", "the Hard Set of G_0"))
+TITLE = "Self-evolution under the same simulation budget (RQ2)"
 
 
 OTHER_SCALE = " ²"  # marks a `<family>-evo` row: its f is on its own monitor's score scale
@@ -43,7 +49,8 @@ def tables(res: dict) -> tuple[tuple[str, tuple[str, ...]], ...]:
     """(title, methods) of each table: RQ2 (with methods that are neither RQ2 nor ablation),
     and the evolution ablation."""
     other = tuple(m for m in ran(res) if m not in MAIN + ABLATION)
-    return ("RQ2", MAIN + other), ("Evolution ablation", ("evoeye",) + ABLATION)
+    return (("Acquisition methods compared (RQ2)", MAIN + other),
+            ("Evolution ablation", ("evoeye",) + ABLATION))
 
 
 def own_initial(method: str) -> tuple[str, str] | None:
@@ -138,25 +145,35 @@ def _has_unreachable(results: dict) -> bool:
                for row in table_rows(res, strategies) for cell in row)
 
 
-def markdown(results: dict) -> str:
-    head = ["method"] + [f"{s} {c}" for s in ("Test", "Hard") for c in COLUMNS]
-    out = ["# evoeye RQ2: self-evolution under the same budget", ""]
-    if _has_unreachable(results):
-        out += [UNREACHABLE_NOTE, ""]
+def set_tables(rows: list[list[str]]) -> list[tuple[str, Table]]:
+    """`table_rows`' rows as one narrow table per set (Test, Hard): method and COLUMNS."""
+    head = ["Method"] + [c.replace("@0", "@").upper() + " %"
+                         for c in COLUMNS]
+    n = len(COLUMNS)
+    return [(name, Table(head, [[r[0], *r[1 + i * n:1 + (i + 1) * n]] for r in rows]))
+            for i, (_, name) in enumerate(SETS)]
+
+
+def _sections(results: dict):
+    """(heading, note, table) of every table of the report, in order."""
     for scenario, res in results.items():
         for title, strategies in tables(res):
-            out += [f"## {scenario} — {title} (mean ± sample SD over seeds, %)", "",
-                    "| " + " | ".join(head) + " |", "|" + "---|" * len(head)]
-            out += ["| " + " | ".join(r) + " |" for r in table_rows(res, strategies)]
-            out.append("")
-        out += [f"## {scenario} — what each strategy acquired (mean ± sample SD over seeds)",
-                "",
-                "| " + " | ".join(ACQUISITION_HEAD) + " |", "|---" * len(ACQUISITION_HEAD) + "|"]
+            for name, table in set_tables(table_rows(res, strategies)):
+                yield (f"{scenario}: {title}, on {name}",
+                       "Last round; mean ± sample SD over seeds, in %.", table)
         acquired = acquisition_rows(res)
-        out += ["| " + " | ".join(r) + " |" for r in acquired]
-        out.append("")
-        if any(r[0].endswith(OTHER_SCALE) for r in acquired):
-            out += [OTHER_SCALE_NOTE, ""]
+        note = ACQUISITION_NOTE + (" " + OTHER_SCALE_NOTE
+                                   if any(r[0].endswith(OTHER_SCALE) for r in acquired) else "")
+        yield (f"{scenario}: what each method acquired", note + " Mean ± sample SD over seeds.",
+               Table(list(ACQUISITION_HEAD), acquired))
+
+
+def markdown(results: dict) -> str:
+    out = [f"# {TITLE}", ""]
+    if _has_unreachable(results):
+        out += [UNREACHABLE_NOTE, ""]
+    for heading, note, table in _sections(results):
+        out += [f"## {heading}", "", note, "", table.markdown(), ""]
     return "\n".join(out)
 
 
@@ -200,32 +217,25 @@ def _scatter(b: dict) -> str:
             f'acquired)</text></svg>')
 
 
-def _html_table(head: Sequence[str], rows: Sequence[Sequence[str]]) -> str:
-    cells = "".join("<tr>" + "".join(f"<td>{escape(c)}</td>" for c in r) + "</tr>" for r in rows)
-    return ("<table border=1 cellpadding=3><tr>" + "".join(f"<th>{escape(h)}</th>" for h in head)
-            + f"</tr>{cells}</table>")
-
-
 def html(results: dict) -> str:
-    body = [f"<p>{escape(UNREACHABLE_NOTE)}</p>"] if _has_unreachable(results) else []
+    body = [f"<h1>{escape(TITLE)}</h1>"]
+    if _has_unreachable(results):
+        body.append(f"<p>{escape(UNREACHABLE_NOTE)}</p>")
+    sections = list(_sections(results))
     for scenario, res in results.items():
         body.append(f"<h2>{escape(scenario)}</h2>")
-        for title, strategies in tables(res):
-            head = ["method"] + [f"{s} {c}" for s in ("Test", "Hard") for c in COLUMNS]
-            body.append(f"<h3>{title}</h3>" + _html_table(head, table_rows(res, strategies)))
-        acquired = acquisition_rows(res)
-        body.append("<h3>What each strategy acquired</h3>" + _html_table(
-            ACQUISITION_HEAD, acquired))
-        if any(r[0].endswith(OTHER_SCALE) for r in acquired):
-            body.append(f"<p>{escape(OTHER_SCALE_NOTE)}</p>")
+        for heading, note, table in sections:
+            if heading.startswith(f"{scenario}: "):
+                body.append(f"<h3>{escape(heading.split(': ', 1)[1])}</h3>"
+                            f"<p>{escape(note)}</p>{table.html()}")
         for split in ("test", "hard"):
             for col in ("f1@0.05", "auprc"):
                 body += [_intervals(res, split, col), _curves(res, split, col)]
         spots = [r["blind_spots"] for r in res.get("evoeye", []) if r.get("blind_spots")]
         if spots:
             body.append("<h3>Blind-spot map (EvoEye, first seed)</h3>" + _scatter(spots[0]))
-    return ("<!doctype html><meta charset=utf-8><title>evoeye RQ2</title>"
-            "<body style='font-family:sans-serif'>" + "".join(body) + "</body>")
+    return (f"<!doctype html><meta charset=utf-8><title>evoeye: {escape(TITLE)}</title>"
+            f"<style>{CSS}</style><body>" + "".join(body) + "</body>")
 
 
 def write_experiment_report(root: DataRoot, results: dict,
@@ -238,3 +248,53 @@ def write_experiment_report(root: DataRoot, results: dict,
     (folder / "rq2.json").write_text(json.dumps(results, indent=1, default=float),
                                      encoding="utf-8")
     return folder
+
+
+def _rate(split: dict | None, key: str) -> str:
+    """A round's rate in % ('–' if not assessed, 'n/r' where its target FPR was unreachable)."""
+    if split is None:
+        return DASH
+    return pct(split[key]) if reached(split, key) else UNREACHABLE
+
+
+def rounds_table(rows: Sequence[RoundRow]) -> Table:
+    """A campaign round by round: new runs, simulated time so far, and its monitor G_r on the
+    Test Set and on G_0's Hard Set (%)."""
+    out = []
+    for r in rows:
+        m = r.metrics
+        out.append([str(r.round), str(len(r.scenario_ids)), f"{r.simulated_s:.0f}",
+                    r.monitor_version, _rate(m and m.test, "f1@0.05"),
+                    _rate(m and m.test, "auprc"), _rate(m and m.hard, "f1@0.05")])
+    return Table(["Round", "New runs", "Sim s", "Monitor", "Test F1@.05 %", "Test AUPRC %",
+                  "Hard F1@.05 %"], out)
+
+
+def rounds_markdown(rows: Sequence[RoundRow]) -> str:
+    """A campaign's artifact: what it is, the rounds table, and what the last round changed."""
+    if not rows:
+        return "# Evolution\n\nNo round stored yet."
+    first = rows[0]
+    head = (f"# Evolution: {first.logical_scenario}, {first.strategy}, seed {first.seed}\n\n"
+            f"Campaign `{first.campaign_id}`: {len(rows) - 1} round(s) after G_0.")
+    return "\n\n".join([head, rounds_table(rows).markdown(), change_words(rows)])
+
+
+def change_words(rows: Sequence[RoundRow]) -> str:
+    """What evolution changed, G_0 to the last round's monitor, in words (with the sizes the
+    figures rest on)."""
+    if len(rows) < 2:
+        return "No acquisition round yet: the monitor is still G_0."
+    g0, last = rows[0], rows[-1]
+    new = sum(len(r.scenario_ids) for r in rows[1:])
+    text = (f"{len(rows) - 1} round(s) added {new} runs ({last.simulated_s - g0.simulated_s:.0f}"
+            f" s simulated) and replaced G_0 {g0.monitor_version} by {last.monitor_version}")
+    a, b = g0.metrics, last.metrics
+    if a is None or b is None:
+        return text + " (not assessed: run with --assess to see its effect)."
+    return (f"{text}: Test-Set F1@0.05 {_rate(a.test, 'f1@0.05')} → {_rate(b.test, 'f1@0.05')} "
+            f"%, Hard-Set F1@0.05 {_rate(a.hard, 'f1@0.05')} → {_rate(b.hard, 'f1@0.05')} % "
+            f"(the Hard Set: the {a.hard.get('unsafe', 0)} unsafe test frames G_0 missed and "
+            f"the safe frames of their runs, {a.hard.get('frames', 0)} in all). One campaign "
+            "seed, frame-level figures: a change this size can come from retraining alone; "
+            "`evoeye experiment` compares methods over seeds, with a re-seeded G_0 as control.")

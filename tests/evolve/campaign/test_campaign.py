@@ -273,7 +273,7 @@ def test_cli_evolve_prints_the_state_and_round_metrics(root_copy, seeded) -> Non
 
     root = root_copy("cli")
     args = ["evolve", "--root", str(root.path), "--scenario", SCENARIO, "--strategy", "uniform",
-            "--budget-s", "0", "--monitor", seeded[1]]
+            "--budget-s", "1", "--monitor", seeded[1]]  # no run fits in 1 s (up to 20 s each)
     res = CliRunner().invoke(app, args)
     assert res.exit_code == 0, res.output
     assert "campaign evo-uniform-s0-" in res.output and "round 0:" in res.output
@@ -281,6 +281,9 @@ def test_cli_evolve_prints_the_state_and_round_metrics(root_copy, seeded) -> Non
     assert "evolve: " in res.stderr and "sim s" in res.stderr  # the progress bar
     bad = CliRunner().invoke(app, [*args[:6], "grid"])
     assert bad.exit_code != 0
+    none = CliRunner().invoke(app, [*args[:8], "0", *args[9:]])  # --budget-s 0
+    assert none.exit_code == 2 and "--budget-s" in none.output
+    assert "leaves no run to simulate" in none.output and "campaign evo-" not in none.output
 
 
 def test_cli_evolve_without_a_monitor_is_one_line_naming_evoeye_train(root_copy) -> None:
@@ -295,7 +298,7 @@ def test_cli_evolve_without_a_monitor_is_one_line_naming_evoeye_train(root_copy)
     root = root_copy("no-monitor")
     shutil.rmtree(root.monitors)
     res = CliRunner().invoke(app, ["evolve", "--root", str(root.path), "--scenario", SCENARIO,
-                                   "--budget-s", "0"])
+                                   "--budget-s", "1"])
     assert res.exit_code == ExitCode.USER_ERROR, res.output
     assert "Traceback" not in res.output and len(res.output.strip().splitlines()) == 2
     assert "no monitor trained on" in res.output and "evoeye train --scenario" in res.output

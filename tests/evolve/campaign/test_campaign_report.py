@@ -90,7 +90,10 @@ def test_seeds_with_an_unreachable_fpr_are_counted_not_averaged_as_zero() -> Non
 
 def test_report_files_hold_tables_curves_and_map(tmp_path) -> None:
     md = markdown(RESULTS)
-    assert "## highway-cut-in — RQ2" in md and "Evolution ablation" in md
+    assert md.startswith("# Self-evolution under the same simulation budget (RQ2)")
+    assert "## highway-cut-in: Acquisition methods compared (RQ2), on the Test Set" in md
+    assert "## highway-cut-in: Evolution ablation, on the Hard Set of G_0" in md
+    assert "| Method | F1@.05 % | F1@.01 % | AUROC % | AUPRC % |" in md
     page = html(RESULTS)
     assert page.count("<svg") == 9  # 4 error-bar charts, 4 curves, the blind-spot map
     assert 'data-series="evoeye"' in page
@@ -108,6 +111,17 @@ def test_acquisition_table_averages_over_seeds() -> None:
     assert rows["uniform"] == ["uniform", "40 ± 0", "30.0 ± 14.1", "10.0 ± 0.0", "25.0 ± 0.0",
                                "7.5 ± 3.5"]
     assert "| uniform | 40 ± 0 | 30.0 ± 14.1 |" in markdown(RESULTS)
+
+
+def test_every_table_fits_the_artifact_view() -> None:
+    from evoeye.evolve.campaign.report import _sections
+
+    res = {**RESULTS["highway-cut-in"],
+           "reseeded": [{"test": _m(0.2), "hard": _m(0.2)}, {"test": _m(0.4), "hard": _m(0.3)}]}
+    sections = list(_sections({"highway-cut-in": res}))
+    assert len(sections) == 5  # two tables × two sets, and the acquisition
+    for heading, _, table in sections:
+        assert table.fits(), (heading, table.width_chars())
     assert OTHER_SCALE_NOTE not in markdown(RESULTS)  # no `<family>-evo` row, no note
 
 
@@ -199,7 +213,7 @@ def test_a_round_in_one_line_shows_an_unreachable_f1_as_nr() -> None:
     m = RoundMetrics("fusion-b",
                      test={"f1@0.05": None, "reachable@0.05": False, "auprc": 0.5},
                      hard={"f1@0.05": 0.25, "reachable@0.05": True, "auprc": None})
-    assert brief(m) == "test F1@0.05 n/r AUPRC 0.500 | hard F1@0.05 0.250"
+    assert brief(m) == "test F1@0.05 n/r, AUPRC 50.0 % | hard F1@0.05 25.0 %"
     assert brief(None) == ""
 
 

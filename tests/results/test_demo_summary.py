@@ -1,0 +1,101 @@
+"""The demo's ending: the headline per scenario, what evolution changed, which figure is which."""
+
+from __future__ import annotations
+
+import pytest
+
+from evoeye.evaluation.scenario import FalseAlarms, LeadTimes
+from evoeye.monitor.pretrained import PACKAGED, install, packaged_cards, packaged_versions
+from evoeye.paths import DataRoot
+from evoeye.results import demo
+from evoeye.store.feedback import RoundMetrics, RoundRow
+
+SCENARIO = "highway-cut-in"
+
+
+def _report(warned: int, collisions: int) -> dict:
+    def monitor(name: str, hit: int) -> dict:
+        lead = LeadTimes(hit, collisions, [2.0] * hit, [f"v{i}" for i in range(hit)])
+        fa = FalseAlarms(1, 20, 1, 0.1, [1] + [0] * 19, [0.005] * 20)
+        return {"name": name, "scenario": {"3": {
+            "at_fpr": {"0.05": {"reachable": True}}, "lead_time": {"0.05": lead.to_dict()},
+            "false_alarms": {"0.05": fa.to_dict()}}}}
+
+    return {"logical_scenario": SCENARIO, "fprs": [0.05], "ks": [3], "frame_period_s": 0.05,
+            "dataset": {"test": {"scenarios": collisions + 20, "violations": collisions}},
+            "monitors": [monitor("fusion", warned), monitor("ttc", warned // 2)]}
+
+
+def _rounds() -> list[RoundRow]:
+    def metrics(test: float, hard: float) -> RoundMetrics:
+        return RoundMetrics("v", test={"f1@0.05": test, "auprc": 0.5},
+                            hard={"f1@0.05": hard, "frames": 300, "unsafe": 40})
+
+    return [RoundRow("evo-1", SCENARIO, "evoeye", 0, 0, "fusion-a", [], 30, 0.0, 0.0,
+                     metrics(0.6, 0.0)),
+            RoundRow("evo-1", SCENARIO, "evoeye", 0, 1, "fusion-b", ["x", "y", "z", "w"], 34,
+                     61.5, 3.0, metrics(0.62, 0.25))]
+
+
+def test_the_summary_answers_how_many_how_early_and_how_many_false_alarms(tmp_path) -> None:
+    result = demo.DemoResult(DataRoot.resolve(tmp_path), [_report(12, 14)],
+                             {SCENARIO: _rounds()}, tmp_path / "reports" / "demo")
+    text = demo.summary_text(result)
+    assert "Operating point: each monitor's alarm threshold is set on validation runs" in text
+    assert "FusionMonitor warned of 12 of 14 collisions" in text
+    assert "a median 2.0 (2.0–2.0) s before the collision" in text
+    assert "false alarms per hour of safe driving (1 of 20 safe runs alarmed)" in text
+    assert "Best rule-based baseline, TTC warned of 6 of 14" in text
+    assert "Verdict: FusionMonitor warns of more collisions than TTC" in text
+    assert ("Evolution: 1 round(s) added 4 runs (62 s simulated) and replaced G_0 fusion-a by "
+            "fusion-b: Test-Set F1@0.05 60.0 → 62.0 %, Hard-Set F1@0.05 0.0 → 25.0 %") in text
+    assert "Which figure is which" in text and "Fewer than" not in text  # 14 collisions
+    assert [w for w, _ in result.paths()][-1] == "this summary"
+
+
+def test_too_few_collisions_are_said_so_in_the_summary(tmp_path) -> None:
+    result = demo.DemoResult(DataRoot.resolve(tmp_path), [_report(2, 2)], {})
+    text = demo.summary_text(result)
+    assert "2 test collisions: too few to compare" in text and "Evolution:" not in text
+    assert f"Fewer than {demo.MIN_COLLISIONS} test collisions in a scenario" in text
+
+
+def test_a_monitor_is_shipped_per_scenario_and_installs_into_a_root(tmp_path) -> None:
+    from evoeye.monitor.families import load_version
+    from evoeye.results import demo_monitors
+    from evoeye.scenarios import SCENARIOS
+
+    versions = packaged_versions()
+    assert set(versions) == set(SCENARIOS)
+    cards = packaged_cards()
+    root = DataRoot.resolve(tmp_path)
+    for scenario, version in versions.items():
+        card = cards[scenario]
+        params = card["selection"]["train"]["params"]
+        assert (params["train_frac"], params["val_frac"]) == (0.8, 0.2)  # demo_monitors.SPLITS
+        assert card["data"]["train"]["runs"] >= 300 and card["parent"] is None
+        shipped = card["shipped"]  # which runs trained it: not the demo's (seed, batch)
+        assert (shipped["batch"], shipped["simulation_seed"]) == (demo_monitors.BATCH,
+                                                                 demo_monitors.SEED)
+        assert card["hyperparameters"]["seed"] == shipped["training_seed"] == 0
+        assert sum(p.stat().st_size for p in (PACKAGED / version).iterdir()) < 400_000
+        assert install(root, version) == version == install(root, version)
+        monitor = load_version(root, version)  # the weights match the card's sha256
+        assert monitor.card["logical_scenario"] == scenario
+
+
+def test_a_scenario_without_a_shipped_monitor_is_one_clear_error(tmp_path, monkeypatch) -> None:
+    monkeypatch.setattr(demo, "packaged_versions", lambda: {})
+    with pytest.raises(LookupError, match="make demo-monitors"):
+        demo.shipped_monitor(DataRoot.resolve(tmp_path), SCENARIO)
+
+
+def test_the_demo_runs_are_never_the_shipped_monitors_training_runs() -> None:
+    from evoeye.batch import plan_uniform
+    from evoeye.results import demo_monitors
+
+    for scenario in demo.RUNS:
+        shipped = {s.params for s in plan_uniform(scenario, 500, demo_monitors.SEED,
+                                                  batch=demo_monitors.BATCH)}
+        fresh = {s.params for s in plan_uniform(scenario, 120, 0, batch=demo.BATCH)}
+        assert not shipped & fresh
