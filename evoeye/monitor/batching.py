@@ -15,7 +15,8 @@ Both draw every random number from the training's generator, so a seed gives one
 from __future__ import annotations
 
 import math
-from collections.abc import Callable, Iterator
+from collections.abc import Callable
+from dataclasses import dataclass
 
 import numpy as np
 import torch
@@ -24,6 +25,15 @@ from evoeye.monitor.fusion import net_inputs
 from evoeye.monitor.model import FRAME_INPUTS, FusionNet
 from evoeye.monitor.recipes import TrainParams
 from evoeye.store.windows import Windows
+
+
+@dataclass
+class Batch:
+    """One batch's inputs on the training device, in the form its batching's `forward` takes,
+    and its (b,) labels."""
+
+    inputs: tuple
+    label: torch.Tensor
 
 
 class WindowBatches:
@@ -35,16 +45,20 @@ class WindowBatches:
     def steps(self) -> int:
         return math.ceil(len(self.train) / self.size)
 
-    def epoch(self, gen: torch.Generator) -> Iterator[np.ndarray]:
+    def epoch(self, gen: torch.Generator) -> list[np.ndarray]:
+        """The epoch's batches of window indices."""
         order = torch.randperm(len(self.train), generator=gen).numpy()
-        for start in range(0, len(order), self.size):
-            yield np.sort(order[start:start + self.size])  # sorted: faster gather
+        return [np.sort(order[start:start + self.size])  # sorted: faster gather
+                for start in range(0, len(order), self.size)]
 
-    def logits(self, net: FusionNet, index: np.ndarray) -> tuple[torch.Tensor, torch.Tensor]:
-        """((b,) logits, (b,) labels) of the windows `index`."""
+    def gather(self, index: np.ndarray) -> Batch:
         batch = self.train.batch(index)
-        return (net(*(t.to(self.device) for t in net_inputs(batch))),
-                batch.label.to(self.device))
+        return Batch(tuple(t.to(self.device) for t in net_inputs(batch)),
+                     batch.label.to(self.device))
+
+    @staticmethod
+    def forward(net: FusionNet, batch: Batch) -> torch.Tensor:
+        return net(*batch.inputs)  # (b,) logits
 
 
 class ChunkBatches:
@@ -61,20 +75,22 @@ class ChunkBatches:
     def steps(self) -> int:
         return math.ceil(len(self.train) / self.size)
 
-    def epoch(self, gen: torch.Generator) -> Iterator[np.ndarray]:
+    def epoch(self, gen: torch.Generator) -> list[np.ndarray]:
+        """The epoch's batches of window indices."""
         order = chunk_order(len(self.train), self.chunk, gen)
-        for start in range(0, len(order), self.size):
-            yield order[start:start + self.size]
+        return [order[start:start + self.size] for start in range(0, len(order), self.size)]
 
-    def logits(self, net: FusionNet, index: np.ndarray) -> tuple[torch.Tensor, torch.Tensor]:
-        """((b,) logits, (b,) labels) of the windows `index`."""
+    def gather(self, index: np.ndarray) -> Batch:
         rows, inverse = self.train.distinct_frames(index)  # (U,), (b, L)
         at = torch.from_numpy(rows).to(self.device)
         windows = torch.from_numpy(index).to(self.device)
-        logit = net.forward_frames([f.index_select(0, at) for f in self.frames],
-                                   torch.from_numpy(inverse).to(self.device),
-                                   self.context_mask[windows])
-        return logit, self.label[windows]
+        return Batch(([f.index_select(0, at) for f in self.frames],
+                      torch.from_numpy(inverse).to(self.device), self.context_mask[windows]),
+                     self.label[windows])
+
+    @staticmethod
+    def forward(net: FusionNet, batch: Batch) -> torch.Tensor:
+        return net.forward_frames(*batch.inputs)  # (b,) logits
 
 
 def chunk_order(n: int, chunk: int, gen: torch.Generator) -> np.ndarray:

@@ -32,9 +32,13 @@ from evoeye.monitor.fusion import FusionMonitor
 from evoeye.monitor.model import FusionNet
 from evoeye.monitor.recipes import TrainParams
 from evoeye.monitor.threads import intra_op_threads
+from evoeye.phases import PhaseClock
 from evoeye.store.windows import Windows
 
 Progress = Callable[[dict[str, Any]], None]  # called after every epoch with its history row
+# where a training's time goes: making and gathering batches, the forward pass and loss, the
+# backward pass, clipping and the optimiser step, validation after every epoch
+FIT_PHASES = ("batches", "forward", "backward", "optimiser", "validation")
 
 
 @dataclass
@@ -47,6 +51,7 @@ class FitResult:
     pos_weight: float
     time_s: float  # wall seconds of the loop
     cpu_s: float  # CPU seconds of the thread that ran it (load inflates wall time, not this)
+    phases: dict[str, dict[str, float]]  # FIT_PHASES: {"wall_s", "cpu_s"} of each
 
 
 def _deterministic(mode: bool) -> None:
@@ -122,28 +127,37 @@ def fit(net: FusionNet, train: Windows, val: Windows,
     # AUPRC needs both classes in validation; without, early stopping falls back to val loss
     use_auprc = ranking_metrics(np.zeros(len(val)), val.label)["auprc"] is not None
     best, best_state, best_epoch, history = -np.inf, copy.deepcopy(net.state_dict()), 0, []
+    clock = PhaseClock(FIT_PHASES, time.thread_time)
     t0, c0 = time.perf_counter(), time.thread_time()
     step = 0
     net.train()
     for epoch in range(1, params.epochs + 1):
         total = 0.0
-        for idx in batches.epoch(gen):
-            opt.lr = lr_at(step)
-            step += 1
-            logit, label = batches.logits(net, idx)
-            loss = loss_fn(logit, label)
-            opt.zero_grad()
-            loss.backward()
-            nn.utils.clip_grad_norm_(net.parameters(), params.grad_clip)
-            opt.step()
-            total += float(loss.detach()) * len(idx)
-        scores, val_loss = _val_score(net, val)
-        metrics = ranking_metrics(scores, val.label)
-        row = {"epoch": epoch, "train_loss": total / len(train), "val_loss": val_loss, **metrics}
-        history.append(row)
-        criterion = metrics["auprc"] if use_auprc else -val_loss
-        if criterion > best + 1e-6:
-            best, best_epoch, best_state = criterion, epoch, copy.deepcopy(net.state_dict())
+        with clock("batches"):
+            epoch_batches = batches.epoch(gen)
+        for idx in epoch_batches:
+            with clock("batches"):
+                batch = batches.gather(idx)
+            with clock("forward"):
+                loss = loss_fn(batches.forward(net, batch), batch.label)
+            with clock("backward"):
+                opt.zero_grad()
+                loss.backward()
+            with clock("optimiser"):
+                opt.lr = lr_at(step)
+                step += 1
+                nn.utils.clip_grad_norm_(net.parameters(), params.grad_clip)
+                opt.step()
+                total += float(loss.detach()) * len(idx)
+        with clock("validation"):
+            scores, val_loss = _val_score(net, val)
+            metrics = ranking_metrics(scores, val.label)
+            row = {"epoch": epoch, "train_loss": total / len(train), "val_loss": val_loss,
+                   **metrics}
+            history.append(row)
+            criterion = metrics["auprc"] if use_auprc else -val_loss
+            if criterion > best + 1e-6:
+                best, best_epoch, best_state = criterion, epoch, copy.deepcopy(net.state_dict())
         if progress is not None:
             progress(row)
         if epoch - best_epoch >= params.patience:
@@ -151,4 +165,4 @@ def fit(net: FusionNet, train: Windows, val: Windows,
     net.load_state_dict(best_state)
     net.eval()
     return FitResult(net, best_epoch, history, pos_weight, time.perf_counter() - t0,
-                     time.thread_time() - c0)
+                     time.thread_time() - c0, clock.rounded())

@@ -227,7 +227,8 @@ def _card(t: _Trained, scenario: str | None, horizon_s: float, init_from: str | 
                             "early_stopping": "val AUPRC"},
         "training": {"best_epoch": result.best_epoch, "epochs_run": len(result.history),
                      "time_s": round(result.time_s, 2), "cpu_s": round(result.cpu_s, 2),
-                     "device": str(device), "history": result.history},
+                     "device": str(device), "phases": result.phases,
+                     "history": result.history},
         **thresholds_to_card(t.thresholds),
         "metrics": {"val": split_metrics(t.scores, val.label, t.thresholds)},
     }
