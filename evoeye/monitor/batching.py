@@ -112,9 +112,11 @@ BATCHINGS: dict[str, Callable[[Windows, TrainParams, torch.device],
     "chunks": ChunkBatches,
 }
 
+TAIL = 0.3  # "hold-decay": the share of the steps, at the end, over which lr falls to 0
 SCHEDULES: dict[str, Callable[[float], float]] = {  # share of the decay done → factor of lr
     "constant": lambda done: 1.0,
     "cosine": lambda done: 0.5 * (1.0 + math.cos(math.pi * min(done, 1.0))),
+    "hold-decay": lambda done: min(1.0, max(0.0, (1.0 - done) / TAIL)),
 }
 
 

@@ -86,3 +86,11 @@ def test_the_learning_rate_warms_up_then_follows_the_schedule() -> None:
     assert lr_at(40) == lr_at(99) == 0.0  # … and stays at 0 past the planned epochs
     constant = batching.lr_schedule(TrainParams(lr=0.3), steps_per_epoch=10)
     assert {constant(s) for s in range(100)} == {0.3}  # v1: its one learning rate, exactly
+
+
+def test_hold_decay_holds_the_peak_then_falls_linearly_to_zero() -> None:
+    params = TrainParams(lr=0.2, epochs=10, schedule="hold-decay")
+    lr_at = batching.lr_schedule(params, steps_per_epoch=10)  # 100 steps, the last 30 decay
+    assert {lr_at(s) for s in range(71)} == {0.2}
+    assert lr_at(85) == pytest.approx(0.2 * 15 / 30) and lr_at(100) == 0.0
+    assert all(lr_at(s) >= lr_at(s + 1) for s in range(100))
