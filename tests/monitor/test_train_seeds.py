@@ -2,15 +2,30 @@
 
 from __future__ import annotations
 
+import shutil
+
 import pytest
 import torch
 
-from evoeye.monitor.registry import read_card
+from evoeye.monitor.registry import load_monitor, read_card, version_dir
 from evoeye.monitor.train import train_monitor, train_monitors
 
 
+@pytest.mark.parametrize("recipe", ["v1", "v2"])
+def test_the_same_seed_trains_the_same_weights_again_on_the_cpu(tiny, recipe: str) -> None:
+    kwargs = {"horizon_s": tiny.horizon_s, "seed": 3, "recipe": recipe, "epochs": 2,
+              "device": "cpu"}
+    first = train_monitor(tiny.root, tiny.scenario, **kwargs)
+    weights = load_monitor(tiny.root, first).net.state_dict()
+    shutil.rmtree(version_dir(tiny.root, first))  # so the second training writes its own
+    again = train_monitor(tiny.root, tiny.scenario, **kwargs)
+    rerun = load_monitor(tiny.root, again).net.state_dict()
+    assert again == first and rerun.keys() == weights.keys()
+    assert all(torch.equal(rerun[name], weights[name]) for name in weights)
+
+
 def test_seeds_trained_together_are_the_seeds_trained_alone(tiny) -> None:
-    kwargs = {"horizon_s": tiny.horizon_s, **tiny.fast, "epochs": 3}
+    kwargs = {"horizon_s": tiny.horizon_s, **tiny.fast, "epochs": 3, "device": "cpu"}
     alone = [train_monitor(tiny.root, tiny.scenario, seed=s, **kwargs) for s in (5, 6, 7)]
     rows: list[dict] = []
     together = train_monitors(tiny.root, tiny.scenario, seeds=[7, 5, 6], parallel=2,
