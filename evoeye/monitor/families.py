@@ -62,8 +62,8 @@ class SavedMonitor(Protocol):
 
 Decoder = Callable[[bytes, dict[str, Any], str], SavedMonitor]  # (checked weights, meta, version)
 Trainer = Callable[..., str]  # (root, scenario, *, train_runs, val_runs, seed, init_from, …) → id
-Initial = Callable[..., str]  # (root, scenario, *, train_runs, val_runs, horizon_s, recipe)
-# → G_0's id (a G_0 the family trains itself trains by the training recipe `recipe`)
+Initial = Callable[..., str]  # (root, scenario, *, train_runs, val_runs, horizon_s[, recipe])
+# → G_0's id (`recipe`, for a family with `recipes`: the training recipe a G_0 it trains uses)
 Fitter = Callable[..., SavedMonitor]  # (root, scenario, splits, *, seed, runs) → trained on the
 # train split (or the RunFilter `runs`), with a training seed (None: the family's default)
 SeedsTrainer = Callable[..., list[str]]  # Trainer's arguments, `seeds` for `seed` → ids

@@ -106,6 +106,7 @@ class Campaign:
         self.space = get_scenario(config.scenario)
         self.family = FAMILIES[config.family]
         self._train = train or self.family.train
+        self._recipe = {"recipe": config.recipe} if self.family.recipes else {}  # its trainings'
         self.assess = assess  # may be set after construction (e.g. from the campaign's ids)
         self._monitors: dict[str, object] = {}
         self.clock = PhaseClock()  # wall seconds per phase of this object's calls
@@ -124,7 +125,7 @@ class Campaign:
         return self.family.initial(self.root, cfg.scenario,
                                    train_runs=list(self.initial["scenario_id"]),
                                    val_runs=self.val_runs, horizon_s=cfg.horizon_s,
-                                   recipe=cfg.recipe)
+                                   **self._recipe)
 
     @cached_property
     def reference(self) -> str:
@@ -302,7 +303,7 @@ class Campaign:
                 horizon_s=cfg.horizon_s, seed=cfg.seed * 1000 + state.round + 1,
                 splits=cfg.splits, init_from=state.monitor if fine_tune else None,
                 context_len=None if fine_tune else self.monitor(self.g0).context_len,
-                recipe=cfg.recipe, **cfg.train_overrides(),
+                **self._recipe, **cfg.train_overrides(),
             )
         return version, time.perf_counter() - t0
 
