@@ -12,6 +12,7 @@ from pydantic import BaseModel, Field, field_validator
 
 from evoeye.evaluation.table import pct
 from evoeye.monitor.inputs import parse_modules
+from evoeye.monitor.recipes import DEFAULT_RECIPE, recipe_params
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 from flows.published import named, publish, train_markdown
@@ -29,10 +30,11 @@ class TrainFlowParams(BaseModel):
     modules: str | None = None  # an ABLATIONS name or a comma list of MODULES; None: all
     seed: int = 0
     split_seed: int = 0
-    epochs: int = Field(40, ge=1)
-    patience: int = Field(8, ge=1)
-    batch_size: int = Field(256, ge=1)
-    lr: float = Field(1e-3, gt=0.0)
+    recipe: str = DEFAULT_RECIPE  # evoeye.monitor.recipes; the fields below override it
+    epochs: int | None = Field(None, ge=1)  # None: the recipe's
+    patience: int | None = Field(None, ge=1)
+    batch_size: int | None = Field(None, ge=1)
+    lr: float | None = Field(None, gt=0.0)
     init_from: str | None = None  # fine-tune this version
 
     @field_validator("modules")
@@ -45,6 +47,12 @@ class TrainFlowParams(BaseModel):
         start = f"from-{self.init_from}" if self.init_from else f"seed{self.seed}"
         return f"train-{self.scenario or 'sql'}-{start}"
 
+    @field_validator("recipe")
+    @classmethod
+    def _known_recipe(cls, value: str) -> str:
+        recipe_params(value)  # raises ValueError naming the choices
+        return value
+
 
 @task(task_run_name="train-{params.scenario}")
 def train_version(params: TrainFlowParams, root: DataRoot) -> str:
@@ -56,8 +64,8 @@ def train_version(params: TrainFlowParams, root: DataRoot) -> str:
         modules=parse_modules(params.modules), seed=params.seed,
         splits=SplitSpec(seed=params.split_seed),
         train_runs=params.train_sql, val_runs=params.val_sql, init_from=params.init_from,
-        epochs=params.epochs, patience=params.patience, batch_size=params.batch_size,
-        lr=params.lr,
+        recipe=params.recipe, **{k: v for k in ("epochs", "patience", "batch_size", "lr")
+                                 if (v := getattr(params, k)) is not None},
     )
 
 

@@ -13,6 +13,7 @@ from evoeye.paths import DataRoot
 from evoeye.results.config import (
     PAPER_INITIAL_RUNS,
     PARTS,
+    RECIPES,
     ResultsConfig,
     parse_initial_runs,
 )
@@ -97,6 +98,9 @@ def results_command(
         min=1, help="Epochs of every training (default: each trainer's).")] = None,
     patience: Annotated[int | None, typer.Option(min=1, help="Early-stopping patience.")] =
         None,
+    recipe: Annotated[str, typer.Option(
+        help=f"Training recipe of every monitor trained from scratch, one of "
+             f"{', '.join(RECIPES)} (campaign updates keep theirs).")] = D.recipe,
     workers: Annotated[int, typer.Option(
         min=1, help="Processes simulating the data, then running campaigns side by side.")
     ] = D.workers,
@@ -125,7 +129,7 @@ def results_command(
             context_lens=tuple(context_len or D.context_lens),
             inputs=tuple(inputs or D.inputs), methods=tuple(method or D.methods),
             budget_s=budget_s, n_round=n_round, update=update, feedback=feedback,
-            epochs=epochs, patience=patience, workers=workers)
+            epochs=epochs, patience=patience, recipe=recipe, workers=workers)
         config.check_names()
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from None

@@ -10,7 +10,8 @@ line reads it at start-up — so the defaults below that come from elsewhere are
 against their sources by tests/evolve/campaign/test_config.py; validation loads the registries.
 
 Every field but `budget_s` and `reference` enters the campaign id (`Campaign.campaign_id`), so
-the same configuration resumes the same campaign.
+the same configuration resumes the same campaign (a field added later enters it only where it
+differs from what campaigns did before it, so those keep their ids).
 """
 
 from __future__ import annotations
@@ -30,6 +31,7 @@ FINETUNE_EPOCHS, FINETUNE_PATIENCE = 10, 4
 REPLAY_EPOCHS, REPLAY_PATIENCE = 2, 1  # per round: passes over the new runs and their replay
 REPLAY_RATIO = 1.0  # earlier runs replayed per new run of the round
 DEFAULT_FAMILY = "fusion"  # evoeye.monitor.families.DEFAULT_FAMILY
+DEFAULT_RECIPE, LEGACY_RECIPE = "v2", "v1"  # evoeye.monitor.recipes
 DEFAULT_DELTA = 0.2  # evoeye.scenarios.DEFAULT_DELTA
 DEFAULT_HORIZON_S = 3.0  # evoeye.store.windows.DEFAULT_HORIZON_S
 MAX_RUN_S = 20.0  # no run lasts longer than this: evoeye.sim.runner.SimConfig().duration_s
@@ -67,9 +69,16 @@ def _methods() -> Collection[str]:
     return methods()
 
 
+def _recipes() -> Collection[str]:
+    from evoeye.monitor.recipes import RECIPES
+
+    return RECIPES
+
+
 KNOWN: dict[str, Callable[[], Collection[str]]] = {  # the names a value of each kind may take
     "scenario": _scenarios, "strategy": _strategies, "update": lambda: UPDATE_MODES,
     "feedback": lambda: FEEDBACK_MODES, "family": _families, "method": _methods,
+    "recipe": _recipes,
 }
 
 
@@ -130,6 +139,9 @@ class CampaignConfig:
                          "Set).", names="family")
     reference: str | None = option(None, "Another family than fusion: the FusionMonitor G_0 "
                                    "whose Hard Set judges (default: the newest).")
+    recipe: str = option(DEFAULT_RECIPE, "Training recipe of the monitor updates (and of a G_0 "
+                         "the campaign trains itself): v1 (every campaign before recipes had "
+                         "names) or v2.", names="recipe")
     horizon_s: float = option(DEFAULT_HORIZON_S, "Label horizon H, s.", gt=0.0)
     splits: SplitSpec = option(factory=SplitSpec, help="The train/val/test split.")
     max_run_s: float = option(MAX_RUN_S, "No run lasts longer, s (the simulator's duration).",

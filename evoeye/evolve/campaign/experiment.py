@@ -20,7 +20,7 @@ from scipy.stats import spearmanr
 
 from evoeye.evaluation.table import UNREACHABLE, pct
 from evoeye.evolve.campaign.assess import Assessor
-from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.config import LEGACY_RECIPE, CampaignConfig
 from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.campaign.state import CampaignState, read_initial
 from evoeye.evolve.campaign.workers import CampaignJob, assessor, run_campaigns
@@ -200,13 +200,14 @@ def reseeded_controls(root: DataRoot, cfg: CampaignConfig, k: int,
     for v in list_versions(root):
         card = read_card(root, v)
         if (card.get("logical_scenario") == cfg.scenario and not card.get("parent")
-                and card.get("selection", {}).get("train") == selection):
+                and card.get("selection", {}).get("train") == selection
+                and card.get("recipe", LEGACY_RECIPE) == cfg.recipe):
             have[card.get("hyperparameters", {}).get("seed")] = v
     out = []
     for seed in range(CONTROL_SEED, CONTROL_SEED + k):
         version = have.get(seed) or train_monitor(
             root, cfg.scenario, train_runs=ids, val_runs=campaign.val_runs, seed=seed,
-            splits=cfg.splits, horizon_s=cfg.horizon_s)
+            splits=cfg.splits, horizon_s=cfg.horizon_s, recipe=cfg.recipe)
         out.append(assess(version).as_dict())
     return out
 

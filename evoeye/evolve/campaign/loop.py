@@ -49,7 +49,7 @@ import numpy as np
 
 from evoeye.atomic import remove_stale_temps
 from evoeye.batch import simulate_and_keep
-from evoeye.evolve.campaign.config import REPLAY_RATIO, CampaignConfig
+from evoeye.evolve.campaign.config import LEGACY_RECIPE, REPLAY_RATIO, CampaignConfig
 from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
 from evoeye.evolve.campaign.state import (
@@ -106,6 +106,7 @@ class Campaign:
         self.space = get_scenario(config.scenario)
         self.family = FAMILIES[config.family]
         self._train = train or self.family.train
+        self._recipe = {"recipe": config.recipe} if self.family.recipes else {}  # its trainings'
         self.assess = assess  # may be set after construction (e.g. from the campaign's ids)
         self._monitors: dict[str, object] = {}
         self.clock = PhaseClock()  # wall seconds per phase of this object's calls
@@ -123,7 +124,8 @@ class Campaign:
             return cfg.monitor
         return self.family.initial(self.root, cfg.scenario,
                                    train_runs=list(self.initial["scenario_id"]),
-                                   val_runs=self.val_runs, horizon_s=cfg.horizon_s)
+                                   val_runs=self.val_runs, horizon_s=cfg.horizon_s,
+                                   **self._recipe)
 
     @cached_property
     def reference(self) -> str:
@@ -153,6 +155,8 @@ class Campaign:
             cfg.pop("feedback")
         if cfg["family"] == DEFAULT_FAMILY:  # likewise
             cfg.pop("family")
+        if cfg["recipe"] == LEGACY_RECIPE:  # the recipe every campaign before it trained by
+            cfg.pop("recipe")
         cfg["monitor"] = self.g0
         cfg["initial"] = hashlib.sha256("\n".join(self.initial["scenario_id"]).encode()).hexdigest()
         digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]
@@ -299,7 +303,7 @@ class Campaign:
                 horizon_s=cfg.horizon_s, seed=cfg.seed * 1000 + state.round + 1,
                 splits=cfg.splits, init_from=state.monitor if fine_tune else None,
                 context_len=None if fine_tune else self.monitor(self.g0).context_len,
-                **cfg.train_overrides(),
+                **self._recipe, **cfg.train_overrides(),
             )
         return version, time.perf_counter() - t0
 
