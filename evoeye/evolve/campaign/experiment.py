@@ -25,7 +25,7 @@ from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.campaign.state import CampaignState, read_initial
 from evoeye.evolve.campaign.workers import CampaignJob, assessor, run_campaigns
 from evoeye.evolve.search.fitness import CRITICALITY_SCALE_M
-from evoeye.evolve.search.strategies import STRATEGIES
+from evoeye.evolve.search.registry import STRATEGIES
 from evoeye.monitor.families import DEFAULT_FAMILY, evolvable_families, initial_monitor
 from evoeye.paths import DataRoot
 from evoeye.store.connections import shared_connections

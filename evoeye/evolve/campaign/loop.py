@@ -59,7 +59,7 @@ from evoeye.evolve.campaign.state import (
     run_outcome,
     run_seed,
 )
-from evoeye.evolve.search.strategies import FEEDBACK_BLIND, make_strategy
+from evoeye.evolve.search.registry import FEEDBACK_BLIND, make_strategy
 from evoeye.heap import frozen_heap
 from evoeye.log import read_run
 from evoeye.monitor.families import (
