@@ -8,7 +8,7 @@ predicted at the record from the others:
 * `evoeye-knn` — μ + σ (population) of f̄ over the k = 10 nearest records in normalised θ
   (Chebyshev, the δ-box's metric; the record itself included, as in S_δ): the paper's potential
   over a neighbourhood that always holds k records;
-* `evoeye-forest` — a random forest's out-of-bag prediction of f̄ (each record predicted by the
+* `evoeye-forest` — a forest's out-of-bag prediction of f̄ (each record predicted by the
   trees that did not see it), so a record's own feedback does not count.
 
 If the feedback is predictable in θ, these steer; if not, they behave like `no-feedback` with
@@ -22,7 +22,7 @@ from __future__ import annotations
 from collections.abc import Callable
 
 import numpy as np
-from sklearn.ensemble import RandomForestRegressor
+from sklearn.ensemble import ExtraTreesRegressor
 from sklearn.neighbors import NearestNeighbors
 
 from evoeye.evolve.search.feedback import normalise_feedback
@@ -44,7 +44,8 @@ Smoother = Callable[[np.ndarray, np.ndarray, np.random.Generator],
 def knn_smoother(u: np.ndarray, fbar: np.ndarray,
                  rng: np.random.Generator) -> tuple[np.ndarray, Callable]:
     """q = μ + σ of f̄ over the KNN_K nearest scored records (Chebyshev)."""
-    index = NearestNeighbors(n_neighbors=min(KNN_K, len(u)), metric="chebyshev").fit(u)
+    index = NearestNeighbors(n_neighbors=min(KNN_K, len(u)), metric="chebyshev",
+                             algorithm="kd_tree").fit(u)  # no OpenMP: cheap in one thread
 
     def q(at: np.ndarray) -> np.ndarray:
         near = fbar[index.kneighbors(at, return_distance=False)]  # (c, k)
@@ -55,10 +56,11 @@ def knn_smoother(u: np.ndarray, fbar: np.ndarray,
 
 def forest_smoother(u: np.ndarray, fbar: np.ndarray,
                     rng: np.random.Generator) -> tuple[np.ndarray, Callable]:
-    """q = a random forest's out-of-bag prediction of f̄ (its prediction at other points)."""
-    model = RandomForestRegressor(n_estimators=N_TREES, min_samples_leaf=MIN_SAMPLES_LEAF,
-                                  oob_score=True, random_state=int(rng.integers(2**31 - 1)),
-                                  n_jobs=1).fit(u, fbar)
+    """q = a forest's out-of-bag prediction of f̄ (its prediction at other points): extra-trees
+    on bootstrap samples (a random forest's exhaustive splits cost ≈ 3.5× as much)."""
+    model = ExtraTreesRegressor(n_estimators=N_TREES, min_samples_leaf=MIN_SAMPLES_LEAF,
+                                bootstrap=True, oob_score=True,
+                                random_state=int(rng.integers(2**31 - 1)), n_jobs=1).fit(u, fbar)
     own = np.asarray(model.oob_prediction_, dtype=float)
     missing = ~np.isfinite(own)  # a record no tree left out (unlikely with 100 trees)
     own[missing] = model.predict(u[missing]) if missing.any() else own[missing]
