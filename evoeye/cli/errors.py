@@ -54,6 +54,9 @@ KNOWN_ERRORS: dict[str, str] = {
                                               "or name it with --monitor",
     "evoeye.evolve.campaign.state.NoInitialDataError": "simulate and ingest the scenario's initial "
                                                   "runs: `evoeye simulate …`, `evoeye ingest`",
+    "evoeye.evolve.campaign.state.MixedProfilesError": "simulate each ADS profile's runs under "
+                                                       "a data root of its own (--root)",
+    "evoeye.ads.profiles.UnknownProfileError": "",
     "evoeye.results.study.EmptySplitError": "simulate the data with the command (--initial-runs "
                                             "N --test-runs M), or check --test-batch and the "
                                             "shares",

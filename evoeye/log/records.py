@@ -46,6 +46,7 @@ def run_values(episode: Episode) -> dict[str, Any]:
         "batch": spec.batch,
         "source": spec.source,
         "round": int(spec.round),
+        "ads_profile": spec.ads,
         "software_version": episode.software_version,
         "rate_hz": float(episode.rate_hz),
         "status": out.status,
@@ -91,11 +92,14 @@ def _typed(prop: dict[str, Any], value: Any, name: str) -> Any:
 def decode_run(record: dict[str, str]) -> dict[str, Any]:
     """The MCAP metadata record → typed run metadata; ValueError naming the field if malformed."""
     props = load_schema(RUN_SCHEMA_FILE)["properties"]
-    missing = [name for name in props if name not in record]
+    missing = [name for name, prop in props.items() if name not in record and "default" not in prop]
     if missing:
         raise ValueError(f"missing fields {missing}")
     typed = {}
     for name, prop in props.items():
+        if name not in record:  # a field added since the log was written: its default
+            typed[name] = prop["default"]
+            continue
         raw = record[name]
         try:
             value = raw if _is_string(prop) else orjson.loads(raw)

@@ -20,6 +20,7 @@ import pyarrow as pa
 import pyarrow.compute as pc
 
 from evoeye.ads.messages import FrameMessages
+from evoeye.ads.profiles import DEFAULT_PROFILE
 from evoeye.log import TOPICS
 from evoeye.log.channels import CHANNELS
 from evoeye.scene import EGO_ID
@@ -301,6 +302,7 @@ def scenario_row(
             "seed": int(meta["seed"]),
             "source": str(meta["source"]),
             "round": int(meta["round"]),
+            "ads_profile": str(meta.get("ads_profile") or DEFAULT_PROFILE),
             "software_version": str(meta["software_version"]),
             "rate_hz": float(meta["rate_hz"]),
             "status": str(meta["status"]),

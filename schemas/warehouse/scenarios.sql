@@ -11,6 +11,7 @@ CREATE TABLE scenarios (
     seed              BIGINT    NOT NULL,  -- simulation seed
     source            VARCHAR   NOT NULL,  -- how x was acquired: initial/uniform/evoeye/avfuzzer/…
     round             INTEGER   NOT NULL,  -- acquisition round (0 = initial data)
+    ads_profile       VARCHAR   NOT NULL,  -- the ADS profile that drove the ego ('default', …)
     software_version  VARCHAR   NOT NULL,  -- ADS + simulator version that produced the run
     rate_hz           DOUBLE    NOT NULL,  -- frame rate of the runtime signals
     status            VARCHAR   NOT NULL,  -- 'ok', or 'failed' when the run could not finish

@@ -56,6 +56,7 @@ from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
 from evoeye.evolve.campaign.state import (
     CampaignState,
     acquired_runs,
+    initial_profile,
     read_initial,
     records_of,
     run_outcome,
@@ -243,7 +244,7 @@ class Campaign:
                 prop = state.strategy.propose(state.records)
                 spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
                                 batch=self.campaign_id, source=cfg.strategy,
-                                round=state.round + 1)
+                                round=state.round + 1, ads=initial_profile(self.initial))
                 result, episode = simulate_and_keep(spec, self.root)
             if result.status == "error":
                 raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
