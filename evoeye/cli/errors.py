@@ -57,6 +57,9 @@ KNOWN_ERRORS: dict[str, str] = {
     "evoeye.evolve.campaign.state.MixedProfilesError": "simulate each ADS profile's runs under "
                                                        "a data root of its own (--root)",
     "evoeye.ads.profiles.UnknownProfileError": "",
+    "evoeye.evolve.predictability.check.RegimeError": "simulate and ingest runs of the regime "
+                                                      "(`evoeye simulate …`, `evoeye ingest`), "
+                                                      "or narrow it with --batch / --ads",
     "evoeye.results.study.EmptySplitError": "simulate the data with the command (--initial-runs "
                                             "N --test-runs M), or check --test-batch and the "
                                             "shares",
