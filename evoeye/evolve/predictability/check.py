@@ -114,12 +114,14 @@ def simulate_collided(scenario: str, x: np.ndarray, seed: int, profile: str) -> 
 
 
 def label_noise(runs: RegimeRuns, sample: int, seeds: int, seed: int = 0, workers: int = 1,
-                simulate: Simulate = simulate_collided) -> metrics.Flips:
-    """`sample` of the runs' θ (seeded), each re-simulated under `seeds` new seeds with its own
-    ADS profile: how often the outcome flips."""
-    rng = np.random.default_rng(seed)
-    pick = np.sort(rng.choice(len(runs.params), size=min(sample, len(runs.params)),
-                              replace=False))
+                simulate: Simulate = simulate_collided,
+                near_boundary: bool = False) -> metrics.Flips:
+    """`sample` of the runs' θ — drawn uniformly (seeded), or those of smallest |signed
+    margin| — each re-simulated under `seeds` new seeds with its own ADS profile: how often the
+    outcome flips."""
+    n = min(sample, len(runs.params))
+    pick = np.sort(np.argsort(np.abs(runs.margin_m), kind="stable")[:n] if near_boundary
+                   else np.random.default_rng(seed).choice(len(runs.params), n, replace=False))
     jobs = [(runs.scenario, runs.params[i], _noise_seed(seed, i, j), runs.ads_profile)
             for i in pick for j in range(seeds)]
     if workers > 1:
@@ -154,8 +156,10 @@ def check_regime(root: DataRoot, scenario: str, *, batch: str | None = None,
         mask, per_run = monitor_error(root, runs, version, feedback)
         n_unseen = int(mask.sum())
         error = metrics.cv_regression(runs.u[mask], per_run[mask], seed) if n_unseen else None
-    noise = label_noise(runs, sample, seeds, seed, workers, simulate) if sample and seeds \
-        else None
+    noise = boundary = None
+    if sample and seeds:
+        noise = label_noise(runs, sample, seeds, seed, workers, simulate)
+        boundary = label_noise(runs, sample, seeds, seed, workers, simulate, near_boundary=True)
     return {
         "scenario": scenario, "ads_profile": runs.ads_profile, "batch": batch,
         "runs": len(runs.scenario_id), "collision_share": float(runs.collided.mean()),
@@ -163,5 +167,6 @@ def check_regime(root: DataRoot, scenario: str, *, batch: str | None = None,
         "monitor": {"version": version, "feedback": feedback, "unseen_runs": n_unseen,
                     "error": metrics.as_dict(error), "note": note},
         "label_noise": metrics.as_dict(noise),
-        "verdict": metrics.verdict(collision, error, noise),
+        "boundary_noise": metrics.as_dict(boundary),
+        "verdict": metrics.verdict(collision, error, noise, boundary),
     }

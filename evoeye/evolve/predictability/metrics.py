@@ -99,8 +99,10 @@ def flips(own: np.ndarray, again: np.ndarray) -> Flips:
                  float(again[done].mean()) if done.any() else float("nan"))
 
 
-def verdict(collision: Classified, error: Regressed | None, noise: Flips | None) -> list[str]:
-    """What the figures mean for acquisition, one plain sentence each."""
+def verdict(collision: Classified, error: Regressed | None, noise: Flips | None = None,
+            boundary: Flips | None = None) -> list[str]:
+    """What the figures mean for acquisition, one plain sentence each (`noise`: re-runs of θ
+    drawn uniformly; `boundary`: of the θ nearest the failure boundary)."""
     lines = []
     if collision.auroc is None:
         lines.append("Too few runs of one outcome to tell whether θ predicts a collision.")
@@ -120,10 +122,15 @@ def verdict(collision: Classified, error: Regressed | None, noise: Flips | None)
         rho = "–" if error.spearman is None else f"{error.spearman:.2f}"
         lines.append(f"θ does not predict the monitor's error (Spearman {rho}): no strategy "
                      "that chooses θ can beat Uniform at finding where this monitor errs.")
-    if noise is not None:
-        lines.append(f"{100 * noise.flip_share:.0f} % of re-simulations with a new seed flip "
-                     f"the outcome ({100 * noise.ambiguous_share:.0f} % of θ are ambiguous): "
-                     "that much of the outcome is chance no choice of θ removes.")
+    for flips_of, where in ((noise, "θ drawn uniformly"),
+                            (boundary, "the θ nearest the failure boundary")):
+        if flips_of is None:
+            continue
+        share = f"{100 * flips_of.flip_share:.0f} %"
+        lines.append(f"Re-simulated with new seeds, {share} of the outcomes of {where} flip "
+                     f"({100 * flips_of.ambiguous_share:.0f} % of them are ambiguous)" + (
+                         ": there, that much of the outcome is chance no choice of θ removes."
+                         if flips_of.flip_share > 0 else ": the outcome is a function of θ."))
     return lines
 
 

@@ -44,11 +44,13 @@ def regime_markdown(r: dict[str, Any]) -> list[str]:
     out.append("")
     if mon["note"]:
         out += [f"No monitor: {mon['note']}", ""]
-    if noise:
-        out += [f"Label noise: {noise['thetas']} θ re-simulated with {noise['seeds']} new seeds "
-                f"each: {100 * noise['flip_share']:.1f} % of the re-simulations flip the "
-                f"outcome, {100 * noise['ambiguous_share']:.1f} % of θ are ambiguous, "
-                f"{100 * noise['collision_share']:.1f} % collide.", ""]
+    for flips, where in ((noise, "drawn uniformly"), (r.get("boundary_noise"),
+                                                     "nearest the failure boundary (|margin|)")):
+        if flips:
+            out += [f"Label noise, {flips['thetas']} θ {where}, re-simulated with "
+                    f"{flips['seeds']} new seeds each: {100 * flips['flip_share']:.1f} % of the "
+                    f"re-simulations flip the outcome, {100 * flips['ambiguous_share']:.1f} % of "
+                    f"θ are ambiguous, {100 * flips['collision_share']:.1f} % collide.", ""]
     return out + ["Verdict:", "", *(f"* {line}" for line in r["verdict"]), ""]
 
 

@@ -54,7 +54,8 @@ def test_check_regime_reports_every_figure(root) -> None:
     assert r["collision"]["runs"] == 26 and r["collision"]["auroc"] is not None
     assert r["monitor"]["unseen_runs"] >= 6
     assert (r["label_noise"]["thetas"], r["label_noise"]["seeds"]) == (3, 2)
-    assert r["label_noise"]["collision_share"] == 1.0 and len(r["verdict"]) == 3
+    assert r["label_noise"]["collision_share"] == 1.0 and len(r["verdict"]) == 4
+    assert r["boundary_noise"]["thetas"] == 3
     only = check_regime(data, SCENARIO, batch="later", sample=0)
     assert only["runs"] == 6 and only["label_noise"] is None
 

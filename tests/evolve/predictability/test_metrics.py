@@ -76,6 +76,22 @@ def test_a_coin_flip_outcome_flips_half_the_time_and_seeds_are_new_and_distinct(
     assert len(set(used)) == 200
 
 
+def test_the_boundary_sample_is_the_theta_of_smallest_margin():
+    runs = _runs()
+    margin = np.linspace(-3.0, 5.0, 40)
+    runs = RegimeRuns(runs.scenario, runs.ads_profile, None, runs.scenario_id, runs.params,
+                      runs.collided, margin, runs.ingested_at)
+    seen = []
+
+    def record(scenario, x, seed, profile):
+        seen.append(tuple(x))
+        return 0.0
+
+    label_noise(runs, sample=5, seeds=1, simulate=record, near_boundary=True)
+    nearest = np.argsort(np.abs(margin))[:5]
+    assert sorted(seen) == sorted(tuple(x) for x in runs.params[nearest])
+
+
 def test_failed_re_simulations_are_left_out():
     f = metrics.flips(np.array([True, False]), np.array([[1.0, np.nan], [np.nan, 1.0]]))
     assert f.flip_share == 0.5 and f.ambiguous_share == 0.5 and f.collision_share == 1.0
@@ -89,5 +105,9 @@ def test_the_verdict_says_plainly_when_theta_cannot_steer():
     assert "learnable" in lines[0]
     assert "no strategy that chooses θ can beat Uniform" in lines[1]
     good = metrics.verdict(metrics.Classified(200, 50, 0.52), metrics.Regressed(
-        200, 0.2, 0.45, 1e-9), metrics.Flips(30, 4, 0.1, 0.2, 0.3))
-    assert "hardly predicts" in good[0] and "can steer" in good[1] and "10 %" in good[2]
+        200, 0.2, 0.45, 1e-9), metrics.Flips(30, 4, 0.0, 0.0, 0.3),
+        metrics.Flips(30, 4, 0.1, 0.2, 0.3))
+    assert "hardly predicts" in good[0] and "can steer" in good[1]
+    assert "0 % of the outcomes of θ drawn uniformly" in good[2] and "function of θ" in good[2]
+    assert "10 % of the outcomes of the θ nearest the failure boundary" in good[3]
+    assert "chance" in good[3]
