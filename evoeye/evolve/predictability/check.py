@@ -113,15 +113,21 @@ def simulate_collided(scenario: str, x: np.ndarray, seed: int, profile: str) -> 
     return np.nan if episode.outcome.status != "ok" else float(episode.outcome.collided)
 
 
-def label_noise(runs: RegimeRuns, sample: int, seeds: int, seed: int = 0, workers: int = 1,
-                simulate: Simulate = simulate_collided,
-                near_boundary: bool = False) -> metrics.Flips:
-    """`sample` of the runs' θ — drawn uniformly (seeded), or those of smallest |signed
-    margin| — each re-simulated under `seeds` new seeds with its own ADS profile: how often the
-    outcome flips."""
-    n = min(sample, len(runs.params))
-    pick = np.sort(np.argsort(np.abs(runs.margin_m), kind="stable")[:n] if near_boundary
-                   else np.random.default_rng(seed).choice(len(runs.params), n, replace=False))
+def uniform_pick(n: int, sample: int, seed: int) -> np.ndarray:
+    """`sample` of n runs drawn uniformly (seeded), ascending."""
+    return np.sort(np.random.default_rng(seed).choice(n, min(sample, n), replace=False))
+
+
+def boundary_pick(p_collision: np.ndarray, sample: int) -> np.ndarray:
+    """The `sample` runs whose out-of-fold collision probability is nearest ½: the θ where
+    the outcome is least predictable, where boundary-seeking samples (ascending)."""
+    return np.sort(np.argsort(np.abs(p_collision - 0.5), kind="stable")[:sample])
+
+
+def label_noise(runs: RegimeRuns, pick: np.ndarray, seeds: int, seed: int = 0,
+                workers: int = 1, simulate: Simulate = simulate_collided) -> metrics.Flips:
+    """The runs `pick` (indices), each re-simulated under `seeds` new seeds with its own ADS
+    profile: how often the outcome flips."""
     jobs = [(runs.scenario, runs.params[i], _noise_seed(seed, i, j), runs.ads_profile)
             for i in pick for j in range(seeds)]
     if workers > 1:
@@ -141,11 +147,14 @@ def check_regime(root: DataRoot, scenario: str, *, batch: str | None = None,
                  sample: int = 30, seeds: int = 4, seed: int = 0, workers: int = 1,
                  simulate: Simulate = simulate_collided) -> dict[str, Any]:
     """Every figure of one regime, as a JSON-able dict (`sample` or `seeds` 0: no re-runs;
-    `monitor` None: the scenario's initial monitor, if there is one)."""
+    `monitor` None: the scenario's initial monitor, if there is one). The label noise is
+    measured twice: on `sample` θ drawn uniformly, and on the `sample` θ nearest the failure
+    boundary (`boundary_pick`)."""
     from evoeye.monitor.families import NoMonitorError
 
     runs = regime_runs(root, scenario, batch, ads)
-    collision = metrics.cv_auroc(runs.u, runs.collided, seed)
+    p_collision = metrics.cv_probabilities(runs.u, runs.collided, seed)
+    collision = metrics.classified(runs.collided, p_collision)
     margin = metrics.cv_regression(runs.u, runs.margin_m, seed)
     error, version, n_unseen, note = None, monitor, 0, None
     try:
@@ -158,8 +167,11 @@ def check_regime(root: DataRoot, scenario: str, *, batch: str | None = None,
         error = metrics.cv_regression(runs.u[mask], per_run[mask], seed) if n_unseen else None
     noise = boundary = None
     if sample and seeds:
-        noise = label_noise(runs, sample, seeds, seed, workers, simulate)
-        boundary = label_noise(runs, sample, seeds, seed, workers, simulate, near_boundary=True)
+        noise = label_noise(runs, uniform_pick(len(runs.params), sample, seed), seeds, seed,
+                            workers, simulate)
+        if p_collision is not None:
+            boundary = label_noise(runs, boundary_pick(p_collision, sample), seeds, seed,
+                                   workers, simulate)
     return {
         "scenario": scenario, "ads_profile": runs.ads_profile, "batch": batch,
         "runs": len(runs.scenario_id), "collision_share": float(runs.collided.mean()),

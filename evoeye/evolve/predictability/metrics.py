@@ -58,17 +58,28 @@ class Flips:
     collision_share: float  # collisions among the re-simulations
 
 
-def cv_auroc(u: np.ndarray, y: np.ndarray, seed: int) -> Classified:
-    """AUROC of out-of-fold collision probabilities of a random forest on u (n, dim) → y (n,)."""
+def cv_probabilities(u: np.ndarray, y: np.ndarray, seed: int) -> np.ndarray | None:
+    """Out-of-fold collision probabilities (n,) of a random forest on u (n, dim) → y (n,);
+    None with too few runs or too few of one class."""
     y = np.asarray(y, dtype=bool)
-    positives = int(y.sum())
-    if len(y) < MIN_RUNS or min(positives, len(y) - positives) < FOLDS:
-        return Classified(len(y), positives, None)
+    if len(y) < MIN_RUNS or min(int(y.sum()), int((~y).sum())) < FOLDS:
+        return None
     model = RandomForestClassifier(n_estimators=N_TREES, min_samples_leaf=MIN_SAMPLES_LEAF,
                                    random_state=seed, n_jobs=1)
     folds = StratifiedKFold(FOLDS, shuffle=True, random_state=seed)
-    p = cross_val_predict(model, u, y, cv=folds, method="predict_proba")[:, 1]
-    return Classified(len(y), positives, float(roc_auc_score(y, p)))
+    return cross_val_predict(model, u, y, cv=folds, method="predict_proba")[:, 1]
+
+
+def classified(y: np.ndarray, p: np.ndarray | None) -> Classified:
+    """The AUROC of out-of-fold probabilities p (`cv_probabilities`) for outcomes y."""
+    y = np.asarray(y, dtype=bool)
+    auroc = None if p is None else float(roc_auc_score(y, p))
+    return Classified(len(y), int(y.sum()), auroc)
+
+
+def cv_auroc(u: np.ndarray, y: np.ndarray, seed: int) -> Classified:
+    """AUROC of out-of-fold collision probabilities of a random forest on u (n, dim) → y (n,)."""
+    return classified(y, cv_probabilities(u, y, seed))
 
 
 def cv_regression(u: np.ndarray, y: np.ndarray, seed: int) -> Regressed:

@@ -44,8 +44,9 @@ def regime_markdown(r: dict[str, Any]) -> list[str]:
     out.append("")
     if mon["note"]:
         out += [f"No monitor: {mon['note']}", ""]
-    for flips, where in ((noise, "drawn uniformly"), (r.get("boundary_noise"),
-                                                     "nearest the failure boundary (|margin|)")):
+    boundary = (r["boundary_noise"], "nearest the failure boundary (out-of-fold P(collision) "
+                                     "nearest ½)")
+    for flips, where in ((noise, "drawn uniformly"), boundary):
         if flips:
             out += [f"Label noise, {flips['thetas']} θ {where}, re-simulated with "
                     f"{flips['seeds']} new seeds each: {100 * flips['flip_share']:.1f} % of the "

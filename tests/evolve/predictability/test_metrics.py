@@ -4,7 +4,12 @@ import numpy as np
 import pytest
 
 from evoeye.evolve.predictability import metrics
-from evoeye.evolve.predictability.check import RegimeRuns, label_noise
+from evoeye.evolve.predictability.check import (
+    RegimeRuns,
+    boundary_pick,
+    label_noise,
+    uniform_pick,
+)
 from evoeye.scenarios import get_scenario
 
 CROSSING = get_scenario("unprotected-intersection")
@@ -58,7 +63,7 @@ def test_a_deterministic_outcome_never_flips():
         assert profile == "default" and scenario == CROSSING.name
         return float(CROSSING.normalise(x)[0] < 0.5)
 
-    f = label_noise(runs, sample=20, seeds=3, simulate=deterministic)
+    f = label_noise(runs, uniform_pick(40, 20, 0), seeds=3, simulate=deterministic)
     assert (f.thetas, f.seeds) == (20, 3)
     assert f.flip_share == 0.0 and f.ambiguous_share == 0.0
 
@@ -71,25 +76,16 @@ def test_a_coin_flip_outcome_flips_half_the_time_and_seeds_are_new_and_distinct(
         used.append(seed)
         return float(np.random.default_rng(seed).random() < 0.5)
 
-    f = label_noise(runs, sample=40, seeds=5, simulate=coin)
+    f = label_noise(runs, np.arange(40), seeds=5, simulate=coin)
     assert 0.4 < f.flip_share < 0.6 and f.ambiguous_share > 0.9
     assert len(set(used)) == 200
 
 
-def test_the_boundary_sample_is_the_theta_of_smallest_margin():
-    runs = _runs()
-    margin = np.linspace(-3.0, 5.0, 40)
-    runs = RegimeRuns(runs.scenario, runs.ads_profile, None, runs.scenario_id, runs.params,
-                      runs.collided, margin, runs.ingested_at)
-    seen = []
-
-    def record(scenario, x, seed, profile):
-        seen.append(tuple(x))
-        return 0.0
-
-    label_noise(runs, sample=5, seeds=1, simulate=record, near_boundary=True)
-    nearest = np.argsort(np.abs(margin))[:5]
-    assert sorted(seen) == sorted(tuple(x) for x in runs.params[nearest])
+def test_the_boundary_sample_is_where_collision_is_a_coin_toss():
+    p = np.array([0.9, 0.45, 0.1, 0.62, 0.5, 0.0])
+    np.testing.assert_array_equal(boundary_pick(p, 3), [1, 3, 4])
+    picked = uniform_pick(40, 10, seed=0)
+    assert len(set(picked)) == 10 and list(picked) == sorted(picked)
 
 
 def test_failed_re_simulations_are_left_out():
