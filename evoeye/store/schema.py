@@ -31,8 +31,9 @@ DDL_SCHEMA = "ddl"  # the DuckDB schema holding the declared, always empty, tabl
 # (LAYOUT_KEY; parts without it are layout 1). Bump it with any change to their DDL: a
 # warehouse holds parts of one layout only (`check_layout`), so the views need not reconcile
 # schemas file by file. 1: frame_features arrays as FLOAT[] lists (evoeye <= 0.4.0);
-# 2: as little-endian float32 bytes (BLOB); 3: scenarios.ads_profile.
-LAYOUT_VERSION = 3
+# 2: as little-endian float32 bytes (BLOB); 3: scenarios.ads_profile; 4: scenarios.label_source
+# and the frames' message ages (age_*), for recordings imported from other stacks.
+LAYOUT_VERSION = 4
 LAYOUT_KEY = b"evoeye.warehouse_layout"
 
 
