@@ -171,3 +171,15 @@ def interval_chart(rows: Sequence[tuple[str, float | None, float | None, float |
             body.append(f'<circle cx="{f.x(mean):.1f}" cy="{y:.1f}" r="4" fill="{_color(i)}" '
                         f'data-estimate="{mean:.4g}"/>')
     return f.svg(body, title)
+
+
+STANDALONE_CSS = ("svg{font:11px sans-serif;background:#fafafa} .t{font-size:13px;"
+                  "font-weight:600} .s{font-size:11px}")
+
+
+def standalone(svg: str) -> str:
+    """A chart as a file of its own (an .svg an image viewer or a README shows): with the SVG
+    namespace and the report's fonts, which inline charts take from the page."""
+    head, rest = svg.split(">", 1)
+    return (head.replace("<svg ", '<svg xmlns="http://www.w3.org/2000/svg" ', 1)
+            + f"><style>{STANDALONE_CSS}</style>" + rest + "\n")

@@ -20,9 +20,11 @@ VIEWS_DIR = PROJECT_DIR / "warehouse" / "views"
 QUERIES_DIR = PROJECT_DIR / "warehouse" / "queries"
 
 TABLES = ("scenarios", "frames", "frame_features")
-# Tables later stages append to, as flat parts under warehouse/<table>/ (no partitions), that
-# every connection sees as a view of the same name (`attribution`: evoeye explain).
-DERIVED_TABLES = ("attribution",)
+# Tables later stages append to, as flat parts under warehouse/<table>/ (no partitions): explain,
+# evaluate and the evolution campaign. Each is read through its macro `<table>_parts(files)`
+# (PARTS_SQL): every connection sees all its parts as the view `<table>`.
+DERIVED_TABLES = ("attribution", "monitor_scores", "feedback", "campaign_rounds", "committee")
+PARTS_SQL = PROJECT_DIR / "warehouse" / "parts.sql"
 # Hive partition keys, in folder order: they are columns of the views, not of the files.
 PARTITION_KEYS = ("logical_scenario", "batch")
 DDL_SCHEMA = "ddl"  # the DuckDB schema holding the declared, always empty, tables

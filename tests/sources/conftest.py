@@ -91,8 +91,9 @@ def _bag_at(path: Path, msgs, identity: dict | None = None) -> Path:
     """Write `msgs` as a bag folder at `path` (with the run identity, if given)."""
     import orjson
 
-    from evoeye.sources.autoware.bag import IDENTITY, RUN_KEY
+    from evoeye.sources.autoware.bag import IDENTITY, OPTIONAL_IDENTITY, RUN_KEY
 
-    custom = {RUN_KEY: orjson.dumps({k: identity[k] for k in IDENTITY}).decode()} \
+    kept = [*IDENTITY, *(k for k in OPTIONAL_IDENTITY if identity and k in identity)]
+    custom = {RUN_KEY: orjson.dumps({k: identity[k] for k in kept}).decode()} \
         if identity else None
     return write_bag(path, msgs, custom)

@@ -88,6 +88,18 @@ def test_the_golden_bag_imports_labelled_by_its_collision_topic() -> None:
     assert run.metadata["logical_scenario"] == "external"  # no evoeye identity in it
 
 
+
+def test_an_exported_bag_keeps_its_run_s_ads_profile_an_older_one_the_default(
+        sim_runs, messages, bag_at, tmp_path: Path) -> None:
+    meta, msgs = messages(sim_runs.safe())
+    msgs = [m for m in msgs if m[0] < 500_000_000]
+    cautious = read_bag(bag_at(tmp_path / "cautious", msgs, {**meta, "ads_profile": "cautious"}))
+    assert cautious.metadata["ads_profile"] == "cautious"
+    before_profiles = {k: v for k, v in meta.items() if k != "ads_profile"}
+    assert read_bag(bag_at(tmp_path / "old", msgs, before_profiles)).metadata[
+        "ads_profile"] == "default"
+    assert read_bag(bag_at(tmp_path / "foreign", msgs)).metadata["ads_profile"] == "default"
+
 # -- old type names (autoware_auto_*, before 2024): their own definitions, the same frames -------
 OLD = {  # old type → its definition; the fields a converter reads have the same names
     "autoware_auto_perception_msgs/msg/TrackedObjectKinematics":

@@ -9,7 +9,14 @@ import numpy as np
 import pytest
 
 from evoeye.sources.autoware.config import Mapping, Vehicle
-from evoeye.sources.autoware.convert import ConversionError, objects, odometry, uuid_int, yaw
+from evoeye.sources.autoware.convert import (
+    ConversionError,
+    Ego,
+    objects,
+    odometry,
+    uuid_int,
+    yaw,
+)
 from evoeye.sources.autoware.export import Exporter
 from evoeye.sources.autoware.grids import plan_points, predictions
 
@@ -68,16 +75,65 @@ def test_a_held_prediction_is_resampled_at_the_frame_s_times() -> None:
     assert len(rows["x_m"][0]) == 30 and rows["x_m"][0][-1] == pytest.approx(30.5)
 
 
-def test_a_held_trajectory_is_resampled_at_the_frame_s_times() -> None:
+def _straight(speed_mps: float, n: int = 41, x0_m: float = 0.0):
+    """A trajectory along +x at `speed_mps`, points 0.1 s apart from x0_m."""
     from evoeye.sources.autoware.convert import Trajectory
 
-    t = np.arange(41) * 0.1
-    traj = Trajectory(t, 20.0 * t, np.zeros_like(t), np.zeros_like(t), np.full_like(t, 20.0),
-                      np.zeros_like(t), False)
-    plan = plan_points(traj, 0.1, (0.0, 0.0))
+    t = np.arange(n) * 0.1
+    return Trajectory(t, x0_m + speed_mps * t, np.zeros_like(t), np.zeros_like(t),
+                      np.full_like(t, speed_mps), np.zeros_like(t), False)
+
+
+def test_a_held_trajectory_is_resampled_from_where_the_ego_is_on_it() -> None:
+    traj = _straight(20.0)
+    # 0.1 s old, the ego where the trajectory expected it: the age and the pose agree
+    plan = plan_points(traj, Ego(2.0, 0.0, 0.0, 20.0), 0.1, (0.0, 0.0))
     assert plan["t_rel_s"][:2] == pytest.approx([0.0, 0.1])
-    assert plan["x_m"][:2] == pytest.approx([2.0, 4.0])  # 0.1 s old: 2 m further on
+    assert plan["x_m"][:2] == pytest.approx([2.0, 4.0])
     assert len(plan["t_rel_s"]) == 41 and plan["x_m"][-1] == pytest.approx(82.0)
+    # 0.3 m short of it and 0.4 m off the path: point 0 level with the ego, on the path (the
+    # plan's lateral offset is the ego's, as evoeye's ADS plans from its route), the rest
+    # 0.1 s apart from there
+    plan = plan_points(traj, Ego(1.7, 0.4, 0.0, 20.0), 0.1, (0.0, 0.0))
+    assert plan["x_m"][:3] == pytest.approx([1.7, 3.7, 5.7])
+    assert plan["y_m"][:3] == pytest.approx([0.0, 0.0, 0.0])
+    assert plan["x_m"][-1] == pytest.approx(81.7)  # the covered grid stays whole
+
+
+def test_a_trajectory_starting_behind_the_ego_starts_level_with_it() -> None:
+    # Autoware keeps a few metres of trajectory behind the ego: its first point is not "now"
+    traj = _straight(10.0, n=61, x0_m=-5.0)
+    plan = plan_points(traj, Ego(0.0, 0.0, 0.0, 10.0), 0.0, (0.0, 0.0))
+    assert plan["x_m"][:2] == pytest.approx([0.0, 1.0])
+
+
+def test_where_a_trajectory_dwells_its_age_places_the_ego() -> None:
+    from evoeye.sources.autoware.convert import Trajectory
+
+    # stopped for 1 s at x = 0, then away at 1 m/s²: the ego at x = 0 fits any of that second
+    t = np.arange(41) * 0.1
+    moving = np.clip(t - 1.0, 0.0, None)
+    traj = Trajectory(t, 0.5 * moving**2, np.zeros_like(t), np.zeros_like(t), moving,
+                      (t >= 1.0).astype(float), False)
+    plan = plan_points(traj, Ego(0.0, 0.0, 0.0, 0.0), 0.3, (0.0, 0.0))
+    assert plan["speed_mps"][:9] == pytest.approx([0.0] * 8 + [0.1])  # moves 0.7 s on
+
+
+def test_the_ego_is_found_on_the_segments_heading_its_way() -> None:
+    from evoeye.sources.autoware.convert import Trajectory
+
+    # a U-turn: out along +x at y = 0, back along -x at y = 3. The ego at (5, 1) is nearer the
+    # outward leg; heading -x, it is on the return leg (Autoware's nearest-segment yaw limit)
+    t = np.arange(41) * 0.1
+    out = t <= 2.0
+    x = np.where(out, 5.0 * t, 10.0 - 5.0 * (t - 2.0))
+    y = np.where(out, 0.0, 3.0)
+    h = np.where(out, 0.0, np.pi)
+    traj = Trajectory(t, x, y, h, np.full_like(t, 5.0), np.zeros_like(t), False)
+    heading_out = plan_points(traj, Ego(5.0, 1.0, 0.0, 5.0), 0.0, (0.0, 0.0))
+    heading_back = plan_points(traj, Ego(5.0, 1.0, np.pi, 5.0), 0.0, (0.0, 0.0))
+    assert (heading_out["x_m"][0], heading_out["y_m"][0]) == pytest.approx((5.0, 0.0))
+    assert (heading_back["x_m"][0], heading_back["y_m"][0]) == pytest.approx((5.0, 3.0))
 
 
 def _shift(msg, dx: float, dy: float) -> None:

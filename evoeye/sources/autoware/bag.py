@@ -3,10 +3,10 @@
 Only the mapped topics are decoded (point clouds and images never are). The bag's definitions
 decode it when it embeds them (MCAP); otherwise ROS 2 Humble's types and the vendored Autoware
 ones do (`typestore`). A bag that evoeye exported carries its run's identity (rosbag2
-custom data `evoeye.run`: scenario id, logical scenario, parameters, seed, round): it comes back
-under that id. Any other bag is a run of logical scenario `external`, its id from its bytes, so
-the same bag imported twice is the same run. Labels come from the bag's ground truth alone
-(`labels.py`), never from that record.
+custom data `evoeye.run`: scenario id, logical scenario, parameters, seed, round, ADS profile):
+it comes back under that id. Any other bag is a run of logical scenario `external`, its id
+from its bytes, so the same bag imported twice is the same run. Labels come from the bag's
+ground truth alone (`labels.py`), never from that record.
 """
 
 from __future__ import annotations
@@ -18,6 +18,7 @@ from typing import Any
 
 import orjson
 
+from evoeye.ads import DEFAULT_PROFILE
 from evoeye.log.records import UNLABELLED
 from evoeye.sources.autoware.config import REQUIRED_ROLES, Mapping
 from evoeye.sources.autoware.convert import ConversionError, converter
@@ -28,6 +29,10 @@ from evoeye.sources.autoware.typestore import typestore
 EXTERNAL_SCENARIO = "external"
 RUN_KEY = "evoeye.run"  # rosbag2 custom data of an exported bag: its run's identity (JSON)
 IDENTITY = ("scenario_id", "logical_scenario", "param_names", "params", "seed", "source", "round")
+# kept too, with its value when a bag lacks it: a bag exported before profiles was driven by the
+# default profile; another stack's bag names none of evoeye's ADS profiles, and takes the run
+# record's default too
+OPTIONAL_IDENTITY = {"ads_profile": DEFAULT_PROFILE}
 SOFTWARE = "autoware"
 
 
@@ -94,7 +99,9 @@ def _identity(path: Path, custom: dict[str, str]) -> dict[str, Any]:
     if RUN_KEY not in custom:
         return {}
     try:
-        return {k: orjson.loads(custom[RUN_KEY])[k] for k in IDENTITY}
+        record = orjson.loads(custom[RUN_KEY])
+        return {**{k: record[k] for k in IDENTITY},
+                **{k: record.get(k, default) for k, default in OPTIONAL_IDENTITY.items()}}
     except (orjson.JSONDecodeError, KeyError, TypeError) as e:
         raise BagError(f"{path}: custom data {RUN_KEY}: malformed ({e})") from None
 
@@ -130,6 +137,7 @@ def _metadata(path: Path, custom: dict[str, str], assembler: FrameAssembler,
         "batch": "",  # the importer's batch
         "source": identity.get("source", SOFTWARE),
         "round": identity.get("round", 0),
+        "ads_profile": identity.get("ads_profile", DEFAULT_PROFILE),
         "software_version": SOFTWARE,
         "rate_hz": assembler.mapping.rate_hz,
         "status": "ok",

@@ -25,7 +25,7 @@ import numpy as np
 import orjson
 
 from evoeye.log import TOPICS, read_run
-from evoeye.sources.autoware.bag import IDENTITY, RUN_KEY
+from evoeye.sources.autoware.bag import IDENTITY, OPTIONAL_IDENTITY, RUN_KEY
 from evoeye.sources.autoware.config import Mapping
 from evoeye.sources.autoware.convert import CLASS_NAMES
 from evoeye.sources.autoware.typestore import typestore
@@ -348,5 +348,5 @@ def export_run(log: str | Path, out_dir: str | Path, *, mapping: Mapping | None 
     """Write the run log as the rosbag2 folder `<out_dir>/<scenario id>/` (MCAP); its path.
     An existing folder of that name is replaced."""
     meta, messages = bag_messages(Path(log), mapping or Mapping(), RATES[rates], collision)
-    identity = orjson.dumps({k: meta[k] for k in IDENTITY}).decode()
+    identity = orjson.dumps({k: meta[k] for k in (*IDENTITY, *OPTIONAL_IDENTITY)}).decode()
     return write_bag(Path(out_dir) / str(meta["scenario_id"]), messages, {RUN_KEY: identity})

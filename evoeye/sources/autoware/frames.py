@@ -173,7 +173,8 @@ class FrameAssembler:
             TOPICS.predictions: {"t_s": t_s, **grids.predictions(
                 got["predicted"][1], ages["predicted"], origin)},
             TOPICS.plan: {"t_s": t_s, **self._decision(got),
-                          **grids.plan_points(got["trajectory"][1], ages["trajectory"], origin)},
+                          **grids.plan_points(got["trajectory"][1], ego, ages["trajectory"],
+                                             origin)},
             TOPICS.control: {
                 "t_s": t_s, "throttle": accel_cmd / v.accel_max_mps2 if accel_cmd > 0 else 0.0,
                 "brake": accel_cmd / v.accel_min_mps2 if accel_cmd < 0 else 0.0,
