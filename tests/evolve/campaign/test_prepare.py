@@ -4,9 +4,9 @@ from __future__ import annotations
 
 import pytest
 
+from evoeye.evolve.campaign import loop
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.experiment import campaigns_of
-from evoeye.evolve.campaign import loop
 from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.campaign.workers import CampaignJob, prepare_campaigns, run_campaign
 from evoeye.store import SplitSpec
