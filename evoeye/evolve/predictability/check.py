@@ -154,7 +154,7 @@ def check_regime(root: DataRoot, scenario: str, *, batch: str | None = None,
 
     runs = regime_runs(root, scenario, batch, ads)
     p_collision = metrics.cv_probabilities(runs.u, runs.collided, seed)
-    collision = metrics.classified(runs.collided, p_collision)
+    collision = metrics.classified(runs.collided, p_collision, seed)
     margin = metrics.cv_regression(runs.u, runs.margin_m, seed)
     error, version, n_unseen, note = None, monitor, 0, None
     try:

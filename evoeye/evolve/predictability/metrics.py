@@ -20,6 +20,7 @@ MIN_RUNS = 20  # fewer runs (or, for AUROC, fewer than FOLDS of either class): n
 RHO_MIN = 0.2
 P_MAX = 0.05
 AUROC_MIN = 0.6
+BOOTSTRAP = 1000  # resamples of the runs for the AUROC's 95 % interval
 
 
 @dataclass(frozen=True)
@@ -29,6 +30,8 @@ class Classified:
     runs: int
     positives: int
     auroc: float | None  # None: too few runs or too few of one class
+    auroc_ci: tuple[float, float] | None = None  # 95 %, bootstrap over the runs
+    fold_aurocs: tuple[float, ...] = ()  # each fold's AUROC on its held-out runs
 
 
 @dataclass(frozen=True)
@@ -58,6 +61,10 @@ class Flips:
     collision_share: float  # collisions among the re-simulations
 
 
+def _folds(seed: int) -> StratifiedKFold:
+    return StratifiedKFold(FOLDS, shuffle=True, random_state=seed)
+
+
 def cv_probabilities(u: np.ndarray, y: np.ndarray, seed: int) -> np.ndarray | None:
     """Out-of-fold collision probabilities (n,) of a random forest on u (n, dim) → y (n,);
     None with too few runs or too few of one class."""
@@ -66,20 +73,35 @@ def cv_probabilities(u: np.ndarray, y: np.ndarray, seed: int) -> np.ndarray | No
         return None
     model = RandomForestClassifier(n_estimators=N_TREES, min_samples_leaf=MIN_SAMPLES_LEAF,
                                    random_state=seed, n_jobs=1)
-    folds = StratifiedKFold(FOLDS, shuffle=True, random_state=seed)
-    return cross_val_predict(model, u, y, cv=folds, method="predict_proba")[:, 1]
+    return cross_val_predict(model, u, y, cv=_folds(seed), method="predict_proba")[:, 1]
 
 
-def classified(y: np.ndarray, p: np.ndarray | None) -> Classified:
-    """The AUROC of out-of-fold probabilities p (`cv_probabilities`) for outcomes y."""
+def auroc_interval(y: np.ndarray, p: np.ndarray, seed: int) -> tuple[float, float]:
+    """95 % percentile interval of the AUROC of p for y over BOOTSTRAP resamples of the runs
+    (resamples holding one class only are skipped)."""
+    rng = np.random.default_rng(seed)
+    draws = rng.integers(0, len(y), size=(BOOTSTRAP, len(y)))
+    both = [d for d in draws if 0 < y[d].sum() < len(d)]
+    aurocs = [roc_auc_score(y[d], p[d]) for d in both]
+    low, high = np.percentile(aurocs, [2.5, 97.5])
+    return float(low), float(high)
+
+
+def classified(y: np.ndarray, p: np.ndarray | None, seed: int = 0) -> Classified:
+    """The AUROC of out-of-fold probabilities p (`cv_probabilities` with `seed`) for outcomes
+    y, its bootstrap interval and each fold's."""
     y = np.asarray(y, dtype=bool)
-    auroc = None if p is None else float(roc_auc_score(y, p))
-    return Classified(len(y), int(y.sum()), auroc)
+    if p is None:
+        return Classified(len(y), int(y.sum()), None)
+    folds = tuple(float(roc_auc_score(y[held], p[held]))
+                  for _, held in _folds(seed).split(np.zeros(len(y)), y))
+    return Classified(len(y), int(y.sum()), float(roc_auc_score(y, p)),
+                      auroc_interval(y, p, seed), folds)
 
 
 def cv_auroc(u: np.ndarray, y: np.ndarray, seed: int) -> Classified:
     """AUROC of out-of-fold collision probabilities of a random forest on u (n, dim) → y (n,)."""
-    return classified(y, cv_probabilities(u, y, seed))
+    return classified(y, cv_probabilities(u, y, seed), seed)
 
 
 def cv_regression(u: np.ndarray, y: np.ndarray, seed: int) -> Regressed:

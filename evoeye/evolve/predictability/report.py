@@ -27,6 +27,15 @@ def _regressed(r: dict | None) -> str:
             f"(p {r['spearman_p']:.1g})")
 
 
+def _auroc(c: dict) -> str:
+    if c["auroc"] is None:
+        return "–"
+    low, high = c["auroc_ci"]
+    folds = c["fold_aurocs"]
+    return (f"AUROC {_num(c['auroc'])} (95 % CI {_num(low)}–{_num(high)}; folds "
+            f"{_num(min(folds))}–{_num(max(folds))})")
+
+
 def regime_markdown(r: dict[str, Any]) -> list[str]:
     """One regime's section."""
     c, m, mon, noise = r["collision"], r["margin"], r["monitor"], r["label_noise"]
@@ -35,7 +44,7 @@ def regime_markdown(r: dict[str, Any]) -> list[str]:
            f"{100 * r['collision_share']:.1f} % collide", "",
            f"| what θ alone predicts ({FOLDS}-fold CV, random forest) | runs | figure |",
            "|---|---|---|",
-           f"| collision | {c['runs']} ({c['positives']} collide) | AUROC {_num(c['auroc'])} |",
+           f"| collision | {c['runs']} ({c['positives']} collide) | {_auroc(c)} |",
            f"| signed safety margin (gap m; a collision −1 m) | {m['runs']} | {_regressed(m)} |"]
     if mon["version"]:
         err = mon["error"]

@@ -27,6 +27,17 @@ def test_a_planted_boundary_is_predicted_and_noise_is_not():
     assert abs(noise.auroc - 0.5) < 0.1
 
 
+def test_the_auroc_comes_with_its_interval_and_each_folds():
+    u = _u()
+    planted = metrics.cv_auroc(u, u[:, 0] + u[:, 1] < 0.8, seed=0)
+    low, high = planted.auroc_ci
+    assert 0.8 < low < planted.auroc < high <= 1.0
+    assert len(planted.fold_aurocs) == metrics.FOLDS and min(planted.fold_aurocs) > 0.8
+    noise = metrics.cv_auroc(u, np.random.default_rng(1).random(300) < 0.3, seed=0)
+    assert noise.auroc_ci[0] < 0.5 < noise.auroc_ci[1]
+    assert min(noise.fold_aurocs) < noise.auroc < max(noise.fold_aurocs)
+
+
 def test_too_few_of_one_class_gives_no_auroc():
     u = _u(40)
     y = np.zeros(40, bool)
