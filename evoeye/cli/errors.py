@@ -58,6 +58,9 @@ KNOWN_ERRORS: dict[str, str] = {
     "evoeye.evolve.campaign.state.MixedProfilesError": "simulate each ADS profile's runs under "
                                                        "a data root of its own (--root)",
     "evoeye.ads.profiles.UnknownProfileError": "",
+    "evoeye.evolve.predictability.check.RegimeError": "simulate and ingest runs of the regime "
+                                                      "(`evoeye simulate …`, `evoeye ingest`), "
+                                                      "or narrow it with --batch / --ads",
     "evoeye.evaluation.audit.runs.NoLogsError": "name a batch the root holds (above), or "
                                                 "leave out --scenario and --batch to audit "
                                                 "them all; `evoeye simulate …` makes runs",
