@@ -1,0 +1,105 @@
+"""A supervision end to end on four real runs: calibrated thresholds, one record per run whose
+simulations are the unsupervised run until their first alarm, logs with the supervisor's
+channels, and a resume that redoes nothing finished and recomputes the same bytes."""
+
+from __future__ import annotations
+
+import shutil
+
+import numpy as np
+import pytest
+
+from evoeye.evaluation.supervision import check_held_out, supervise
+from evoeye.evaluation.supervision.batch import plan_supervision, record_path
+from evoeye.evaluation.supervision.sweep import ReproductionError, RunJob, supervise_run
+from evoeye.evaluation.supervision.triggers import sweep_thresholds
+from evoeye.log import read_run
+from evoeye.store import SplitSpec
+
+TRIGGERS = [("baseline", "ttc")]
+
+
+def _supervise(sup):
+    return supervise(sup.root, sup.scenario, sup.batch, TRIGGERS, splits=sup.splits,
+                     fprs=sup.fprs, logs="all")
+
+
+@pytest.fixture(scope="module")
+def result(sup):
+    return _supervise(sup)
+
+
+def test_every_run_gets_a_record_paired_with_its_logged_outcome(sup, result) -> None:
+    (trigger,) = result.settings.triggers
+    assert trigger.name == "ttc" and list(trigger.thresholds) == sorted(set(trigger.thresholds))
+    assert len(result.records) == 4 and not result.errors
+    logged = {s.scenario_id: m for s, m in plan_supervision(sup.root, result.settings).runs}
+    for r in result.records:
+        u, t = r["unsupervised"], r["triggers"]["ttc"]
+        assert u["collided"] == logged[r["scenario_id"]]["collided"]
+        assert len(t["sim_of"]) == len(t["first_alarm_frame"]) == len(trigger.thresholds)
+        for j, (first, sim) in enumerate(zip(t["first_alarm_frame"], t["sim_of"],
+                                             strict=True)):
+            assert (first is None) == (sim is None)  # no alarm: the unsupervised run
+            if sim is not None:
+                s = t["sims"][sim]
+                assert j in s["thresholds"] and s["first_alarm_frame"] == first
+                assert s["interventions"] >= 1 and s["fallback_s"] > 0
+        # a lower threshold alarms no later
+        frames = [f if f is not None else 10**6 for f in t["first_alarm_frame"]]
+        assert frames == sorted(frames)
+    assert sum(r["unsupervised"]["collided"] for r in result.records) == 2
+
+
+def test_each_simulation_is_logged_with_the_supervisor_channels(result) -> None:
+    r = next(r for r in result.records if r["triggers"]["ttc"]["sims"])
+    sim = r["triggers"]["ttc"]["sims"][0]
+    run = read_run(result.folder / sim["log"])
+    states = [m for _, m in run.messages("/supervisor")]
+    assert len(states) == round(sim["duration_s"] * 20)
+    modes = [s["mode"] for s in states]
+    first = sim["first_alarm_frame"]
+    assert set(modes[:first]) == {"nominal"} and modes[first] == "braking"
+    assert states[first]["alarm"] and not any(s["alarm"] for s in states[:first])
+    assert run.metadata["scenario_id"] == r["scenario_id"]
+
+
+def test_a_resumed_supervision_skips_finished_runs_and_recomputes_the_same_bytes(
+        sup, result) -> None:
+    again = _supervise(sup)
+    assert again.done_before == 4 and again.records == result.records
+    victim = next(r for r in result.records if r["triggers"]["ttc"]["sims"])
+    path = record_path(result.folder, victim["scenario_id"])
+    logs = [result.folder / s["log"] for s in victim["triggers"]["ttc"]["sims"]]
+    before = path.read_bytes(), [p.read_bytes() for p in logs]
+    path.unlink()
+    for p in logs:
+        p.unlink()
+    redone = _supervise(sup)
+    assert redone.done_before == 3
+    assert (path.read_bytes(), [p.read_bytes() for p in logs]) == before
+
+
+def test_a_run_that_does_not_reproduce_its_log_is_an_error(sup, result, tmp_path) -> None:
+    spec, meta = plan_supervision(sup.root, result.settings).runs[0]
+    bad = RunJob(str(sup.root.path), str(tmp_path), result.settings, spec,
+                 {**meta, "collided": not meta["collided"]})
+    with pytest.raises(ReproductionError, match="another software version"):
+        supervise_run(bad)
+    shutil.rmtree(tmp_path, ignore_errors=True)
+
+
+def test_the_batch_must_be_held_out_of_train_and_validation(sup) -> None:
+    check_held_out(sup.root, sup.scenario, sup.batch, sup.splits)  # the batch is not ingested
+    ingested = SplitSpec(seed=0, train_frac=0.3, val_frac=0.3)
+    with pytest.raises(ValueError, match="not held out"):
+        check_held_out(sup.root, sup.scenario, "b000", ingested)
+
+
+def test_targets_giving_the_same_threshold_are_one() -> None:
+    scores = np.r_[np.zeros(90), np.linspace(0.5, 0.9, 10)]  # 10 % of the negatives above 0
+    thresholds, targets, realised = sweep_thresholds(scores, np.zeros(100, np.int8),
+                                                     (0.5, 0.2, 0.1, 0.05))
+    assert thresholds == (0.0, pytest.approx(0.5 + 4 * 0.4 / 9))
+    assert targets == (0.5, 0.05)  # 0.5, 0.2 and 0.1 all give 0.0: the loosest names it
+    assert realised == (0.1, 0.05)
