@@ -56,6 +56,7 @@ class SuperviseParams(BaseModel):
     val_frac: float = Field(0.2, ge=0.0, le=1.0)
     test_batch: str | None = None  # default: `batch`
     logs: str = Field("collided", json_schema_extra={"enum": list(LOG_POLICIES)})
+    logs_into_runs: bool = False  # True: the supervised logs are ingested as training data
     budgets: list[float] = Field(default_factory=lambda: list(BUDGETS_PER_H))
     limit: int | None = Field(None, ge=1)
     workers: int = Field(2, ge=1, le=64)
@@ -92,7 +93,8 @@ def calibrate(root: DataRoot, scenario: str, params: SuperviseParams) -> Setting
     triggers = calibrate_triggers(root, scenario, sources, params.splits, params.fprs,
                                   params.horizon_s)
     return Settings(scenario, params.batch, tuple(triggers), params.fallback,
-                    params.consecutive, params.horizon_s, params.splits, params.logs)
+                    params.consecutive, params.horizon_s, params.splits, params.logs,
+                    logs_into_runs=params.logs_into_runs)
 
 
 @task(retries=1, retry_delay_seconds=1, task_run_name="supervise-{job.spec.scenario_id}")

@@ -76,6 +76,10 @@ def supervise_command(
         callback=plain_batch, help="The held-out Test Set batch (default: --batch).")] = None,
     logs: Annotated[str, typer.Option(help=f"Which supervised runs to log: "
                                       f"{', '.join(LOG_POLICIES)}.")] = "collided",
+    logs_into_runs: Annotated[bool, typer.Option(
+        "--logs-into-runs", help="Write the supervised runs' logs to runs/<scenario>/<batch>"
+        "-supervised/ (ids of their own), so the next `evoeye ingest` takes them in as "
+        "training data; by default they stay out of the warehouse.")] = False,
     budgets: Annotated[str, typer.Option(help="False interventions per hour the triggers are "
                                          "compared at.")] =
         ",".join(f"{b:g}" for b in SUPERVISE_BUDGETS),
@@ -121,7 +125,8 @@ def supervise_command(
         result = supervise(data, scenario, batch, sources, splits=splits,
                            fprs=parse_floats(fprs, "--fprs"), fallback=fallback,
                            consecutive=consecutive, horizon_s=horizon_s, logs=logs,
-                           workers=workers, limit=limit, progress=bar)
+                           logs_into_runs=logs_into_runs, workers=workers, limit=limit,
+                           progress=bar)
         summary = summarise_supervision(result.settings, result.records,
                                         parse_floats(budgets, "--budgets"))
     except (ValueError, KeyError) as exc:

@@ -24,16 +24,18 @@ def supervise(root: DataRoot, scenario: str, batch: str, sources: Sequence[tuple
               fprs: Sequence[float] = SWEEP_FPRS,
               fallback: FallbackConfig = FallbackConfig(),  # noqa: B008 (frozen dataclass)
               consecutive: int = 1, horizon_s: float = DEFAULT_HORIZON_S,
-              logs: str = "collided", workers: int = 1, limit: int | None = None,
+              logs: str = "collided", logs_into_runs: bool = False, workers: int = 1,
+              limit: int | None = None,
               progress: Callable[[Iterable], Iterable] | None = None) -> SupervisionResult:
     """Calibrate the triggers (`sources`: ("version", id) or ("baseline", name)) on the
-    scenario's validation split, then supervise every run of `batch` (resuming a killed one).
+    scenario's validation split, then supervise every run of `batch` (resuming a killed one);
+    with `logs_into_runs` the supervised runs' logs go where `evoeye ingest` takes them in.
     ValueError if a run of the batch is in the train or validation split: a trigger must not
     be judged on the runs it learned or was calibrated on."""
     check_held_out(root, scenario, batch, splits)
     triggers = calibrate_triggers(root, scenario, sources, splits, fprs, horizon_s)
     settings = Settings(scenario, batch, tuple(triggers), fallback, consecutive, horizon_s,
-                        splits, logs)
+                        splits, logs, logs_into_runs=logs_into_runs)
     return run_supervision(root, settings, workers=workers, progress=progress, limit=limit)
 
 

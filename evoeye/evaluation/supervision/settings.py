@@ -2,15 +2,17 @@
 its results live.
 
 A supervision's results go to `<root>/supervision/<logical scenario>/<batch>/<key>/`, the key a
-hash of every setting that changes a result (all but the log policy), so a supervision run again
-with the same settings finds its finished runs and one with other settings starts apart:
+hash of every setting that changes a result (all but which logs are kept, and where), so a
+supervision run again with the same settings finds its finished runs and one with other
+settings starts apart:
 
-    settings.json                  these settings
-    runs/<scenario_id>.json        one record per run (`sweep.supervise_run`)
-    logs/<trigger>/<id>.tNN.mcap   supervised runs' logs (threshold NN of the trigger leads)
+    settings.json                        these settings
+    runs/<scenario_id>.json              one record per run (`sweep.supervise_run`)
+    logs/<trigger>/<id>.<trigger>.tNN.mcap  supervised runs' logs (threshold NN leads)
 
-Nothing under `supervision/` is ingested: supervised runs never enter training data unless a
-user copies their logs into `runs/` (docs/supervisor.md).
+Nothing under `supervision/` is ingested: supervised runs never enter training data unless
+asked (`logs_into_runs`: their logs go to `runs/<scenario>/<batch>-supervised/` instead, under
+ids of their own, and the next `evoeye ingest` takes them in).
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ class Settings:
     splits: SplitSpec = field(default_factory=SplitSpec)  # where the baselines were trained
     logs: str = "collided"  # LOG_POLICIES
     software_version: str = __version__
+    logs_into_runs: bool = False  # the logs go where `evoeye ingest` takes them in
 
     def __post_init__(self) -> None:
         check_batch_name(self.batch)
@@ -63,18 +66,20 @@ class Settings:
                 "triggers": [t.to_dict() for t in self.triggers],
                 "fallback": asdict(self.fallback), "consecutive": self.consecutive,
                 "horizon_s": self.horizon_s, "splits": asdict(self.splits), "logs": self.logs,
-                "software_version": self.software_version}
+                "software_version": self.software_version,
+                "logs_into_runs": self.logs_into_runs}
 
     @classmethod
     def of(cls, d: dict) -> Settings:
         return cls(d["scenario"], d["batch"], tuple(TriggerSpec.of(t) for t in d["triggers"]),
                    FallbackConfig(**d["fallback"]), d["consecutive"], d["horizon_s"],
-                   SplitSpec(**d["splits"]), d["logs"], d["software_version"])
+                   SplitSpec(**d["splits"]), d["logs"], d["software_version"],
+                   d.get("logs_into_runs", False))
 
     @property
     def key(self) -> str:
-        """10 hex of the settings that change a result (all but the log policy)."""
-        data = {k: v for k, v in self.to_dict().items() if k != "logs"}
+        """10 hex of the settings that change a result (all but where logs go)."""
+        data = {k: v for k, v in self.to_dict().items() if k not in ("logs", "logs_into_runs")}
         return hashlib.sha256(json.dumps(data, sort_keys=True).encode()).hexdigest()[:10]
 
     def folder(self, root: DataRoot) -> Path:

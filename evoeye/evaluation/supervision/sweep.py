@@ -22,7 +22,7 @@ without supervision is the only reference all triggers share.
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 
 import numpy as np
@@ -200,19 +200,31 @@ def sweep_trigger(job: RunJob, trigger: TriggerSpec, scores: list[float],
             "sims": sims}
 
 
+def supervised_spec(spec: RunSpec, trigger: str, lead: int) -> RunSpec:
+    """How a supervised run's log names itself: its own scenario id (the run's, suffixed with
+    the trigger and its leading threshold) and source, in batch `<batch>-supervised`, so it is
+    never mistaken for, nor ingested as a duplicate of, the unsupervised run."""
+    return replace(spec, scenario_id=f"{spec.scenario_id}.{trigger}.t{lead:02d}",
+                   batch=f"{spec.batch}-supervised", source="supervised")
+
+
 def _log(job: RunJob, trigger: TriggerSpec, run: SupervisedRun, lead: int,
          collided: bool) -> str | None:
-    """Write the simulation's log if the policy asks for it; its path under the folder."""
-    if job.settings.logs == "none" or (job.settings.logs == "collided" and not collided):
+    """Write the simulation's log if the policy asks for it: under the supervision's folder,
+    or (`logs_into_runs`) where `evoeye ingest` finds it. Its path under the data root."""
+    s = job.settings
+    if s.logs == "none" or (s.logs == "collided" and not collided):
         return None
-    rel = Path("logs") / trigger.name / f"{job.spec.scenario_id}.t{lead:02d}.mcap"
-    path = Path(job.folder) / rel
+    root = DataRoot.resolve(job.root)
+    spec = supervised_spec(job.spec, trigger.name, lead)
+    path = (root.run_log(spec.scenario, spec.batch, spec.scenario_id) if s.logs_into_runs else
+            Path(job.folder) / "logs" / trigger.name / f"{spec.scenario_id}.mcap")
     path.parent.mkdir(parents=True, exist_ok=True)
     record = {"trigger": trigger.name, "trigger_version": trigger.version,
-              "thresholds": list(run.thresholds), "consecutive": job.settings.consecutive,
-              "fallback": job.settings.to_dict()["fallback"]}
-    write_episode(run.episode, path, Supervision(run.states, record))
-    return rel.as_posix()
+              "thresholds": list(run.thresholds), "consecutive": s.consecutive,
+              "fallback": s.to_dict()["fallback"], "unsupervised_id": job.spec.scenario_id}
+    write_episode(replace(run.episode, spec=spec), path, Supervision(run.states, record))
+    return root.relative(path)
 
 
 def supervise_run(job: RunJob) -> dict:

@@ -27,6 +27,7 @@ class Supervised:
     batch: str = BATCH
     splits: SplitSpec = SPLITS
     fprs: tuple[float, ...] = FPRS
+    batch_seed: int = BATCH_SEED
 
 
 @pytest.fixture(scope="session")

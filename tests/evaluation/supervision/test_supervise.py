@@ -5,16 +5,18 @@ channels, and a resume that redoes nothing finished and recomputes the same byte
 from __future__ import annotations
 
 import shutil
+from pathlib import Path
 
 import numpy as np
 import pytest
 
+from evoeye.batch import plan_uniform, run_batch
 from evoeye.evaluation.supervision import check_held_out, supervise
 from evoeye.evaluation.supervision.batch import plan_supervision, record_path
 from evoeye.evaluation.supervision.sweep import ReproductionError, RunJob, supervise_run
 from evoeye.evaluation.supervision.triggers import sweep_thresholds
 from evoeye.log import read_run
-from evoeye.store import SplitSpec
+from evoeye.store import SplitSpec, Warehouse, ingest
 
 TRIGGERS = [("baseline", "ttc")]
 
@@ -51,17 +53,21 @@ def test_every_run_gets_a_record_paired_with_its_logged_outcome(sup, result) -> 
     assert sum(r["unsupervised"]["collided"] for r in result.records) == 2
 
 
-def test_each_simulation_is_logged_with_the_supervisor_channels(result) -> None:
+def test_each_simulation_is_logged_with_the_supervisor_channels(sup, result) -> None:
     r = next(r for r in result.records if r["triggers"]["ttc"]["sims"])
     sim = r["triggers"]["ttc"]["sims"][0]
-    run = read_run(result.folder / sim["log"])
+    path = sup.root.path / sim["log"]
+    assert result.folder in path.parents  # never where `evoeye ingest` looks
+    run = read_run(path)
     states = [m for _, m in run.messages("/supervisor")]
     assert len(states) == round(sim["duration_s"] * 20)
     modes = [s["mode"] for s in states]
     first = sim["first_alarm_frame"]
     assert set(modes[:first]) == {"nominal"} and modes[first] == "braking"
     assert states[first]["alarm"] and not any(s["alarm"] for s in states[:first])
-    assert run.metadata["scenario_id"] == r["scenario_id"]
+    meta = run.metadata
+    assert meta["scenario_id"] == f"{r['scenario_id']}.ttc.t{sim['lead']:02d}"
+    assert meta["source"] == "supervised" and meta["batch"] == f"{sup.batch}-supervised"
 
 
 def test_a_resumed_supervision_skips_finished_runs_and_recomputes_the_same_bytes(
@@ -70,7 +76,7 @@ def test_a_resumed_supervision_skips_finished_runs_and_recomputes_the_same_bytes
     assert again.done_before == 4 and again.records == result.records
     victim = next(r for r in result.records if r["triggers"]["ttc"]["sims"])
     path = record_path(result.folder, victim["scenario_id"])
-    logs = [result.folder / s["log"] for s in victim["triggers"]["ttc"]["sims"]]
+    logs = [sup.root.path / s["log"] for s in victim["triggers"]["ttc"]["sims"]]
     before = path.read_bytes(), [p.read_bytes() for p in logs]
     path.unlink()
     for p in logs:
@@ -103,3 +109,19 @@ def test_targets_giving_the_same_threshold_are_one() -> None:
     assert thresholds == (0.0, pytest.approx(0.5 + 4 * 0.4 / 9))
     assert targets == (0.5, 0.05)  # 0.5, 0.2 and 0.1 all give 0.0: the loosest names it
     assert realised == (0.1, 0.05)
+
+
+def test_asked_for_the_logs_go_where_ingest_takes_them_in(new_eval_root, sup) -> None:
+    root = new_eval_root()
+    run_batch(plan_uniform(sup.scenario, 4, sup.batch_seed, batch=sup.batch)[1:2], root)  # collides
+    out = supervise(root, sup.scenario, sup.batch, TRIGGERS, splits=sup.splits, fprs=sup.fprs,
+                    logs="all", logs_into_runs=True)
+    logs = [s["log"] for r in out.records for s in r["triggers"]["ttc"]["sims"]]
+    assert logs and all(p.startswith(f"runs/{sup.scenario}/{sup.batch}-supervised/")
+                        for p in logs)
+    report = ingest(root)
+    ids = {Path(p).stem for p in logs}
+    assert ids <= set(report.ingested) and not report.duplicates
+    sources = Warehouse(root).sql("SELECT DISTINCT source FROM scenarios WHERE batch = $b",
+                                  {"b": f"{sup.batch}-supervised"}).column("source").to_pylist()
+    assert sources == ["supervised"]
