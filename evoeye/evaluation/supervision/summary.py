@@ -160,6 +160,7 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
             "collisions_prevented": int(prevented[:, j].sum()),
             "collisions_caused": int(caused[:, j].sum()),
             "caused_rear_end": int((caused[:, j] & table.rear_end[:, j]).sum()),
+            "rear_end": int(table.rear_end[:, j].sum()),  # every supervised one hit from behind
             "interventions": int(table.interventions[:, j].sum()),
             "false_interventions": int(table.false[:, j].sum()),
             "fallback_s_per_h": float(_ratio(table.fallback_s[:, j].sum(),
