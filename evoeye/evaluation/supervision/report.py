@@ -10,13 +10,12 @@ operating curves. Tables stay narrow (at most eight columns) for the Prefect art
 from __future__ import annotations
 
 import json
-from dataclasses import dataclass
 from datetime import UTC, datetime
 from html import escape
 from pathlib import Path
 
 from evoeye.evaluation.plots import operating_chart
-from evoeye.evaluation.report import CSS, DASH, Table, pct
+from evoeye.evaluation.report import DASH, ReportFiles, Table, html_page, pct
 from evoeye.monitor.families import DEFAULT_FAMILY
 from evoeye.paths import DataRoot
 
@@ -166,30 +165,14 @@ def html_report(summaries: list[dict], title: str = "evoeye supervision report")
             body.append(differences_table(s).html())
         for name, label in _triggers(s):
             body += [f"<h3>{escape(label)}</h3>", curve_table(s, name).html()]
-    return ("<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">"
-            f"<title>{escape(title)}</title><style>{CSS}</style></head><body>"
-            + "".join(body) + "</body></html>\n")
-
-
-@dataclass(frozen=True)
-class ReportFiles:
-    folder: Path
-    markdown: Path
-    html: Path
-    json: Path
+    return html_page(title, body)
 
 
 def write_report(root: DataRoot, summaries: list[dict], name: str | None = None) -> ReportFiles:
     """supervision.md, report.html and report.json under `<root>/reports/<name>/`."""
-    name = name or f"supervision-{datetime.now(UTC):%Y%m%dT%H%M%SZ}"
-    if not name or "/" in name or name.startswith("."):
-        raise ValueError(f"report name must be a plain folder name, got {name!r}")
-    folder = root.reports / name
-    folder.mkdir(parents=True, exist_ok=True)
-    files = ReportFiles(folder, folder / "supervision.md", folder / "report.html",
-                        folder / "report.json")
+    files = ReportFiles.under(root, name, "supervision", "supervision.md")
     files.markdown.write_text(markdown_report(summaries), encoding="utf-8")
-    files.html.write_text(html_report(summaries, f"evoeye supervision — {name}"),
+    files.html.write_text(html_report(summaries, f"evoeye supervision — {files.folder.name}"),
                           encoding="utf-8")
     files.json.write_text(json.dumps(summaries, indent=1) + "\n", encoding="utf-8")
     return files
