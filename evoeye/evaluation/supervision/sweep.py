@@ -128,7 +128,8 @@ class Reference:
 
 
 def summarise(run: SupervisedRun, ref: Reference) -> dict:
-    """What one supervised simulation cost and achieved (before its own collision, if any)."""
+    """What one (finished) supervised simulation cost and achieved, before its own collision
+    if it has one."""
     ep, states, dt_s = run.episode, run.states, ref.dt_s
     o = ep.outcome
     end = len(states)
@@ -145,9 +146,8 @@ def summarise(run: SupervisedRun, ref: Reference) -> dict:
     first_lead = (ref.collision_time_s - starts[0] * dt_s
                   if starts and verdicts[0] == "true" else None)
     return {
-        "status": o.status, "reason": o.reason, "collided": o.collided,
-        "collision_time_s": o.collision_time_s, "other_actor": o.other_actor,
-        "struck_from_behind": struck_from_behind(ep) if o.status == STATUS_OK else False,
+        "collided": o.collided, "collision_time_s": o.collision_time_s,
+        "other_actor": o.other_actor, "struck_from_behind": struck_from_behind(ep),
         "duration_s": o.duration_s, "min_distance_m": o.min_distance_m,
         "interventions": len(starts), "false_interventions": verdicts.count("false"),
         "true_interventions": verdicts.count("true"), "first_lead_s": first_lead,
@@ -179,15 +179,19 @@ def sweep_trigger(job: RunJob, trigger: TriggerSpec, scores: list[float],
     index = {t: i for i, t in enumerate(trigger.thresholds)}
     sim_of: list[int | None] = [None] * len(first)
     sims: list[dict] = []
-    pending = [tuple(t for t, f in zip(trigger.thresholds, first, strict=True) if f is not None)]
-    while pending and pending[0]:
+    alarmed = tuple(t for t, f in zip(trigger.thresholds, first, strict=True) if f is not None)
+    pending = [alarmed] if alarmed else []
+    while pending:
         group = pending.pop(0)
         lead = index[group[0]]
         risk_scorer = scorer(DataRoot.resolve(job.root), s, trigger)
         run = run_supervised(job.spec, lambda m, sc=risk_scorer: sc.score(FrameInputs.of(m)),
                              Trigger(trigger.name, trigger.version, group, s.consecutive),
                              s.fallback)
-        _check_prefix(run, scores, first[lead], f"{job.spec.scenario_id} {trigger.name}")
+        name = f"{job.spec.scenario_id} {trigger.name}"
+        if run.episode.outcome.status != STATUS_OK:  # a broken run is no outcome to count
+            raise RuntimeError(f"{name}: the supervised run failed: {run.episode.outcome.reason}")
+        _check_prefix(run, scores, first[lead], name)
         pending += [f.thresholds for f in run.forks]
         summary = summarise(run, ref)
         summary |= {"lead": lead, "first_alarm_frame": first[lead],
