@@ -78,11 +78,14 @@ def headline(summary: dict, budget: float = HEADLINE_BUDGET_PER_H) -> str:
 
 def budget_table(summary: dict, budget: float) -> Table:
     rows = [[r["label"], f"{pct(r['prevented_share'])}{ci(r['prevented_ci'])}",
-             _rate(r["false_interventions_per_h"]), str(r["collisions_caused"]),
-             DASH if r["threshold"] is None else f"{r['threshold']:.4g}", _opt(r["lead_s"], ".2f")]
+             f"{_rate(r['false_interventions_per_h'])}"
+             f"{ci(r['false_interventions_ci'], scale=1.0)}",
+             f"{_opt(r['lead_s'], '.2f')}{ci(r['lead_ci'], scale=1.0)}",
+             str(r["collisions_caused"]),
+             "off" if r["threshold"] is None else f"{r['threshold']:.4g}"]
             for r in _at(summary, budget)]
-    return Table(["Trigger", f"Prevented % at ≤ {budget:g}/h [95 % CI]", "False int./h",
-                  "Caused", "Threshold", "Lead s"], rows)
+    return Table(["Trigger", f"Prevented % (recall) at ≤ {budget:g}/h",
+                  "False int./h (false alarms/h)", "Lead s", "Caused", "Threshold"], rows)
 
 
 def differences_table(summary: dict) -> Table:
@@ -105,7 +108,8 @@ def curve_table(summary: dict, trigger: str) -> Table:
                      f"{pct(p['prevented_share'])}{ci(p['prevented_ci'])}",
                      f"{p['collisions_caused']} ({p['caused_rear_end']})",
                      _opt(p["fallback_s_per_h"], ".0f"), _opt(p["peak_decel_mps2"]),
-                     _opt(p["peak_jerk_mps3"], ".0f"), _opt(p["lead_s"], ".2f")])
+                     _opt(p["peak_jerk_mps3"], ".0f"),
+                     f"{_opt(p['lead_s'], '.2f')}{ci(p['lead_ci'], scale=1.0)}"])
     return Table(["Threshold (val FPR)", "False int./h [CI]", "Prevented % [CI]",
                   "Caused (rear-end)", "Fallback s/h", "Decel m/s²", "Jerk m/s³", "Lead s"], rows)
 

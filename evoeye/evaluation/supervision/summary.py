@@ -13,12 +13,16 @@ Per trigger and threshold, over the runs (each paired with its unsupervised run)
   intervened (means over them), and the lead time of the first true intervention (median).
 
 At a budget β the trigger runs at its threshold that prevents the most collisions with at most
-β false interventions per hour (supervision off, preventing none, always meets it).
+β false interventions per hour (supervision off, preventing none, always meets it): the
+collisions it prevents there (recall at a false-alarm budget), and at that threshold its false
+interventions per hour and lead time.
 
 CIs: 95 % percentile bootstrap over runs, B resamples (seeded). Every trigger's and threshold's
 figures come from the same resamples — the comparison is paired run by run — computed at once
 as products of the resampling counts with the per-run values; the operating point at a budget
-is chosen again in every resample, so its CI includes the choice. Percentile rather than BCa:
+is chosen again in every resample, so its CI includes the choice (the CIs of the false
+interventions and the lead time at a budget are those of the threshold chosen on all runs).
+Medians in a resample are weighted by the resampling counts. Percentile rather than BCa:
 a choice among thresholds is no smooth statistic, and BCa's correction assumes one.
 """
 
@@ -128,6 +132,19 @@ def _ci(samples: np.ndarray) -> list:
     return pairs if samples.ndim > 1 else pairs[0]
 
 
+def weighted_medians(values: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """(B,) the (lower) median of the finite `values` (R,) in each resample (counts `weights`
+    (B, R)); NaN in a resample that holds none of them."""
+    keep = np.flatnonzero(np.isfinite(values))
+    if keep.size == 0:
+        return np.full(len(weights), np.nan)
+    order = keep[np.argsort(values[keep], kind="stable")]
+    cum = np.cumsum(weights[:, order], axis=1)  # (B, n)
+    total = cum[:, -1:]
+    idx = np.argmax(cum >= total / 2.0, axis=1)
+    return np.where(total[:, 0] > 0, values[order][idx], np.nan)
+
+
 def _mean_over(values: np.ndarray, where: np.ndarray) -> list[float | None]:
     """Per threshold, the mean of `values` (R, Θ) over the runs `where` (R, Θ) holds."""
     n = where.sum(axis=0)
@@ -147,8 +164,10 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
     bf = _ratio(weights @ table.false, (weights @ table.safe_s)[:, None] / 3600.0)
     p_ci, f_ci = _ci(bp), _ci(bf)
     acted = table.interventions > 0
-    lead = [float(np.nanmedian(col)) if np.isfinite(col).any() else None
+    once = np.ones((1, len(c0)))
+    lead = [None if np.isnan(m := weighted_medians(col, once)[0]) else float(m)
             for col in table.lead_s.T]
+    lead_ci = [_ci(weighted_medians(col, weights)) for col in table.lead_s.T]
     points = []
     for j, thr in enumerate(t.thresholds):
         points.append({
@@ -167,7 +186,7 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
                                              table.duration_s[:, j].sum() / 3600.0)),
             "peak_decel_mps2": _mean_over(table.decel_mps2, acted)[j],
             "peak_jerk_mps3": _mean_over(table.jerk_mps3, acted)[j],
-            "lead_s": lead[j],
+            "lead_s": lead[j], "lead_ci": lead_ci[j],
         })
     return points, bp, bf
 
@@ -233,10 +252,12 @@ def _operating_point(points: list[dict], budget: float) -> dict:
     ok = [p for p in points if p["false_interventions_per_h"] <= budget + 1e-12]
     if not ok:
         return {"threshold": None, "prevented_share": 0.0, "false_interventions_per_h": 0.0,
-                "collisions_caused": 0, "lead_s": None}
+                "false_interventions_ci": [0.0, 0.0], "collisions_caused": 0, "lead_s": None,
+                "lead_ci": [None, None]}
     p = max(ok, key=lambda p: (p["prevented_share"] or 0.0, -p["false_interventions_per_h"]))
     return {k: p[k] for k in ("threshold", "prevented_share", "false_interventions_per_h",
-                              "collisions_caused", "lead_s")}
+                              "false_interventions_ci", "collisions_caused", "lead_s",
+                              "lead_ci")}
 
 
 def _share_at(points: list[dict], budget: float) -> float:

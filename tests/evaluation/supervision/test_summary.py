@@ -12,6 +12,7 @@ from evoeye.evaluation.supervision.summary import (
     at_budget,
     resampling_counts,
     summarise_supervision,
+    weighted_medians,
 )
 from evoeye.evaluation.supervision.triggers import TriggerSpec
 
@@ -114,3 +115,9 @@ def test_the_same_records_and_seed_give_the_same_summary(data) -> None:
     assert a == b
     counts = resampling_counts(40, 300, seed=4)
     assert counts.shape == (300, 40) and (counts.sum(axis=1) == 40).all()
+
+
+def test_a_resample_s_median_counts_each_run_as_often_as_it_is_drawn() -> None:
+    values = np.array([3.0, 1.0, np.nan, 2.0])
+    counts = np.array([[1, 1, 1, 1], [0, 0, 4, 0], [3, 1, 0, 0], [0, 2, 0, 1]], float)
+    np.testing.assert_array_equal(weighted_medians(values, counts), [2.0, np.nan, 3.0, 1.0])
