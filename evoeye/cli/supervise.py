@@ -148,9 +148,9 @@ def supervise_command(
 
 
 def _print_summary(summary: dict, done_before: int) -> None:
-    from evoeye.evaluation.supervision.report import ci, headline
+    from evoeye.evaluation.supervision.report import ci, headline, headline_budget
 
-    budget = 1.0 if 1.0 in summary["budgets_per_h"] else summary["budgets_per_h"][0]
+    budget = headline_budget(summary)
     t = table(f"supervise {summary['scenario']}: at ≤ {budget:g} false intervention/h",
               ["trigger", "prevented % [CI]", "false int./h", "caused", "threshold"],
               left=("trigger",))

@@ -48,8 +48,16 @@ def _at(summary: dict, budget: float) -> list[dict]:
     return [r for r in summary["at_budget"] if r["budget_per_h"] == budget]
 
 
-def headline(summary: dict, budget: float = HEADLINE_BUDGET_PER_H) -> str:
-    """One paragraph: the FusionMonitor against the best rule-based trigger at the budget."""
+def headline_budget(summary: dict) -> float:
+    """HEADLINE_BUDGET_PER_H if the summary has it, else its first budget."""
+    budgets = summary["budgets_per_h"]
+    return HEADLINE_BUDGET_PER_H if HEADLINE_BUDGET_PER_H in budgets else budgets[0]
+
+
+def headline(summary: dict, budget: float | None = None) -> str:
+    """One paragraph: the FusionMonitor against the best rule-based trigger at the budget
+    (default `headline_budget`)."""
+    budget = headline_budget(summary) if budget is None else budget
     rows = {r["trigger"]: r for r in _at(summary, budget)}
     head = (f"**{summary['scenario']}** ({summary['runs']} runs, "
             f"{summary['collisions_unsupervised']} unsupervised collisions, "
@@ -152,7 +160,7 @@ def curve_svg(summary: dict) -> str:
     series = [(label, [p for p in summary["points"] if p["trigger"] == name])
               for name, label in _triggers(summary)]
     return operating_chart(series, title=f"Operating curves, {summary['scenario']}",
-                           budget=HEADLINE_BUDGET_PER_H)
+                           budget=headline_budget(summary))
 
 
 def html_report(summaries: list[dict], title: str = "evoeye supervision report") -> str:

@@ -121,3 +121,17 @@ def test_a_resample_s_median_counts_each_run_as_often_as_it_is_drawn() -> None:
     values = np.array([3.0, 1.0, np.nan, 2.0])
     counts = np.array([[1, 1, 1, 1], [0, 0, 4, 0], [3, 1, 0, 0], [0, 2, 0, 1]], float)
     np.testing.assert_array_equal(weighted_medians(values, counts), [2.0, np.nan, 3.0, 1.0])
+
+
+def test_the_report_leads_with_the_fusion_monitor_against_the_best_rule(data) -> None:
+    from evoeye.evaluation.supervision.report import headline, markdown_report
+
+    settings, records = data
+    s = summarise_supervision(settings, records, budgets=(5.0, 60.0), resamples=500)
+    text = headline(s, 5.0)
+    assert "the FusionMonitor prevents 80.0 %" in text and "causes 0 new ones" in text
+    assert "best rule-based trigger, ttc, prevents 20.0 %" in text
+    assert "Paired difference +60.0 points" in text and "more than every rule-based" in text
+    md = markdown_report([s])
+    assert md.index("FusionMonitor prevents") < md.index("| Trigger |")  # headline first
+    assert "### ttc: operating curve" in md
