@@ -181,8 +181,8 @@ def operating_chart(series: Sequence[tuple[str, Sequence[dict]]], *, title: str,
     A point: {"false_interventions_per_h", "false_interventions_ci", "prevented_share",
     "prevented_ci"} (shares in [0, 1]). `budget` draws a dashed vertical line."""
     xs = [p["false_interventions_per_h"] for _, pts in series for p in pts]
-    xs += [v for _, pts in series for p in pts for v in p["false_interventions_ci"] if v]
-    positive = [v for v in [*xs, budget or 0.0] if v > 0]
+    xs += [v for _, pts in series for p in pts for v in p["false_interventions_ci"]]
+    positive = [v for v in [*xs, budget] if v is not None and v > 0]
     lo = 10.0 ** np.floor(np.log10(min([*positive, 0.1])))
     hi = 10.0 ** np.ceil(np.log10(max([*positive, 10.0 * lo])))
     f = _Frame((float(np.log10(lo)), float(np.log10(hi))), (0.0, 100.0), height=HEIGHT + 40)
@@ -202,7 +202,8 @@ def operating_chart(series: Sequence[tuple[str, Sequence[dict]]], *, title: str,
         body.append(f'<line x1="{gx(budget):.1f}" y1="{f.y0}" x2="{gx(budget):.1f}" '
                     f'y2="{f.y1}" stroke="#888" stroke-dasharray="4 3"/>')
     for i, (label, pts) in enumerate(series):
-        shown = [p for p in pts if p["prevented_share"] is not None]
+        shown = [p for p in pts if p["prevented_share"] is not None
+                 and p["false_interventions_per_h"] is not None]
         if not shown:
             continue
         line = " ".join(f"{gx(p['false_interventions_per_h']):.1f},"

@@ -107,6 +107,11 @@ def _ratio(num: np.ndarray, den: np.ndarray, scale: float = 1.0) -> np.ndarray:
         return np.where(den > 0, scale * num / np.where(den > 0, den, 1.0), np.nan)
 
 
+def _finite(x: float | np.ndarray) -> float | None:
+    """A figure for JSON: None where undefined (no collision, no safe driving to divide by)."""
+    return float(x) if np.isfinite(x) else None
+
+
 def resampling_counts(n_runs: int, resamples: int = RESAMPLES, seed: int = 0) -> np.ndarray:
     """(B, R) how often each run is drawn in each bootstrap resample (seeded)."""
     rng = np.random.default_rng(seed)
@@ -173,8 +178,8 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
         points.append({
             "trigger": t.name, "label": t.label, "threshold": thr,
             "target_fpr": t.target_fprs[j], "val_fpr": t.val_fprs[j],
-            "prevented_share": None if np.isnan(p_share[j]) else float(p_share[j]),
-            "prevented_ci": p_ci[j], "false_interventions_per_h": float(fi[j]),
+            "prevented_share": _finite(p_share[j]),
+            "prevented_ci": p_ci[j], "false_interventions_per_h": _finite(fi[j]),
             "false_interventions_ci": f_ci[j],
             "collisions_prevented": int(prevented[:, j].sum()),
             "collisions_caused": int(caused[:, j].sum()),
@@ -182,8 +187,8 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
             "rear_end": int(table.rear_end[:, j].sum()),  # every supervised one hit from behind
             "interventions": int(table.interventions[:, j].sum()),
             "false_interventions": int(table.false[:, j].sum()),
-            "fallback_s_per_h": float(_ratio(table.fallback_s[:, j].sum(),
-                                             table.duration_s[:, j].sum() / 3600.0)),
+            "fallback_s_per_h": _finite(_ratio(table.fallback_s[:, j].sum(),
+                                               table.duration_s[:, j].sum() / 3600.0)),
             "peak_decel_mps2": _mean_over(table.decel_mps2, acted)[j],
             "peak_jerk_mps3": _mean_over(table.jerk_mps3, acted)[j],
             "lead_s": lead[j], "lead_ci": lead_ci[j],
@@ -249,7 +254,8 @@ def summarise_supervision(settings: Settings, records: list[dict],
 def _operating_point(points: list[dict], budget: float) -> dict:
     """The threshold a trigger runs at within the budget (most prevented, then fewest false
     interventions), or supervision off."""
-    ok = [p for p in points if p["false_interventions_per_h"] <= budget + 1e-12]
+    ok = [p for p in points if p["false_interventions_per_h"] is not None
+          and p["false_interventions_per_h"] <= budget + 1e-12]
     if not ok:
         return {"threshold": None, "prevented_share": 0.0, "false_interventions_per_h": 0.0,
                 "false_interventions_ci": [0.0, 0.0], "collisions_caused": 0, "lead_s": None,
