@@ -74,6 +74,8 @@ def main() -> None:
                              Trigger("fusion", monitor.version, (threshold,)))
         return run.episode
 
+    for spec in (ss[0] for ss in specs.values()):  # warm-up: ONNX export, compiled kernels
+        supervised(spec, 0.0)
     print(f"machine: {describe()}")
     print(f"monitor: {monitor.version}; {args.runs} runs per scenario, best of {args.repeat}")
     print("| logical scenario | plain ms/frame | "
