@@ -23,6 +23,7 @@ from evoeye.evaluation.supervision.summary import BUDGETS_PER_H, summarise_super
 from evoeye.evaluation.supervision.sweep import supervise_run
 from evoeye.evaluation.supervision.triggers import (
     DEFAULT_BASELINES,
+    RECALLS,
     SWEEP_FPRS,
     calibrate_triggers,
 )
@@ -45,6 +46,7 @@ class SuperviseParams(BaseModel):
     monitors: list[str] = Field(default_factory=list)  # trained versions, each on its scenario
     baselines: list[str] = Field(default_factory=lambda: list(DEFAULT_BASELINES))
     fprs: list[float] = Field(default_factory=lambda: list(SWEEP_FPRS))
+    recalls: list[float] = Field(default_factory=lambda: list(RECALLS))
     consecutive: int = Field(1, ge=1)
     decel_mps2: float = Field(F.decel_mps2, gt=0.0)
     jerk_mps3: float = Field(F.jerk_mps3, gt=0.0)
@@ -91,7 +93,7 @@ def calibrate(root: DataRoot, scenario: str, params: SuperviseParams) -> Setting
                 if trained_on(load_version(root, v)) in (None, scenario)]
     sources = [("version", v) for v in versions] + [("baseline", b) for b in params.baselines]
     triggers = calibrate_triggers(root, scenario, sources, params.splits, params.fprs,
-                                  params.horizon_s)
+                                  params.horizon_s, params.recalls)
     return Settings(scenario, params.batch, tuple(triggers), params.fallback,
                     params.consecutive, params.horizon_s, params.splits, params.logs,
                     logs_into_runs=params.logs_into_runs)

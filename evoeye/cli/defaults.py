@@ -14,6 +14,7 @@ ABLATION_NAMES = ("perception", "perception+prediction", "perception+prediction+
                   "all")  # evoeye.monitor.inputs.ABLATIONS
 SWEEP_FPRS = (0.05, 0.02, 0.01, 0.005, 0.002, 0.001, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5,
               1e-5)  # evoeye.evaluation.supervision.triggers.SWEEP_FPRS
+SWEEP_RECALLS = (0.2, 0.1, 0.05)  # evoeye.evaluation.supervision.triggers.RECALLS
 SUPERVISE_BASELINES = ("ttc", "ttc-2d", "rss", "aem",
                        "context-only")  # evoeye.evaluation.supervision.triggers
 SUPERVISE_BUDGETS = (0.5, 1.0, 2.0)  # evoeye.evaluation.supervision.summary.BUDGETS_PER_H

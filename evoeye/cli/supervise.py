@@ -19,6 +19,7 @@ from evoeye.cli.defaults import (
     SUPERVISE_BASELINES,
     SUPERVISE_BUDGETS,
     SWEEP_FPRS,
+    SWEEP_RECALLS,
 )
 from evoeye.cli.errors import ExitCode, UserError
 from evoeye.cli.evaluate import parse_baselines
@@ -54,6 +55,9 @@ def supervise_command(
     fprs: Annotated[str, typer.Option(
         help="Target FPRs on validation frames the thresholds are calibrated for.")] =
         ",".join(f"{f:g}" for f in SWEEP_FPRS),
+    recalls: Annotated[str, typer.Option(
+        help="Beyond them, target frame recalls on validation for thresholds above every "
+        "validation negative ('none' for none).")] = ",".join(f"{r:g}" for r in SWEEP_RECALLS),
     consecutive: Annotated[int, typer.Option(min=1, help="K: frames above the threshold "
                                              "that raise the alarm.")] = 1,
     decel_mps2: Annotated[float, typer.Option(help="Fallback deceleration, m/s².")] =
@@ -123,7 +127,9 @@ def supervise_command(
     bar = lambda it: tqdm(it, desc=f"supervise {scenario}", unit="run")  # noqa: E731
     try:
         result = supervise(data, scenario, batch, sources, splits=splits,
-                           fprs=parse_floats(fprs, "--fprs"), fallback=fallback,
+                           fprs=parse_floats(fprs, "--fprs"),
+                           recalls=() if recalls == "none" else parse_floats(recalls, "--recalls"),
+                           fallback=fallback,
                            consecutive=consecutive, horizon_s=horizon_s, logs=logs,
                            logs_into_runs=logs_into_runs, workers=workers, limit=limit,
                            progress=bar)

@@ -12,7 +12,7 @@ from collections.abc import Callable, Iterable, Sequence
 
 from evoeye.evaluation.supervision.batch import SupervisionResult, batch_runs, run_supervision
 from evoeye.evaluation.supervision.settings import Settings
-from evoeye.evaluation.supervision.triggers import SWEEP_FPRS, calibrate_triggers
+from evoeye.evaluation.supervision.triggers import RECALLS, SWEEP_FPRS, calibrate_triggers
 from evoeye.paths import DataRoot
 from evoeye.sim.supervisor import FallbackConfig
 from evoeye.store import RunFilter, SplitSpec, Warehouse, select_runs
@@ -21,7 +21,7 @@ from evoeye.store.windows import DEFAULT_HORIZON_S
 
 def supervise(root: DataRoot, scenario: str, batch: str, sources: Sequence[tuple[str, str]], *,
               splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
-              fprs: Sequence[float] = SWEEP_FPRS,
+              fprs: Sequence[float] = SWEEP_FPRS, recalls: Sequence[float] = RECALLS,
               fallback: FallbackConfig = FallbackConfig(),  # noqa: B008 (frozen dataclass)
               consecutive: int = 1, horizon_s: float = DEFAULT_HORIZON_S,
               logs: str = "collided", logs_into_runs: bool = False, workers: int = 1,
@@ -33,7 +33,7 @@ def supervise(root: DataRoot, scenario: str, batch: str, sources: Sequence[tuple
     ValueError if a run of the batch is in the train or validation split: a trigger must not
     be judged on the runs it learned or was calibrated on."""
     check_held_out(root, scenario, batch, splits)
-    triggers = calibrate_triggers(root, scenario, sources, splits, fprs, horizon_s)
+    triggers = calibrate_triggers(root, scenario, sources, splits, fprs, horizon_s, recalls)
     settings = Settings(scenario, batch, tuple(triggers), fallback, consecutive, horizon_s,
                         splits, logs, logs_into_runs=logs_into_runs)
     return run_supervision(root, settings, workers=workers, progress=progress, limit=limit)

@@ -110,7 +110,7 @@ def differences_table(summary: dict) -> Table:
 def curve_table(summary: dict, trigger: str) -> Table:
     rows = []
     for p in (p for p in summary["points"] if p["trigger"] == trigger):
-        rows.append([f"{p['threshold']:.4g} ({p['target_fpr']:g})",
+        rows.append([f"{p['threshold']:.4g} ({p['target']})",
                      f"{_rate(p['false_interventions_per_h'])}"
                      f"{ci(p['false_interventions_ci'], scale=1.0)}",
                      f"{pct(p['prevented_share'])}{ci(p['prevented_ci'])}",
@@ -118,7 +118,7 @@ def curve_table(summary: dict, trigger: str) -> Table:
                      _opt(p["fallback_s_per_h"], ".0f"), _opt(p["peak_decel_mps2"]),
                      _opt(p["peak_jerk_mps3"], ".0f"),
                      f"{_opt(p['lead_s'], '.2f')}{ci(p['lead_ci'], scale=1.0)}"])
-    return Table(["Threshold (val FPR)", "False int./h [CI]", "Prevented % [CI]",
+    return Table(["Threshold (val target)", "False int./h [CI]", "Prevented % [CI]",
                   "Caused (rear-end)", "Fallback s/h", "Decel m/s²", "Jerk m/s³", "Lead s"], rows)
 
 

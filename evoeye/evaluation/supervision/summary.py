@@ -177,7 +177,7 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
     for j, thr in enumerate(t.thresholds):
         points.append({
             "trigger": t.name, "label": t.label, "threshold": thr,
-            "target_fpr": t.target_fprs[j], "val_fpr": t.val_fprs[j],
+            "target": t.targets[j], "val_fpr": t.val_fprs[j], "val_recall": t.val_recalls[j],
             "prevented_share": _finite(p_share[j]),
             "prevented_ci": p_ci[j], "false_interventions_per_h": _finite(fi[j]),
             "false_interventions_ci": f_ci[j],

@@ -21,8 +21,9 @@ SAFE_S = 18.0  # per run: 40 runs → 0.2 h of safe driving
 
 
 def trigger(name: str, source: str = "baseline") -> TriggerSpec:
-    return TriggerSpec(name, source, name, f"{name}-v", THRESHOLDS, (0.05, 0.01, 0.001),
-                       (0.05, 0.01, 0.001))
+    return TriggerSpec(name, source, name, f"{name}-v", THRESHOLDS,
+                       ("FPR 0.05", "FPR 0.01", "FPR 0.001"), (0.05, 0.01, 0.001),
+                       (0.5, 0.3, 0.1))
 
 
 def sim(collided: bool, false: int = 0, *, rear: bool = False, fallback_s: float = 2.0,

@@ -14,7 +14,7 @@ from evoeye.batch import plan_uniform, run_batch
 from evoeye.evaluation.supervision import check_held_out, supervise
 from evoeye.evaluation.supervision.batch import plan_supervision, record_path
 from evoeye.evaluation.supervision.sweep import ReproductionError, RunJob, supervise_run
-from evoeye.evaluation.supervision.triggers import sweep_thresholds
+from evoeye.evaluation.supervision.triggers import realised, sweep_thresholds
 from evoeye.log import read_run
 from evoeye.store import SplitSpec, Warehouse, ingest
 
@@ -102,13 +102,16 @@ def test_the_batch_must_be_held_out_of_train_and_validation(sup) -> None:
         check_held_out(sup.root, sup.scenario, "b000", ingested)
 
 
-def test_targets_giving_the_same_threshold_are_one() -> None:
-    scores = np.r_[np.zeros(90), np.linspace(0.5, 0.9, 10)]  # 10 % of the negatives above 0
-    thresholds, targets, realised = sweep_thresholds(scores, np.zeros(100, np.int8),
-                                                     (0.5, 0.2, 0.1, 0.05))
-    assert thresholds == (0.0, pytest.approx(0.5 + 4 * 0.4 / 9))
-    assert targets == (0.5, 0.05)  # 0.5, 0.2 and 0.1 all give 0.0: the loosest names it
-    assert realised == (0.1, 0.05)
+def test_targets_giving_the_same_threshold_are_one_and_recalls_go_beyond() -> None:
+    negatives = np.r_[np.zeros(90), np.linspace(0.5, 0.9, 10)]  # 10 % of them above 0
+    positives = np.linspace(0.0, 1.0, 21)  # 0.95 and 1.0 lie above every negative
+    scores, labels = np.r_[negatives, positives], np.r_[np.zeros(100), np.ones(21)]
+    sweep = sweep_thresholds(scores, labels, (0.5, 0.2, 0.1, 0.05), recalls=(0.5, 0.05))
+    assert list(sweep) == pytest.approx([0.0, 0.5 + 4 * 0.4 / 9, 0.95])
+    # 0.5, 0.2 and 0.1 all give 0.0: the loosest names it; recall 0.5 is below a negative
+    assert list(sweep.values()) == ["FPR 0.5", "FPR 0.05", "recall 0.05"]
+    fpr, recall = realised(scores, labels, list(sweep))
+    assert fpr == (0.1, 0.05, 0.0) and recall[2] == 1 / 21
 
 
 def test_asked_for_the_logs_go_where_ingest_takes_them_in(new_eval_root, sup) -> None:
