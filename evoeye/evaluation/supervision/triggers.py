@@ -116,6 +116,10 @@ def calibrate_triggers(root: DataRoot, scenario: str,
     """Each (source, ref) as a trigger with its sweep's thresholds, calibrated on the
     scenario's validation windows (each monitor at its own L)."""
     monitors = [load_monitor(root, scenario, splits, source, ref) for source, ref in sources]
+    for m in monitors:
+        trained = (getattr(m, "card", None) or {}).get("logical_scenario")
+        if trained not in (None, scenario):
+            raise ValueError(f"{m.version} was trained on {trained}, not {scenario}")
     names = [m.name for m in monitors]
     if dupes := sorted({n for n in names if names.count(n) > 1}):
         raise ValueError(f"two triggers named {dupes}: give one monitor of each name")
