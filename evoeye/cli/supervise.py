@@ -133,6 +133,8 @@ def supervise_command(
                            consecutive=consecutive, horizon_s=horizon_s, logs=logs,
                            logs_into_runs=logs_into_runs, workers=workers, limit=limit,
                            progress=bar)
+        for sid, reason in result.errors:
+            err().print(f"[yellow]error[/] {sid}: {reason}")
         summary = summarise_supervision(result.settings, result.records,
                                         parse_floats(budgets, "--budgets"))
     except (ValueError, KeyError) as exc:
@@ -148,8 +150,6 @@ def supervise_command(
         _print_summary(summary, result.done_before)
         for path in [files.html, *written]:
             out().print(f"report: {path}")
-    for sid, reason in result.errors:
-        err().print(f"[yellow]error[/] {sid}: {reason}")
     exit_with(ExitCode.PARTIAL if result.errors else ExitCode.OK)
 
 

@@ -6,11 +6,15 @@ is written atomically once all its triggers are done, so a supervision killed at
 started again skips the runs with a record and redoes the rest (their logs, written atomically
 too, come out byte for byte the same); the `.tmp` files of killed writers are removed first.
 Runs fan out over worker processes that die with the parent; one that fails is reported and the
-others go on.
+others go on. The workers are spawned, not forked: the calling process has scored the
+validation split (torch, and the context-only control's OpenMP runtime, which does not survive
+a fork: forked workers died at their first run); each worker loads the triggers again from
+their specs, once.
 """
 
 from __future__ import annotations
 
+import multiprocessing as mp
 import os
 import time
 from collections.abc import Callable, Iterable
@@ -21,7 +25,6 @@ from pathlib import Path
 import orjson
 
 from evoeye.atomic import remove_stale_temps
-from evoeye.batch import pool_context
 from evoeye.evaluation.supervision.settings import Settings, open_folder
 from evoeye.evaluation.supervision.sweep import RunJob, supervise_run
 from evoeye.lifeline import die_with_parent
@@ -118,7 +121,7 @@ def run_supervision(root: DataRoot, settings: Settings, *, workers: int = 1,
             except Exception as exc:  # noqa: BLE001 - reported per run, the batch goes on
                 errors.append((job.spec.scenario_id, f"{type(exc).__name__}: {exc}"))
     else:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=pool_context(),
+        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
                                  initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
             futures: dict[Future, RunJob] = {pool.submit(supervise_run, j): j
                                              for j in plan.jobs}

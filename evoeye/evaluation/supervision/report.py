@@ -61,7 +61,7 @@ def headline(summary: dict, budget: float | None = None) -> str:
     rows = {r["trigger"]: r for r in _at(summary, budget)}
     head = (f"**{summary['scenario']}** ({summary['runs']} runs, "
             f"{summary['collisions_unsupervised']} unsupervised collisions, "
-            f"{summary['safe_h']:.1f} h of safe driving): at ≤ {budget:g} false intervention "
+            f"{summary['safe_h']:.2f} h of safe driving): at ≤ {budget:g} false intervention "
             "per hour of safe driving, ")
     fusion = rows.get(DEFAULT_FAMILY)
     diffs = [d for d in summary["differences"] if d["budget_per_h"] == budget and d["rule_based"]]

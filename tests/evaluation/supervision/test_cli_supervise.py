@@ -30,7 +30,8 @@ def _args(sup, *extra: str, batch: str | None = None) -> list[str]:
 
 def test_json_rows_hold_exactly_the_listed_fields(sup, tmp_path) -> None:
     docs = tmp_path / "docs"
-    res = RUNNER.invoke(app, _args(sup, "--json", "--name", "cli", "--docs", str(docs)))
+    res = RUNNER.invoke(app, _args(sup, "--json", "--name", "cli", "--docs", str(docs),
+                                   "--workers", "2"))  # spawned workers load the triggers
     assert res.exit_code == 0, res.output
     out = json.loads(res.stdout)
     assert out["rows"] and all(tuple(r) == ROW_FIELDS for r in out["rows"])
