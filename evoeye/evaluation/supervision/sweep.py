@@ -41,6 +41,9 @@ from evoeye.sim.supervisor import SupervisedRun, Trigger, first_engagements, run
 from evoeye.store.labels import eligible_frames, frame_labels
 
 FALLBACK_MODES = ("braking", "holding")  # an intervention: the fallback drives the ego
+# the jerk of a step into the final stop is left out: a stop's own, the same for any stop (the
+# ADS's too: braking that no longer finds speed to take off)
+STOPPING_MPS = 0.5
 _SCORERS: dict[tuple, OnlineScorer] = {}  # this process's, by (root, scenario, splits, source)
 
 
@@ -141,8 +144,10 @@ def summarise(run: SupervisedRun, ref: Reference) -> dict:
     verdicts = [ref.judge(k) for k in starts]
     acting = np.array([m != "nominal" for m in modes], dtype=bool)  # (F,)
     accel = np.array([s.accel_cmd_mps2 for s in states[:end]])
-    jerk = np.abs(np.diff(accel)) / dt_s if end > 1 else np.zeros(0)  # (F-1,)
-    near = acting[1:] | acting[:-1] if end > 1 else np.zeros(0, bool)
+    speed = np.array([f.scene.speed_mps[0] for f in ep.frames[:end]])
+    jerk = np.abs(np.diff(accel)) / dt_s if end > 1 else np.zeros(0)  # (F-1,) step k-1 → k
+    near = (acting[1:] | acting[:-1]) & (speed[1:] > STOPPING_MPS) if end > 1 \
+        else np.zeros(0, bool)
     first_lead = (ref.collision_time_s - starts[0] * dt_s
                   if starts and verdicts[0] == "true" else None)
     return {
