@@ -18,6 +18,7 @@ from pathlib import Path
 
 import numpy as np
 
+from evoeye.ads.profiles import DEFAULT_PROFILE
 from evoeye.atomic import remove_stale_temps
 from evoeye.lifeline import die_with_parent
 from evoeye.log import LogError, read_run, write_episode
@@ -29,19 +30,21 @@ from evoeye.sim.runner import run_episode, run_spec
 
 def plan_uniform(
     scenario: str, n: int, seed: int, *, batch: str | None = None, source: str = "uniform",
-    round: int = 0,
+    round: int = 0, ads: str = DEFAULT_PROFILE,
 ) -> list[RunSpec]:
-    """n concrete scenarios drawn uniformly, each with its own run seed; all fixed by `seed`."""
+    """n concrete scenarios drawn uniformly, each with its own run seed; all fixed by `seed`
+    (the same vectors and run seeds under every ADS profile `ads`)."""
     if n < 1:
         raise ValueError(f"--n must be at least 1, got {n}")
     if seed < 0:
         raise ValueError(f"--seed must be non-negative, got {seed}")
     space = get_scenario(scenario)
-    batch = check_batch_name(batch or f"{source}-seed{seed}")
+    profile = "" if ads == DEFAULT_PROFILE else f"{ads}-"
+    batch = check_batch_name(batch or f"{source}-{profile}seed{seed}")
     xs = space.sample(np.random.default_rng(seed), n)
     run_seeds = np.random.SeedSequence(seed).generate_state(n)
     return [
-        run_spec(scenario, x, int(s), batch=batch, source=source, round=round)
+        run_spec(scenario, x, int(s), batch=batch, source=source, round=round, ads=ads)
         for x, s in zip(xs, run_seeds, strict=True)
     ]
 

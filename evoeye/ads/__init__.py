@@ -9,10 +9,13 @@ from evoeye.ads.config import (
     SensorConfig,
     TrackerConfig,
 )
+from evoeye.ads.profiles import ADS_PROFILES, DEFAULT_PROFILE, ads_profile, check_profile
 from evoeye.ads.stack import ADS
 
 __all__ = [
     "ADS",
+    "ADS_PROFILES",
+    "DEFAULT_PROFILE",
     "ADSConfig",
     "ControlConfig",
     "LocalizationConfig",
@@ -20,4 +23,6 @@ __all__ = [
     "PredictionConfig",
     "SensorConfig",
     "TrackerConfig",
+    "ads_profile",
+    "check_profile",
 ]

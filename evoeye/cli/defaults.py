@@ -2,6 +2,7 @@
 from; tests/cli/test_defaults.py checks each against its source."""
 
 SCENARIO_NAMES = ("highway-cut-in", "unprotected-intersection")  # evoeye.scenarios.SCENARIOS
+ADS_PROFILE_NAMES = ("default", "cautious", "firm-yield")  # evoeye.ads.profiles.ADS_PROFILES
 SPLIT_SEED, TRAIN_FRAC, VAL_FRAC = 0, 0.5, 0.125  # evoeye.store.SplitSpec()
 CONTEXT_LEN = 5  # evoeye.store.windows.DEFAULT_CONTEXT_LEN
 HORIZON_S = 3.0  # evoeye.store.windows.DEFAULT_HORIZON_S

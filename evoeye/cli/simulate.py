@@ -9,7 +9,7 @@ import typer
 from rich.table import Table
 
 from evoeye.cli.app import app, exit_with
-from evoeye.cli.defaults import SCENARIO_NAMES
+from evoeye.cli.defaults import ADS_PROFILE_NAMES, SCENARIO_NAMES
 from evoeye.cli.errors import ExitCode, UserError
 from evoeye.cli.output import err, out, table
 from evoeye.paths import BadNameError, DataRoot, check_batch_name
@@ -49,8 +49,22 @@ def summary_table(title: str, rows: list[tuple[str, BatchSummary]]) -> Table:
     return t
 
 
+def known_profile(name: str) -> str:
+    """Typer callback: refuse an unknown --ads before anything runs."""
+    if name not in ADS_PROFILE_NAMES:
+        raise typer.BadParameter(f"unknown ADS profile {name!r}; known: "
+                                 f"{', '.join(ADS_PROFILE_NAMES)}")
+    return name
+
+
+AdsOpt = Annotated[str, typer.Option(
+    "--ads", callback=known_profile, help=f"ADS profile that drives the ego: "
+    f"{', '.join(ADS_PROFILE_NAMES)} (docs/world.md). A non-default profile's runs get ids, and "
+    "a default batch name, of their own.")]
+
+
 def simulate_batch(scenario: str, n: int, seed: int, data: DataRoot, workers: int,
-                   batch: str | None = None) -> BatchSummary:
+                   batch: str | None = None, ads: str = "default") -> BatchSummary:
     """Plan, check the root can be written (PermissionError & co. if not), run with a progress
     bar, and report failures by scenario id."""
     from tqdm import tqdm
@@ -58,7 +72,7 @@ def simulate_batch(scenario: str, n: int, seed: int, data: DataRoot, workers: in
     from evoeye.batch import plan_uniform, run_batch
 
     try:
-        specs = plan_uniform(scenario, n, seed, batch=batch)
+        specs = plan_uniform(scenario, n, seed, batch=batch, ads=ads)
     except ValueError as exc:  # includes ScenarioError and BadNameError
         raise UserError(str(exc), "see `evoeye simulate --help`") from exc
     data.runs.mkdir(parents=True, exist_ok=True)
@@ -91,13 +105,14 @@ def simulate(
     root: RootOpt = None,
     workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 1,
     batch: BatchOpt = None,
+    ads: AdsOpt = "default",
 ) -> None:
     """Simulate N uniformly sampled concrete scenarios and write one MCAP log per run.
 
     Exits 3 if any run failed (the table and the lines above say which and why).
     """
     data = DataRoot.resolve(root)
-    summary = simulate_batch(scenario, n, seed, data, workers, batch)
+    summary = simulate_batch(scenario, n, seed, data, workers, batch, ads)
     out().print(summary_table("simulate", [(scenario, summary)]))
     out().print(f"logs: {data.runs / scenario}")
     exit_with(failures_code([(scenario, summary)]))

@@ -15,6 +15,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from evoeye import __version__
+from evoeye.ads.profiles import DEFAULT_PROFILE
 from evoeye.batch import pool_context
 from evoeye.paths import DataRoot
 from evoeye.sim.counterfactual import VARIANTS, Explanation, explain_run
@@ -29,6 +30,7 @@ def spec_of(record: dict[str, Any]) -> RunSpec:
         scenario=record["logical_scenario"], params=tuple(float(v) for v in record["params"]),
         seed=int(record["seed"]), scenario_id=record["scenario_id"], batch=record["batch"],
         source=record["source"], round=int(record["round"]),
+        ads=record.get("ads_profile") or DEFAULT_PROFILE,
     )
 
 

@@ -223,3 +223,15 @@ def operating_chart(series: Sequence[tuple[str, Sequence[dict]]], *, title: str,
             body.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="3" fill="{_color(i)}"/>')
     body += _legend(f, [label for label, _ in series], f.x0 + 8, f.y1 + 14)
     return f.svg(body, title)
+
+
+STANDALONE_CSS = ("svg{font:11px sans-serif;background:#fafafa} .t{font-size:13px;"
+                  "font-weight:600} .s{font-size:11px}")
+
+
+def standalone(svg: str) -> str:
+    """A chart as a file of its own (an .svg an image viewer or a README shows): with the SVG
+    namespace and the report's fonts, which inline charts take from the page."""
+    head, rest = svg.split(">", 1)
+    return (head.replace("<svg ", '<svg xmlns="http://www.w3.org/2000/svg" ', 1)
+            + f"><style>{STANDALONE_CSS}</style>" + rest + "\n")

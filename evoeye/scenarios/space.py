@@ -143,10 +143,14 @@ class LogicalScenario:
         lo, hi = np.clip(u - delta, 0.0, 1.0), np.clip(u + delta, 0.0, 1.0)
         return self.denormalise(rng.uniform(lo, hi))
 
-    def scenario_id(self, x: np.ndarray, seed: int) -> str:
-        """A stable id for (logical scenario, vector, seed): the same inputs give the same id."""
+    def scenario_id(self, x: np.ndarray, seed: int, variant: str = "") -> str:
+        """A stable id for (logical scenario, vector, seed[, variant]): the same inputs give the
+        same id. `variant` (e.g. a non-default ADS profile) is hashed in when not empty, so the
+        ids of runs without one are as they always were."""
         arr = self.validate(x)
         h = hashlib.sha1(f"{self.name}|{int(seed)}|".encode())
+        if variant:
+            h.update(f"{variant}|".encode())
         h.update(arr.astype("<f8").tobytes())  # exact: two vectors differing in 1 ulp differ
         digest = h.hexdigest()
         return f"{self.name}-{digest[:12]}"

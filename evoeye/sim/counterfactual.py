@@ -21,7 +21,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from evoeye.ads import ADS, ADSConfig
+from evoeye.ads import ADS, ADSConfig, ads_profile
 from evoeye.ads.messages import ControlCommand, FrameMessages
 from evoeye.ads.oracle import (
     GroundTruthPerception,
@@ -238,7 +238,7 @@ def explain_run(spec: RunSpec, sim: SimConfig | None = None, ads_config: ADSConf
                 variants: tuple[str, ...] = tuple(VARIANTS)) -> Explanation:
     """Re-simulate the factual run, then each variant. Raises NotACollisionError if the factual
     re-simulation does not collide."""
-    sim, ads_config = sim or SimConfig(), ads_config or ADSConfig()
+    sim, ads_config = sim or SimConfig(), ads_config or ads_profile(spec.ads)
     factual = run_episode(spec, sim, ads_config)
     o = factual.outcome
     if o.status != STATUS_OK or not o.collided:

@@ -22,6 +22,7 @@ class RunSpec:
     batch: str = "default"
     source: str = "initial"  # how it was acquired: initial / uniform / evoeye / avfuzzer / …
     round: int = 0
+    ads: str = "default"  # the ADS profile that drives the ego (evoeye.ads.profiles)
 
 
 @dataclass(frozen=True)

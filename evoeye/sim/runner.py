@@ -15,7 +15,7 @@ from typing import Protocol
 import numpy as np
 
 from evoeye import __version__
-from evoeye.ads import ADS, ADSConfig
+from evoeye.ads import ADS, DEFAULT_PROFILE, ADSConfig, ads_profile, check_profile
 from evoeye.ads.messages import FrameMessages
 from evoeye.scenarios import get_scenario
 from evoeye.scene import RoadMap, SceneState
@@ -48,13 +48,16 @@ class SimConfig:
 def run_spec(
     scenario: str, params, seed: int, *, batch: str = "default", source: str = "initial",
     round: int = 0,  # noqa: A002 - the paper's name for an acquisition round
+    ads: str = DEFAULT_PROFILE,
 ) -> RunSpec:
-    """A validated RunSpec whose id is derived from (scenario, params, seed)."""
+    """A validated RunSpec whose id is derived from (scenario, params, seed, ADS profile)."""
     space = get_scenario(scenario)
     x = space.validate(params)
+    check_profile(ads)
     return RunSpec(
         scenario=scenario, params=tuple(float(v) for v in x), seed=int(seed),
-        scenario_id=space.scenario_id(x, seed), batch=batch, source=source, round=round,
+        scenario_id=space.scenario_id(x, seed, "" if ads == DEFAULT_PROFILE else ads),
+        batch=batch, source=source, round=round, ads=ads,
     )
 
 
@@ -102,6 +105,7 @@ def run_episode(
     """
     config = config or SimConfig()
     get_scenario(spec.scenario).validate(spec.params)  # a bad vector is the caller's error: raise
+    check_profile(spec.ads)
     world_rng, ads_rng = _seeds(spec.seed)
     dt = 1.0 / config.rate_hz
     n_frames = int(round(config.duration_s * config.rate_hz))
@@ -114,7 +118,8 @@ def run_episode(
     try:
         world, cruise_mps = build_world(spec, world_rng)
         road_map = world.road_map
-        ads = driver(road_map, ads_rng, (ads_config or ADSConfig()).with_cruise_speed(cruise_mps))
+        ads = driver(road_map, ads_rng,
+                     (ads_config or ads_profile(spec.ads)).with_cruise_speed(cruise_mps))
         for k in range(n_frames):
             scene = world.scene()
             scene.t_s = k * dt  # exact frame time, free of float accumulation

@@ -12,6 +12,7 @@ from __future__ import annotations
 import re
 from typing import Any
 
+from evoeye.ads.profiles import DEFAULT_PROFILE
 from evoeye.scenarios import ScenarioError, get_scenario
 from evoeye.store.records import RunRecordError
 
@@ -54,7 +55,8 @@ def check_metadata(meta: dict[str, Any]) -> None:
     except (ScenarioError, TypeError, ValueError, KeyError) as e:
         raise RunRecordError(f"run metadata does not fit its logical scenario: {e}") from None
     sid = str(meta.get("scenario_id"))
-    expected = space.scenario_id(x, seed)
+    profile = str(meta.get("ads_profile") or DEFAULT_PROFILE)
+    expected = space.scenario_id(x, seed, "" if profile == DEFAULT_PROFILE else profile)
     if CANONICAL_ID.fullmatch(sid) and sid != expected:
         raise RunRecordError(f"scenario_id {sid} does not match its parameters and seed "
                              f"(they give {expected})")

@@ -6,6 +6,7 @@ from evoeye.cli import defaults
 
 
 def test_help_defaults_equal_their_sources() -> None:
+    from evoeye.ads.profiles import ADS_PROFILES
     from evoeye.evaluation.monitors import BASELINES
     from evoeye.monitor.inputs import ABLATIONS, MODULES
     from evoeye.monitor.protocol import TARGET_FPRS
@@ -16,7 +17,7 @@ def test_help_defaults_equal_their_sources() -> None:
 
     split = SplitSpec()
     pairs = {
-        "SCENARIO_NAMES": tuple(SCENARIOS),
+        "SCENARIO_NAMES": tuple(SCENARIOS), "ADS_PROFILE_NAMES": tuple(ADS_PROFILES),
         "SPLIT_SEED": split.seed, "TRAIN_FRAC": split.train_frac, "VAL_FRAC": split.val_frac,
         "CONTEXT_LEN": DEFAULT_CONTEXT_LEN, "HORIZON_S": DEFAULT_HORIZON_S,
         "TARGET_FPRS": TARGET_FPRS, "RUNS_PER_PART": DEFAULT_RUNS_PER_PART,

@@ -74,3 +74,13 @@ def test_the_summary_keeps_the_scenario_name_whole_in_a_pipe(tmp_path) -> None:
     assert result.exit_code == ExitCode.OK, result.output
     row = next(line for line in result.stdout.splitlines() if "highway-cut" in line)
     assert "highway-cut-in" in row and "…" not in result.stdout
+
+
+def test_ads_names_a_profile_and_its_runs_go_to_a_batch_of_their_own(tmp_path) -> None:
+    result = runner.invoke(app, [*SIM[:-1], "1", "--ads", "firm-yield", "--root", str(tmp_path)])
+    assert result.exit_code == ExitCode.OK, result.output
+    logs = list((tmp_path / "runs" / "highway-cut-in").glob("*/*.mcap"))
+    assert [p.parent.name for p in logs] == ["uniform-firm-yield-seed0"]
+    refused = runner.invoke(app, [*SIM, "--ads", "reckless", "--root", str(tmp_path / "x")])
+    assert refused.exit_code == 2 and "known: default, cautious, firm-yield" in refused.output
+    assert not (tmp_path / "x").exists()  # refused before anything ran

@@ -6,7 +6,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from evoeye.evaluation.plots import interval_chart
+from evoeye.evaluation.plots import interval_chart, standalone
 
 
 def _svg(text: str) -> ET.Element:
@@ -77,3 +77,12 @@ def test_operating_curves_put_points_on_a_log_axis_with_their_whiskers() -> None
     assert xs[1] == pytest.approx(ticks["1"], abs=0.1)
     assert xs[2] == pytest.approx(ticks["≤0.1"], abs=0.1)  # 0 sits on the first decade's edge
     assert len(list(root.iter(f"{NS}circle"))) == 4
+
+
+def test_a_standalone_chart_is_an_svg_file_with_the_same_marks() -> None:
+    chart = interval_chart([("a", 10.0, 5.0, 15.0)], title="t", xlabel="x")
+    root = ET.fromstring(standalone(chart))  # parses as a file: the namespace is declared
+    assert root.tag == f"{NS}svg" and root.find(f"{NS}style").text.startswith("svg{font:")
+    inline = _svg(chart)
+    assert [e.attrib for e in root.iter(f"{NS}circle")] == \
+        [e.attrib for e in inline.iter(f"{NS}circle")]

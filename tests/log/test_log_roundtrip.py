@@ -135,3 +135,15 @@ def test_frames_without_obstacles_round_trip(tmp_path: Path) -> None:
     assert first["x_m"] == [] and first["track_id"] == []
     (_, update), *_ = run.messages(TOPICS.scene)
     assert [e["id"] for e in update["entities"]] == ["actor/0", "predictions", "plan"]
+
+
+def test_a_log_written_before_profiles_existed_reads_as_the_default_profile(
+        episode: Episode) -> None:
+    from evoeye.log.records import decode_run, encode_run
+
+    record = encode_run(run_values(episode))
+    assert decode_run(record)["ads_profile"] == "default"
+    older = {k: v for k, v in record.items() if k != "ads_profile"}
+    assert decode_run(older) == decode_run(record)
+    with pytest.raises(ValueError, match="missing fields \\['seed'\\]"):  # others stay required
+        decode_run({k: v for k, v in record.items() if k != "seed"})

@@ -232,3 +232,23 @@ def test_a_run_of_another_minor_release_is_quarantined(root: DataRoot, episode_f
     why = reasons["runs/highway-cut-in/b000/newer.mcap"]
     assert f"written by evoeye {versions['newer']}" in why
     assert f"{major}.{minor}" in why and "docs/warehouse.md" in why
+
+
+def test_the_ads_profile_is_a_column_and_explain_resimulates_under_it(
+        root: DataRoot, episode_factory, log_writer) -> None:
+    from dataclasses import replace
+
+    from evoeye.evaluation.explain import pending_runs
+
+    plain = episode_factory("p-default", n_frames=6, seed=1, collision_frame=3)
+    firm = episode_factory("p-firm", n_frames=6, seed=2, collision_frame=3)
+    firm.spec = replace(firm.spec, ads="firm-yield")
+    for ep in (plain, firm):
+        log_writer(root, ep)
+    ingest(root)
+    rows = Warehouse(root).sql("SELECT scenario_id, ads_profile FROM scenarios "
+                               "ORDER BY scenario_id").to_pylist()
+    assert rows == [{"scenario_id": "p-default", "ads_profile": "default"},
+                    {"scenario_id": "p-firm", "ads_profile": "firm-yield"}]
+    specs = {s.scenario_id: s.ads for s in pending_runs(root)}
+    assert specs == {"p-default": "default", "p-firm": "firm-yield"}

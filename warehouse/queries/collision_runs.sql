@@ -1,7 +1,8 @@
 -- The collision runs to explain (`evoeye explain`): their RunSpec fields, optionally of one
 -- logical scenario and one batch, without those whose every variant is stored already for
 -- $software_version ($variants: how many variants a finished explanation has).
-SELECT s.scenario_id, s.logical_scenario, s.batch, s.params, s.seed, s.source, s.round
+SELECT s.scenario_id, s.logical_scenario, s.batch, s.params, s.seed, s.source, s.round,
+       s.ads_profile
 FROM scenarios AS s
 WHERE s.status = 'ok' AND s.collided
   AND ($logical_scenario IS NULL OR s.logical_scenario = $logical_scenario)

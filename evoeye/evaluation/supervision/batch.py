@@ -25,6 +25,7 @@ from pathlib import Path
 import orjson
 
 from evoeye.atomic import remove_stale_temps
+from evoeye.evaluation.explain import spec_of
 from evoeye.evaluation.supervision.settings import Settings, open_folder
 from evoeye.evaluation.supervision.sweep import RunJob, supervise_run
 from evoeye.lifeline import die_with_parent
@@ -47,9 +48,7 @@ def batch_runs(root: DataRoot, scenario: str, batch: str) -> list[tuple[RunSpec,
     out = []
     for path in logs:
         m = read_run(path, topics=()).metadata
-        out.append((RunSpec(m["logical_scenario"], tuple(float(v) for v in m["params"]),
-                            int(m["seed"]), m["scenario_id"], m["batch"], m["source"],
-                            int(m["round"])), m))
+        out.append((spec_of(m), m))
     return out
 
 

@@ -15,6 +15,7 @@ _LAZY = {
     "CampaignConfig": "evoeye.evolve.campaign.config",
     "Campaign": "evoeye.evolve.campaign.loop",
     "CampaignState": "evoeye.evolve.campaign.state",
+    "MixedProfilesError": "evoeye.evolve.campaign.state",
     "NoInitialDataError": "evoeye.evolve.campaign.state",
     "Assessor": "evoeye.evolve.campaign.assess",
     "run_experiment": "evoeye.evolve.campaign.experiment",

@@ -54,6 +54,7 @@ from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
 from evoeye.evolve.campaign.state import (
     CampaignState,
+    initial_profile,
     read_initial,
     records_of,
     run_outcome,
@@ -248,7 +249,7 @@ class Campaign:
                 prop = state.strategy.propose(state.records)
                 spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
                                 batch=self.campaign_id, source=cfg.strategy,
-                                round=state.round + 1)
+                                round=state.round + 1, ads=initial_profile(self.initial))
                 result, episode = simulate_and_keep(spec, self.root)
             if result.status == "error":
                 raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "

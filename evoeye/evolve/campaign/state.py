@@ -21,6 +21,10 @@ class NoInitialDataError(LookupError):
     """A campaign needs the scenario's initial (round 0) runs in the warehouse."""
 
 
+class MixedProfilesError(ValueError):
+    """D_init holds runs of several ADS profiles: a campaign's regime is one profile."""
+
+
 def read_initial(root: DataRoot, scenario: str, splits: SplitSpec) -> dict[str, np.ndarray]:
     """D_init: the train split of the scenario's round-0 runs, columns by name (a warehouse
     query; the same for every campaign of the scenario and split)."""
@@ -28,8 +32,20 @@ def read_initial(root: DataRoot, scenario: str, splits: SplitSpec) -> dict[str, 
     if not t["scenario_id"]:
         raise NoInitialDataError(f"no initial (round 0) training runs of {scenario!r} in "
                                  f"{root.warehouse}: simulate and ingest them first")
-    return {k: np.asarray(v, dtype=object if k == "scenario_id" else None)
+    profiles = sorted(set(t["ads_profile"]))
+    if len(profiles) > 1:
+        raise MixedProfilesError(f"the initial runs of {scenario!r} in {root.warehouse} were "
+                                 f"driven by several ADS profiles ({', '.join(profiles)}): a "
+                                 "campaign acquires runs of one regime; keep each profile's "
+                                 "runs in a data root of its own")
+    return {k: np.asarray(v, dtype=object if k in ("scenario_id", "ads_profile") else None)
             for k, v in t.items()}
+
+
+def initial_profile(initial: dict[str, np.ndarray]) -> str:
+    """The ADS profile of D_init's runs (`read_initial` checks there is one): the campaign
+    acquires its runs under it too."""
+    return str(initial["ads_profile"][0])
 
 
 @dataclass

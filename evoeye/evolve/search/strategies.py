@@ -9,7 +9,7 @@
   removed: the potential of a seed is its own normalised feedback (S_δ(x) shrinks to {x}), so
   p(x) = (f̄(x) + ε) / (max_D f̄ + ε), regardless of how its neighbourhood was explored.
 * `uniform` — uniform samples of X (the paper's Uniform baseline).
-* `avfuzzer` — the GA of DESIGN.md §4, see `evoeye.evolve.search.avfuzzer`.
+* `avfuzzer` — the GA of docs/avfuzzer.md, see `evoeye.evolve.search.avfuzzer`.
 
 Proposal k of a density-aware or uniform strategy draws from `default_rng([seed, k])` only, so
 the same seed, counter and records give the same proposal; `replay` just restores the counter.
