@@ -12,8 +12,13 @@ import pytest
 
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.evaluation.supervision import check_held_out, supervise
-from evoeye.evaluation.supervision.batch import plan_supervision, record_path
-from evoeye.evaluation.supervision.sweep import ReproductionError, RunJob, supervise_run
+from evoeye.evaluation.supervision.batch import batch_runs, plan_supervision, record_path
+from evoeye.evaluation.supervision.sweep import (
+    ReproductionError,
+    RunJob,
+    supervise_run,
+    supervised_spec,
+)
 from evoeye.evaluation.supervision.triggers import realised, sweep_thresholds
 from evoeye.log import read_run
 from evoeye.store import SplitSpec, Warehouse, ingest
@@ -128,3 +133,12 @@ def test_asked_for_the_logs_go_where_ingest_takes_them_in(new_eval_root, sup) ->
     sources = Warehouse(root).sql("SELECT DISTINCT source FROM scenarios WHERE batch = $b",
                                   {"b": f"{sup.batch}-supervised"}).column("source").to_pylist()
     assert sources == ["supervised"]
+
+
+def test_a_supervised_run_keeps_the_ads_profile_of_its_run(new_eval_root, sup) -> None:
+    root = new_eval_root()
+    specs = plan_uniform(sup.scenario, 2, sup.batch_seed, batch=sup.batch, ads="cautious")
+    run_batch(specs, root)
+    runs = batch_runs(root, sup.scenario, sup.batch)
+    assert {spec for spec, _ in runs} == set(specs)  # the profile and the ids
+    assert {supervised_spec(spec, "ttc", 0).ads for spec, _ in runs} == {"cautious"}
