@@ -14,7 +14,7 @@ from datetime import UTC, datetime
 from html import escape
 from pathlib import Path
 
-from evoeye.evaluation.plots import operating_chart
+from evoeye.evaluation.plots import operating_chart, standalone
 from evoeye.evaluation.report import DASH, ReportFiles, Table, html_page, pct
 from evoeye.monitor.families import DEFAULT_FAMILY
 from evoeye.paths import DataRoot
@@ -196,8 +196,7 @@ def write_docs(folder: Path, summary: dict) -> list[Path]:
     folder.mkdir(parents=True, exist_ok=True)
     stem = f"supervision-{summary['scenario']}"
     svg, md, js = (folder / f"{stem}{ext}" for ext in (".svg", ".md", ".json"))
-    standalone = curve_svg(summary).replace("<svg ", '<svg xmlns="http://www.w3.org/2000/svg" ', 1)
-    svg.write_text(standalone + "\n", encoding="utf-8")
+    svg.write_text(standalone(curve_svg(summary)), encoding="utf-8")
     md.write_text(markdown_report([summary], {summary["scenario"]: svg.name}), encoding="utf-8")
     js.write_text(json.dumps(summary, indent=1) + "\n", encoding="utf-8")
     return [md, svg, js]
