@@ -11,6 +11,7 @@ Layout under the root (default `./evoeye-data`, or `$EVOEYE_HOME`, or `--root`):
     quarantine/…                                         logs that could not be read, and why
     monitors/<version>/{model.pt,card.json}              trained monitor versions (cards)
     replays/<log>.<monitor>.risk.mcap                    logs with a monitor's risk (`replay`)
+    supervision/<logical_scenario>/<batch>/<key>/…       supervised runs (`supervise`)
 """
 
 from __future__ import annotations
@@ -93,6 +94,11 @@ class DataRoot:
     def replays(self) -> Path:
         """Run logs copied with a monitor's risk channel (`evoeye replay`); never ingested."""
         return self.path / "replays"
+
+    @property
+    def supervision(self) -> Path:
+        """Supervised re-simulations of batches (`evoeye supervise`); never ingested."""
+        return self.path / "supervision"
 
     @property
     def reports(self) -> Path:

@@ -12,6 +12,7 @@ as a pickle whose sha256 is checked against `meta.json` before it is loaded (`re
 
 from __future__ import annotations
 
+import functools
 import hashlib
 import json
 import pickle
@@ -21,7 +22,7 @@ from typing import Any
 
 import numpy as np
 from sklearn.ensemble import HistGradientBoostingClassifier
-from threadpoolctl import threadpool_limits
+from threadpoolctl import ThreadpoolController
 
 from evoeye.monitor.families import read_version
 from evoeye.monitor.protocol import Thresholds
@@ -37,6 +38,13 @@ CONTROLS = {"context-only": ("ctx-", CONTEXT_INPUTS), "where-when": ("ww-", WHER
 SPEED = CONTROL_FEATURES.index("ego_speed_mps")
 MODEL_FILE, META_FILE = "model.pkl", "meta.json"
 THREADS = 1  # OpenMP threads for fit and predict (module doc)
+
+
+@functools.cache
+def _threadpools() -> ThreadpoolController:
+    """The process's thread pools, found once: `threadpool_limits` scans the loaded libraries
+    (/proc/self/maps) on every call, ≈ 30 ms — ruinous for one window scored per frame."""
+    return ThreadpoolController()
 
 
 def context_inputs(windows: Windows, inputs: tuple[str, ...] = CONTEXT_INPUTS) -> np.ndarray:
@@ -86,7 +94,7 @@ class ContextOnlyMonitor:
     def score(self, windows: Windows) -> np.ndarray:
         if len(windows) == 0:
             return np.zeros(0)
-        with threadpool_limits(THREADS):
+        with _threadpools().limit(limits=THREADS):
             return self.model.predict_proba(context_inputs(windows, self.inputs))[:, 1]
 
     def save(self, folder: Path, meta: dict | None = None) -> Path:
@@ -135,7 +143,7 @@ def train_context_only(train: Windows, config: ContextConfig = ContextConfig(), 
         raise ValueError(f"the {name} control needs both classes; {int(y.sum())} of "
                          f"{len(y)} training windows are unsafe")
     model = context_classifier(config)
-    with threadpool_limits(THREADS):
+    with _threadpools().limit(limits=THREADS):
         model.fit(x, y)
     data = hashlib.sha256(np.ascontiguousarray(x).tobytes() + y.tobytes()).hexdigest()
     return ContextOnlyMonitor(config, model, data, name=name)

@@ -14,3 +14,12 @@ BASELINE_NAMES = ("ttc", "ttc-2d", "rss", "rss-2s", "aem",
 MODULE_NAMES = ("perception", "prediction", "planning", "control")  # evoeye.monitor.inputs.MODULES
 ABLATION_NAMES = ("perception", "perception+prediction", "perception+prediction+planning",
                   "all")  # evoeye.monitor.inputs.ABLATIONS
+SWEEP_FPRS = (0.05, 0.02, 0.01, 0.005, 0.002, 0.001, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5,
+              1e-5)  # evoeye.evaluation.supervision.triggers.SWEEP_FPRS
+SWEEP_RECALLS = (0.2, 0.1, 0.05)  # evoeye.evaluation.supervision.triggers.RECALLS
+SUPERVISE_BASELINES = ("ttc", "ttc-2d", "rss", "aem",
+                       "context-only")  # evoeye.evaluation.supervision.triggers
+SUPERVISE_BUDGETS = (0.5, 1.0, 2.0)  # evoeye.evaluation.supervision.summary.BUDGETS_PER_H
+LOG_POLICIES = ("none", "collided", "all")  # evoeye.evaluation.supervision.settings.LOG_POLICIES
+FALLBACK = {"decel_mps2": 6.0, "jerk_mps3": 10.0, "onset_s": 0.1, "hold_s": 1.0,
+            "standstill_mps": 0.1}  # dataclasses.asdict(evoeye.sim.supervisor.FallbackConfig())

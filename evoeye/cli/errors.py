@@ -72,6 +72,12 @@ KNOWN_ERRORS: dict[str, str] = {
     "evoeye.results.reproduce.PlanError": "give the findings.json `evoeye findings` wrote (or "
                                           "its folder, e.g. docs/results), and --root only "
                                           "for its runs",
+    "evoeye.evaluation.supervision.batch.NoRunsError": "simulate the batch first, or check "
+                                                       "--scenario, --batch and --root",
+    "evoeye.evaluation.supervision.settings.SettingsMismatchError": "move that supervision "
+                                                                    "folder aside",
+    "evoeye.evaluation.supervision.sweep.ReproductionError": "re-simulate the batch with this "
+                                                             "software version",
     "evoeye.store.lock.WarehouseLockedError": "wait for the other writer to finish, then run "
                                               "again",
     "evoeye.store.schema.WarehouseLayoutError": "re-ingest: move warehouse/scenarios, "

@@ -173,6 +173,58 @@ def interval_chart(rows: Sequence[tuple[str, float | None, float | None, float |
     return f.svg(body, title)
 
 
+def operating_chart(series: Sequence[tuple[str, Sequence[dict]]], *, title: str,
+                    budget: float | None = None) -> str:
+    """Operating curves: per series (label, points) its points joined in threshold order, x the
+    false interventions per hour (log scale; 0 and anything below the first decade drawn on
+    its edge, marked ≤) and y the collisions prevented in %, each with its CI as whiskers.
+    A point: {"false_interventions_per_h", "false_interventions_ci", "prevented_share",
+    "prevented_ci"} (shares in [0, 1]). `budget` draws a dashed vertical line."""
+    xs = [p["false_interventions_per_h"] for _, pts in series for p in pts]
+    xs += [v for _, pts in series for p in pts for v in p["false_interventions_ci"]]
+    positive = [v for v in [*xs, budget] if v is not None and v > 0]
+    lo = 10.0 ** np.floor(np.log10(min([*positive, 0.1])))
+    hi = 10.0 ** np.ceil(np.log10(max([*positive, 10.0 * lo])))
+    f = _Frame((float(np.log10(lo)), float(np.log10(hi))), (0.0, 100.0), height=HEIGHT + 40)
+    decades = np.arange(np.log10(lo), np.log10(hi) + 1e-9)
+    body = f.axes(title, "false interventions per hour of safe driving (log)",
+                  "collisions prevented (%)", [], [0, 20, 40, 60, 80, 100])
+    for i, d in enumerate(decades):
+        x = f.x(d)
+        body.append(f'<line x1="{x:.1f}" y1="{f.y0}" x2="{x:.1f}" y2="{f.y1}" stroke="#eee"/>')
+        body.append(f'<text x="{x:.1f}" y="{f.y0 + 15}" text-anchor="middle">'
+                    f'{"≤" if i == 0 else ""}{10.0 ** d:g}</text>')
+
+    def gx(v: float | None) -> float:
+        return f.x(float(np.log10(max(v or 0.0, lo))))
+
+    if budget:
+        body.append(f'<line x1="{gx(budget):.1f}" y1="{f.y0}" x2="{gx(budget):.1f}" '
+                    f'y2="{f.y1}" stroke="#888" stroke-dasharray="4 3"/>')
+    for i, (label, pts) in enumerate(series):
+        shown = [p for p in pts if p["prevented_share"] is not None
+                 and p["false_interventions_per_h"] is not None]
+        if not shown:
+            continue
+        line = " ".join(f"{gx(p['false_interventions_per_h']):.1f},"
+                        f"{f.y(100 * p['prevented_share']):.1f}" for p in shown)
+        body.append(f'<polyline points="{line}" fill="none" stroke="{_color(i)}" '
+                    f'stroke-width="1.5" data-series="{escape(label)}"/>')
+        for p in shown:
+            x, y = gx(p["false_interventions_per_h"]), f.y(100 * p["prevented_share"])
+            (plo, phi), (flo, fhi) = p["prevented_ci"], p["false_interventions_ci"]
+            if plo is not None and phi is not None:
+                body.append(f'<line x1="{x:.1f}" y1="{f.y(100 * plo):.1f}" x2="{x:.1f}" '
+                            f'y2="{f.y(100 * phi):.1f}" stroke="{_color(i)}" '
+                            'stroke-opacity="0.5"/>')
+            if flo is not None and fhi is not None:
+                body.append(f'<line x1="{gx(flo):.1f}" y1="{y:.1f}" x2="{gx(fhi):.1f}" '
+                            f'y2="{y:.1f}" stroke="{_color(i)}" stroke-opacity="0.5"/>')
+            body.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="3" fill="{_color(i)}"/>')
+    body += _legend(f, [label for label, _ in series], f.x0 + 8, f.y1 + 14)
+    return f.svg(body, title)
+
+
 STANDALONE_CSS = ("svg{font:11px sans-serif;background:#fafafa} .t{font-size:13px;"
                   "font-weight:600} .s{font-size:11px}")
 

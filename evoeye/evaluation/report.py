@@ -222,6 +222,12 @@ def html_report(reports: list[dict], title: str = f"evoeye: {TITLE}") -> str:
         body += ["<h2>Root causes (evoeye explain)</h2>",
                  f'<p class="note">{escape(ATTRIBUTION_NOTE)}</p>',
                  attribution_table(causes).html()]
+    return html_page(title, body)
+
+
+def html_page(title: str, body: list[str]) -> str:
+    """A self-contained HTML page of `body`'s elements: inline CSS, no scripts, nothing
+    external."""
     return ("<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">"
             f"<title>{escape(title)}</title><style>{CSS}</style></head><body>"
             + "".join(body) + "</body></html>\n")
@@ -234,16 +240,23 @@ class ReportFiles:
     html: Path
     json: Path
 
+    @classmethod
+    def under(cls, root: DataRoot, name: str | None, prefix: str, markdown: str) -> ReportFiles:
+        """The files of report `name` (default `<prefix>-<UTC time>`) in `<root>/reports/`,
+        its folder made: `markdown`, report.html and report.json."""
+        name = name or f"{prefix}-{datetime.now(UTC):%Y%m%dT%H%M%SZ}"
+        if not name or "/" in name or name.startswith("."):
+            raise ValueError(f"report name must be a plain folder name, got {name!r}")
+        folder = root.path / "reports" / name
+        folder.mkdir(parents=True, exist_ok=True)
+        return cls(folder, folder / markdown, folder / "report.html", folder / "report.json")
+
 
 def write_report(root: DataRoot, reports: list[dict],
                  name: str | None = None) -> ReportFiles:
     """Write rq1.md, report.html and report.json under `<root>/reports/<name>/`."""
-    name = name or f"rq1-{datetime.now(UTC):%Y%m%dT%H%M%SZ}"
-    if not name or "/" in name or name.startswith("."):
-        raise ValueError(f"report name must be a plain folder name, got {name!r}")
-    folder = root.path / "reports" / name
-    folder.mkdir(parents=True, exist_ok=True)
-    files = ReportFiles(folder, folder / "rq1.md", folder / "report.html", folder / "report.json")
+    files = ReportFiles.under(root, name, "rq1", "rq1.md")
+    name = files.folder.name
     files.markdown.write_text(markdown_report(reports), encoding="utf-8")
     files.html.write_text(html_report(reports, f"evoeye: {TITLE} — {name}"), encoding="utf-8")
     files.json.write_text(json.dumps(reports, indent=1) + "\n", encoding="utf-8")

@@ -25,6 +25,7 @@ from evoeye.ads.messages import (
 from evoeye.log import viz
 from evoeye.scene import SceneState
 from evoeye.sim.episode import Frame
+from evoeye.sim.supervisor import SupervisorState
 
 # The one place that locates the schemas (the project is installed editable).
 SCHEMA_DIR = Path(__file__).resolve().parents[2] / "schemas" / "mcap"
@@ -143,3 +144,29 @@ AGES_CHANNEL = Channel(AGES_TOPIC, "message_ages.v1.json", _not_simulated, None)
 CHANNELS: dict[str, Channel] = {c.topic: c for c in (*FRAME_CHANNELS, MAP_CHANNEL, AGES_CHANNEL)}
 # Channels whose messages a log may lack altogether: their warehouse columns are then NULL.
 OPTIONAL_TOPICS = frozenset({AGES_TOPIC})
+
+
+# -- a supervised run's own channels (`evoeye supervise`), written beside the frame channels ------
+SUPERVISOR_RECORD = "evoeye.supervisor"  # the MCAP metadata record of the trigger and fallback
+SUPERVISOR_SCHEMA_FILE = "supervisor.v1.json"
+
+
+def _supervisor_state(source: tuple[Frame, SupervisorState], t_ns: int) -> dict[str, Any]:
+    state = source[1]
+    return {name: getattr(state, name) for name in schema_fields(SUPERVISOR_SCHEMA_FILE)}
+
+
+def _supervisor_label(source: tuple[Frame, SupervisorState], t_ns: int) -> dict[str, Any]:
+    frame, state = source
+    ego = frame.messages.localization
+    acting = state.mode != "nominal"
+    what = f"FALLBACK {state.mode} {state.accel_cmd_mps2:+.1f} m/s² · " if acting else ""
+    return viz.ego_label(t_ns, ego.x_m, ego.y_m, ego.heading_rad,
+                         f"{what}{state.trigger} {state.score:.2f}", acting,
+                         ("supervisor/text", "supervisor/fallback"))
+
+
+SUPERVISOR_CHANNELS: tuple[Channel, ...] = (
+    Channel("/supervisor", SUPERVISOR_SCHEMA_FILE, _supervisor_state, SupervisorState),
+    Channel("/viz/supervisor", "scene_update.v1.json", _supervisor_label, None),
+)

@@ -198,3 +198,40 @@ def map_update(road_map: RoadMap, t_ns: int) -> dict[str, Any]:
         "lines": lines,
     }
     return {"deletions": _NONE, "entities": [entity]}
+
+
+# -- labels over the ego (a monitor's risk, the supervisor's state) ----------------------------
+TEXT_HEIGHT_M = 4.0
+ALERT_BOX_M = (7.0, 3.5, 2.0)  # drawn around the ego's pose: length, width, height
+CALM_TEXT_COLOR = {"r": 1.0, "g": 1.0, "b": 1.0, "a": 1.0}
+ALERT_BOX_COLOR = {**CRASHED_COLOR, "a": 0.35}
+
+
+def _labelled(t_ns: int, entity_id: str, **primitives: Any) -> dict[str, Any]:
+    return {**_ENTITY, "timestamp": stamp(t_ns), "id": entity_id, "metadata": [],
+            **{kind: primitives.get(kind, []) for kind in
+               ("arrows", "cubes", "spheres", "cylinders", "lines", "triangles", "texts",
+                "models")}}
+
+
+def ego_label(t_ns: int, x_m: float, y_m: float, heading_rad: float, text: str, alert: bool,
+              ids: tuple[str, str]) -> dict[str, Any]:
+    """A SceneUpdate replacing the previous one of its topic: `text` above the ego at (x_m,
+    y_m), red while `alert`, and while alert a translucent red box around the ego; `ids` are
+    the entity ids of the text and of the box."""
+    h = float(heading_rad)
+    orientation = {"x": 0.0, "y": 0.0, "z": sin(0.5 * h), "w": cos(0.5 * h)}
+    at = {"x": float(x_m), "y": float(y_m)}
+    label = {
+        "pose": {"position": {**at, "z": TEXT_HEIGHT_M}, "orientation": orientation},
+        "billboard": True, "font_size": 18.0, "scale_invariant": True,
+        "color": CRASHED_COLOR if alert else CALM_TEXT_COLOR, "text": text,
+    }
+    entities = [_labelled(t_ns, ids[0], texts=[label])]
+    if alert:
+        length, width, height = ALERT_BOX_M
+        box = {"pose": {"position": {**at, "z": height / 2}, "orientation": orientation},
+               "size": {"x": length, "y": width, "z": height}, "color": ALERT_BOX_COLOR}
+        entities.append(_labelled(t_ns, ids[1], cubes=[box]))
+    return {"deletions": [{"timestamp": stamp(t_ns), "type": DELETE_ALL, "id": ""}],
+            "entities": entities}

@@ -3,14 +3,16 @@
 
 Layout: the `evoeye.run` metadata record, the `evoeye.road_map` attachment, one `/viz/map`
 message at the first frame time, then per frame one message on each of the seven frame channels,
-all at log time = publish time = simulation time. Nothing depends on the wall clock, so the same
-episode always gives the same bytes.
+all at log time = publish time = simulation time. A supervised run's log (`Supervision`) adds the
+`evoeye.supervisor` metadata record and per frame a message on /supervisor and /viz/supervisor.
+Nothing depends on the wall clock, so the same episode always gives the same bytes.
 """
 
 from __future__ import annotations
 
 import os
 from collections.abc import Sequence
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -28,12 +30,15 @@ from evoeye.log.channels import (
     ROAD_MAP_ATTACHMENT,
     RUN_RECORD,
     SCHEMA_ENCODING,
+    SUPERVISOR_CHANNELS,
+    SUPERVISOR_RECORD,
     Channel,
     log_time_ns,
 )
 from evoeye.log.mcap_writer import McapWriter
 from evoeye.log.records import encode_run, road_map_dict, run_values
 from evoeye.sim.episode import Episode
+from evoeye.sim.supervisor import SupervisorState
 
 # Chunk compression, chosen by measurement: CPU ms/frame of write_episode on 400 frames (best of
 # 7, 2-core dev VM) and MB per run, for none / lz4 / zstd-1 / zstd-3:
@@ -47,6 +52,16 @@ ZSTD_LEVEL = 1
 CHUNK_SIZE_BYTES = 1024 * 1024
 LIBRARY = f"evoeye/{__version__}; {LIBRARY_IDENTIFIER}"
 _OPTIONS = orjson.OPT_SERIALIZE_NUMPY
+
+
+@dataclass(frozen=True)
+class Supervision:
+    """What a supervised run's log adds (`evoeye supervise`): the supervisor's state per frame
+    (channels /supervisor and /viz/supervisor) and a metadata record (trigger, thresholds,
+    fallback), each value stored as its JSON text."""
+
+    states: Sequence[SupervisorState]  # one per frame
+    record: dict[str, Any]
 
 
 def _fallback(value: Any) -> Any:
@@ -80,12 +95,18 @@ def _register(writer: McapWriter, channels: tuple[Channel, ...]) -> list[int]:
     return channel_ids
 
 
-def write_stream(episode: Episode, stream: BinaryIO) -> None:
+def write_stream(episode: Episode, stream: BinaryIO,
+                 supervisor: Supervision | None = None) -> None:
     """Write the episode as MCAP to an open binary stream (no atomicity; see write_episode)."""
     writer = McapWriter(stream, COMPRESSION, ZSTD_LEVEL, CHUNK_SIZE_BYTES)
     writer.start(profile="", library=LIBRARY)
-    map_id, *frame_ids = _register(writer, (MAP_CHANNEL, *FRAME_CHANNELS))
+    extra = SUPERVISOR_CHANNELS if supervisor else ()
+    map_id, *ids = _register(writer, (MAP_CHANNEL, *FRAME_CHANNELS, *extra))
+    frame_ids, extra_ids = ids[: len(FRAME_CHANNELS)], ids[len(FRAME_CHANNELS):]
     writer.add_metadata(RUN_RECORD, encode_run(run_values(episode)))
+    if supervisor:
+        writer.add_metadata(SUPERVISOR_RECORD, {k: orjson.dumps(v).decode()
+                                                for k, v in supervisor.record.items()})
     writer.add_attachment(
         create_time=0,  # the wall clock stays out: identical episodes give identical bytes
         log_time=0,
@@ -96,11 +117,14 @@ def write_stream(episode: Episode, stream: BinaryIO) -> None:
     t0_ns = log_time_ns(episode.frames[0].scene.t_s) if episode.frames else 0
     writer.add_message(map_id, t0_ns, dumps(MAP_CHANNEL.encode(episode.road_map, t0_ns)), t0_ns)
     encoders = [(cid, ch.encode) for cid, ch in zip(frame_ids, FRAME_CHANNELS, strict=True)]
+    extras = [(cid, ch.encode) for cid, ch in zip(extra_ids, extra, strict=True)]
     add = writer.add_message
     for seq, frame in enumerate(episode.frames):
         t_ns = log_time_ns(frame.scene.t_s)
         for cid, encode in encoders:
             add(cid, t_ns, dumps(encode(frame, t_ns)), t_ns, seq)
+        for cid, encode in extras:
+            add(cid, t_ns, dumps(encode((frame, supervisor.states[seq]), t_ns)), t_ns, seq)
     writer.finish()
 
 
@@ -129,7 +153,8 @@ def write_run(metadata: dict[str, Any], frames: Sequence[dict[str, dict[str, Any
     return path
 
 
-def write_episode(episode: Episode, path: str | os.PathLike) -> Path:
+def write_episode(episode: Episode, path: str | os.PathLike,
+                  supervisor: Supervision | None = None) -> Path:
     """Write one run's log to `path` atomically and return the path.
 
     The bytes go to `<path>.<pid>.tmp` in the same folder, are flushed and fsynced, then renamed
@@ -139,5 +164,5 @@ def write_episode(episode: Episode, path: str | os.PathLike) -> Path:
     """
     path = Path(path)
     with atomic_file(path) as f:
-        write_stream(episode, f)
+        write_stream(episode, f, supervisor)
     return path

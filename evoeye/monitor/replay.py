@@ -18,7 +18,6 @@ from __future__ import annotations
 import io
 import os
 from dataclasses import dataclass
-from math import cos, sin
 from pathlib import Path
 from typing import Any
 
@@ -36,7 +35,7 @@ from evoeye.atomic import atomic_file
 from evoeye.log import TOPICS, read_run
 from evoeye.log.channels import MESSAGE_ENCODING, SCHEMA_ENCODING, load_schema, log_time_ns
 from evoeye.log.mcap_writer import McapWriter
-from evoeye.log.viz import CRASHED_COLOR, FRAME_ID, stamp
+from evoeye.log.viz import ego_label
 from evoeye.log.writer import CHUNK_SIZE_BYTES, COMPRESSION, LIBRARY, ZSTD_LEVEL, dumps
 from evoeye.monitor.fusion import FusionMonitor
 from evoeye.monitor.runtime import RiskState, RuntimeMonitor
@@ -52,10 +51,6 @@ MESSAGE_TYPES = (  # FrameMessages field, topic, message type
     ("plan", TOPICS.plan, PlannedTrajectory),
     ("control", TOPICS.control, ControlCommand),
 )
-TEXT_HEIGHT_M = 4.0
-ALARM_BOX_M = (7.0, 3.5, 2.0)  # drawn around the ego's pose: length, width, height
-SAFE_TEXT_COLOR = {"r": 1.0, "g": 1.0, "b": 1.0, "a": 1.0}
-ALARM_BOX_COLOR = {**CRASHED_COLOR, "a": 0.35}
 
 
 @dataclass(frozen=True)
@@ -121,36 +116,11 @@ def risk_message(state: RiskState, version: str) -> dict[str, Any]:
             "threshold": state.threshold, "monitor_version": version}
 
 
-def _entity(t_ns: int, entity_id: str, **primitives: Any) -> dict[str, Any]:
-    entity: dict[str, Any] = {
-        "timestamp": stamp(t_ns), "frame_id": FRAME_ID, "id": entity_id,
-        "lifetime": {"sec": 0, "nsec": 0}, "frame_locked": False, "metadata": [],
-    }
-    for kind in ("arrows", "cubes", "spheres", "cylinders", "lines", "triangles", "texts",
-                 "models"):
-        entity[kind] = primitives.get(kind, [])
-    return entity
-
-
 def marker_update(state: RiskState, ego: Localization, t_ns: int) -> dict[str, Any]:
     """The /viz/monitor SceneUpdate of one frame: score text, and a red box while alarming."""
-    h = float(ego.heading_rad)
-    orientation = {"x": 0.0, "y": 0.0, "z": sin(0.5 * h), "w": cos(0.5 * h)}
-    at = {"x": float(ego.x_m), "y": float(ego.y_m)}
-    text = {
-        "pose": {"position": {**at, "z": TEXT_HEIGHT_M}, "orientation": orientation},
-        "billboard": True, "font_size": 18.0, "scale_invariant": True,
-        "color": CRASHED_COLOR if state.alarm else SAFE_TEXT_COLOR,
-        "text": f"{'ALARM ' if state.alarm else ''}risk {state.score:.2f}",
-    }
-    entities = [_entity(t_ns, "monitor/risk", texts=[text])]
-    if state.alarm:
-        length, width, height = ALARM_BOX_M
-        box = {"pose": {"position": {**at, "z": height / 2}, "orientation": orientation},
-               "size": {"x": length, "y": width, "z": height}, "color": ALARM_BOX_COLOR}
-        entities.append(_entity(t_ns, "monitor/alarm", cubes=[box]))
-    return {"deletions": [{"timestamp": stamp(t_ns), "type": 1, "id": ""}],
-            "entities": entities}
+    return ego_label(t_ns, ego.x_m, ego.y_m, ego.heading_rad,
+                     f"{'ALARM ' if state.alarm else ''}risk {state.score:.2f}", state.alarm,
+                     ("monitor/risk", "monitor/alarm"))
 
 
 def _write_copy(source: bytes, stream: io.BufferedWriter,

@@ -30,6 +30,21 @@ def test_help_defaults_equal_their_sources() -> None:
     assert shown == pairs
 
 
+def test_supervise_help_defaults_equal_their_sources() -> None:
+    from dataclasses import asdict
+
+    from evoeye.evaluation.supervision.settings import LOG_POLICIES
+    from evoeye.evaluation.supervision.summary import BUDGETS_PER_H
+    from evoeye.evaluation.supervision.triggers import DEFAULT_BASELINES, RECALLS, SWEEP_FPRS
+    from evoeye.sim.supervisor import FallbackConfig
+
+    assert defaults.SWEEP_FPRS == SWEEP_FPRS and defaults.SWEEP_RECALLS == RECALLS
+    assert defaults.SUPERVISE_BASELINES == DEFAULT_BASELINES
+    assert defaults.SUPERVISE_BUDGETS == BUDGETS_PER_H
+    assert defaults.LOG_POLICIES == LOG_POLICIES
+    assert asdict(FallbackConfig()) == defaults.FALLBACK
+
+
 def test_every_known_error_names_an_exception_class_that_exists() -> None:
     import importlib
 

@@ -73,6 +73,12 @@ def eval_root(tmp_path_factory: pytest.TempPathFactory) -> DataRoot:
 
 
 @pytest.fixture(scope="session")
+def new_eval_root(tmp_path_factory: pytest.TempPathFactory):
+    """Builds another warehouse like eval_root's, for a test that adds to its data root."""
+    return lambda: build_warehouse(DataRoot.resolve(tmp_path_factory.mktemp("eval") / "data"))
+
+
+@pytest.fixture(scope="session")
 def splits() -> SplitSpec:
     return SPLITS
 

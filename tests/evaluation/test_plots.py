@@ -57,6 +57,28 @@ def test_an_empty_chart_still_renders() -> None:
     assert root.get("aria-label") == "empty"
 
 
+def _point(fi: float | None, prevented: float | None, fi_ci=(None, None), p_ci=(None, None)):
+    return {"false_interventions_per_h": fi, "false_interventions_ci": list(fi_ci),
+            "prevented_share": prevented, "prevented_ci": list(p_ci)}
+
+
+def test_operating_curves_put_points_on_a_log_axis_with_their_whiskers() -> None:
+    from evoeye.evaluation.plots import operating_chart
+
+    a = [_point(100.0, 0.9, (80.0, 120.0), (0.8, 1.0)), _point(1.0, 0.5), _point(0.0, 0.1)]
+    b = [_point(10.0, 0.4), _point(None, None)]  # an undefined point is left out
+    root = _svg(operating_chart([("a", a), ("b", b)], title="t", budget=1.0))
+    lines = {p.get("data-series"): p.get("points") for p in root.iter(f"{NS}polyline")}
+    assert set(lines) == {"a", "b"} and len(lines["b"].split()) == 1
+    ticks = {t.text: float(t.get("x")) for t in root.iter(f"{NS}text")
+             if t.text and t.text.lstrip("≤").replace(".", "").isdigit()}
+    xs = [float(xy.split(",")[0]) for xy in lines["a"].split()]
+    assert xs[0] == pytest.approx(ticks["100"], abs=0.1)
+    assert xs[1] == pytest.approx(ticks["1"], abs=0.1)
+    assert xs[2] == pytest.approx(ticks["≤0.1"], abs=0.1)  # 0 sits on the first decade's edge
+    assert len(list(root.iter(f"{NS}circle"))) == 4
+
+
 def test_a_standalone_chart_is_an_svg_file_with_the_same_marks() -> None:
     chart = interval_chart([("a", 10.0, 5.0, 15.0)], title="t", xlabel="x")
     root = ET.fromstring(standalone(chart))  # parses as a file: the namespace is declared

@@ -37,10 +37,11 @@ def log_path(request: pytest.FixtureRequest, tmp_path_factory: pytest.TempPathFa
 
 
 def test_schema_files_exist_and_are_all_used() -> None:
+    from evoeye.log.channels import SUPERVISOR_CHANNELS  # a supervised run's added channels
     from evoeye.monitor.replay import RISK_SCHEMA_FILE  # the replay's added channel
 
-    used = {c.schema_file for c in CHANNELS.values()} | {RUN_SCHEMA_FILE, ROAD_MAP_SCHEMA_FILE,
-                                                         RISK_SCHEMA_FILE}
+    used = {c.schema_file for c in (*CHANNELS.values(), *SUPERVISOR_CHANNELS)} | {
+        RUN_SCHEMA_FILE, ROAD_MAP_SCHEMA_FILE, RISK_SCHEMA_FILE}
     assert {p.name for p in SCHEMA_FILES} == used
 
 

@@ -1,0 +1,172 @@
+"""`evoeye supervise`: a batch re-simulated with each monitor as a safety supervisor's trigger."""
+
+from __future__ import annotations
+
+import json
+import sys
+from pathlib import Path
+from typing import Annotated
+
+import typer
+
+from evoeye.cli.app import app, exit_with
+from evoeye.cli.defaults import (
+    FALLBACK,
+    HORIZON_S,
+    LOG_POLICIES,
+    SCENARIO_NAMES,
+    SPLIT_SEED,
+    SUPERVISE_BASELINES,
+    SUPERVISE_BUDGETS,
+    SWEEP_FPRS,
+    SWEEP_RECALLS,
+)
+from evoeye.cli.errors import ExitCode, UserError
+from evoeye.cli.evaluate import parse_baselines
+from evoeye.cli.output import err, out, table
+from evoeye.cli.simulate import RootOpt, plain_batch
+from evoeye.paths import DataRoot
+
+
+def parse_floats(text: str, what: str) -> tuple[float, ...]:
+    """'0.05,0.01' → (0.05, 0.01); a clear error naming `what` otherwise."""
+    try:
+        values = tuple(float(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise typer.BadParameter(f"{what}: give comma-separated numbers, got {text!r}") from None
+    if not values or min(values) <= 0:
+        raise typer.BadParameter(f"{what}: give positive numbers, got {text!r}")
+    return values
+
+
+@app.command("supervise")
+def supervise_command(
+    scenario: Annotated[str, typer.Option(help=f"Logical scenario: {', '.join(SCENARIO_NAMES)}.")],
+    batch: Annotated[str, typer.Option(
+        callback=plain_batch, help="The batch of logged runs to supervise (e.g. the Test Set's "
+        "test-seed<S>): the same scenarios and seeds, paired.")],
+    root: RootOpt = None,
+    monitor: Annotated[list[str] | None, typer.Option(
+        "--monitor", help="A trained monitor version as a trigger (the FusionMonitor; "
+        "repeatable, one per monitor name).")] = None,
+    baselines: Annotated[str, typer.Option(
+        help="Comma-separated baselines as triggers ('none' for none).")] =
+        ",".join(SUPERVISE_BASELINES),
+    fprs: Annotated[str, typer.Option(
+        help="Target FPRs on validation frames the thresholds are calibrated for.")] =
+        ",".join(f"{f:g}" for f in SWEEP_FPRS),
+    recalls: Annotated[str, typer.Option(
+        help="Beyond them, target frame recalls on validation for thresholds above every "
+        "validation negative ('none' for none).")] = ",".join(f"{r:g}" for r in SWEEP_RECALLS),
+    consecutive: Annotated[int, typer.Option(min=1, help="K: frames above the threshold "
+                                             "that raise the alarm.")] = 1,
+    decel_mps2: Annotated[float, typer.Option(help="Fallback deceleration, m/s².")] =
+        FALLBACK["decel_mps2"],
+    jerk_mps3: Annotated[float, typer.Option(help="Fallback jerk limit, m/s³.")] =
+        FALLBACK["jerk_mps3"],
+    onset_s: Annotated[float, typer.Option(help="Brake dead time before the ramp, s.")] =
+        FALLBACK["onset_s"],
+    hold_s: Annotated[float, typer.Option(help="The fallback ends once the score stays at or "
+                                          "below the threshold this long, s.")] =
+        FALLBACK["hold_s"],
+    horizon_s: Annotated[float, typer.Option(min=0.0, help="H: an intervention is true if the "
+                                             "unsupervised run collides within it.")] = HORIZON_S,
+    split_seed: Annotated[int, typer.Option(help="Split seed (calibration and the trained "
+                                            "baselines).")] = SPLIT_SEED,
+    train_frac: Annotated[float, typer.Option(help="Train share of the other round-0 runs.")] =
+        0.8,
+    val_frac: Annotated[float, typer.Option(help="Validation share of them.")] = 0.2,
+    test_batch: Annotated[str | None, typer.Option(
+        callback=plain_batch, help="The held-out Test Set batch (default: --batch).")] = None,
+    logs: Annotated[str, typer.Option(help=f"Which supervised runs to log: "
+                                      f"{', '.join(LOG_POLICIES)}.")] = "collided",
+    logs_into_runs: Annotated[bool, typer.Option(
+        "--logs-into-runs", help="Write the supervised runs' logs to runs/<scenario>/<batch>"
+        "-supervised/ (ids of their own), so the next `evoeye ingest` takes them in as "
+        "training data; by default they stay out of the warehouse.")] = False,
+    budgets: Annotated[str, typer.Option(help="False interventions per hour the triggers are "
+                                         "compared at.")] =
+        ",".join(f"{b:g}" for b in SUPERVISE_BUDGETS),
+    workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 1,
+    limit: Annotated[int | None, typer.Option(min=1, help="Only the batch's first N runs.")] =
+        None,
+    name: Annotated[str | None, typer.Option(
+        help="Report folder name under <root>/reports (default supervision-<UTC time>).")] =
+        None,
+    docs: Annotated[Path | None, typer.Option(
+        help="Also write supervision-<scenario>.md/.svg/.json here (e.g. docs/results).")] = None,
+    as_json: Annotated[bool, typer.Option("--json", help="Print the figures as one JSON "
+                                          "object (its `rows`: per trigger and threshold).")] =
+        False,
+) -> None:
+    """Re-simulate a batch with each trigger's supervisor: the monitor beside the ADS, a
+    minimal-risk fallback on its alarm. Per trigger and threshold: collisions prevented and
+    caused, false interventions per hour of safe driving, and what the fallback costs; the
+    operating curves with paired bootstrap CIs. Resumes a killed run; exits 3 if a run failed.
+    """
+    from tqdm import tqdm
+
+    from evoeye.evaluation.supervision import supervise
+    from evoeye.evaluation.supervision.report import write_docs, write_report
+    from evoeye.evaluation.supervision.summary import summarise_supervision
+    from evoeye.sim.supervisor import FallbackConfig
+    from evoeye.store import SplitSpec
+
+    if logs not in LOG_POLICIES:
+        raise typer.BadParameter(f"--logs: one of {', '.join(LOG_POLICIES)}, got {logs!r}")
+    sources = [("version", v) for v in monitor or []]
+    sources += [("baseline", b) for b in parse_baselines(baselines)]
+    if not sources:
+        raise typer.BadParameter("no trigger: give --monitor or --baselines")
+    try:
+        splits = SplitSpec(split_seed, train_frac, val_frac, test_batch or batch)
+        fallback = FallbackConfig(decel_mps2, jerk_mps3, onset_s, hold_s)
+    except ValueError as exc:
+        raise typer.BadParameter(str(exc)) from exc
+    data = DataRoot.existing(root)
+    bar = lambda it: tqdm(it, desc=f"supervise {scenario}", unit="run")  # noqa: E731
+    try:
+        result = supervise(data, scenario, batch, sources, splits=splits,
+                           fprs=parse_floats(fprs, "--fprs"),
+                           recalls=() if recalls == "none" else parse_floats(recalls, "--recalls"),
+                           fallback=fallback,
+                           consecutive=consecutive, horizon_s=horizon_s, logs=logs,
+                           logs_into_runs=logs_into_runs, workers=workers, limit=limit,
+                           progress=bar)
+        for sid, reason in result.errors:
+            err().print(f"[yellow]error[/] {sid}: {reason}")
+        summary = summarise_supervision(result.settings, result.records,
+                                        parse_floats(budgets, "--budgets"))
+    except (ValueError, KeyError) as exc:
+        raise UserError(str(exc).strip("'\""), "check --scenario, --batch, --monitor and the "
+                        "split options, and that `evoeye ingest` has run") from exc
+    summary["folder"] = str(result.folder)
+    summary["errors"] = [{"scenario_id": s, "reason": r} for s, r in result.errors]
+    files = write_report(data, [summary], name)
+    written = write_docs(docs, summary) if docs else []
+    if as_json:
+        sys.stdout.write(json.dumps(summary) + "\n")
+    else:
+        _print_summary(summary, result.done_before)
+        for path in [files.html, *written]:
+            out().print(f"report: {path}")
+    exit_with(ExitCode.PARTIAL if result.errors else ExitCode.OK)
+
+
+def _print_summary(summary: dict, done_before: int) -> None:
+    from evoeye.evaluation.supervision.report import ci, headline, headline_budget
+
+    budget = headline_budget(summary)
+    t = table(f"supervise {summary['scenario']}: at ≤ {budget:g} false intervention/h",
+              ["trigger", "prevented % [CI]", "false int./h", "caused", "threshold"],
+              left=("trigger",))
+    for r in (r for r in summary["at_budget"] if r["budget_per_h"] == budget):
+        t.add_row(r["label"], f"{100 * r['prevented_share']:.1f}{ci(r['prevented_ci'])}",
+                  f"{r['false_interventions_per_h']:.2f}", str(r["collisions_caused"]),
+                  "off" if r["threshold"] is None else f"{r['threshold']:.4g}")
+    out().print(t)
+    out().print(headline(summary, budget).replace("**", ""))
+    sims = summary["simulations"]
+    out().print(f"{summary['runs']} runs ({done_before} done before), {sims['shared']} "
+                f"simulations (every threshold alone: {sims['naive']}); results in "
+                f"{summary['folder']}")

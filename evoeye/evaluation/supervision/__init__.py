@@ -1,0 +1,58 @@
+"""The monitor in the loop: what a runtime monitor buys at run time as a safety supervisor.
+
+`supervise` calibrates the triggers on validation (`triggers`), re-simulates a batch under every
+trigger and threshold with the fallback of `evoeye.sim.supervisor` (`sweep`, `batch`), and
+`summary` / `report` turn the paired records into the operating curves (collisions prevented
+against false interventions per hour of safe driving) with paired bootstrap CIs.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterable, Sequence
+
+from evoeye.evaluation.supervision.batch import SupervisionResult, batch_runs, run_supervision
+from evoeye.evaluation.supervision.settings import Settings
+from evoeye.evaluation.supervision.triggers import RECALLS, SWEEP_FPRS, calibrate_triggers
+from evoeye.paths import DataRoot
+from evoeye.sim.supervisor import FallbackConfig
+from evoeye.store import RunFilter, SplitSpec, Warehouse, select_runs
+from evoeye.store.windows import DEFAULT_HORIZON_S
+
+
+def supervise(root: DataRoot, scenario: str, batch: str, sources: Sequence[tuple[str, str]], *,
+              splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
+              fprs: Sequence[float] = SWEEP_FPRS, recalls: Sequence[float] = RECALLS,
+              fallback: FallbackConfig = FallbackConfig(),  # noqa: B008 (frozen dataclass)
+              consecutive: int = 1, horizon_s: float = DEFAULT_HORIZON_S,
+              logs: str = "collided", logs_into_runs: bool = False, workers: int = 1,
+              limit: int | None = None,
+              progress: Callable[[Iterable], Iterable] | None = None) -> SupervisionResult:
+    """Calibrate the triggers (`sources`: ("version", id) or ("baseline", name)) on the
+    scenario's validation split, then supervise every run of `batch` (resuming a killed one);
+    with `logs_into_runs` the supervised runs' logs go where `evoeye ingest` takes them in.
+    ValueError if a run of the batch is in the train or validation split: a trigger must not
+    be judged on the runs it learned or was calibrated on."""
+    check_held_out(root, scenario, batch, splits)
+    triggers = calibrate_triggers(root, scenario, sources, splits, fprs, horizon_s, recalls)
+    settings = Settings(scenario, batch, tuple(triggers), fallback, consecutive, horizon_s,
+                        splits, logs, logs_into_runs=logs_into_runs)
+    return run_supervision(root, settings, workers=workers, progress=progress, limit=limit)
+
+
+def check_held_out(root: DataRoot, scenario: str, batch: str, splits: SplitSpec) -> None:
+    """ValueError naming how many of the batch's runs the train and val splits hold."""
+    ids = {spec.scenario_id for spec, _ in batch_runs(root, scenario, batch)}
+    con = Warehouse(root).connect()
+    try:
+        seen = {split: ids & set(select_runs(con, RunFilter(scenario, split, splits=splits))
+                                 .column("scenario_id").to_pylist())
+                for split in ("train", "val")}
+    finally:
+        con.close()
+    if any(seen.values()):
+        raise ValueError(f"{' and '.join(f'{len(v)} runs in {k}' for k, v in seen.items() if v)}"
+                         f": batch {batch} is not held out under split {splits}; give it as "
+                         "the test batch (--test-batch) or supervise another batch")
+
+
+__all__ = ["Settings", "SupervisionResult", "run_supervision", "supervise"]

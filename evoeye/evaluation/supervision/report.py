@@ -1,0 +1,202 @@
+"""The supervision report: Markdown, a self-contained HTML page and JSON, from summary dicts.
+
+Everything renders from `summarise_supervision`'s dicts (what `--json` prints), one per logical
+scenario. Headline first: at a false-intervention budget, the collisions each trigger prevents,
+the FusionMonitor against the best rule-based trigger with the paired CI of the difference and
+the collisions it causes; then every trigger at each budget, the paired differences, and the
+operating curves. Tables stay narrow (at most eight columns) for the Prefect artifact view.
+"""
+
+from __future__ import annotations
+
+import json
+from datetime import UTC, datetime
+from html import escape
+from pathlib import Path
+
+from evoeye.evaluation.plots import operating_chart, standalone
+from evoeye.evaluation.report import DASH, ReportFiles, Table, html_page, pct
+from evoeye.monitor.families import DEFAULT_FAMILY
+from evoeye.paths import DataRoot
+
+HEADLINE_BUDGET_PER_H = 1.0
+TERMS = ("Collisions prevented (scenario-level recall of the paper's RQ1, here closed loop): "
+         "unsupervised collisions the supervised run does not have. False interventions per "
+         "hour of safe driving (false alarms per hour; the paper's FPR counted per hour): "
+         "fallback engagements while the unsupervised run had no collision within H. Lead: "
+         "median time from the first true intervention to the unsupervised collision (warning "
+         "lead time). Intervals: 95 % paired percentile bootstrap over runs.")
+
+
+def ci(pair: list | None, scale: float = 100.0, signed: bool = False) -> str:
+    """' [low, high]' in the given scale, or '' when undefined."""
+    if not pair or pair[0] is None or pair[1] is None:
+        return ""
+    form = "+.1f" if signed else ".1f"
+    return f" [{scale * pair[0]:{form}}, {scale * pair[1]:{form}}]"
+
+
+def _rate(x: float | None) -> str:
+    return DASH if x is None else f"{x:.2f}"
+
+
+def _opt(x: float | None, form: str = ".1f") -> str:
+    return DASH if x is None else f"{x:{form}}"
+
+
+def _at(summary: dict, budget: float) -> list[dict]:
+    return [r for r in summary["at_budget"] if r["budget_per_h"] == budget]
+
+
+def headline_budget(summary: dict) -> float:
+    """HEADLINE_BUDGET_PER_H if the summary has it, else its first budget."""
+    budgets = summary["budgets_per_h"]
+    return HEADLINE_BUDGET_PER_H if HEADLINE_BUDGET_PER_H in budgets else budgets[0]
+
+
+def headline(summary: dict, budget: float | None = None) -> str:
+    """One paragraph: the FusionMonitor against the best rule-based trigger at the budget
+    (default `headline_budget`)."""
+    budget = headline_budget(summary) if budget is None else budget
+    rows = {r["trigger"]: r for r in _at(summary, budget)}
+    head = (f"**{summary['scenario']}** ({summary['runs']} runs, "
+            f"{summary['collisions_unsupervised']} unsupervised collisions, "
+            f"{summary['safe_h']:.2f} h of safe driving): at ≤ {budget:g} false intervention "
+            "per hour of safe driving, ")
+    fusion = rows.get(DEFAULT_FAMILY)
+    diffs = [d for d in summary["differences"] if d["budget_per_h"] == budget and d["rule_based"]]
+    if fusion is None or not diffs:
+        best = max(rows.values(), key=lambda r: r["prevented_share"])
+        return head + (f"{best['label']} prevents the most collisions: "
+                       f"{pct(best['prevented_share'])} %{ci(best['prevented_ci'])}.")
+    rival = min(diffs, key=lambda d: d["difference"])  # the best rule-based trigger
+    r = rows[rival["b"]]
+    verdict = ("more than" if (rival["ci"][0] or 0) > 0 else
+               "fewer than" if (rival["ci"][1] or 0) < 0 else "no surely different share from")
+    return head + (
+        f"the {fusion['label']} prevents {pct(fusion['prevented_share'])} %"
+        f"{ci(fusion['prevented_ci'])} of them and causes {fusion['collisions_caused']} new "
+        f"ones; the best rule-based trigger, {r['label']}, prevents "
+        f"{pct(r['prevented_share'])} %{ci(r['prevented_ci'])}. Paired difference "
+        f"{100 * rival['difference']:+.1f} points{ci(rival['ci'], signed=True)}: "
+        f"{verdict} every rule-based trigger"
+        + ("." if verdict != "more than" or all((d["ci"][0] or 0) > 0 for d in diffs)
+           else " but not all of them (table below)."))
+
+
+def budget_table(summary: dict, budget: float) -> Table:
+    rows = [[r["label"], f"{pct(r['prevented_share'])}{ci(r['prevented_ci'])}",
+             f"{_rate(r['false_interventions_per_h'])}"
+             f"{ci(r['false_interventions_ci'], scale=1.0)}",
+             f"{_opt(r['lead_s'], '.2f')}{ci(r['lead_ci'], scale=1.0)}",
+             str(r["collisions_caused"]),
+             "off" if r["threshold"] is None else f"{r['threshold']:.4g}"]
+            for r in _at(summary, budget)]
+    return Table(["Trigger", f"Prevented % (recall) at ≤ {budget:g}/h",
+                  "False int./h (false alarms/h)", "Lead s", "Caused", "Threshold"], rows)
+
+
+def differences_table(summary: dict) -> Table:
+    budgets = summary["budgets_per_h"]
+    by = {(d["b"], d["budget_per_h"]): d for d in summary["differences"]}
+    names = list(dict.fromkeys(d["b"] for d in summary["differences"]))
+    labels = {p["trigger"]: p["label"] for p in summary["points"]}
+    rows = [[labels[n] + ("" if by[n, budgets[0]]["rule_based"] else " (trained)")]
+            + [f"{100 * by[n, b]['difference']:+.1f}{ci(by[n, b]['ci'], signed=True)}"
+               for b in budgets] for n in names]
+    return Table(["FusionMonitor − trigger"] + [f"≤ {b:g}/h, points" for b in budgets], rows)
+
+
+def curve_table(summary: dict, trigger: str) -> Table:
+    rows = []
+    for p in (p for p in summary["points"] if p["trigger"] == trigger):
+        rows.append([f"{p['threshold']:.4g} ({p['target']})",
+                     f"{_rate(p['false_interventions_per_h'])}"
+                     f"{ci(p['false_interventions_ci'], scale=1.0)}",
+                     f"{pct(p['prevented_share'])}{ci(p['prevented_ci'])}",
+                     f"{p['collisions_caused']} ({p['caused_rear_end']})",
+                     _opt(p["fallback_s_per_h"], ".0f"), _opt(p["peak_decel_mps2"]),
+                     _opt(p["peak_jerk_mps3"], ".0f"),
+                     f"{_opt(p['lead_s'], '.2f')}{ci(p['lead_ci'], scale=1.0)}"])
+    return Table(["Threshold (val target)", "False int./h [CI]", "Prevented % [CI]",
+                  "Caused (rear-end)", "Fallback s/h", "Decel m/s²", "Jerk m/s³", "Lead s"], rows)
+
+
+def _setup(summary: dict) -> str:
+    s = summary["settings"]
+    fb, sims = s["fallback"], summary["simulations"]
+    return (f"Batch `{summary['batch']}`, each run paired with its unsupervised run; alarm at "
+            f"K = {s['consecutive']} frame(s) above the threshold; fallback: braking ramped at "
+            f"{fb['jerk_mps3']:g} m/s³ to {fb['decel_mps2']:g} m/s² after {fb['onset_s']:g} s, "
+            f"released after {fb['hold_s']:g} s at or below the threshold; H = "
+            f"{s['horizon_s']:g} s; software {s['software_version']}. Simulations: "
+            f"{sims['shared']} (every threshold alone: {sims['naive']}; only those with an "
+            f"alarm: {sims['alarmed']}).")
+
+
+def _triggers(summary: dict) -> list[tuple[str, str]]:
+    return list(dict.fromkeys((p["trigger"], p["label"]) for p in summary["points"]))
+
+
+def markdown_report(summaries: list[dict], figures: dict[str, str] | None = None) -> str:
+    """Every scenario's supervision; `figures` maps a scenario to its curve figure's file."""
+    parts = ["# Monitor in the loop: the supervisor's operating curves", ""]
+    parts += [line for s in summaries for line in (headline(s), "")] + [TERMS, ""]
+    for s in summaries:
+        parts += [f"## {s['scenario']}", "", _setup(s), ""]
+        for b in s["budgets_per_h"]:
+            parts += [budget_table(s, b).markdown(), ""]
+        if s["differences"]:
+            parts += ["Paired differences in collisions prevented (FusionMonitor − trigger), "
+                      "points [95 % CI]:", "", differences_table(s).markdown(), ""]
+        if figures and s["scenario"] in figures:
+            parts += [f"![operating curves, {s['scenario']}]({figures[s['scenario']]})", ""]
+        for name, label in _triggers(s):
+            parts += [f"### {label}: operating curve", "", curve_table(s, name).markdown(), ""]
+    return "\n".join(parts)
+
+
+def curve_svg(summary: dict) -> str:
+    series = [(label, [p for p in summary["points"] if p["trigger"] == name])
+              for name, label in _triggers(summary)]
+    return operating_chart(series, title=f"Operating curves, {summary['scenario']}",
+                           budget=headline_budget(summary))
+
+
+def html_report(summaries: list[dict], title: str = "evoeye supervision report") -> str:
+    """One self-contained HTML page: inline CSS and SVG, no scripts, no external resources."""
+    stamp = f"{datetime.now(UTC):%Y-%m-%d %H:%M} UTC"
+    body = [f"<h1>{escape(title)}</h1>", f'<p class="note">Generated {stamp}.</p>']
+    body += [f"<p>{escape(headline(s)).replace('**', '')}</p>" for s in summaries]
+    body.append(f'<p class="note">{escape(TERMS)}</p>')
+    for s in summaries:
+        body += [f"<h2>{escape(s['scenario'])}</h2>", f'<p class="note">{escape(_setup(s))}</p>',
+                 f'<div class="charts">{curve_svg(s)}</div>']
+        body += [budget_table(s, b).html() for b in s["budgets_per_h"]]
+        if s["differences"]:
+            body.append(differences_table(s).html())
+        for name, label in _triggers(s):
+            body += [f"<h3>{escape(label)}</h3>", curve_table(s, name).html()]
+    return html_page(title, body)
+
+
+def write_report(root: DataRoot, summaries: list[dict], name: str | None = None) -> ReportFiles:
+    """supervision.md, report.html and report.json under `<root>/reports/<name>/`."""
+    files = ReportFiles.under(root, name, "supervision", "supervision.md")
+    files.markdown.write_text(markdown_report(summaries), encoding="utf-8")
+    files.html.write_text(html_report(summaries, f"evoeye supervision — {files.folder.name}"),
+                          encoding="utf-8")
+    files.json.write_text(json.dumps(summaries, indent=1) + "\n", encoding="utf-8")
+    return files
+
+
+def write_docs(folder: Path, summary: dict) -> list[Path]:
+    """supervision-<scenario>.md (linking its .svg curves) and .json in `folder` (docs/results)."""
+    folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
+    stem = f"supervision-{summary['scenario']}"
+    svg, md, js = (folder / f"{stem}{ext}" for ext in (".svg", ".md", ".json"))
+    svg.write_text(standalone(curve_svg(summary)), encoding="utf-8")
+    md.write_text(markdown_report([summary], {summary["scenario"]: svg.name}), encoding="utf-8")
+    js.write_text(json.dumps(summary, indent=1) + "\n", encoding="utf-8")
+    return [md, svg, js]

@@ -1,0 +1,270 @@
+"""The operating curves of a supervision: per trigger and threshold, what supervision prevents,
+causes and costs, with paired bootstrap CIs; and every trigger at a false-intervention budget.
+
+Per trigger and threshold, over the runs (each paired with its unsupervised run):
+
+* collisions prevented: unsupervised collisions the supervised run does not have, as a share of
+  the unsupervised collisions (a collision that only changes partner, e.g. to a car running
+  into the braking ego from behind, is not prevented);
+* collisions caused: supervised collisions of runs that had none (rear-end ones apart);
+* false interventions per hour of safe driving: false interventions (`sweep`) over the hours of
+  the unsupervised runs' eligible frames labelled 0 — one denominator for every trigger;
+* time in fallback per hour driven, the peak deceleration and the peak jerk of the runs that
+  intervened (means over them), and the lead time of the first true intervention (median).
+
+At a budget β the trigger runs at its threshold that prevents the most collisions with at most
+β false interventions per hour (supervision off, preventing none, always meets it): the
+collisions it prevents there (recall at a false-alarm budget), and at that threshold its false
+interventions per hour and lead time.
+
+CIs: 95 % percentile bootstrap over runs, B resamples (seeded). Every trigger's and threshold's
+figures come from the same resamples — the comparison is paired run by run — computed at once
+as products of the resampling counts with the per-run values; the operating point at a budget
+is chosen again in every resample, so its CI includes the choice (the CIs of the false
+interventions and the lead time at a budget are those of the threshold chosen on all runs).
+Medians in a resample are weighted by the resampling counts. Percentile rather than BCa:
+a choice among thresholds is no smooth statistic, and BCa's correction assumes one.
+"""
+
+from __future__ import annotations
+
+import warnings
+from dataclasses import dataclass
+
+import numpy as np
+
+from evoeye.evaluation.supervision.settings import Settings
+from evoeye.evaluation.supervision.triggers import TriggerSpec
+from evoeye.monitor.families import DEFAULT_FAMILY
+
+BUDGETS_PER_H = (0.5, 1.0, 2.0)
+RESAMPLES = 4999
+CONFIDENCE = 0.95
+ROW_FIELDS = ("trigger", "threshold", "runs", "collisions_unsupervised", "collisions_prevented",
+              "collisions_caused", "false_interventions_per_h")
+
+
+@dataclass(frozen=True)
+class RunTable:
+    """One trigger's per-run values, (R,) for the unsupervised run and (R, Θ) per threshold."""
+
+    trigger: TriggerSpec
+    collided0: np.ndarray  # (R,) bool
+    safe_s: np.ndarray  # (R,)
+    collided: np.ndarray  # (R, Θ) bool
+    rear_end: np.ndarray  # (R, Θ) bool: collided, struck from behind
+    false: np.ndarray  # (R, Θ) false interventions
+    interventions: np.ndarray  # (R, Θ)
+    fallback_s: np.ndarray  # (R, Θ)
+    duration_s: np.ndarray  # (R, Θ)
+    decel_mps2: np.ndarray  # (R, Θ) peak, 0 without intervention
+    jerk_mps3: np.ndarray  # (R, Θ)
+    lead_s: np.ndarray  # (R, Θ) first true intervention's lead time, NaN if none
+
+    @classmethod
+    def of(cls, trigger: TriggerSpec, records: list[dict]) -> RunTable:
+        n = len(trigger.thresholds)
+        unsup = [r["unsupervised"] for r in records]
+        cols: dict[str, list] = {k: [] for k in ("collided", "rear_end", "false", "interventions",
+                                                 "fallback_s", "duration_s", "decel", "jerk",
+                                                 "lead")}
+        for r, u in zip(records, unsup, strict=True):
+            t = r["triggers"][trigger.name]
+            if len(t["sim_of"]) != n:
+                raise ValueError(f"{r['scenario_id']}: {len(t['sim_of'])} thresholds recorded "
+                                 f"for {trigger.name}, {n} expected")
+            sims = [None if i is None else t["sims"][i] for i in t["sim_of"]]
+            def col(key: str, default, sims=sims):  # noqa: ANN001, ANN202 - per threshold
+                return [default if s is None else s[key] for s in sims]
+            cols["collided"].append(col("collided", u["collided"]))
+            rear = [s["collided"] and s["struck_from_behind"] if s else
+                    u["collided"] and u["struck_from_behind"] for s in sims]
+            cols["rear_end"].append(rear)
+            cols["false"].append(col("false_interventions", 0))
+            cols["interventions"].append(col("interventions", 0))
+            cols["fallback_s"].append(col("fallback_s", 0.0))
+            cols["duration_s"].append(col("duration_s", u["duration_s"]))
+            cols["decel"].append(col("peak_decel_mps2", 0.0))
+            cols["jerk"].append(col("peak_jerk_mps3", 0.0))
+            cols["lead"].append([np.nan if v is None else v for v in col("first_lead_s", None)])
+        a = {k: np.array(v, dtype=float).reshape(len(records), n) for k, v in cols.items()}
+        return cls(trigger, np.array([u["collided"] for u in unsup], bool),
+                   np.array([u["safe_s"] for u in unsup], float), a["collided"] > 0,
+                   a["rear_end"] > 0, a["false"], a["interventions"], a["fallback_s"],
+                   a["duration_s"], a["decel"], a["jerk"], a["lead"])
+
+    @property
+    def prevented(self) -> np.ndarray:  # (R, Θ)
+        return self.collided0[:, None] & ~self.collided
+
+    @property
+    def caused(self) -> np.ndarray:  # (R, Θ)
+        return ~self.collided0[:, None] & self.collided
+
+
+def _ratio(num: np.ndarray, den: np.ndarray, scale: float = 1.0) -> np.ndarray:
+    with np.errstate(invalid="ignore", divide="ignore"):
+        return np.where(den > 0, scale * num / np.where(den > 0, den, 1.0), np.nan)
+
+
+def _finite(x: float | np.ndarray) -> float | None:
+    """A figure for JSON: None where undefined (no collision, no safe driving to divide by)."""
+    return float(x) if np.isfinite(x) else None
+
+
+def resampling_counts(n_runs: int, resamples: int = RESAMPLES, seed: int = 0) -> np.ndarray:
+    """(B, R) how often each run is drawn in each bootstrap resample (seeded)."""
+    rng = np.random.default_rng(seed)
+    return rng.multinomial(n_runs, np.full(n_runs, 1.0 / n_runs), size=resamples).astype(float)
+
+
+def at_budget(prevented: np.ndarray, fi_per_h: np.ndarray, budget: float) -> np.ndarray:
+    """(…,) the largest prevented share among thresholds (last axis) with at most `budget`
+    false interventions per hour; 0 (supervision off) if none meets it."""
+    ok = fi_per_h <= budget + 1e-12
+    return np.where(ok, np.nan_to_num(prevented, nan=0.0), 0.0).max(axis=-1, initial=0.0)
+
+
+def _ci(samples: np.ndarray) -> list:
+    """The percentile interval over axis 0: [low, high] for (B,) samples, one per column for
+    (B, Θ); None where undefined (e.g. no unsupervised collision in any resample)."""
+    lo_hi = [50 * (1 - CONFIDENCE), 50 * (1 + CONFIDENCE)]
+    with warnings.catch_warnings():  # an all-NaN column is undefined, not an error
+        warnings.simplefilter("ignore", RuntimeWarning)
+        q = np.nanpercentile(samples, lo_hi, axis=0)  # (2,) or (2, Θ)
+    pairs = [[None if not np.isfinite(v) else float(v) for v in col]
+             for col in np.atleast_2d(q.T)]
+    return pairs if samples.ndim > 1 else pairs[0]
+
+
+def weighted_medians(values: np.ndarray, weights: np.ndarray) -> np.ndarray:
+    """(B,) the (lower) median of the finite `values` (R,) in each resample (counts `weights`
+    (B, R)); NaN in a resample that holds none of them."""
+    keep = np.flatnonzero(np.isfinite(values))
+    if keep.size == 0:
+        return np.full(len(weights), np.nan)
+    order = keep[np.argsort(values[keep], kind="stable")]
+    cum = np.cumsum(weights[:, order], axis=1)  # (B, n)
+    total = cum[:, -1:]
+    idx = np.argmax(cum >= total / 2.0, axis=1)
+    return np.where(total[:, 0] > 0, values[order][idx], np.nan)
+
+
+def _mean_over(values: np.ndarray, where: np.ndarray) -> list[float | None]:
+    """Per threshold, the mean of `values` (R, Θ) over the runs `where` (R, Θ) holds."""
+    n = where.sum(axis=0)
+    s = np.where(where, values, 0.0).sum(axis=0)
+    return [float(v / k) if k else None for v, k in zip(s, n, strict=True)]
+
+
+def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np.ndarray,
+                                                                  np.ndarray]:
+    """The curve points of one trigger, and its resampled (B, Θ) prevented share and FI/h."""
+    t = table.trigger
+    c0, prevented, caused = table.collided0, table.prevented, table.caused
+    safe_h = table.safe_s.sum() / 3600.0
+    p_share = _ratio(prevented.sum(axis=0), np.full(len(t.thresholds), c0.sum()))
+    fi = _ratio(table.false.sum(axis=0), np.full(len(t.thresholds), safe_h))
+    bp = _ratio(weights @ prevented, (weights @ c0)[:, None])  # (B, Θ)
+    bf = _ratio(weights @ table.false, (weights @ table.safe_s)[:, None] / 3600.0)
+    p_ci, f_ci = _ci(bp), _ci(bf)
+    acted = table.interventions > 0
+    once = np.ones((1, len(c0)))
+    lead = [None if np.isnan(m := weighted_medians(col, once)[0]) else float(m)
+            for col in table.lead_s.T]
+    lead_ci = [_ci(weighted_medians(col, weights)) for col in table.lead_s.T]
+    points = []
+    for j, thr in enumerate(t.thresholds):
+        points.append({
+            "trigger": t.name, "label": t.label, "threshold": thr,
+            "target": t.targets[j], "val_fpr": t.val_fprs[j], "val_recall": t.val_recalls[j],
+            "prevented_share": _finite(p_share[j]),
+            "prevented_ci": p_ci[j], "false_interventions_per_h": _finite(fi[j]),
+            "false_interventions_ci": f_ci[j],
+            "collisions_prevented": int(prevented[:, j].sum()),
+            "collisions_caused": int(caused[:, j].sum()),
+            "caused_rear_end": int((caused[:, j] & table.rear_end[:, j]).sum()),
+            "rear_end": int(table.rear_end[:, j].sum()),  # every supervised one hit from behind
+            "interventions": int(table.interventions[:, j].sum()),
+            "false_interventions": int(table.false[:, j].sum()),
+            "fallback_s_per_h": _finite(_ratio(table.fallback_s[:, j].sum(),
+                                               table.duration_s[:, j].sum() / 3600.0)),
+            "peak_decel_mps2": _mean_over(table.decel_mps2, acted)[j],
+            "peak_jerk_mps3": _mean_over(table.jerk_mps3, acted)[j],
+            "lead_s": lead[j], "lead_ci": lead_ci[j],
+        })
+    return points, bp, bf
+
+
+def summarise_supervision(settings: Settings, records: list[dict],
+                          budgets: tuple[float, ...] = BUDGETS_PER_H,
+                          resamples: int = RESAMPLES, seed: int = 0) -> dict:
+    """The supervision's figures (module doc) as one JSON-serialisable dict; `rows` holds, per
+    trigger and threshold, exactly ROW_FIELDS."""
+    ok = [r for r in records if r["status"] == "ok"]
+    if not ok:
+        raise ValueError("no run of this supervision simulated: nothing to summarise")
+    weights = resampling_counts(len(ok), resamples, seed)
+    tables = [RunTable.of(t, ok) for t in settings.triggers]
+    points, curves = [], {}
+    for table in tables:
+        pts, bp, bf = trigger_points(table, weights)
+        points += pts
+        curves[table.trigger.name] = (pts, bp, bf)
+    c0 = tables[0].collided0
+    budget_rows, differences = [], []
+    for b in budgets:
+        chosen = {}
+        for name, (pts, bp, bf) in curves.items():
+            chosen[name] = at_budget(bp, bf, b)  # (B,)
+            best = _operating_point(pts, b)
+            budget_rows.append({"budget_per_h": b, "trigger": name,
+                                "label": settings.trigger(name).label,
+                                "prevented_ci": _ci(chosen[name]), **best})
+        if DEFAULT_FAMILY in chosen:
+            for name in chosen:
+                if name == DEFAULT_FAMILY:
+                    continue
+                d = chosen[DEFAULT_FAMILY] - chosen[name]
+                point = (_share_at(curves[DEFAULT_FAMILY][0], b)
+                         - _share_at(curves[name][0], b))
+                differences.append({"budget_per_h": b, "a": DEFAULT_FAMILY, "b": name,
+                                    "rule_based": settings.trigger(name).rule_based,
+                                    "difference": point, "ci": _ci(d)})
+    sims = sum(len(r["triggers"][t.name]["sims"]) for r in ok for t in settings.triggers)
+    alarmed = sum(f is not None for r in ok for t in settings.triggers
+                  for f in r["triggers"][t.name]["first_alarm_frame"])
+    return {
+        "scenario": settings.scenario, "batch": settings.batch, "runs": len(ok),
+        "failed_runs": len(records) - len(ok),
+        "collisions_unsupervised": int(c0.sum()),
+        "safe_h": float(tables[0].safe_s.sum() / 3600.0),
+        "rows": [dict(zip(ROW_FIELDS, (p["trigger"], p["threshold"], len(ok), int(c0.sum()),
+                                       p["collisions_prevented"], p["collisions_caused"],
+                                       p["false_interventions_per_h"]), strict=True))
+                 for p in points],
+        "points": points, "at_budget": budget_rows, "differences": differences,
+        "simulations": {"shared": sims + len(ok), "alarmed": alarmed + len(ok),
+                        "naive": len(ok) * (1 + sum(len(t.thresholds) for t in settings.triggers))},
+        "resamples": resamples, "confidence": CONFIDENCE, "budgets_per_h": list(budgets),
+        "settings": settings.to_dict(),
+    }
+
+
+def _operating_point(points: list[dict], budget: float) -> dict:
+    """The threshold a trigger runs at within the budget (most prevented, then fewest false
+    interventions), or supervision off."""
+    ok = [p for p in points if p["false_interventions_per_h"] is not None
+          and p["false_interventions_per_h"] <= budget + 1e-12]
+    if not ok:
+        return {"threshold": None, "prevented_share": 0.0, "false_interventions_per_h": 0.0,
+                "false_interventions_ci": [0.0, 0.0], "collisions_caused": 0, "lead_s": None,
+                "lead_ci": [None, None]}
+    p = max(ok, key=lambda p: (p["prevented_share"] or 0.0, -p["false_interventions_per_h"]))
+    return {k: p[k] for k in ("threshold", "prevented_share", "false_interventions_per_h",
+                              "false_interventions_ci", "collisions_caused", "lead_s",
+                              "lead_ci")}
+
+
+def _share_at(points: list[dict], budget: float) -> float:
+    return _operating_point(points, budget)["prevented_share"] or 0.0

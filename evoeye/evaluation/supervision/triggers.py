@@ -1,0 +1,138 @@
+"""The triggers a supervision compares, and the thresholds each is swept over.
+
+A trigger is a monitor — a trained version (the FusionMonitor, by version) or a baseline by
+name (TTC, TTC-2D, RSS, the AEM, the context-only control: `evaluation.monitors.BASELINES`) —
+with thresholds calibrated on the scenario's validation frames, one per target false-positive
+rate of the sweep (`calibrate`, the function every evaluation uses), from the paper's two
+operating points down to the strictest the split resolves. Beyond it — above every validation
+negative, where no FPR target reaches — the sweep goes on by the validation positives: one
+threshold per target frame recall of `RECALLS` that still lies above the top negative, so a
+trigger whose strictest FPR threshold still alarms too often on new runs has stricter ones to
+offer. Targets that give the same threshold are one threshold. A worker loads the monitor again
+from its `TriggerSpec` (picklable; kept per process), so the sweep runs the same on local
+processes or a task runner.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Sequence
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from evoeye.evaluation.dataset import load_split, narrow
+from evoeye.evaluation.monitors import BASELINES, check_scores, monitor_context_len
+from evoeye.monitor.calibration import calibrate
+from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES, load_version
+from evoeye.monitor.protocol import Monitor
+from evoeye.paths import DataRoot
+from evoeye.store import SplitSpec
+from evoeye.store.windows import DEFAULT_HORIZON_S
+
+# target FPRs on validation frames: the paper's 0.05 and 0.01, then stricter, to 1e-5 (below one
+# false frame in the ≈ 80–150 k validation frames of a 1 000-run root)
+SWEEP_FPRS = (0.05, 0.02, 0.01, 0.005, 0.002, 0.001, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5, 1e-5)
+RECALLS = (0.2, 0.1, 0.05)  # target frame recalls on validation, above every negative
+RULES = ("ttc", "ttc-2d", "rss", "rss-2s")  # the rule-based triggers (no training)
+DEFAULT_BASELINES = ("ttc", "ttc-2d", "rss", "aem", "context-only")  # `evoeye supervise`'s
+
+
+@dataclass(frozen=True)
+class TriggerSpec:
+    """A trigger as a worker finds it again, and its thresholds (ascending, distinct)."""
+
+    name: str  # the monitor's name: "fusion", "ttc", …; unique in a supervision
+    source: str  # "version" (a trained version's id in `ref`) or "baseline" (a name in `ref`)
+    ref: str
+    version: str
+    thresholds: tuple[float, ...]
+    targets: tuple[str, ...]  # per threshold, the loosest target that gave it: "FPR 0.05", …
+    val_fprs: tuple[float, ...]  # per threshold, the FPR it realises on validation
+    val_recalls: tuple[float, ...]  # … and the frame recall
+
+    @property
+    def label(self) -> str:
+        """How reports name it: a family's label (FusionMonitor), else its name."""
+        return FAMILIES[DEFAULT_FAMILY].label if self.name == DEFAULT_FAMILY else self.name
+
+    @property
+    def rule_based(self) -> bool:
+        return self.source == "baseline" and self.ref in RULES
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+    @classmethod
+    def of(cls, d: dict) -> TriggerSpec:
+        return cls(**{**d, **{k: tuple(d[k]) for k in ("thresholds", "targets", "val_fprs",
+                                                       "val_recalls")}})
+
+
+def load_monitor(root: DataRoot, scenario: str, splits: SplitSpec, source: str,
+                 ref: str) -> Monitor:
+    """The monitor of a trigger: a saved version by id, or the named baseline (trained ones are
+    found again by their training key, or trained)."""
+    if source == "version":
+        return load_version(root, ref)
+    if source == "baseline":
+        if ref not in BASELINES:
+            raise KeyError(f"unknown baseline {ref!r}; known: {sorted(BASELINES)}")
+        return BASELINES[ref](root, scenario, splits)
+    raise ValueError(f"unknown trigger source {source!r}")
+
+
+def sweep_thresholds(scores: np.ndarray, labels: np.ndarray, fprs: Sequence[float],
+                     recalls: Sequence[float] = RECALLS) -> dict[float, str]:
+    """Threshold → the loosest target giving it ("FPR α" of `fprs`, then "recall r" of
+    `recalls` for those above every negative), ascending."""
+    cal = calibrate(scores, labels, fprs)
+    found: dict[float, str] = {}
+    for fpr in sorted(cal.by_fpr, reverse=True):  # loosest first: it names its threshold
+        found.setdefault(cal.by_fpr[fpr], f"FPR {fpr:g}")
+    top_negative = float(np.max(scores[labels == 0]))
+    positive = np.sort(scores[labels == 1])[::-1]  # descending
+    for r in sorted(recalls, reverse=True):
+        k = int(np.floor(r * len(positive)))  # k positives strictly above the k-th one
+        if 0 < k < len(positive) and positive[k] > top_negative:
+            found.setdefault(float(positive[k]), f"recall {r:g}")
+    return dict(sorted(found.items()))
+
+
+def realised(scores: np.ndarray, labels: np.ndarray, thresholds: Sequence[float]
+             ) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """(FPR, frame recall) each threshold realises on these scores (alarm: score > threshold)."""
+    neg, pos = scores[labels == 0], scores[labels == 1]
+    fpr = tuple(float((neg > t).mean()) if neg.size else 0.0 for t in thresholds)
+    rec = tuple(float((pos > t).mean()) if pos.size else 0.0 for t in thresholds)
+    return fpr, rec
+
+
+def calibrate_triggers(root: DataRoot, scenario: str,
+                       sources: Sequence[tuple[str, str]],
+                       splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
+                       fprs: Sequence[float] = SWEEP_FPRS,
+                       horizon_s: float = DEFAULT_HORIZON_S,
+                       recalls: Sequence[float] = RECALLS) -> list[TriggerSpec]:
+    """Each (source, ref) as a trigger with its sweep's thresholds, calibrated on the
+    scenario's validation windows (each monitor at its own L)."""
+    monitors = [load_monitor(root, scenario, splits, source, ref) for source, ref in sources]
+    for m in monitors:
+        trained = (getattr(m, "card", None) or {}).get("logical_scenario")
+        if trained not in (None, scenario):
+            raise ValueError(f"{m.version} was trained on {trained}, not {scenario}")
+    names = [m.name for m in monitors]
+    if dupes := sorted({n for n in names if names.count(n) > 1}):
+        raise ValueError(f"two triggers named {dupes}: give one monitor of each name")
+    L = max(monitor_context_len(m) for m in monitors)
+    val = load_split(root, scenario, "val", splits, context_len=L, horizon_s=horizon_s)
+    if len(val) == 0:
+        raise ValueError(f"{scenario}: the validation split has no frames to calibrate on")
+    specs = []
+    for (source, ref), m in zip(sources, monitors, strict=True):
+        scores = check_scores(m, m.score(narrow(val.windows, monitor_context_len(m))), len(val))
+        labels = val.windows.label
+        sweep = sweep_thresholds(scores, labels, fprs, recalls)
+        fpr, recall = realised(scores, labels, list(sweep))
+        specs.append(TriggerSpec(m.name, source, ref, m.version, tuple(sweep),
+                                 tuple(sweep.values()), fpr, recall))
+    return specs

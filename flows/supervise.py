@@ -1,0 +1,153 @@
+"""Flow: `evoeye supervise` over one or more logical scenarios — calibrate the triggers, one task
+per run, then the report.
+
+A thin wrapper over `evoeye.evaluation.supervision`: a run's record is written once it is done,
+so a crashed flow run started again redoes only the runs without one. The headline and the
+budget tables are published as a Markdown artifact.
+"""
+
+from __future__ import annotations
+
+from typing import Any
+
+from prefect import flow, get_run_logger, task
+from prefect.artifacts import create_markdown_artifact
+from pydantic import BaseModel, Field
+
+from evoeye.evaluation.monitors import BASELINES
+from evoeye.evaluation.rq1 import trained_on
+from evoeye.evaluation.supervision.batch import RunJob, collect, plan_supervision
+from evoeye.evaluation.supervision.report import markdown_report, write_docs, write_report
+from evoeye.evaluation.supervision.settings import LOG_POLICIES, Settings
+from evoeye.evaluation.supervision.summary import BUDGETS_PER_H, summarise_supervision
+from evoeye.evaluation.supervision.sweep import supervise_run
+from evoeye.evaluation.supervision.triggers import (
+    DEFAULT_BASELINES,
+    RECALLS,
+    SWEEP_FPRS,
+    calibrate_triggers,
+)
+from evoeye.monitor.families import load_version
+from evoeye.paths import DataRoot, check_batch_name
+from evoeye.scenarios import SCENARIOS
+from evoeye.sim.supervisor import FallbackConfig
+from evoeye.store import SplitSpec
+from flows.runners import task_runner
+
+F = FallbackConfig()
+
+
+class SuperviseParams(BaseModel):
+    """What to supervise and how (validated before anything runs)."""
+
+    root: str | None = None
+    scenarios: list[str] = Field(default_factory=lambda: list(SCENARIOS))
+    batch: str  # the batch of logged runs of each scenario, e.g. the Test Set's
+    monitors: list[str] = Field(default_factory=list)  # trained versions, each on its scenario
+    baselines: list[str] = Field(default_factory=lambda: list(DEFAULT_BASELINES))
+    fprs: list[float] = Field(default_factory=lambda: list(SWEEP_FPRS))
+    recalls: list[float] = Field(default_factory=lambda: list(RECALLS))
+    consecutive: int = Field(1, ge=1)
+    decel_mps2: float = Field(F.decel_mps2, gt=0.0)
+    jerk_mps3: float = Field(F.jerk_mps3, gt=0.0)
+    onset_s: float = Field(F.onset_s, ge=0.0)
+    hold_s: float = Field(F.hold_s, ge=0.0)
+    horizon_s: float = Field(3.0, ge=0.0)
+    split_seed: int = Field(0, ge=0)
+    train_frac: float = Field(0.8, ge=0.0, le=1.0)
+    val_frac: float = Field(0.2, ge=0.0, le=1.0)
+    test_batch: str | None = None  # default: `batch`
+    logs: str = Field("collided", json_schema_extra={"enum": list(LOG_POLICIES)})
+    logs_into_runs: bool = False  # True: the supervised logs are ingested as training data
+    budgets: list[float] = Field(default_factory=lambda: list(BUDGETS_PER_H))
+    limit: int | None = Field(None, ge=1)
+    workers: int = Field(2, ge=1, le=64)
+    dask_address: str | None = None
+    report_name: str = "supervision"
+    docs: str | None = None  # also write supervision-<scenario>.md/.svg/.json here
+
+    @property
+    def splits(self) -> SplitSpec:
+        return SplitSpec(self.split_seed, self.train_frac, self.val_frac,
+                         self.test_batch or self.batch)
+
+    @property
+    def fallback(self) -> FallbackConfig:
+        return FallbackConfig(self.decel_mps2, self.jerk_mps3, self.onset_s, self.hold_s)
+
+    def model_post_init(self, __context) -> None:
+        check_batch_name(self.batch)
+        self.splits  # noqa: B018  (validates the shares and the test batch's name)
+        if unknown := [s for s in self.scenarios if s not in SCENARIOS]:
+            raise ValueError(f"unknown logical scenario(s) {unknown}; known: {sorted(SCENARIOS)}")
+        if unknown := [b for b in self.baselines if b not in BASELINES]:
+            raise ValueError(f"unknown baseline(s) {unknown}; known: {sorted(BASELINES)}")
+        if self.logs not in LOG_POLICIES:
+            raise ValueError(f"logs: one of {list(LOG_POLICIES)}, got {self.logs!r}")
+
+
+@task(task_run_name="calibrate-{scenario}")
+def calibrate(root: DataRoot, scenario: str, params: SuperviseParams) -> Settings:
+    """The scenario's triggers (its own monitor versions and the baselines), calibrated."""
+    versions = [v for v in params.monitors
+                if trained_on(load_version(root, v)) in (None, scenario)]
+    sources = [("version", v) for v in versions] + [("baseline", b) for b in params.baselines]
+    triggers = calibrate_triggers(root, scenario, sources, params.splits, params.fprs,
+                                  params.horizon_s, params.recalls)
+    return Settings(scenario, params.batch, tuple(triggers), params.fallback,
+                    params.consecutive, params.horizon_s, params.splits, params.logs,
+                    logs_into_runs=params.logs_into_runs)
+
+
+@task(retries=1, retry_delay_seconds=1, task_run_name="supervise-{job.spec.scenario_id}")
+def supervise_one(job: RunJob) -> str:
+    supervise_run(job)
+    return job.spec.scenario_id
+
+
+def supervise_scenario(root: DataRoot, scenario: str, params: SuperviseParams) -> dict:
+    """Calibrate, supervise every run not done yet (a task each), summarise."""
+    settings = calibrate(root, scenario, params)
+    plan = plan_supervision(root, settings, params.limit)
+    futures = {supervise_one.submit(j): j for j in plan.jobs}
+    errors = []
+    for future, job in futures.items():
+        try:
+            future.result()
+        except Exception as exc:  # noqa: BLE001 - reported per run, the others go on
+            errors.append((job.spec.scenario_id, f"{type(exc).__name__}: {exc}"))
+    result = collect(settings, plan, errors)
+    summary = summarise_supervision(settings, result.records, tuple(params.budgets))
+    summary["folder"] = str(result.folder)
+    summary["errors"] = [{"scenario_id": s, "reason": r} for s, r in result.errors]
+    return summary
+
+
+@flow(name="evoeye-supervise", log_prints=True)
+def supervise_flow(params: SuperviseParams) -> dict[str, Any]:
+    """Every scenario's supervision, the report files and a Markdown artifact."""
+    root = DataRoot.existing(params.root)
+    summaries = [supervise_scenario(root, s, params) for s in params.scenarios]
+    files = write_report(root, summaries, params.report_name)
+    for summary in summaries if params.docs else []:
+        write_docs(params.docs, summary)
+    create_markdown_artifact(markdown=markdown_report(summaries), key="evoeye-supervision",
+                             description=f"supervision report, {files.html}")
+    logger = get_run_logger()
+    for s in summaries:
+        logger.info("%s: %d runs, %d errors; %s", s["scenario"], s["runs"], len(s["errors"]),
+                    s["folder"])
+    return {"summaries": summaries, "report_dir": str(files.folder)}
+
+
+def supervise_batch_flow(params: SuperviseParams) -> dict[str, Any]:
+    """The flow on the chosen task runner (local processes, or a Dask cluster)."""
+    runner = supervise_flow.with_options(
+        task_runner=task_runner(params.workers, params.dask_address))
+    return runner(params)
+
+
+if __name__ == "__main__":
+    from flows.command_line import run_from_command_line
+
+    run_from_command_line(SuperviseParams, supervise_batch_flow, __doc__)

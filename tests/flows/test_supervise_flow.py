@@ -1,0 +1,56 @@
+"""The supervise flow end to end through Prefect: one task per run, the report and an artifact."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import pytest
+
+from evoeye.batch import plan_uniform, run_batch
+from evoeye.evaluation.supervision.summary import ROW_FIELDS
+from evoeye.paths import DataRoot
+from evoeye.store import ingest
+from flows.supervise import SuperviseParams, supervise_flow
+
+SCENARIO = "unprotected-intersection"
+
+
+@pytest.fixture
+def root(tmp_path: Path) -> DataRoot:
+    """12 ingested runs to calibrate on, and a batch of 2 held-out runs to supervise."""
+    root = DataRoot.resolve(tmp_path / "data")
+    run_batch(plan_uniform(SCENARIO, 12, 3), root)
+    ingest(root)
+    run_batch(plan_uniform(SCENARIO, 2, 9, batch="held"), root)
+    return root
+
+
+def test_supervise_flow_writes_the_report_and_an_artifact(prefect_server: None,
+                                                          root: DataRoot, tmp_path) -> None:
+    from prefect.client.orchestration import get_client
+
+    params = SuperviseParams(root=str(root.path), scenarios=[SCENARIO], batch="held",
+                             baselines=["ttc"], fprs=[0.05, 0.01], workers=1,
+                             report_name="flow", docs=str(tmp_path / "docs"))
+    out = supervise_flow(params)
+    (summary,) = out["summaries"]
+    assert summary["runs"] == 2 and not summary["errors"]
+    assert summary["rows"] and all(tuple(r) == ROW_FIELDS for r in summary["rows"])
+    records = list(Path(summary["folder"]).glob("runs/*.json"))
+    assert len(records) == 2
+    folder = Path(out["report_dir"])
+    assert {p.name for p in folder.iterdir()} == {"supervision.md", "report.html", "report.json"}
+    assert (tmp_path / "docs" / f"supervision-{SCENARIO}.svg").exists()
+    with get_client(sync_client=True) as client:
+        artifacts = client.read_artifacts()
+    (artifact,) = [a for a in artifacts if a.key == "evoeye-supervision"]
+    assert "ttc: operating curve" in artifact.data
+
+
+def test_bad_parameters_are_refused_before_anything_runs() -> None:
+    with pytest.raises(ValueError, match="unknown baseline"):
+        SuperviseParams(batch="b", baselines=["ttc", "nope"])
+    with pytest.raises(ValueError, match="not a plain name"):
+        SuperviseParams(batch="../b")
+    with pytest.raises(ValueError, match="logs"):
+        SuperviseParams(batch="b", logs="some")
