@@ -44,6 +44,7 @@ from evoeye.monitor.card import (
 )
 from evoeye.monitor.fusion import FusionMonitor, net_inputs
 from evoeye.monitor.model import MODULES, FusionConfig, FusionNet
+from evoeye.monitor.protocol import Thresholds
 from evoeye.monitor.registry import load_monitor, save_version
 from evoeye.monitor.threads import MONITOR_THREADS, intra_op_threads
 from evoeye.paths import DataRoot
@@ -217,16 +218,9 @@ def train_monitor(
     train = load_windows(warehouse, train_runs, context_len=config.context_len,
                          horizon_s=horizon_s)
     val = load_windows(warehouse, val_runs, context_len=config.context_len, horizon_s=horizon_s)
-    with _reproducible(params.seed, params.threads):
-        if parent is not None:
-            net = copy.deepcopy(parent.net)
-        else:
-            net = FusionNet(FusionConfig.for_spec(train.spec, **_sizes(config)))
-            net.fit_normalizers(_frames_of(train))
-        result = fit(net, train, val, params, progress)
-    with intra_op_threads(params.threads):
-        scores = FusionMonitor(result.net, "training", None).score(val)  # type: ignore[arg-type]
-    thresholds = calibrate_on_validation(scores, val)
+    trained = fit_windows(train, val, params, config=config,
+                          parent=None if parent is None else parent.net, progress=progress)
+    result, thresholds, scores = trained.result, trained.thresholds, trained.val_scores
     card = {
         "name": FusionMonitor.name,
         "created_at": datetime.now(UTC).isoformat(timespec="seconds"),
@@ -250,6 +244,34 @@ def train_monitor(
         "metrics": {"val": split_metrics(scores, val.label, thresholds)},
     }
     return save_version(root, result.net, card)
+
+
+@dataclass
+class Trained:
+    """A fit, its thresholds calibrated on validation, and its validation scores."""
+
+    result: FitResult
+    thresholds: Thresholds
+    val_scores: np.ndarray  # (B_val,) float32
+
+
+def fit_windows(train: Windows, val: Windows, params: TrainParams = TrainParams(), *,
+                config: FusionConfig | None = None, parent: FusionNet | None = None,
+                progress: Progress | None = None) -> Trained:
+    """Train a new FusionNet of `config` (default sizes; normalisers fitted on the training
+    frames), or fine-tune a copy of `parent`, on windows in memory: early-stopped on `val`,
+    calibrated on it. Seeded by `params.seed`; nothing is saved (`train_monitor` saves)."""
+    with _reproducible(params.seed, params.threads):
+        if parent is not None:
+            net = copy.deepcopy(parent)
+        else:
+            net = FusionNet(FusionConfig.for_spec(train.spec,
+                                                  **_sizes(config or FusionConfig())))
+            net.fit_normalizers(_frames_of(train))
+        result = fit(net, train, val, params, progress)
+    with intra_op_threads(params.threads):
+        scores = FusionMonitor(result.net, "training", None).score(val)  # type: ignore[arg-type]
+    return Trained(result, calibrate_on_validation(scores, val), scores)
 
 
 def _sizes(config: FusionConfig) -> dict[str, Any]:
