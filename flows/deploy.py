@@ -7,7 +7,9 @@ Serve it (a long-running process that polls the Prefect API and runs the schedul
                                                 # terminal 2: registers and serves the deployment
 
 Each night's flow run resumes the same campaign (its id follows from the parameters), runs
-`rounds_per_night` rounds and stops; when the budget is spent the runs return at once.
+`rounds_per_night` rounds and stops; when the budget is spent the runs return at once. Without
+`--strategy` it runs the default strategy, `DEFAULT_STRATEGY` of
+`evoeye.evolve.campaign.config` (the same constant `evoeye evolve` defaults to).
 """
 
 from __future__ import annotations

@@ -1,14 +1,15 @@
-"""Tables feedback and campaign_rounds: the evolution campaign's state, append-only and idempotent.
+"""Tables feedback, campaign_rounds and committee: an evolution campaign's state, append-only
+and idempotent.
 
 Layout: `<root>/warehouse/<table>/part-<utc stamp>-<id>.parquet`, columns as declared in
 `schemas/warehouse/<table>.sql`, written and read as every derived table is
-(`evoeye.store.derived`): feedback keyed by monitor version, rounds by campaign. A write locks
-its key (`key_lock`: writers of other keys, e.g. other campaigns, go on in parallel), skips the
-rows already stored — (monitor_version, feedback_mode, scenario_id) for feedback, (campaign_id,
-round) for rounds — and writes the rest as one new part, so a killed campaign that re-runs a
-step adds nothing twice. Feedback written before the feedback_mode column existed
-(prior-corrected rows keyed `<version>+prior`) is read as if written now
-(warehouse/queries/feedback_rows.sql).
+(`evoeye.store.derived`): feedback keyed by monitor version, rounds and committees by campaign.
+A write locks its key (`key_lock`: writers of other keys, e.g. other campaigns, go on in
+parallel), skips the rows already stored — (monitor_version, feedback_mode, scenario_id) for
+feedback, (campaign_id, round) for rounds and committees — and writes the rest as one new part,
+so a killed campaign that re-runs a step adds nothing twice. Feedback written before the
+feedback_mode column existed (prior-corrected rows keyed `<version>+prior`) is read as if
+written now (warehouse/queries/feedback_rows.sql).
 """
 
 from __future__ import annotations
@@ -27,6 +28,7 @@ from evoeye.store.lock import key_lock
 
 FEEDBACK_TABLE = "feedback"
 ROUNDS_TABLE = "campaign_rounds"
+COMMITTEE_TABLE = "committee"
 
 
 # -- feedback ------------------------------------------------------------------------------------
@@ -155,4 +157,27 @@ def write_round(root: DataRoot, row: RoundRow) -> bool:
             "train_s": pa.array([row.train_s], pa.float64()),
             "metrics": pa.array([row.metrics.to_json() if row.metrics else ""], pa.string()),
         }, key=row.campaign_id)
+    return True
+
+
+# -- committees -----------------------------------------------------------------------------------
+def read_committee(root: DataRoot, campaign_id: str) -> dict[int, list[str]]:
+    """round → the companion monitor versions of one campaign's committee after that round."""
+    t = read_parts(root, COMMITTEE_TABLE, "committee_rows", key=campaign_id,
+                   campaign_id=campaign_id)
+    return {int(r["round"]): list(r["companions"]) for r in t.to_pylist()}
+
+
+def write_committee(root: DataRoot, campaign_id: str, round_: int,
+                    companions: Sequence[str]) -> bool:
+    """Store a round's companions unless (campaign_id, round) is stored already; True if
+    written."""
+    with key_lock(root, COMMITTEE_TABLE, [campaign_id]):
+        if round_ in read_committee(root, campaign_id):
+            return False
+        append_part(root, COMMITTEE_TABLE, {
+            "campaign_id": pa.array([campaign_id], pa.string()),
+            "round": pa.array([round_], pa.int32()),
+            "companions": pa.array([list(companions)], pa.list_(pa.string())),
+        }, key=campaign_id)
     return True

@@ -8,7 +8,9 @@ CREATE TABLE feedback (
     logical_scenario  VARCHAR  NOT NULL,
     scenario_id       VARCHAR  NOT NULL,
     monitor_version   VARCHAR  NOT NULL,  -- G_r that scored the run
-    feedback_mode     VARCHAR  NOT NULL,  -- ŷ as G_r scores it ('raw') or 'prior-corrected'
+    feedback_mode     VARCHAR  NOT NULL,  -- ŷ as G_r scores it ('raw') or 'prior-corrected', or
+                                          -- 'disagreement-k<K>[-prior-corrected]': the spread of
+                                          -- G_r's committee's scores (table committee)
     feedback          DOUBLE   NOT NULL,  -- f_r(x) in [0, 1]
     n_contexts        INTEGER  NOT NULL,  -- windows averaged
     part_id           VARCHAR  NOT NULL,  -- the part the row was written in

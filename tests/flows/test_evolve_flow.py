@@ -54,6 +54,26 @@ def test_nightly_deployment_has_cron_and_parameter_schema() -> None:
     assert d.concurrency_limit == 1
 
 
+def test_one_constant_is_the_default_strategy_of_evolve_its_flow_and_the_nightly_run(
+        monkeypatch) -> None:
+    """DEFAULT_STRATEGY is what `evoeye evolve`, EvolveParams and the deployment run."""
+    import inspect
+
+    from evoeye.cli.evolve import evolve_command
+    from evoeye.evolve.campaign import config
+    from flows import deploy
+
+    assert config.DEFAULT_STRATEGY == "evoeye"
+    assert config.CampaignConfig().strategy == config.DEFAULT_STRATEGY
+    assert EvolveParams().strategy == config.DEFAULT_STRATEGY
+    assert inspect.signature(evolve_command).parameters["strategy"].default \
+        == config.DEFAULT_STRATEGY
+    served = {}
+    monkeypatch.setattr("prefect.serve", lambda d: served.setdefault("d", d))
+    deploy.main(["--scenario", SCENARIO])
+    assert served["d"].parameters["params"]["strategy"] == config.DEFAULT_STRATEGY
+
+
 def test_evolution_flow_runs_each_round_as_a_flow_run(prefect_server, seeded) -> None:
     from prefect.client.orchestration import get_client
     from prefect.client.schemas.filters import FlowRunFilter, FlowRunFilterName

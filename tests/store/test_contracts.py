@@ -13,7 +13,13 @@ import pytest
 from evoeye.paths import DataRoot
 from evoeye.store import Warehouse, ingest
 from evoeye.store.attribution import AttributionRow, write_attribution
-from evoeye.store.feedback import FeedbackRows, RoundRow, write_feedback, write_round
+from evoeye.store.feedback import (
+    FeedbackRows,
+    RoundRow,
+    write_committee,
+    write_feedback,
+    write_round,
+)
 from evoeye.store.schema import (
     PARTITION_KEYS,
     TABLES,
@@ -61,11 +67,13 @@ QUERY_PARAMS = {
     "monitor_scores_scenarios": {"version": "m-1"},
     "feedback_rows": {"version": "m-1", "mode": "raw"},
     "campaign_rounds_rows": {"campaign_id": None},
+    "committee_rows": {"campaign_id": "evo-x"},
     "attribution_rows": {"version": "v"},
 }
 DERIVED_PARTS = {"monitor_scores_rows": "monitor_scores", "monitor_scores_scenarios":
                  "monitor_scores", "feedback_rows": "feedback",
-                 "campaign_rounds_rows": "campaign_rounds", "attribution_rows": "attribution"}
+                 "campaign_rounds_rows": "campaign_rounds", "committee_rows": "committee",
+                 "attribution_rows": "attribution"}
 
 
 @pytest.fixture
@@ -85,6 +93,7 @@ def filled(root: DataRoot, add_run) -> DataRoot:
     write_feedback(root, FeedbackRows("highway-cut-in", "m-1", "raw", ids, np.array([0.1, 0.2]),
                                       np.array([4, 5])))
     write_round(root, RoundRow("evo-x", "highway-cut-in", "uniform", 0, 0, "m-1", [], 0, 0.0))
+    write_committee(root, "evo-x", 0, ["m-2", "m-3"])
     return root
 
 

@@ -9,16 +9,19 @@ something registered, which registry (`known`). This module imports nothing heav
 line reads it at start-up — so the defaults below that come from elsewhere are literals, checked
 against their sources by tests/evolve/campaign/test_config.py; validation loads the registries.
 
-Every field but `budget_s` and `reference` enters the campaign id (`Campaign.campaign_id`), so
-the same configuration resumes the same campaign.
+Every field but `budget_s` and `reference` enters the campaign id (`campaign_id`), so the same
+configuration resumes the same campaign; a field at a value that cannot change what a campaign
+does is left out of it, so the campaigns made before the field existed keep their ids.
 """
 
 from __future__ import annotations
 
 import dataclasses
+import hashlib
+import json
 import operator
 import typing
-from collections.abc import Callable, Collection, Mapping
+from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from typing import Any
 
@@ -31,6 +34,8 @@ REPLAY_EPOCHS, REPLAY_PATIENCE = 2, 1  # per round: passes over the new runs and
 REPLAY_RATIO = 1.0  # earlier runs replayed per new run of the round
 DEFAULT_FAMILY = "fusion"  # evoeye.monitor.families.DEFAULT_FAMILY
 DEFAULT_DELTA = 0.2  # evoeye.scenarios.DEFAULT_DELTA
+DEFAULT_STRATEGY = "evoeye"  # of `evoeye evolve`, its flow and the nightly deployment
+COMMITTEE = 3  # monitors in the committee of the `disagreement` strategy
 DEFAULT_HORIZON_S = 3.0  # evoeye.store.windows.DEFAULT_HORIZON_S
 MAX_RUN_S = 20.0  # no run lasts longer than this: evoeye.sim.runner.SimConfig().duration_s
 SPLIT_OPTIONS = {  # the split's fields as options: SplitSpec field → (option, help)
@@ -52,6 +57,12 @@ def _strategies() -> Collection[str]:
     from evoeye.evolve.search import STRATEGIES
 
     return STRATEGIES
+
+
+def _committee_strategies() -> Collection[str]:
+    from evoeye.evolve.search import READS_DISAGREEMENT
+
+    return READS_DISAGREEMENT
 
 
 def _families() -> Collection[str]:
@@ -104,7 +115,7 @@ class CampaignConfig:
     """What a campaign does. Every field but `budget_s` and `reference` is part of its id."""
 
     scenario: str = option("highway-cut-in", "Logical scenario.", names="scenario")
-    strategy: str = option("evoeye", "Acquisition strategy.", names="strategy")
+    strategy: str = option(DEFAULT_STRATEGY, "Acquisition strategy.", names="strategy")
     budget_s: float = option(600.0, "Simulated seconds the acquired runs may use in total.",
                              ge=0.0)
     seed: int = option(0, "Campaign seed: the proposals and the runs' seeds.", ge=0)
@@ -130,6 +141,9 @@ class CampaignConfig:
                          "Set).", names="family")
     reference: str | None = option(None, "Another family than fusion: the FusionMonitor G_0 "
                                    "whose Hard Set judges (default: the newest).")
+    committee: int = option(COMMITTEE, "Monitors whose disagreement the `disagreement` "
+                            "strategy reads: G_r and committee − 1 companions trained beside "
+                            "it (each round costs as many monitor updates).", ge=2)
     horizon_s: float = option(DEFAULT_HORIZON_S, "Label horizon H, s.", gt=0.0)
     splits: SplitSpec = option(factory=SplitSpec, help="The train/val/test split.")
     max_run_s: float = option(MAX_RUN_S, "No run lasts longer, s (the simulator's duration).",
@@ -145,6 +159,9 @@ class CampaignConfig:
                 if value not in names:
                     raise ValueError(f"unknown {f.name} {value!r}; known: {sorted(names)}")
             _check_bounds(f.name, value, meta)
+        if self.family != DEFAULT_FAMILY and self.strategy in _committee_strategies():
+            raise ValueError(f"the {self.strategy} strategy's committee is of FusionMonitors: "
+                             f"it cannot evolve the {self.family} family")
         if self.monitor:
             from evoeye.monitor.families import family_of
 
@@ -163,6 +180,29 @@ class CampaignConfig:
         if patience:
             out["patience"] = patience
         return out
+
+
+def campaign_id(config: CampaignConfig, g0: str, initial_ids: Sequence[str], *,
+                feedback_blind: bool, committee: bool) -> str:
+    """`evo-[<family>-]<strategy>-s<seed>-<hash>` of every field but the budget and the
+    reference, with G_0 and D_init's runs: same inputs, same id. `feedback_blind`: the strategy
+    never reads the feedback; `committee`: it reads a committee's disagreement."""
+    cfg = dataclasses.asdict(config)
+    cfg.pop("budget_s")
+    cfg.pop("reference")
+    # raw: the original loop, whose campaigns keep their ids; a feedback-blind strategy
+    # acquires the same runs and trains the same monitors under either mode
+    if cfg["feedback"] == "raw" or feedback_blind:
+        cfg.pop("feedback")
+    if cfg["family"] == DEFAULT_FAMILY:  # likewise
+        cfg.pop("family")
+    if not committee:  # only a strategy that reads the disagreement trains a committee
+        cfg.pop("committee")
+    cfg["monitor"] = g0
+    cfg["initial"] = hashlib.sha256("\n".join(initial_ids).encode()).hexdigest()
+    digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]
+    family = "" if config.family == DEFAULT_FAMILY else f"{config.family}-"
+    return f"evo-{family}{config.strategy}-s{config.seed}-{digest}"
 
 
 def _check_bounds(name: str, value: float, meta: Mapping[str, Any]) -> None:

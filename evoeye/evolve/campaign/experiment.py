@@ -20,12 +20,13 @@ from scipy.stats import spearmanr
 
 from evoeye.evaluation.report import UNREACHABLE
 from evoeye.evolve.campaign.assess import Assessor
+from evoeye.evolve.campaign.committee import from_scratch
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.campaign.state import CampaignState, read_initial
 from evoeye.evolve.campaign.workers import CampaignJob, assessor, run_campaigns
 from evoeye.evolve.search.fitness import CRITICALITY_SCALE_M
-from evoeye.evolve.search.strategies import STRATEGIES
+from evoeye.evolve.search.registry import STRATEGIES
 from evoeye.monitor.families import DEFAULT_FAMILY, evolvable_families, initial_monitor
 from evoeye.paths import DataRoot
 from evoeye.store.connections import shared_connections
@@ -190,23 +191,12 @@ def reseeded_controls(root: DataRoot, cfg: CampaignConfig, k: int,
     same data — scores above G_0's 0 on it; a strategy has only improved on the Hard Set by what
     it adds over these. Versions already trained (same runs, seed, from scratch) are reused.
     """
-    from evoeye.monitor import list_versions, read_card, train_monitor
-    from evoeye.monitor.card import describe_selection
-
     campaign = Campaign(root, cfg)
     ids = [str(s) for s in campaign.initial["scenario_id"]]
-    selection = describe_selection(ids)
-    have = {}
-    for v in list_versions(root):
-        card = read_card(root, v)
-        if (card.get("logical_scenario") == cfg.scenario and not card.get("parent")
-                and card.get("selection", {}).get("train") == selection):
-            have[card.get("hyperparameters", {}).get("seed")] = v
     out = []
     for seed in range(CONTROL_SEED, CONTROL_SEED + k):
-        version = have.get(seed) or train_monitor(
-            root, cfg.scenario, train_runs=ids, val_runs=campaign.val_runs, seed=seed,
-            splits=cfg.splits, horizon_s=cfg.horizon_s)
+        version = from_scratch(root, cfg.scenario, ids, campaign.val_runs, seed, cfg.splits,
+                               cfg.horizon_s)
         out.append(assess(version).as_dict())
     return out
 

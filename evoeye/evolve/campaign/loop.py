@@ -31,17 +31,17 @@ batch's partition, its rounds, its monitor versions' feedback: `evoeye.store.loc
 campaigns run side by side (`experiment.py`). A run is started only if the budget left is at
 least the longest run (`max_run_s`), so the budget is never overspent.
 
+A strategy that reads the records' disagreement (`disagreement`) has a committee
+(`committee.py`): K − 1 companions updated beside G_r, whose spread of scores is stored per run.
+
 Deviation from Algorithm 1: a last round cut short by the budget still updates the monitor (its
 runs were paid for; training costs no simulated time).
 """
 
 from __future__ import annotations
 
-import hashlib
-import json
 import time
 from collections.abc import Callable, Sequence
-from dataclasses import asdict
 from functools import cached_property
 from pathlib import Path
 
@@ -49,20 +49,27 @@ import numpy as np
 
 from evoeye.atomic import remove_stale_temps
 from evoeye.batch import simulate_and_keep
-from evoeye.evolve.campaign.config import REPLAY_RATIO, CampaignConfig
+from evoeye.evolve.campaign.committee import Committee
+from evoeye.evolve.campaign.config import CampaignConfig, campaign_id
 from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
 from evoeye.evolve.campaign.state import (
     CampaignState,
+    acquired_runs,
     initial_profile,
     read_initial,
     records_of,
     run_outcome,
     run_seed,
 )
-from evoeye.evolve.search.strategies import FEEDBACK_BLIND, make_strategy
+from evoeye.evolve.search.records import Records
+from evoeye.evolve.search.registry import (
+    FEEDBACK_BLIND,
+    READS_DISAGREEMENT,
+    make_strategy,
+    strategy_options,
+)
 from evoeye.heap import frozen_heap
-from evoeye.log import read_run
 from evoeye.monitor.families import (
     DEFAULT_FAMILY,
     FAMILIES,
@@ -72,9 +79,9 @@ from evoeye.monitor.families import (
 )
 from evoeye.monitor.threads import intra_op_threads
 from evoeye.paths import DataRoot
-from evoeye.scenarios import DEFAULT_DELTA, get_scenario
+from evoeye.scenarios import get_scenario
 from evoeye.sim.runner import run_spec
-from evoeye.store import RunFilter, Warehouse
+from evoeye.store import RunFilter
 from evoeye.store.connections import shared_connections
 from evoeye.store.feedback import (
     FeedbackRows,
@@ -142,22 +149,15 @@ class Campaign:
 
     @cached_property
     def campaign_id(self) -> str:
-        """`evo-[aem-]<strategy>-s<seed>-<hash>` of everything but the budget and the reference:
-        same inputs, same id."""
-        cfg = asdict(self.config)
-        cfg.pop("budget_s")
-        cfg.pop("reference")
-        # raw: the original loop, whose campaigns keep their ids; a feedback-blind strategy
-        # acquires the same runs and trains the same monitors under either mode
-        if cfg["feedback"] == "raw" or cfg["strategy"] in FEEDBACK_BLIND:
-            cfg.pop("feedback")
-        if cfg["family"] == DEFAULT_FAMILY:  # likewise
-            cfg.pop("family")
-        cfg["monitor"] = self.g0
-        cfg["initial"] = hashlib.sha256("\n".join(self.initial["scenario_id"]).encode()).hexdigest()
-        digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]
-        family = "" if self.config.family == DEFAULT_FAMILY else f"{self.config.family}-"
-        return f"evo-{family}{self.config.strategy}-s{self.config.seed}-{digest}"
+        """`evo-[aem-]<strategy>-s<seed>-<hash>` (`config.campaign_id`): same inputs, same id."""
+        return campaign_id(self.config, self.g0, self.initial["scenario_id"],
+                           feedback_blind=self.config.strategy in FEEDBACK_BLIND,
+                           committee=self.committee is not None)
+
+    @cached_property
+    def committee(self) -> Committee | None:
+        """The monitors whose disagreement the strategy reads (None if it reads none)."""
+        return Committee(self) if self.config.strategy in READS_DISAGREEMENT else None
 
     def stored_feedback(self, version: str) -> dict[str, float]:
         """scenario_id → f stored under `version` in this campaign's feedback mode (G_0's is
@@ -189,6 +189,8 @@ class Campaign:
         rounds = read_rounds(self.root, self.campaign_id)
         if not rounds:
             self._store_feedback(self.g0, self.initial["scenario_id"])
+            if self.committee is not None:
+                self.committee.store(self.g0, 0, self.initial["scenario_id"])
             row = RoundRow(self.campaign_id, self.config.scenario, self.config.strategy,
                            self.config.seed, 0, self.g0, [], 0, 0.0,
                            metrics=self._metrics(self.g0))
@@ -200,26 +202,17 @@ class Campaign:
         remove_stale_temps(self.root.batch_dir(self.config.scenario, self.campaign_id))
         rounds = self.store_initial_round()
         last = rounds[-1]
-        records, ok = records_of(self.initial, self._acquired(
-            [*(s for r in rounds for s in r.scenario_ids), *new_ids]))
+        ids = [*(s for r in rounds for s in r.scenario_ids), *new_ids]
+        records, ok = records_of(self.initial, acquired_runs(self.root, self.log_path, ids))
         n_init = len(self.initial["scenario_id"])
-        stored = self.stored_feedback(last.monitor_version)
-        records = records.with_feedback(np.array(
-            [stored.get(s, np.nan) for s in records.scenario_id], dtype=float))
-        options = {"delta": self.config.delta} if self.config.delta != DEFAULT_DELTA else {}
-        strategy = make_strategy(self.config.strategy, self.space, self.config.seed, **options)
+        records = self.with_stored(records, last.monitor_version)
+        cfg = self.config
+        strategy = make_strategy(cfg.strategy, self.space, cfg.seed, **strategy_options(
+            cfg.strategy, delta=cfg.delta, batch=cfg.n_round))
         mine = records.tail(n_init)
         strategy.replay(mine.params, mine.fitness)
         return CampaignState(self.campaign_id, last.round, last.monitor_version, records,
                              ok, n_init, strategy, rounds)
-
-    def _acquired(self, ids: list[str]) -> list[dict]:
-        """The outcome (params, collided, min_distance_m, duration_s, status) of acquired runs,
-        from the warehouse; from its log's metadata for a run not ingested."""
-        found = {r["scenario_id"]: r for r in (Warehouse(self.root).query(
-            "campaign_records", ids=ids).to_pylist() if ids else [])}
-        return [found.get(sid) or read_run(self.log_path(sid), topics=()).metadata
-                for sid in ids]
 
     def remaining_s(self, state: CampaignState) -> float:
         return self.config.budget_s - state.spent_s
@@ -244,6 +237,8 @@ class Campaign:
         cfg, monitor = self.config, self.monitor(state.monitor)
         new: list[str] = []
         runs: list[LoggedRun] = []
+        members = (None if self.committee is None  # G_r's committee, for the disagreement
+                   else [state.monitor, *self.committee.companions(state.round)])
         while len(new) < cfg.n_round and not self.done(state):
             with self.clock("simulate"):
                 prop = state.strategy.propose(state.records)
@@ -258,19 +253,26 @@ class Campaign:
                 run = (read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
                        if episode is None else
                        episode_run(episode, result.path, monitor.context_len, cfg.horizon_s))
-                fb = (windows_feedback(monitor, run.windows, cfg.feedback).feedback[0]
-                      if run.ok and run.windows is not None else np.nan)
+                scored = run.ok and run.windows is not None
+                fb = windows_feedback(monitor, run.windows, cfg.feedback).feedback[0] if scored \
+                    else np.nan
+                d = self.committee.disagreement(members, run.windows).feedback[0] \
+                    if scored and members else np.nan
             outcome = run_outcome(run.metadata)
             state.strategy.tell(prop.x, outcome["fitness"])
-            state.records = state.records.append(
-                np.asarray(run.metadata["params"], float), feedback=float(fb), **outcome)
+            state.records = state.records.append(np.asarray(run.metadata["params"], float),
+                                                 feedback=float(fb), disagreement=float(d),
+                                                 **outcome)
             state.ok = np.append(state.ok, run.ok)
             new.append(spec.scenario_id)
             runs.append(run)
         if new:  # in the warehouse, with f_r stored, so that a later step can read them by id
             self._ingest(runs)
             added = state.records.tail(state.records.n - len(new))
-            self._write_feedback(state.monitor, added.scenario_id, added.feedback)
+            self.write_feedback(state.monitor, added.scenario_id, added.feedback)
+            if self.committee is not None:
+                self.write_feedback(state.monitor, added.scenario_id, added.disagreement,
+                                    mode=self.committee.mode)
         return new
 
     def ingest(self) -> IngestReport:
@@ -287,41 +289,26 @@ class Campaign:
     @intra_op_threads()
     def update_monitor(self, state: CampaignState) -> tuple[str, float]:
         """Line 12: G_{r+1} from D_r (train) and the fixed val split; (version, wall seconds)."""
-        cfg = self.config
-        ids = self.training_runs(state)
-        if not ids:  # nothing new to learn from (every run of the round failed): G_r stays
-            return state.monitor, 0.0
-        fine_tune = cfg.update != "retrain"
+        ids = state.training_runs(self.config.update, self.config.seed)
         t0 = time.perf_counter()
         with self.clock("train"):
-            version = self._train(
-                self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
-                horizon_s=cfg.horizon_s, seed=cfg.seed * 1000 + state.round + 1,
-                splits=cfg.splits, init_from=state.monitor if fine_tune else None,
-                context_len=None if fine_tune else self.monitor(self.g0).context_len,
-                **cfg.train_overrides(),
-            )
+            if self.committee is not None:  # its companions, beside G_{r+1}
+                self.committee.update(state, ids)
+            if not ids:  # nothing new to learn from (every run of the round failed): G_r stays
+                return state.monitor, 0.0
+            version = self.train_monitor_version(
+                ids, seed=self.config.seed * 1000 + state.round + 1,
+                init_from=state.monitor if self.config.update != "retrain" else None)
         return version, time.perf_counter() - t0
 
-    def training_runs(self, state: CampaignState) -> list[str]:
-        """The runs of D_r the update trains on: every ok record, or with replay the round's new
-        ok runs after a sample of as many earlier ones (seeded by campaign and round; empty when
-        the round has no ok run)."""
-        ok = state.records.scenario_id[state.ok]
-        if self.config.update != "replay":
-            return [str(s) for s in ok]
-        seen = {*self.initial["scenario_id"], *(s for r in state.rounds for s in r.scenario_ids)}
-        is_new = np.array([s not in seen for s in ok], dtype=bool)
-        new, earlier = ok[is_new], ok[~is_new]
-        if len(new) == 0:
-            return []
-        rng = np.random.default_rng([self.config.seed, state.round + 1])
-        k = min(len(earlier), int(round(REPLAY_RATIO * len(new))))
-        pick = np.sort(rng.choice(len(earlier), size=k, replace=False))
-        collided = state.records.collided[state.ok]
-        if not collided[pick].any() and not collided[is_new].any() and collided[~is_new].any():
-            pick[0:1] = rng.choice(np.flatnonzero(collided[~is_new]), size=1)  # both classes
-        return [str(s) for s in (*earlier[np.sort(pick)], *new)]
+    def train_monitor_version(self, ids: list[str], *, seed: int, init_from: str | None) -> str:
+        """A version of the family trained on runs `ids` (fine-tuned from `init_from`, or from
+        scratch with G_0's context length) and the fixed val split, as the update trains."""
+        cfg = self.config
+        return self._train(self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
+                           horizon_s=cfg.horizon_s, seed=seed, splits=cfg.splits,
+                           init_from=init_from, context_len=None if init_from else
+                           self.monitor(self.g0).context_len, **cfg.train_overrides())
 
     @intra_op_threads()
     def finish_round(self, state: CampaignState, new_ids: list[str], version: str,
@@ -334,13 +321,13 @@ class Campaign:
                       train_s: float) -> RoundRow:
         ok_ids = state.records.scenario_id[state.ok]
         self._store_feedback(version, ok_ids)
+        if self.committee is not None:
+            self.committee.store(version, state.round + 1, ok_ids)
         row = RoundRow(self.campaign_id, self.config.scenario, self.config.strategy,
                        self.config.seed, state.round + 1, version, list(new_ids),
                        state.acquired, state.spent_s, train_s, self._metrics(version))
         store_round(self.root, row)
-        stored = self.stored_feedback(version)
-        state.records = state.records.with_feedback(np.array(
-            [stored.get(s, np.nan) for s in state.records.scenario_id], dtype=float))
+        state.records = self.with_stored(state.records, version)
         state.round, state.monitor = row.round, version
         state.rounds.append(row)
         return row
@@ -385,15 +372,28 @@ class Campaign:
         with self.clock("refresh"):
             fb = warehouse_feedback(self.root, self.monitor(version), todo,
                                     self.config.horizon_s, self.config.feedback)
-        self._write_feedback(version, fb.scenario_id, fb.feedback, fb.n_contexts)
+        self.write_feedback(version, fb.scenario_id, fb.feedback, fb.n_contexts)
 
-    def _write_feedback(self, version: str, ids, feedback, n_contexts=None) -> None:
-        ids, feedback = np.asarray(ids, dtype=object), np.asarray(feedback, float)
-        keep = np.isfinite(feedback)
+    def write_feedback(self, version: str, ids, values, n_contexts=None,
+                       mode: str | None = None) -> None:
+        """Store per-run values (the finite ones) under `version` in `mode` (default: the
+        campaign's feedback mode)."""
+        ids, values = np.asarray(ids, dtype=object), np.asarray(values, float)
+        keep = np.isfinite(values)
         n = np.zeros(len(ids), int) if n_contexts is None else np.asarray(n_contexts)
         write_feedback(self.root, FeedbackRows(self.config.scenario, version,
-                                               self.config.feedback, ids[keep], feedback[keep],
-                                               n[keep]))
+                                               mode or self.config.feedback, ids[keep],
+                                               values[keep], n[keep]))
+
+    def with_stored(self, records: Records, version: str) -> Records:
+        """`records` with the feedback (and the committee's disagreement) stored under G_r =
+        `version`; NaN where none is."""
+        def aligned(stored: dict[str, float]) -> np.ndarray:
+            return np.array([stored.get(s, np.nan) for s in records.scenario_id], dtype=float)
+
+        records = records.with_feedback(aligned(self.stored_feedback(version)))
+        return records if self.committee is None else records.with_disagreement(
+            aligned(self.committee.stored(version)))
 
     def _metrics(self, version: str) -> RoundMetrics | None:
         with self.clock("assess"):

@@ -8,6 +8,8 @@ after a monitor update) are scored from the warehouse.
 
 from __future__ import annotations
 
+import numpy as np
+
 from evoeye.evolve.campaign.config import FEEDBACK_MODES
 from evoeye.evolve.search.feedback import ScenarioFeedback, prior_corrected, scenario_feedback
 from evoeye.paths import DataRoot
@@ -17,13 +19,19 @@ from evoeye.store.windows import Windows, load_windows
 def windows_feedback(monitor, windows: Windows, mode: str = "raw") -> ScenarioFeedback:
     """f_r per run of `windows` under `monitor` (anything with `.score(windows)`); with
     "prior-corrected", ŷ first undoes the monitor's training pos_weight (card, default 1)."""
+    return scenario_feedback(mode_scores(monitor, windows, mode), windows.label,
+                             windows.scenario_id)
+
+
+def mode_scores(monitor, windows: Windows, mode: str = "raw") -> np.ndarray:
+    """ŷ (B,) of every context of `windows` under `monitor`, as the feedback `mode` takes it."""
     if mode not in FEEDBACK_MODES:
         raise ValueError(f"feedback mode must be one of {FEEDBACK_MODES}, got {mode!r}")
     scores = monitor.score(windows)
     if mode == "prior-corrected":
         card = getattr(monitor, "card", None) or {}
         scores = prior_corrected(scores, card.get("hyperparameters", {}).get("pos_weight") or 1.0)
-    return scenario_feedback(scores, windows.label, windows.scenario_id)
+    return scores
 
 
 def warehouse_feedback(root: DataRoot, monitor, scenario_ids, horizon_s: float,

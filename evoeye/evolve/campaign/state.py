@@ -2,15 +2,18 @@
 
 from __future__ import annotations
 
-from collections.abc import Iterable
+from collections.abc import Callable, Iterable
 from dataclasses import asdict, dataclass
+from pathlib import Path
 from typing import Any
 
 import numpy as np
 
+from evoeye.evolve.campaign.config import REPLAY_RATIO
 from evoeye.evolve.search.fitness import criticality
 from evoeye.evolve.search.protocol import Strategy
 from evoeye.evolve.search.records import Records
+from evoeye.log import read_run
 from evoeye.paths import DataRoot
 from evoeye.store import Warehouse
 from evoeye.store.feedback import RoundRow
@@ -69,6 +72,27 @@ class CampaignState:
     def acquired(self) -> int:
         return self.records.n - self.n_init
 
+    def training_runs(self, update: str, seed: int) -> list[str]:
+        """The runs of D_r the monitor update trains on: every ok record, or with `update`
+        "replay" the round's new ok runs after a sample of as many earlier ones (seeded by the
+        campaign `seed` and the round; empty when the round has no ok run)."""
+        ok = self.records.scenario_id[self.ok]
+        if update != "replay":
+            return [str(s) for s in ok]
+        seen = {*self.records.scenario_id[:self.n_init],
+                *(s for r in self.rounds for s in r.scenario_ids)}
+        is_new = np.array([s not in seen for s in ok], dtype=bool)
+        new, earlier = ok[is_new], ok[~is_new]
+        if len(new) == 0:
+            return []
+        rng = np.random.default_rng([seed, self.round + 1])
+        k = min(len(earlier), int(round(REPLAY_RATIO * len(new))))
+        pick = np.sort(rng.choice(len(earlier), size=k, replace=False))
+        collided = self.records.collided[self.ok]
+        if not collided[pick].any() and not collided[is_new].any() and collided[~is_new].any():
+            pick[0:1] = rng.choice(np.flatnonzero(collided[~is_new]), size=1)  # both classes
+        return [str(s) for s in (*earlier[np.sort(pick)], *new)]
+
 
 def run_seed(campaign_seed: int, k: int) -> int:
     """The simulation seed of proposal k (0-based) of a campaign."""
@@ -85,6 +109,15 @@ def run_outcome(run: dict[str, Any]) -> dict[str, Any]:
         "collided": collided, "duration_s": float(run["duration_s"]),
         "scenario_id": str(run["scenario_id"]),
     }
+
+
+def acquired_runs(root: DataRoot, log_path: Callable[[str], Path],
+                  ids: list[str]) -> list[dict[str, Any]]:
+    """The outcome (params, collided, min_distance_m, duration_s, status) of acquired runs by
+    id, from the warehouse; from its log's metadata (at `log_path(id)`) for a run not ingested."""
+    found = {r["scenario_id"]: r for r in (Warehouse(root).query(
+        "campaign_records", ids=ids).to_pylist() if ids else [])}
+    return [found.get(sid) or read_run(log_path(sid), topics=()).metadata for sid in ids]
 
 
 def records_of(initial: dict[str, np.ndarray],

@@ -3,8 +3,9 @@
 No I/O and no monitor: a strategy proposes concrete scenarios (`propose(records)`), hears back
 each one's fitness (`tell`), and reads the records' monitor-oriented feedback; the campaign
 (`evoeye.evolve.campaign`) simulates, scores and stores. Here: the `Strategy` protocol and the
-`STRATEGIES` registry, density-aware mutation, the feedback maths, AV-Fuzzer's GA operators,
-and `criticality`, the fitness every strategy's runs are scored by.
+`STRATEGIES` registry (`registry.py`), pool mode (`pool.py`), density-aware mutation, the
+feedback maths, AV-Fuzzer's GA operators, the surrogates (scikit-learn), and `criticality`,
+the fitness every strategy's runs are scored by.
 """
 
 from evoeye.evolve.search.avfuzzer import AVFuzzer, AVFuzzerConfig
@@ -22,15 +23,17 @@ from evoeye.evolve.search.mutation import (
     exploit_probability,
     regional_potential,
 )
+from evoeye.evolve.search.pool import CandidatePool, PooledStrategy
 from evoeye.evolve.search.protocol import Proposal, Strategy, StrategyError
 from evoeye.evolve.search.records import Records
-from evoeye.evolve.search.strategies import (
+from evoeye.evolve.search.registry import (
     FEEDBACK_BLIND,
+    READS_DISAGREEMENT,
     STRATEGIES,
-    DensityStrategy,
-    UniformStrategy,
     make_strategy,
+    strategy_options,
 )
+from evoeye.evolve.search.strategies import DensityStrategy, UniformStrategy
 
 __all__ = [
     "CRITICALITY_SCALE_M",
@@ -38,10 +41,13 @@ __all__ = [
     "STRATEGIES",
     "AVFuzzer",
     "AVFuzzerConfig",
+    "CandidatePool",
     "DensityIndex",
     "DensityStrategy",
     "Mutation",
+    "PooledStrategy",
     "Proposal",
+    "READS_DISAGREEMENT",
     "Records",
     "ScenarioFeedback",
     "Strategy",
@@ -55,4 +61,5 @@ __all__ = [
     "prior_corrected",
     "regional_potential",
     "scenario_feedback",
+    "strategy_options",
 ]

@@ -187,6 +187,12 @@ class AVFuzzer:
             if s.fitness is None:
                 s.proposed = False
 
+    def replay_results(self, fitness: np.ndarray) -> None:
+        """Re-run the GA on results told in proposal order, whatever x each was simulated at
+        (pool mode: the recorded runs are the pool rows nearest its proposals)."""
+        for f in np.asarray(fitness, dtype=float):
+            self.tell(self.propose().x, f)
+
     def _in_flight(self, x: np.ndarray) -> _Slot | None:
         for s in self._slots:
             if s.proposed and s.fitness is None and np.array_equal(s.x, x):

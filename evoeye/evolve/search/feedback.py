@@ -71,6 +71,17 @@ def scenario_feedback(
     return ScenarioFeedback(scenario_id=ids, feedback=err_sum / np.maximum(n, 1), n_contexts=n)
 
 
+def scenario_disagreement(scores: np.ndarray, scenario_ids: np.ndarray) -> ScenarioFeedback:
+    """A committee's disagreement per scenario: the mean over its contexts of the spread
+    (population std) of K members' scores (K, B) of each context; ids (B,)."""
+    scores = np.asarray(scores, dtype=float)
+    if scores.ndim != 2 or scores.shape[0] < 2:
+        raise ValueError(f"scores must be (K >= 2 members, B contexts), got {scores.shape}")
+    spread = scores.std(axis=0)  # (B,)
+    # |spread − 0| per context, grouped by scenario as the feedback is
+    return scenario_feedback(spread, np.zeros(len(spread)), scenario_ids)
+
+
 def prior_corrected(scores: np.ndarray, pos_weight: float) -> np.ndarray:
     """σ(logit(ŷ) − log w): the probabilities of a model trained with BCE pos_weight = w."""
     if not pos_weight > 0:

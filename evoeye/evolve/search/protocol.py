@@ -9,6 +9,16 @@ The density-aware strategies are stateless apart from a proposal counter (propos
 `default_rng([seed, k])` and reads the records passed in); AV-Fuzzer replays its told history
 through its own deterministic generation logic.
 
+Batches. The surrogate strategies (`boundary`, `disagreement`, the smoothed-feedback loops) fit
+once per batch of `batch` proposals (the loop's N_round) and serve the batch from that fit.
+Proposal k belongs to batch k // batch, chosen from the records as they were at its first
+proposal: the first `records.n − k % batch` rows, since the loop records every proposal before
+asking for the next. So a strategy resumed mid-batch rebuilds the same batch.
+
+Pool mode (`evoeye.evolve.search.pool`): asked with `make_strategy(…, pool=rows)`, a strategy
+picks rows of a finite (m, dim) array of already-simulated candidates instead of free θ; each
+proposal's `pool_index` is its row, and no row is proposed twice or while it is in the records.
+
 The loop, in outline (every proposal must be told and recorded, failed runs included):
 
     strategy = make_strategy(name, space, seed)
@@ -39,9 +49,10 @@ class Proposal:
     """One concrete scenario to simulate, and how the strategy came to it (for logs and plots)."""
 
     x: np.ndarray  # (dim,) in parameter units, inside the logical scenario's ranges
-    kind: str  # "local" / "global" / "uniform" / "ga-init" / "ga" / "ga-restart" / "ga-local"
+    kind: str  # "local" / "global" / "uniform" / "sobol" / "boundary" / "disagreement" / "ga…"
     parent: int | None = None  # row in the records of the seed that was mutated, if any
     p_local: float | None = None  # p_δ(seed) for the density-aware strategies
+    pool_index: int | None = None  # pool mode: the row of the candidate pool x is
 
 
 @runtime_checkable

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
+from dataclasses import dataclass, fields, replace
 
 import numpy as np
 
@@ -12,7 +12,9 @@ class Records:
     """D in acquisition order: vectors, feedback and outcomes; append-only, rows never reordered.
 
     Only `params` and `feedback` steer the density-aware strategies; the other columns are what
-    the loop needs anyway (AV-Fuzzer fitness, collisions, the simulated time charged).
+    the loop needs anyway (AV-Fuzzer fitness, collisions, the simulated time charged), and
+    `disagreement`, which only the `disagreement` strategy reads: how much K monitors disagree
+    on the run (mean over its contexts of the spread of their scores), NaN where unknown.
     """
 
     params: np.ndarray  # (n, dim) concrete scenarios, parameter units
@@ -21,6 +23,7 @@ class Records:
     collided: np.ndarray | None = None  # (n,) bool
     duration_s: np.ndarray | None = None  # (n,) simulated seconds of each run
     scenario_id: np.ndarray | None = None  # (n,) str, to align refreshed feedback with the runs
+    disagreement: np.ndarray | None = None  # (n,) spread of K monitors' scores; NaN = unknown
 
     def __post_init__(self) -> None:
         params = np.asarray(self.params, dtype=float)
@@ -34,6 +37,7 @@ class Records:
             "collided": _column(self.collided, n, False, bool, "collided"),
             "duration_s": _column(self.duration_s, n, 0.0, float, "duration_s"),
             "scenario_id": _column(self.scenario_id, n, "", object, "scenario_id"),
+            "disagreement": _column(self.disagreement, n, np.nan, float, "disagreement"),
         }
         for name, value in cols.items():
             object.__setattr__(self, name, value)
@@ -58,6 +62,7 @@ class Records:
         collided: bool = False,
         duration_s: float = 0.0,
         scenario_id: str = "",
+        disagreement: float = np.nan,
     ) -> Records:
         """A new table with one more run at the end (O(n) copy; n is a few thousand at most)."""
         return Records(
@@ -67,22 +72,27 @@ class Records:
             collided=np.append(self.collided, collided),
             duration_s=np.append(self.duration_s, duration_s),
             scenario_id=np.append(self.scenario_id, np.array([scenario_id], dtype=object)),
+            disagreement=np.append(self.disagreement, disagreement),
         )
 
     def with_feedback(self, feedback: np.ndarray) -> Records:
         """The same runs with every feedback refreshed (after a monitor update)."""
         return replace(self, feedback=np.asarray(feedback, dtype=float))
 
+    def with_disagreement(self, disagreement: np.ndarray) -> Records:
+        """The same runs with every disagreement refreshed (after the monitors' update)."""
+        return replace(self, disagreement=np.asarray(disagreement, dtype=float))
+
     def tail(self, start: int) -> Records:
         """Rows from `start` on, e.g. the records one strategy acquired after D_init."""
-        return Records(
-            params=self.params[start:],
-            feedback=self.feedback[start:],
-            fitness=self.fitness[start:],
-            collided=self.collided[start:],
-            duration_s=self.duration_s[start:],
-            scenario_id=self.scenario_id[start:],
-        )
+        return self._rows(slice(start, None))
+
+    def head(self, stop: int) -> Records:
+        """The first `stop` rows, e.g. the records a batch of proposals was chosen from."""
+        return self._rows(slice(0, stop))
+
+    def _rows(self, rows: slice) -> Records:
+        return Records(**{f.name: getattr(self, f.name)[rows] for f in fields(self)})
 
 
 def _column(value, n: int, default, dtype, name: str) -> np.ndarray:

@@ -1,4 +1,4 @@
-"""Acquisition strategies picked by name: BlindSpotEvolver, its two ablations, Uniform, AV-Fuzzer.
+"""The paper's acquisition strategies: BlindSpotEvolver, its two ablations, Uniform.
 
 * `evoeye` — Algorithm 1, lines 6–7: a uniformly random seed from D_r, then density-aware
   mutation steered by the normalised monitor-oriented feedback of the δ-neighbourhood.
@@ -9,7 +9,9 @@
   removed: the potential of a seed is its own normalised feedback (S_δ(x) shrinks to {x}), so
   p(x) = (f̄(x) + ε) / (max_D f̄ + ε), regardless of how its neighbourhood was explored.
 * `uniform` — uniform samples of X (the paper's Uniform baseline).
-* `avfuzzer` — the GA of DESIGN.md §4, see `evoeye.evolve.search.avfuzzer`.
+
+AV-Fuzzer is in `evoeye.evolve.search.avfuzzer`, the strategies beyond the paper in their own
+modules; `evoeye.evolve.search.registry` names them all.
 
 Proposal k of a density-aware or uniform strategy draws from `default_rng([seed, k])` only, so
 the same seed, counter and records give the same proposal; `replay` just restores the counter.
@@ -22,18 +24,15 @@ from collections.abc import Callable
 
 import numpy as np
 
-from evoeye.evolve.search.avfuzzer import AVFuzzer
 from evoeye.evolve.search.feedback import normalise_feedback
 from evoeye.evolve.search.mutation import (
     EPSILON,
-    ConstantPotential,
-    NeighbourhoodPotential,
     Potential,
-    SeedPotential,
     density_aware_mutation,
     exploit_probability,
 )
-from evoeye.evolve.search.protocol import Proposal, Strategy, StrategyError
+from evoeye.evolve.search.pool import CandidatePool
+from evoeye.evolve.search.protocol import Proposal, StrategyError
 from evoeye.evolve.search.records import Records
 from evoeye.scenarios import DEFAULT_DELTA, LogicalScenario
 
@@ -71,6 +70,11 @@ class UniformStrategy(_Counted):
     def propose(self, records: Records | None = None) -> Proposal:
         return Proposal(x=self.space.sample(self._next_rng()), kind="uniform")
 
+    def propose_in(self, records: Records, pool: CandidatePool, unused: np.ndarray) -> Proposal:
+        """Pool mode: one of the unused rows, uniformly."""
+        i = int(unused[self._next_rng().integers(len(unused))])
+        return Proposal(x=pool.rows[i].copy(), kind="uniform", pool_index=i)
+
 
 class DensityStrategy(_Counted):
     """A random executed record as seed, mutated locally with probability p from its potential."""
@@ -90,8 +94,9 @@ class DensityStrategy(_Counted):
         self.delta = delta
         self.epsilon = epsilon
 
-    def exploit_probabilities(self, records: Records) -> np.ndarray:
-        """p_δ (n,) of every executed record under the current feedback."""
+    def exploit_probabilities(self, records: Records, k: int | None = None) -> np.ndarray:
+        """p_δ (n,) of every executed record under the current feedback (`k`: the proposal
+        they are for, which a batched potential needs)."""
         u = self.space.normalise(records.params)
         q = self.potential(u, normalise_feedback(records.feedback))
         return exploit_probability(q, self.epsilon)
@@ -104,43 +109,20 @@ class DensityStrategy(_Counted):
                 f"{self.name}: records have {records.params.shape[1]} parameters, "
                 f"{self.space.name} has {self.space.dim}"
             )
+        k = self.proposals
         rng = self._next_rng()
-        p = self.exploit_probabilities(records)
+        p = self.exploit_probabilities(records, k)
         i = int(rng.integers(records.n))
         m = density_aware_mutation(self.space, records.params[i], p[i], rng, self.delta)
         return Proposal(x=m.x, kind="local" if m.local else "global", parent=i, p_local=float(p[i]))
 
 
-StrategyFactory = Callable[..., Strategy]
-
-
-def _density(potential: Callable[[float], Potential], name: str) -> StrategyFactory:
+def density_strategy(potential: Callable[[float], Potential],
+                     name: str) -> Callable[..., DensityStrategy]:
+    """The factory of a density-aware strategy whose potential is made from δ."""
     def make(
         space: LogicalScenario, seed: int, delta: float = DEFAULT_DELTA, epsilon: float = EPSILON
     ) -> DensityStrategy:
         return DensityStrategy(space, seed, potential(delta), name, delta, epsilon)
 
     return make
-
-
-STRATEGIES: dict[str, StrategyFactory] = {
-    "evoeye": _density(NeighbourhoodPotential, "evoeye"),
-    "no-feedback": _density(lambda _delta: ConstantPotential(), "no-feedback"),
-    "no-density": _density(lambda _delta: SeedPotential(), "no-density"),
-    "uniform": UniformStrategy,
-    "avfuzzer": AVFuzzer,
-}
-# Strategies whose proposals never read the records' feedback: the feedback mode cannot change
-# what they acquire (the monitor updates are the same too), so it is not part of their identity.
-FEEDBACK_BLIND = frozenset({"uniform", "avfuzzer", "no-feedback"})
-
-
-def make_strategy(name: str, space: LogicalScenario, seed: int, **options) -> Strategy:
-    """The strategy called `name` over `space`, seeded; options go to its factory."""
-    try:
-        factory = STRATEGIES[name]
-    except KeyError:
-        raise StrategyError(
-            f"unknown acquisition strategy {name!r}; known: {sorted(STRATEGIES)}"
-        ) from None
-    return factory(space, seed, **options)

@@ -20,7 +20,7 @@ from evoeye.evolve.campaign.loop import Campaign
 from evoeye.monitor.families import FAMILIES
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec, Warehouse, load_windows
-from evoeye.store.feedback import read_feedback, read_rounds
+from evoeye.store.feedback import read_committee, read_feedback, read_rounds
 from evoeye.store.log_windows import read_logged_run
 
 SCENARIO = "unprotected-intersection"  # of the `seeded` data root (conftest.py)
@@ -46,6 +46,7 @@ def snapshot(root: DataRoot, c: Campaign) -> dict:
                                fb.column("feedback_mode").to_pylist(),
                                fb.column("scenario_id").to_pylist(),
                                fb.column("feedback").to_pylist(), strict=True)),
+        "committee": read_committee(root, c.campaign_id),
     }
 
 
@@ -167,7 +168,7 @@ def family_config(g0: str, family: str, **kw) -> CampaignConfig:
     return config(g0, **kw) if family == "fusion" else config(None, family=family, **kw)
 
 
-@pytest.mark.parametrize("strategy", ["evoeye", "avfuzzer"])
+@pytest.mark.parametrize("strategy", ["evoeye", "avfuzzer", "boundary", "disagreement"])
 def test_killed_mid_round_resumes_to_the_same_records(root_copy, seeded, clean_runs, monkeypatch,
                                                       strategy: str) -> None:
     cfg = config(seeded[1], strategy=strategy)
@@ -194,12 +195,14 @@ def test_killed_mid_round_resumes_to_the_same_records(root_copy, seeded, clean_r
     assert snapshot(root, resumed) == expected
 
 
-@pytest.mark.parametrize("family", ["fusion", "aem"])
+@pytest.mark.parametrize(("family", "strategy"), [("fusion", "evoeye"), ("aem", "evoeye"),
+                                                 ("fusion", "disagreement")])
 def test_killed_during_training_resumes_to_the_same_records(root_copy, seeded, clean_runs,
-                                                            family: str) -> None:
+                                                            family: str, strategy: str) -> None:
+    """(disagreement: killed between the two companions of round 1's committee)"""
     from evoeye.monitor.families import FAMILIES
 
-    cfg = family_config(seeded[1], family, strategy="evoeye")
+    cfg = family_config(seeded[1], family, strategy=strategy)
     calls = {"n": 0}
 
     def dies_in_the_second_update(*args, **kwargs):
@@ -211,8 +214,9 @@ def test_killed_during_training_resumes_to_the_same_records(root_copy, seeded, c
     root = root_copy("killed")
     with pytest.raises(RuntimeError, match="mid-training"):
         Campaign(root, cfg, train=dies_in_the_second_update).run(max_rounds=2)
-    Campaign(root, cfg).run(max_rounds=1)
-    assert snapshot(root, Campaign(root, cfg)) == clean_runs("evoeye", family)
+    stored = len(read_rounds(root, Campaign(root, cfg).campaign_id))  # round 0 and any done
+    Campaign(root, cfg).run(max_rounds=3 - stored)
+    assert snapshot(root, Campaign(root, cfg)) == clean_runs(strategy, family)
 
 
 def test_hard_set_is_the_missed_unsafe_frames_and_the_safe_frames_of_their_runs(seeded) -> None:
@@ -388,5 +392,35 @@ def test_a_round_without_an_ok_run_keeps_its_monitor(root_copy, seeded) -> None:
     state = c.start()
     c.acquire(state)
     state.ok[:] = np.arange(len(state.ok)) < len(c.initial["scenario_id"])  # the round failed
-    assert c.training_runs(state) == []
+    assert state.training_runs(c.config.update, c.config.seed) == []
     assert c.update_monitor(state) == (state.monitor, 0.0)
+
+
+def test_disagreement_campaign_keeps_a_committee_and_each_runs_spread(root_copy, seeded) -> None:
+    """K = 3: two companions per round, found again by later campaigns for round 0, and every
+    record's disagreement is the spread of the committee's scores on its warehouse windows."""
+    from evoeye.evolve.search.feedback import scenario_disagreement
+
+    root = root_copy("committee")
+    c = Campaign(root, config(seeded[1], strategy="disagreement", committee=3))
+    state = c.run(max_rounds=2)
+    committee = read_committee(root, c.campaign_id)
+    assert sorted(committee) == [0, 1, 2] and all(len(v) == 2 for v in committee.values())
+    assert len({*committee[0], *committee[1], *committee[2], *(r.monitor_version
+                                                              for r in state.rounds)}) == 9
+    ok = state.records.scenario_id[state.ok]
+    w = load_windows(root, list(ok), context_len=5, horizon_s=3.0)
+    members = [state.monitor, *committee[2]]
+    expected = scenario_disagreement(np.stack([c.monitor(v).score(w) for v in members]),
+                                     w.scenario_id)
+    np.testing.assert_allclose(state.records.disagreement[state.ok],
+                               expected.aligned(ok), rtol=1e-6)
+    assert np.isfinite(state.records.disagreement[state.ok]).all()
+    # another campaign of the same G_0 and D_init shares round 0's companions
+    other = Campaign(root, config(seeded[1], strategy="disagreement", committee=3, seed=1))
+    assert other.committee.companions(0) == committee[0]
+    # the committee's size is part of a disagreement campaign's id, of no other
+    assert Campaign(root, config(seeded[1], strategy="disagreement", committee=4)).campaign_id \
+        != c.campaign_id
+    assert Campaign(root, config(seeded[1], committee=4)).campaign_id \
+        == Campaign(root, config(seeded[1])).campaign_id

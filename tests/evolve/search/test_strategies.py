@@ -45,8 +45,10 @@ def _run(strategy, space, records, n, start=0):
     return proposals, records
 
 
-def test_registry_holds_the_five_strategies_and_each_is_a_strategy():
-    assert set(STRATEGIES) == {"evoeye", "uniform", "avfuzzer", "no-feedback", "no-density"}
+def test_registry_holds_the_paper_strategies_and_the_new_ones_and_each_is_a_strategy():
+    assert set(STRATEGIES) == {"evoeye", "uniform", "avfuzzer", "no-feedback", "no-density",
+                               "sobol", "boundary", "disagreement", "evoeye-knn",
+                               "evoeye-forest"}
     for name in STRATEGIES:
         strategy = make_strategy(name, CROSSING, seed=1)
         assert isinstance(strategy, Strategy)
