@@ -70,6 +70,14 @@ class EfficiencyConfig:
     boundary_steps: int = 4  # bisections per pair: the final bracket is 1/16 of the pair
     data_seed: int = 7_000  # pool; +1 test, +2 val, +3 oracle, +4 the boundary set's sources
     horizon_s: float = 3.0
+    epochs: int | None = None  # every training (None: the trainer's default)
+    patience: int | None = None
+
+    @property
+    def train_overrides(self) -> dict[str, int]:
+        """TrainParams fields every from-scratch monitor of the study gets."""
+        return {k: v for k, v in (("epochs", self.epochs), ("patience", self.patience))
+                if v is not None}
 
     def __post_init__(self) -> None:
         for name in ("regimes", "strategies", "seeds", "checkpoints", "reference_checkpoints"):
@@ -107,8 +115,16 @@ class EfficiencyConfig:
     def to_dict(self) -> dict:
         return {f.name: getattr(self, f.name) for f in fields(self)}
 
+    def changed(self) -> dict:
+        """The fields that differ from the defaults, as JSON values (lists for tuples)."""
+        default = EfficiencyConfig()
+        return {f.name: list(v) if isinstance(v, tuple) else v for f in fields(self)
+                if (v := getattr(self, f.name)) != getattr(default, f.name)}
+
     @classmethod
     def from_dict(cls, data: Mapping) -> EfficiencyConfig:
+        if not isinstance(data, Mapping):
+            raise ValueError(f"the efficiency config must be a mapping, got {data!r}")
         if unknown := sorted(set(data) - {f.name for f in fields(cls)}):
             raise ValueError(f"unknown efficiency config key(s) {unknown}")
         return cls(**data)
