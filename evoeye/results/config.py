@@ -183,6 +183,8 @@ class ResultsConfig:
         if bad := [n for n in self.context_lens if n < 1]:
             raise ValueError(f"context lengths must be >= 1, got {bad}")
         SplitSpec(self.split_seed, *self.shares, self.held_out_batch)  # shares and batch name
+        if "efficiency" in self.parts:
+            self.efficiency_config.check_names()
 
     @property
     def efficiency_config(self) -> EfficiencyConfig:

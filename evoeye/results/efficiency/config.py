@@ -104,6 +104,21 @@ class EfficiencyConfig:
             raise ValueError(f"the pool ({self.pool_runs}) must hold the initial runs and the "
                              f"largest budget ({points[-1]})")
 
+    def check_names(self) -> None:
+        """ValueError naming a scenario, ADS profile or strategy no registry knows (loads the
+        registries)."""
+        from evoeye.ads.profiles import ADS_PROFILES
+        from evoeye.evolve.search import STRATEGIES as KNOWN
+        from evoeye.scenarios import SCENARIOS
+
+        for regime in self.regimes:
+            scenario, profile = parse_regime(regime)
+            if scenario not in SCENARIOS or profile not in ADS_PROFILES:
+                raise ValueError(f"regime {regime!r}: scenarios are {sorted(SCENARIOS)}, ADS "
+                                 f"profiles {sorted(ADS_PROFILES)}")
+        if unknown := [s for s in self.strategies if s not in KNOWN]:
+            raise ValueError(f"unknown strategy {unknown}; known: {sorted(KNOWN)}")
+
     @property
     def budgets(self) -> tuple[int, ...]:
         """Every checkpoint any strategy reaches (the reference's included)."""

@@ -53,13 +53,24 @@ def regime_results(result: dict, config: EfficiencyConfig) -> dict:
             "where": where_sampled(curves, config.checkpoints[-1])}
 
 
-def run_efficiency(root: DataRoot, config: EfficiencyConfig, *, workers: int = 1,
-                   say: Callable[[str], None] | None = None,
-                   ledger: Ledger | None = None) -> dict:
-    """Every regime of the study: {"config", "regimes": {regime: results}, "findings"}."""
-    regimes = {regime: regime_results(run_regime(root, regime, config, workers=workers,
-                                                 say=say, ledger=ledger), config)
-               for regime in config.regimes}
+def regime_part(root: DataRoot, regime: str, config: EfficiencyConfig, *, workers: int = 1,
+                say: Callable[[str], None] | None = None, ledger: Ledger | None = None) -> dict:
+    """One regime's data, curves and summaries."""
+    return regime_results(run_regime(root, regime, config, workers=workers, say=say,
+                                     ledger=ledger), config)
+
+
+def study_results(config: EfficiencyConfig, regimes: dict[str, dict]) -> dict:
+    """{"config", "regimes": {regime: results}, "findings"} of the regimes' results."""
     out = {"config": config.to_dict(), "regimes": regimes}
     out["findings"] = efficiency_findings(out)
     return out
+
+
+def run_efficiency(root: DataRoot, config: EfficiencyConfig, *, workers: int = 1,
+                   say: Callable[[str], None] | None = None,
+                   ledger: Ledger | None = None) -> dict:
+    """Every regime of the study, then its findings (`study_results`)."""
+    return study_results(config, {regime: regime_part(root, regime, config, workers=workers,
+                                                      say=say, ledger=ledger)
+                                  for regime in config.regimes})
