@@ -44,6 +44,11 @@ def tiny_regime(tmp_path_factory) -> tuple[DataRoot, DataRoot]:
 
 
 @pytest.fixture
+def tiny_config() -> EfficiencyConfig:
+    return TINY
+
+
+@pytest.fixture
 def context(tiny_regime) -> Context:
     root, data = tiny_regime
     sets = RegimeData.load(data, TINY)

@@ -10,7 +10,6 @@ from evoeye.results.efficiency.oracle import run_oracle
 from evoeye.results.efficiency.sets import concat_windows
 
 
-
 def test_every_strategy_starts_from_the_seeds_initial_runs_and_picks_unused_pool_runs(
         context) -> None:
     pool_ids = set(context.bank.pool.scenario_id)
