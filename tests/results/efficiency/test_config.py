@@ -69,3 +69,17 @@ def test_boundary_pairs_join_each_collision_to_its_nearest_safe_run() -> None:
         assert ((u[safe] - u[hit]) ** 2).sum() == pytest.approx(d.min())
     with pytest.raises(ValueError, match="both safe and colliding"):
         boundary_pairs(params, np.zeros(60, bool), space, 5, rng)
+
+
+def test_the_command_refuses_a_bad_study_before_anything_runs(tmp_path) -> None:
+    from typer.testing import CliRunner
+
+    from evoeye.cli import app
+
+    base = ["results", "--part", "efficiency", "--root", str(tmp_path / "r")]
+    for extra, message in ((["--regime", "highway-cut-in:reckless"], "ADS profiles"),
+                           (["--strategy", "annealing"], "unknown strategy"),
+                           (["--mode", "live"], "mode must be one of")):
+        result = CliRunner().invoke(app, [*base, *extra])
+        assert result.exit_code == 2 and message in result.output, result.output
+    assert not (tmp_path / "r").exists()
