@@ -16,7 +16,7 @@ from evoeye.results.config import (
     ResultsConfig,
     parse_initial_runs,
 )
-from evoeye.results.efficiency.config import MODES, EfficiencyConfig
+from evoeye.results.efficiency.config import MODES, REFERENCE, EfficiencyConfig
 
 D = ResultsConfig()  # the defaults --help shows (config.py imports nothing heavy)
 E = EfficiencyConfig()
@@ -104,8 +104,9 @@ def results_command(
                          "SCENARIO:ADS_PROFILE (repeatable; default "
                          f"{', '.join(E.regimes)}).")] = None,
     strategy: Annotated[list[str] | None, typer.Option(
-        "--strategy", help="Sample-efficiency study: the strategies whose curves it draws "
-                           f"(repeatable; default {', '.join(E.strategies)}).")] = None,
+        "--strategy", help="Sample-efficiency study: the strategies whose curves it draws, "
+                           "beside Uniform's, the reference (repeatable; default "
+                           f"{', '.join(E.strategies)}).")] = None,
     mode: Annotated[str, typer.Option(
         help=f"Sample-efficiency study: {' or '.join(MODES)} (pick from the pre-simulated "
              "pool, or simulate what each strategy proposes).")] = E.mode,
@@ -152,7 +153,9 @@ def results_command(
             budget_s=budget_s, n_round=n_round, update=update, feedback=feedback,
             epochs=epochs, patience=patience, workers=workers,
             efficiency=EfficiencyConfig(
-                regimes=tuple(regime or E.regimes), strategies=tuple(strategy or E.strategies),
+                regimes=tuple(regime or E.regimes),
+                strategies=tuple(dict.fromkeys((REFERENCE, *strategy))) if strategy
+                else E.strategies,
                 mode=mode, seeds=tuple(range(first_study_seed, first_study_seed + study_seeds)),
                 oracle=oracle, pool_runs=pool_runs, epochs=epochs, patience=patience
             ).changed())
