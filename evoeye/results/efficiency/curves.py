@@ -95,13 +95,20 @@ class Trajectory:
     kinds: list[str]  # how each acquired run was chosen (the proposal's kind)
 
 
+MARGIN_BINS_M = (0.5, 1.0, 2.0, 4.0, 7.0)  # upper edges of the safe runs' gap bins; then ≥ 7
+
+
 def acquired_summary(collided: np.ndarray, fitness: np.ndarray) -> dict:
     """Where acquired runs fell: how many collided, how near the boundary the others came
-    (their criticality × 10 m is the footprint gap, capped at 10 m)."""
+    (their criticality × 10 m is the footprint gap, capped at 10 m), and the safe runs per
+    gap bin (MARGIN_BINS_M)."""
     collided = np.asarray(collided, bool)
     gap = np.asarray(fitness, float) * 10.0
     safe = ~collided
+    bins = np.bincount(np.searchsorted(MARGIN_BINS_M, gap[safe], side="right"),
+                       minlength=len(MARGIN_BINS_M) + 1)
     return {"runs": int(len(collided)), "collided": int(collided.sum()),
+            "safe_by_gap": [int(b) for b in bins],
             "near_miss_2m": int((safe & (gap < 2.0)).sum()),
             "mean_gap_m": float(np.nanmean(np.where(safe, gap, np.nan))) if safe.any() else None}
 

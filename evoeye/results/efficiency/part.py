@@ -32,6 +32,8 @@ def where_sampled(curves: dict[str, dict[str, dict]], budget: int) -> dict[str, 
             continue
         gaps = [r["mean_gap_m"] for r in rows if r["mean_gap_m"] is not None]
         out[name] = {"runs": float(np.mean([r["runs"] for r in rows])),
+                     "by_gap": [float(v) for v in np.mean(
+                         [np.array(r["safe_by_gap"]) / r["runs"] for r in rows], axis=0)],
                      "collided": float(np.mean([r["collided"] / r["runs"] for r in rows])),
                      "near_miss": float(np.mean([r["near_miss_2m"] / r["runs"] for r in rows])),
                      "mean_gap_m": float(np.mean(gaps)) if gaps else None}

@@ -11,6 +11,7 @@ from html import escape
 
 from evoeye.evaluation.plots import band_chart
 from evoeye.results.efficiency.config import ORACLE, REFERENCE, parse_regime
+from evoeye.results.efficiency.curves import MARGIN_BINS_M
 from evoeye.results.markdown import _md, diff_cell, mean_cell, pct
 
 SET_WORDS = {"test": "the Test Set", "boundary": "the boundary set"}
@@ -58,13 +59,14 @@ def curve_table(summary: dict) -> list[str]:
 
 def where_table(where: dict) -> list[str]:
     """Per strategy, where its acquired runs fell (the mean over seeds at its last common
-    budget)."""
-    rows = [[_label(name), f"{w['runs']:.0f}", f"{pct(w['collided'])} %",
-             f"{pct(w['near_miss'])} %",
-             "–" if w["mean_gap_m"] is None else f"{w['mean_gap_m']:.1f} m"]
-            for name, w in where.items()]
-    return _md(["strategy", "acquired runs", "collided", "safe, within 2 m",
-                "mean gap of the safe ones"], rows)
+    budget): the share that collided, then the safe ones by their smallest gap to another
+    road user."""
+    edges = ["0", *(f"{e:g}" for e in MARGIN_BINS_M)]
+    bins = [f"gap {a}–{b} m" for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    rows = [[_label(name), f"{w['runs']:.0f}", pct(w["collided"]),
+             *(pct(v) for v in w["by_gap"])] for name, w in where.items()]
+    return _md(["strategy", "acquired runs", "collided (%)", *(f"{b} (%)" for b in bins),
+                f"gap ≥ {edges[-1]} m (%)"], rows)
 
 
 def chart(summary: dict, title: str) -> str:
