@@ -105,7 +105,8 @@ class PlannedTrajectory(Message):
 
 # constant velocity; along a lane (or one of its continuations); a lane change left or right;
 # stopping at the end of a lane that gives way (the rule of the road)
-PREDICTION_MODES = ("cv", "lane", "left", "right", "yield")
+# "external": a mode another stack predicted (an imported recording); never one of this ADS's
+PREDICTION_MODES = ("cv", "lane", "left", "right", "yield", "external")
 PLANNING_DECISIONS = ("cruise", "follow", "yield", "proceed", "emergency_brake")
 
 

@@ -4,7 +4,7 @@ Each implements the Protocol of the module it replaces, so it drops into an `ADS
 attribute: perception = the ground truth, prediction = the actors' true futures, planning = the
 ADS's own planner configured carefully, control = an ideal actuator. An oracle is allowed to
 know what the real module cannot (the truth, the future); it is never a different algorithm
-where the issue asks for a better configuration of the same one.
+where a better configuration of the same one is what is asked.
 """
 
 from __future__ import annotations

@@ -10,7 +10,7 @@ import typer
 from evoeye.cli.app import app, exit_with
 from evoeye.cli.errors import ExitCode
 from evoeye.cli.output import out, table
-from evoeye.cli.simulate import RootOpt
+from evoeye.cli.simulate import RootOpt, plain_batch
 from evoeye.paths import DataRoot
 
 if TYPE_CHECKING:
@@ -36,7 +36,8 @@ def summary_table(audits: list[ScenarioAudit]) -> Table:
 def audit_command(
     root: RootOpt = None,
     scenario: Annotated[str | None, typer.Option(help="Only this logical scenario.")] = None,
-    batch: Annotated[str | None, typer.Option(help="Only this batch.")] = None,
+    batch: Annotated[str | None, typer.Option(
+        callback=plain_batch, help="Only this batch (e.g. demo, uniform-seed0).")] = None,
     workers: Annotated[int, typer.Option(min=1, help="Processes reading logs.")] = 1,
     as_json: Annotated[bool, typer.Option("--json", help="Print the report as JSON.")] = False,
     strict: Annotated[bool, typer.Option(
@@ -55,10 +56,7 @@ def audit_command(
         sys.stdout.write(orjson.dumps(report_dict(audits, scenario, batch),
                                       option=orjson.OPT_SERIALIZE_NUMPY).decode() + "\n")
     else:
-        if not audits:
-            out().print(f"no run logs under {data.runs}")
-        else:
-            out().print(summary_table(audits))
+        out().print(summary_table(audits))
         out().print(f"report: {folder / 'audit.md'}")
     if strict and any(s.failed for s in audits):
         exit_with(ExitCode.CHECK_FAILED)

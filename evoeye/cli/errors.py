@@ -57,6 +57,9 @@ KNOWN_ERRORS: dict[str, str] = {
     "evoeye.evolve.campaign.state.MixedProfilesError": "simulate each ADS profile's runs under "
                                                        "a data root of its own (--root)",
     "evoeye.ads.profiles.UnknownProfileError": "",
+    "evoeye.evaluation.audit.runs.NoLogsError": "name a batch the root holds (above), or "
+                                                "leave out --scenario and --batch to audit "
+                                                "them all; `evoeye simulate …` makes runs",
     "evoeye.results.study.EmptySplitError": "simulate the data with the command (--initial-runs "
                                             "N --test-runs M), or check --test-batch and the "
                                             "shares",

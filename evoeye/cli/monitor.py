@@ -149,13 +149,27 @@ def replay_command(
     out().print(f"wrote {report.out}")
 
 
-@app.command("export")
+export_app = typer.Typer(
+    invoke_without_command=True,
+    help="Export a monitor version to ONNX (--monitor, --out), or runs to another stack's "
+         "format (`evoeye export autoware`).")
+app.add_typer(export_app, name="export")
+
+
+@export_app.callback()
 def export_command(
-    monitor: MonitorOpt,
-    output: Annotated[Path, typer.Option("--out", help="ONNX file to write.")],
+    ctx: typer.Context,
+    monitor: Annotated[str | None, typer.Option("--monitor",
+                                                help="Monitor version, e.g. fusion-…")] = None,
+    output: Annotated[Path | None, typer.Option("--out", help="ONNX file to write.")] = None,
     root: RootOpt = None,
 ) -> None:
     """Export a monitor version to ONNX (dynamic batch axis; output: risk in [0, 1])."""
+    if ctx.invoked_subcommand is not None:
+        return
+    if monitor is None or output is None:
+        raise UserError("`evoeye export` needs --monitor and --out (or a subcommand)",
+                        "e.g. `evoeye export --monitor fusion-… --out monitor.onnx`")
     from evoeye.monitor.export import export_onnx
     from evoeye.monitor.registry import load_monitor
 

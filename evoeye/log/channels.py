@@ -51,6 +51,7 @@ class Topics(NamedTuple):
 
 
 TOPICS = Topics()
+AGES_TOPIC = "/ads/message_ages"  # only in a log imported from another stack (evoeye.sources)
 
 
 @cache
@@ -130,4 +131,15 @@ FRAME_CHANNELS: tuple[Channel, ...] = (
 )
 # fmt: on
 MAP_CHANNEL = Channel(TOPICS.map, "scene_update.v1.json", viz.map_update, None)
-CHANNELS: dict[str, Channel] = {c.topic: c for c in (*FRAME_CHANNELS, MAP_CHANNEL)}
+
+
+def _not_simulated(frame: Frame, t_ns: int) -> dict[str, Any]:
+    raise TypeError(f"{AGES_TOPIC} has no message in a simulated episode")
+
+
+# The held messages' ages of a recording imported from another stack (evoeye.sources): written
+# by `write_run`, never by `write_episode` (evoeye's ADS publishes every message at the frame).
+AGES_CHANNEL = Channel(AGES_TOPIC, "message_ages.v1.json", _not_simulated, None)
+CHANNELS: dict[str, Channel] = {c.topic: c for c in (*FRAME_CHANNELS, MAP_CHANNEL, AGES_CHANNEL)}
+# Channels whose messages a log may lack altogether: their warehouse columns are then NULL.
+OPTIONAL_TOPICS = frozenset({AGES_TOPIC})

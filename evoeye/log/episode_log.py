@@ -14,7 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 from typing import Any
 
-from evoeye.log.channels import CHANNELS, FRAME_CHANNELS, MAP_CHANNEL, log_time_ns
+from evoeye.log.channels import CHANNELS, FRAME_CHANNELS, MAP_CHANNEL, OPTIONAL_TOPICS, log_time_ns
 from evoeye.log.records import decode_run, encode_run, run_values
 from evoeye.sim.episode import Episode
 
@@ -34,7 +34,7 @@ class EpisodeLog:
 
     def messages(self, topic: str) -> list[tuple[int, dict[str, Any]]]:
         """[(log_time_ns, message dict)] of a topic, in time order; [] if it has no messages."""
-        if topic not in CHANNELS:
+        if topic not in CHANNELS or topic in OPTIONAL_TOPICS:  # a simulation has none
             return []
         if topic not in self._messages:
             self._messages[topic] = self._encode(topic)

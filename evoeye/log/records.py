@@ -17,6 +17,9 @@ from evoeye.scenarios import SCENARIOS
 from evoeye.scene import Lane, RoadMap
 from evoeye.sim.episode import Episode
 
+SIMULATOR_LABELS = "simulator"  # label_source of a run evoeye simulated: its own ground truth
+UNLABELLED = "none"  # label_source of a recording without ground truth (schemas/mcap/run.v1.json)
+
 
 def _is_string(prop: dict[str, Any]) -> bool:
     return prop.get("type") == "string"
@@ -56,6 +59,7 @@ def run_values(episode: Episode) -> dict[str, Any]:
         "other_actor": None if out.other_actor is None else int(out.other_actor),
         "duration_s": float(out.duration_s),
         "min_distance_m": _float_or_none(out.min_distance_m),
+        "label_source": SIMULATOR_LABELS,
     }
     return {name: values[name] for name in schema_fields(RUN_SCHEMA_FILE)}
 
@@ -90,14 +94,16 @@ def _typed(prop: dict[str, Any], value: Any, name: str) -> Any:
 
 
 def decode_run(record: dict[str, str]) -> dict[str, Any]:
-    """The MCAP metadata record → typed run metadata; ValueError naming the field if malformed."""
-    props = load_schema(RUN_SCHEMA_FILE)["properties"]
-    missing = [name for name, prop in props.items() if name not in record and "default" not in prop]
+    """The MCAP metadata record → typed run metadata; ValueError naming the field if malformed.
+    A field the schema does not require takes its schema default when the record lacks it."""
+    schema = load_schema(RUN_SCHEMA_FILE)
+    props = schema["properties"]
+    missing = [name for name in schema["required"] if name not in record]
     if missing:
         raise ValueError(f"missing fields {missing}")
     typed = {}
     for name, prop in props.items():
-        if name not in record:  # a field added since the log was written: its default
+        if name not in record:
             typed[name] = prop["default"]
             continue
         raw = record[name]

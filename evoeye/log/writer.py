@@ -1,4 +1,5 @@
 """Episode → MCAP file, written atomically: a log either is complete or does not exist.
+(`write_run`: the same for a run imported from another stack, from its channel messages.)
 
 Layout: the `evoeye.run` metadata record, the `evoeye.road_map` attachment, one `/viz/map`
 message at the first frame time, then per frame one message on each of the seven frame channels,
@@ -9,6 +10,7 @@ episode always gives the same bytes.
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from pathlib import Path
 from typing import Any, BinaryIO
 
@@ -19,6 +21,7 @@ from mcap.writer import LIBRARY_IDENTIFIER
 from evoeye import __version__
 from evoeye.atomic import atomic_file
 from evoeye.log.channels import (
+    CHANNELS,
     FRAME_CHANNELS,
     MAP_CHANNEL,
     MESSAGE_ENCODING,
@@ -99,6 +102,31 @@ def write_stream(episode: Episode, stream: BinaryIO) -> None:
         for cid, encode in encoders:
             add(cid, t_ns, dumps(encode(frame, t_ns)), t_ns, seq)
     writer.finish()
+
+
+def write_run(metadata: dict[str, Any], frames: Sequence[dict[str, dict[str, Any]]],
+              path: str | os.PathLike) -> Path:
+    """Write a run that was not simulated here (an imported recording) atomically: its typed
+    run metadata and, per frame, its channel messages by topic (evoeye's own channels, with
+    the same messages in every frame). No road map or scene channel; the log time of a message
+    is its frame's t_s."""
+    topics = list(frames[0]) if frames else []
+    unknown = [t for t in topics if t not in CHANNELS]
+    if unknown:
+        raise ValueError(f"no evoeye channel for topics {unknown}")
+    path = Path(path)
+    with atomic_file(path) as f:
+        writer = McapWriter(f, COMPRESSION, ZSTD_LEVEL, CHUNK_SIZE_BYTES)
+        writer.start(profile="", library=LIBRARY)
+        ids = dict(zip(topics, _register(writer, tuple(CHANNELS[t] for t in topics)),
+                       strict=True))
+        writer.add_metadata(RUN_RECORD, encode_run(metadata))
+        for seq, frame in enumerate(frames):
+            t_ns = log_time_ns(frame[topics[0]]["t_s"])
+            for topic in topics:
+                writer.add_message(ids[topic], t_ns, dumps(frame[topic]), t_ns, seq)
+        writer.finish()
+    return path
 
 
 def write_episode(episode: Episode, path: str | os.PathLike) -> Path:

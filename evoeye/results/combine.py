@@ -114,9 +114,9 @@ def combined_markdown(combined: dict, source: str) -> str:
 
 
 def write_combined(combined: dict, out: Path | None = None, readme: Path | None = None) -> str:
-    """findings.md (returned; with `out`, written there beside findings.json), and with
-    `readme`, spliced into its findings section."""
-    from evoeye.results.markdown import splice_readme
+    """findings.md (returned; with `out`, written there beside findings.json and RQ1's figure),
+    and with `readme`, its summary spliced into the README's findings section."""
+    from evoeye.results.readme import write_figure, write_readme_section
 
     source = str(out / "findings.json") if out is not None else "the runs below"
     text = combined_markdown(combined, source)
@@ -125,7 +125,9 @@ def write_combined(combined: dict, out: Path | None = None, readme: Path | None 
         (out / "findings.json").write_text(json.dumps(combined, indent=1) + "\n",
                                            encoding="utf-8")
         (out / "findings.md").write_text(text, encoding="utf-8")
+        write_figure(combined["tables"], out)
     if readme is not None:
-        readme.write_text(splice_readme(readme.read_text(encoding="utf-8"), text),
-                          encoding="utf-8")
+        write_readme_section(readme, combined["findings"], source,
+                             None if out is None else out / "findings.md",
+                             command="evoeye findings")
     return text

@@ -6,10 +6,10 @@ come from elsewhere are literals checked against their sources by tests/results/
 Sizes, and why:
 
 * Training seeds (RQ1, the monitor ablation; the first k are RQ2's re-seeded G_0s): 6.
-  The issue asks for at least 5, but 5 pairs can never give a Wilcoxon p below 2 / 2^5 = 0.0625;
+  At least 5 are wanted, but 5 pairs can never give a Wilcoxon p below 2 / 2^5 = 0.0625;
   6 can reach 0.031.
 * Campaign seeds (RQ2 and the evolution ablations, paired across methods): 20, inside the 16–25
-  pairs the issue estimates for a 5-F1-point difference at 80 % power (the report prints the
+  pairs estimated for a 5-F1-point difference at 80 % power (the report prints the
   pairs each comparison's measured SDs and pair correlation call for).
 * Final seeds: each campaign's final monitor is judged by the mean over k = 3 training seeds of
   its last update (module doc of `evoeye.results.rq2`).

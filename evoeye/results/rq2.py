@@ -25,7 +25,7 @@ re-seeded G_0s — G_0's recipe with the study's first k training seeds, G_0 the
 plus every safe test frame). RQ2 thus trains k G_0s whatever the number of training seeds RQ1
 and the monitor ablation use, and its units stay valid when that number grows. Rows: "G_0"
 (the start of every campaign, one value), "G_0 (k seeds)" (G_0's recipe, no new data, mean of k
-training seeds: the issue's control), and likewise "<family> G_0" for a `<family>-evo` method
+training seeds: the no-new-data control), and likewise "<family> G_0" for a `<family>-evo` method
 (AEM-Evo's start: the AEM trained on D_init).
 """
 

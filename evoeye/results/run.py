@@ -27,7 +27,8 @@ from evoeye.results.config import MONITOR_PARTS, PAPER_TEST_RUNS, ResultsConfig
 from evoeye.results.efficiency.report import efficiency_findings_markdown, efficiency_markdown
 from evoeye.results.findings import check_findings
 from evoeye.results.html import results_html
-from evoeye.results.markdown import findings_markdown, part_markdown, splice_readme
+from evoeye.results.markdown import findings_markdown, part_markdown
+from evoeye.results.readme import write_figure, write_readme_section
 from evoeye.results.rq1 import ablation, rq1
 from evoeye.results.rq2 import rq2
 from evoeye.results.study import Progress, Study, monitor_study, prepare_data, share_logs
@@ -186,15 +187,15 @@ def markdown_files(results: dict, source: str = "results.json") -> dict[str, str
 
 def write_results(root: DataRoot, results: dict, name: str = "results", *,
                   docs: Path | None = None, readme: Path | None = None) -> Path:
-    """Write the files under `<root>/reports/<name>/` (and into `docs`, and the README's
-    findings section); the report folder."""
+    """Write the files under `<root>/reports/<name>/` (and into `docs`, and the findings'
+    summary into the README's section); the report folder."""
     if not name or "/" in name or name.startswith("."):
         raise ValueError(f"report name must be a plain folder name, got {name!r}")
     folder = root.reports / name
     folder.mkdir(parents=True, exist_ok=True)
     (folder / "results.json").write_text(json.dumps(results, indent=1) + "\n", encoding="utf-8")
-    files = markdown_files(results, str(docs / "results.json") if docs is not None
-                           else "results.json")
+    source = str(docs / "results.json") if docs is not None else "results.json"
+    files = markdown_files(results, source)
     for file, text in files.items():
         (folder / file).write_text(text, encoding="utf-8")
     (folder / "results.html").write_text(results_html(results, f"evoeye results — {name}"),
@@ -204,8 +205,8 @@ def write_results(root: DataRoot, results: dict, name: str = "results", *,
         for file in DOCS_FILES:
             if (folder / file).is_file():
                 shutil.copyfile(folder / file, docs / file)
+        write_figure(results["tables"], docs)
     if readme is not None:
-        section = files["findings.md"]
-        readme.write_text(splice_readme(readme.read_text(encoding="utf-8"), section),
-                          encoding="utf-8")
+        write_readme_section(readme, results["findings"], source,
+                             (docs if docs is not None else folder) / "findings.md")
     return folder

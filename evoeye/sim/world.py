@@ -6,8 +6,9 @@ triggers on relative state (`traffic.py`), the NPCs move along their paths with 
 dynamics (`npc.py`), and contacts are checked for every pair of vehicles: a contact marks both
 as crashed (recorded in the ground truth) and a crashed vehicle brakes to a standstill, so no
 two vehicles ever pass through each other. We do not call `env.step` (observation and
-rendering work per step: ~8× slower, DESIGN.md §5) nor `road.step` (its pairwise checks are
-per-pair Python); the road network and the ego's dynamics are highway-env's.
+rendering work per step: ~140 steps/s for 7 vehicles, against ~1100 stepping the road directly)
+nor `road.step` (its pairwise checks are per-pair Python); the road network and the ego's
+dynamics are highway-env's.
 """
 
 from __future__ import annotations

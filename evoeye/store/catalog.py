@@ -26,10 +26,11 @@ from evoeye.store.schema import (
     TABLES,
     create_declared_tables,
 )
-from evoeye.store.sqlfiles import query, view_scripts
+from evoeye.store.sqlfiles import parts_macros, query, view_scripts
 
 READ_ONLY_STATEMENTS = frozenset({duckdb.StatementType.SELECT, duckdb.StatementType.EXPLAIN})
 PART_GLOB = "/".join(["*"] * len(PARTITION_KEYS) + ["*.parquet"])  # */*/*.parquet
+CODE_VIEWS = ("attribution",)  # the derived tables' views the view scripts read (run_attribution)
 
 
 def _string_literal(text: str) -> str:
@@ -60,11 +61,11 @@ def _parquet_view_sql(table: str, table_dir: Path, has_parts: bool) -> str:
 
 
 def _derived_view_sql(table: str, table_dir: Path, has_parts: bool) -> str:
-    """The view `<table>` over the flat parts of a derived table, or its empty declared table."""
+    """The view `<table>` over every flat part of a derived table, read by its macro
+    `<table>_parts` (warehouse/parts.sql), or its empty declared table."""
     source = f"{DDL_SCHEMA}.{table}"
     if has_parts:
-        source = (f"read_parquet({_string_literal(str(table_dir / '*.parquet'))}, "
-                  "union_by_name = true)")
+        source = f"{table}_parts({_string_literal(str(table_dir / '*.parquet'))})"
     return f"CREATE OR REPLACE VIEW {table} AS SELECT * FROM {source}"
 
 
@@ -77,15 +78,20 @@ def parts_present(root: DataRoot) -> tuple[bool, ...]:
 
 
 def install_views(con: duckdb.DuckDBPyConnection, root: DataRoot,
-                  present: tuple[bool, ...] | None = None) -> None:
-    """Create the declared tables, the Parquet base views and every view script on `con`, for
-    the tables `present` (default: as they are now, `parts_present`)."""
+                  present: tuple[bool, ...] | None = None, *, for_user: bool = False) -> None:
+    """Create the declared tables, the Parquet base views, the derived tables' macros and views
+    and every view script on `con`, for the tables `present` (default: as they are now,
+    `parts_present`). The derived tables' views are the user's (`for_user`: `evoeye sql`, the
+    DuckDB file) but those the view scripts read (CODE_VIEWS): binding a view reads its parts'
+    footers, and the code reads those tables by key (`derived.read_parts`) instead."""
     present = parts_present(root) if present is None else present
     create_declared_tables(con)
     for table, has_parts in zip(TABLES, present[:len(TABLES)], strict=True):
         con.execute(_parquet_view_sql(table, root.table_dir(table), has_parts))
+    con.execute(parts_macros())
     for table, has_parts in zip(DERIVED_TABLES, present[len(TABLES):], strict=True):
-        con.execute(_derived_view_sql(table, root.table_dir(table), has_parts))
+        if for_user or table in CODE_VIEWS:
+            con.execute(_derived_view_sql(table, root.table_dir(table), has_parts))
     for _, script in view_scripts():
         con.execute(script)
 
@@ -108,18 +114,20 @@ class Warehouse:
         self.root = root
 
     def connect(self) -> duckdb.DuckDBPyConnection:
-        """An in-memory DuckDB with every warehouse view; the caller closes it. Inside
-        `shared_connections()`, a connection to the block's database of the warehouse in its
-        present state (`evoeye.store.connections`)."""
+        """An in-memory DuckDB with the warehouse views the code reads (every one but the
+        appended tables' views `read_only_sql` adds, `install_views`); the caller closes it.
+        Inside `shared_connections()`, a connection to the block's database of the warehouse
+        in its present state (`evoeye.store.connections`)."""
         present = parts_present(self.root)
         return connection(("views", str(self.root.path), present),
                           lambda: self._new(present))
 
-    def _new(self, present: tuple[bool, ...]) -> duckdb.DuckDBPyConnection:
+    def _new(self, present: tuple[bool, ...],
+             for_user: bool = False) -> duckdb.DuckDBPyConnection:
         """A new in-memory DuckDB with the views of the tables `present`."""
         con = duckdb.connect()
         try:
-            install_views(con, self.root, present)
+            install_views(con, self.root, present, for_user=for_user)
         except BaseException:
             con.close()
             raise
@@ -138,7 +146,7 @@ class Warehouse:
         and unless `allow_files`, no file but the warehouse's own Parquet (duckdb's
         PermissionException otherwise); the last statement's result as Arrow. Always a
         database of its own: locking it down locks the whole database."""
-        con = self._new(parts_present(self.root))
+        con = self._new(parts_present(self.root), for_user=True)
         try:
             statements = con.extract_statements(text)
             refused = sorted({s.type.name for s in statements} - {t.name for t in
@@ -165,7 +173,7 @@ def write_catalog(root: DataRoot) -> None:
     root.warehouse.mkdir(parents=True, exist_ok=True)
     con = duckdb.connect(str(root.duckdb_file))
     try:
-        install_views(con, root)
+        install_views(con, root, for_user=True)
         con.execute("CHECKPOINT")
     finally:
         con.close()

@@ -3,7 +3,8 @@
 monitor_scores (evaluation), feedback and campaign_rounds (evolution) and attribution (explain)
 are written one part per write — `part-<utc stamp>-<id>.parquet`, columns as the table's DDL
 declares them (temporary file, fsync, rename: a killed write leaves no partial part) — and read
-back with a query from `warehouse/queries/` whose `$glob` names the parts, every value bound.
+back with a query from `warehouse/queries/` whose `$glob` names the parts, every value bound,
+through the table's macro `<table>_parts` (`warehouse/parts.sql`), which the views use too.
 Each table's module keeps its own key and writes under the warehouse writer lock (`lock.py`).
 
 A part holding the rows of one key only (one monitor version's feedback or scores, one
@@ -29,7 +30,7 @@ from evoeye.atomic import atomic_file, fsync_dir
 from evoeye.paths import DataRoot
 from evoeye.store.connections import connection
 from evoeye.store.schema import canonical_schema, declared_schema
-from evoeye.store.sqlfiles import query
+from evoeye.store.sqlfiles import parts_macros, query
 
 PART_SUFFIX = ".parquet"
 KEY_SEPARATOR = "--"
@@ -87,6 +88,13 @@ def append_part(root: DataRoot, table: str, columns: dict[str, pa.Array], *,
     return root.relative(write_part(root.table_dir(table), name, out))
 
 
+def _parts_connection() -> duckdb.DuckDBPyConnection:
+    """An in-memory DuckDB with the derived tables' macros `<table>_parts(files)`."""
+    con = duckdb.connect()
+    con.execute(parts_macros())
+    return con
+
+
 def read_parts(root: DataRoot, table: str, query_name: str, *, key: str | None = None,
                **params: Any) -> pa.Table:
     """`warehouse/queries/<query_name>.sql` over the parts of `table` (their paths bound to
@@ -95,7 +103,7 @@ def read_parts(root: DataRoot, table: str, query_name: str, *, key: str | None =
     files = part_files(root.table_dir(table), key)
     if not files:
         return declared_schema(table).empty_table()
-    con = connection(("bare",), duckdb.connect)
+    con = connection(("parts",), _parts_connection)
     try:
         return con.sql(query(query_name), params={
             "glob": [str(f) for f in files], **params}).to_arrow_table()

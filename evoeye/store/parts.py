@@ -63,9 +63,8 @@ def check_part_layout(path: Path, metadata: dict[bytes, bytes] | None = None) ->
         warehouse = path.parents[len(PARTITION_KEYS) + 1]  # <root>/warehouse
         raise WarehouseLayoutError(
             f"{path}: a warehouse part of layout {found}; this evoeye reads layout "
-            f"{LAYOUT_VERSION} only (docs/warehouse.md says what changed) — re-ingest: "
-            "move the folders "
-            f"{', '.join(t for t in TABLES)} out of {warehouse} and run "
+            f"{LAYOUT_VERSION} only (docs/warehouse.md, Warehouse layouts) — re-ingest: move "
+            f"the folders {', '.join(t for t in TABLES)} out of {warehouse} and run "
             "`evoeye ingest` on the data root again (its logs under runs/ are the source)")
 
 

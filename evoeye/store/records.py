@@ -3,7 +3,9 @@
 The frame columns are derived from the DDL, not listed here: column `<prefix><field>` takes
 field `<field>` of the topic behind `<prefix>` (`loc_` ← /ads/localization, …, `gt_` ←
 /sim/ground_truth); a `gt_` scalar column of a per-actor field takes the ego's entry (actor 0).
-Message i of every topic belongs to frame i; the ground-truth channel is the frame clock.
+Message i of every topic belongs to frame i; the ground-truth channel is the frame clock. A log
+without any message on an optional topic (`OPTIONAL_TOPICS`: the message ages of an imported
+recording) gets NULL in that topic's columns.
 """
 
 from __future__ import annotations
@@ -22,7 +24,8 @@ import pyarrow.compute as pc
 from evoeye.ads.messages import FrameMessages
 from evoeye.ads.profiles import DEFAULT_PROFILE
 from evoeye.log import TOPICS
-from evoeye.log.channels import CHANNELS
+from evoeye.log.channels import AGES_TOPIC, CHANNELS, OPTIONAL_TOPICS
+from evoeye.log.records import SIMULATOR_LABELS
 from evoeye.scene import EGO_ID
 from evoeye.store.features import FEATURES, FeatureSpec, FrameFeatures, frame_features, pack
 from evoeye.store.live_columns import live_column
@@ -34,6 +37,7 @@ PREFIX_TOPIC = {
     "pred_": TOPICS.predictions,
     "plan_": TOPICS.plan,
     "ctrl_": TOPICS.control,
+    "age_": AGES_TOPIC,
     "gt_": TOPICS.ground_truth,
 }
 # Where a column name is not prefix + field name (the column says what the field means).
@@ -82,6 +86,9 @@ def _aligned_messages(run: RunSource, topics: Sequence[str]) -> dict[str, list[d
         if topic in out:
             continue
         msgs = [msg for _, msg in run.messages(topic)]
+        if not msgs and topic in OPTIONAL_TOPICS:
+            out[topic] = [None] * len(clock)
+            continue
         if len(msgs) != len(clock):
             raise RunRecordError(
                 f"{topic} has {len(msgs)} messages for {len(clock)} frames of {FRAME_CLOCK}"
@@ -101,6 +108,8 @@ def _is_array_field(topic: str, field: str) -> bool:
 def _column(msgs: list[dict[str, Any]], field: str, typ: pa.DataType, ego: bool,
             decoded: bool) -> pa.Array:
     # ego: a per-actor ground-truth array, whose first row is always the ego's
+    if msgs and msgs[0] is None:  # an optional topic the log has no message on
+        return pa.nulls(len(msgs), typ)
     values = [m[field][0] for m in msgs] if ego else [m[field] for m in msgs]
     return pa.array(values, type=typ) if decoded else live_column(values, typ)
 
@@ -173,7 +182,10 @@ def frame_features_table(frames: pa.Table, spec: FeatureSpec = FEATURES, *,
     return pa.table([columns[name] for name in names], names=names)
 
 
-TOPIC_ATTRIBUTE = dict(zip(TOPICS, TOPICS._fields, strict=True))  # topic → FrameMessages field
+# topic → FrameMessages field, for the topics a live frame carries (not the ground truth, nor
+# the ages of an imported recording)
+TOPIC_ATTRIBUTE = {topic: name for topic, name in zip(TOPICS, TOPICS._fields, strict=True)
+                   if name in FrameMessages.__dataclass_fields__}
 
 
 def _plain(value: Any) -> Any:
@@ -192,7 +204,7 @@ def runtime_table(frames: Sequence[FrameMessages]) -> pa.Table:
         "t_s": pa.array([f.localization.t_s for f in frames], pa.float64())
     }
     for name, (topic, field) in frame_column_sources().items():
-        if topic != FRAME_CLOCK:
+        if topic in TOPIC_ATTRIBUTE:
             messages = [getattr(f, TOPIC_ATTRIBUTE[topic]) for f in frames]
             columns[name] = pa.array([_plain(getattr(m, field)) for m in messages],
                                      type=schema.field(name).type)
@@ -212,7 +224,7 @@ def _message_fields() -> dict[str, tuple[str, str, np.dtype]]:
     numbers are stored as: a FLOAT column rounds to float32 in the warehouse, so here too)."""
     schema = file_schema("frames")
     return {name: (TOPIC_ATTRIBUTE[topic], field, _stored_dtype(schema.field(name).type))
-            for name, (topic, field) in frame_column_sources().items() if topic != FRAME_CLOCK}
+            for name, (topic, field) in frame_column_sources().items() if topic in TOPIC_ATTRIBUTE}
 
 
 class MessageSignals:
@@ -312,6 +324,7 @@ def scenario_row(
             "other_actor": None if meta["other_actor"] is None else int(meta["other_actor"]),
             "duration_s": float(meta["duration_s"]),
             "min_distance_m": _finite_or_none(meta["min_distance_m"]),
+            "label_source": str(meta.get("label_source", SIMULATOR_LABELS)),
             "n_frames": int(n_frames),
             "log_path": log_path,
             "ingest_id": ingest_id,

@@ -20,9 +20,11 @@ VIEWS_DIR = PROJECT_DIR / "warehouse" / "views"
 QUERIES_DIR = PROJECT_DIR / "warehouse" / "queries"
 
 TABLES = ("scenarios", "frames", "frame_features")
-# Tables later stages append to, as flat parts under warehouse/<table>/ (no partitions), that
-# every connection sees as a view of the same name (`attribution`: evoeye explain).
-DERIVED_TABLES = ("attribution",)
+# Tables later stages append to, as flat parts under warehouse/<table>/ (no partitions): explain,
+# evaluate and the evolution campaign. Each is read through its macro `<table>_parts(files)`
+# (PARTS_SQL): every connection sees all its parts as the view `<table>`.
+DERIVED_TABLES = ("attribution", "monitor_scores", "feedback", "campaign_rounds")
+PARTS_SQL = PROJECT_DIR / "warehouse" / "parts.sql"
 # Hive partition keys, in folder order: they are columns of the views, not of the files.
 PARTITION_KEYS = ("logical_scenario", "batch")
 DDL_SCHEMA = "ddl"  # the DuckDB schema holding the declared, always empty, tables
@@ -31,8 +33,9 @@ DDL_SCHEMA = "ddl"  # the DuckDB schema holding the declared, always empty, tabl
 # (LAYOUT_KEY; parts without it are layout 1). Bump it with any change to their DDL: a
 # warehouse holds parts of one layout only (`check_layout`), so the views need not reconcile
 # schemas file by file. 1: frame_features arrays as FLOAT[] lists (evoeye <= 0.4.0);
-# 2: as little-endian float32 bytes (BLOB); 3: scenarios.ads_profile.
-LAYOUT_VERSION = 3
+# 2: as little-endian float32 bytes (BLOB); 3: scenarios.ads_profile; 4: scenarios.label_source
+# and the frames' message ages (age_*), for recordings imported from other stacks.
+LAYOUT_VERSION = 4
 LAYOUT_KEY = b"evoeye.warehouse_layout"
 
 

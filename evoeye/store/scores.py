@@ -18,7 +18,8 @@ import numpy as np
 import pyarrow as pa
 
 from evoeye.paths import DataRoot
-from evoeye.store.derived import append_part, read_parts
+from evoeye.store.derived import append_part, part_files, read_parts
+from evoeye.store.ingest import refresh_catalog
 from evoeye.store.lock import key_lock
 from evoeye.store.schema import declared_schema
 
@@ -85,8 +86,10 @@ def read_scores(
 
 
 def write_scores(root: DataRoot, rows: ScoreRows) -> ScoresWritten:
-    """Append the scores of every run not yet stored for this monitor version, as one part."""
+    """Append the scores of every run not yet stored for this monitor version, as one part;
+    the table's first part also rewrites the DuckDB catalog file, whose view read no part."""
     ids = np.asarray(rows.scenario_id, dtype=object)
+    first = not part_files(root.table_dir(SCORES_TABLE))
     with key_lock(root, SCORES_TABLE, [rows.monitor_version]):
         done = scored_scenarios(root, rows.monitor_version)
         keep = np.array([i not in done for i in ids.tolist()], dtype=bool)
@@ -104,4 +107,6 @@ def write_scores(root: DataRoot, rows: ScoreRows) -> ScoresWritten:
             "t_s": pa.array(np.asarray(rows.t_s, dtype=np.float64)[keep], pa.float64()),
             "score": pa.array(np.asarray(rows.score, dtype=np.float32)[keep], pa.float32()),
         }, part_column="evaluation_id", key=rows.monitor_version)
+    if first and root.duckdb_file.exists():
+        refresh_catalog(root)
     return ScoresWritten(n, len(new_ids), skipped, part)

@@ -1,7 +1,9 @@
-"""The read side of the warehouse, in SQL files: `warehouse/views/*.sql`, `warehouse/queries/*.sql`.
+"""The read side of the warehouse, in SQL files: `warehouse/views/*.sql`, `warehouse/queries/*.sql`
+and `warehouse/parts.sql`.
 
 Views (and table macros) are scripts run in file-name order when a connection opens; queries are
-single statements with `$name` parameters, bound by DuckDB and never formatted into the text.
+single statements with `$name` parameters, bound by DuckDB and never formatted into the text;
+`parts.sql` holds the macros that read the derived tables' parts, for the views and the queries.
 """
 
 from __future__ import annotations
@@ -9,7 +11,7 @@ from __future__ import annotations
 from functools import cache
 from pathlib import Path
 
-from evoeye.store.schema import QUERIES_DIR, VIEWS_DIR
+from evoeye.store.schema import PARTS_SQL, QUERIES_DIR, VIEWS_DIR
 
 
 @cache
@@ -29,3 +31,9 @@ def query(name: str) -> str:
     if not path.is_file():
         raise KeyError(f"no query {name!r} in {QUERIES_DIR}; known: {query_names()}")
     return path.read_text(encoding="utf-8")
+
+
+@cache
+def parts_macros() -> str:
+    """The script defining each derived table's macro `<table>_parts(files)`."""
+    return PARTS_SQL.read_text(encoding="utf-8")

@@ -2,8 +2,10 @@
 -- Runtime signals M(x), the only columns a monitor may read, are prefixed by ADS module:
 --   loc_  localization (the ego's own estimate)     obs_  perception (one list entry per obstacle)
 --   pred_ prediction (n obstacles x K points)       plan_ planning (P trajectory points)
---   ctrl_ control command
+--   ctrl_ control command                           age_  each module message's age (imports)
 -- Ground truth O(x) of the ego is prefixed gt_: evaluation and labels only, never monitor input.
+-- In a run of label_source 'none' (scenarios) gt_ holds the ego's own estimate and no collision:
+-- such a run is never labelled (views eligible_frames, scenario_splits).
 -- World frame, SI units. Per-point arrays are 32-bit floats (the monitor's dtype; sub-mm at km).
 -- logical_scenario and batch are hive partition keys (folder names, not stored in the files).
 -- Rows are visible only for runs whose scenarios row is committed with the same ingest_id.
@@ -52,6 +54,13 @@ CREATE TABLE frames (
     ctrl_brake             DOUBLE,
     ctrl_steering_rad      DOUBLE,
     ctrl_accel_cmd_mps2    DOUBLE,
+    -- message ages: frame time minus the header stamp of the message held for the frame, s;
+    -- NULL for evoeye's own runs, whose modules publish every message at the frame time
+    age_localization_s     DOUBLE,
+    age_obstacles_s        DOUBLE,
+    age_predictions_s      DOUBLE,
+    age_plan_s             DOUBLE,
+    age_control_s          DOUBLE,
     -- ground truth of the ego (actor 0): evaluation only
     gt_x_m                 DOUBLE   NOT NULL,
     gt_y_m                 DOUBLE   NOT NULL,

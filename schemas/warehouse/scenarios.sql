@@ -21,6 +21,10 @@ CREATE TABLE scenarios (
     other_actor       INTEGER,             -- actor of the first ego collision
     duration_s        DOUBLE    NOT NULL,  -- simulated time
     min_distance_m    DOUBLE,              -- min ego-actor footprint distance over the run
+    label_source      VARCHAR   NOT NULL,  -- what labelled collisions: 'simulator', a recorded
+                                           -- ground truth ('ground_truth_objects:<topic>',
+                                           -- 'collision_topic:<topic>'), or 'none' (unlabelled:
+                                           -- never in a split, a label, a window or a metric)
     n_frames          INTEGER   NOT NULL,  -- rows of this run in frames
     log_path          VARCHAR   NOT NULL,  -- the MCAP log, relative to the data root
     ingest_id         VARCHAR   NOT NULL,  -- the Parquet part this run was committed in

@@ -9,7 +9,7 @@ import sys
 import pytest
 
 HEAVY = ("torch", "sklearn", "highway_env", "pandas", "duckdb", "pyarrow", "numpy", "scipy",
-         "prefect", "polars", "onnx", "mcap")
+         "prefect", "polars", "onnx", "mcap", "rosbags")
 PROBE = """
 import json, sys
 from evoeye.cli import app

@@ -6,7 +6,7 @@ import xml.etree.ElementTree as ET
 
 import pytest
 
-from evoeye.evaluation.plots import interval_chart
+from evoeye.evaluation.plots import interval_chart, standalone
 
 
 def _svg(text: str) -> ET.Element:
@@ -55,3 +55,12 @@ def test_error_bars_sit_at_their_values_on_the_axis() -> None:
 def test_an_empty_chart_still_renders() -> None:
     root = _svg(interval_chart([], title="empty", xlabel="x"))
     assert root.get("aria-label") == "empty"
+
+
+def test_a_standalone_chart_is_an_svg_file_with_the_same_marks() -> None:
+    chart = interval_chart([("a", 10.0, 5.0, 15.0)], title="t", xlabel="x")
+    root = ET.fromstring(standalone(chart))  # parses as a file: the namespace is declared
+    assert root.tag == f"{NS}svg" and root.find(f"{NS}style").text.startswith("svg{font:")
+    inline = _svg(chart)
+    assert [e.attrib for e in root.iter(f"{NS}circle")] == \
+        [e.attrib for e in inline.iter(f"{NS}circle")]

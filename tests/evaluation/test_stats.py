@@ -154,7 +154,7 @@ def test_t_power_matches_the_rejection_rate_of_scipys_paired_t_test() -> None:
 
 
 def test_the_wilcoxon_design_has_the_power_it_promises() -> None:
-    sd_a = sd_b = 0.085  # the figures: SD 8.5 F1 points, a 5-point difference
+    sd_a = sd_b = 0.085  # the S1 Hard Set's SD, 8.5 F1 points, and a 5-point difference
     n = pairs_needed(0.05, sd_a, sd_b, 0.6)
     assert 16 <= n <= 25 and n > pairs_needed(0.05, sd_a, sd_b, 0.6, test="t")
     rng = np.random.default_rng(9)

@@ -16,6 +16,7 @@ from evoeye.results.combine import ResultsFileError, combine, write_combined
 from evoeye.results.config import BASELINES
 from evoeye.results.findings import check_findings
 from evoeye.results.markdown import README_BEGIN, README_END
+from evoeye.results.readme import FIGURE, readme_section, rq1_figure
 from evoeye.results.rq1 import FUSION_LABEL
 from evoeye.results.tables import build_tables
 
@@ -116,8 +117,11 @@ def test_the_command_writes_the_files_and_the_readme_section(tmp_path: Path) -> 
     assert f"* `{a}`: rq1 (s1) — training seeds 6, sim seed 60606, Test Set seed 60607" in text
     saved = json.loads((out / "findings.json").read_text())
     assert saved == json.loads(json.dumps(combine([a, b]), default=float))
-    assert readme.read_text() == f"intro\n{README_BEGIN}\n{text.strip()}\n{README_END}\nrest\n"
+    section = readme_section(saved["findings"], str(out / "findings.json"),
+                             command="evoeye findings", details="docs/findings.md")
+    assert readme.read_text() == f"intro\n{README_BEGIN}\n{section.strip()}\n{README_END}\nrest\n"
     assert text == write_combined(saved, out)  # rendering is a function of the JSON alone
+    assert (out / FIGURE).read_text() == rq1_figure(saved["tables"])  # RQ1's, beside it
     bad = tmp_path / "bad.json"
     bad.write_text("{", encoding="utf-8")
     res = runner.invoke(app, ["findings", str(a), str(bad)])

@@ -9,6 +9,7 @@ import pyarrow as pa
 import pyarrow.parquet as pq
 
 from evoeye.paths import DataRoot
+from evoeye.store import Warehouse
 from evoeye.store.feedback import (
     FeedbackRows,
     RoundMetrics,
@@ -62,6 +63,11 @@ def test_feedback_written_before_the_mode_column_reads_as_now(root: DataRoot) ->
                       t.column("feedback").to_pylist(), strict=True)) == [
         ("prior-corrected", "r-1", 0.3), ("prior-corrected", "r-2", 0.4), ("raw", "r-1", 0.1),
         ("raw", "r-2", 0.8)]
+    columns = "monitor_version, feedback_mode, scenario_id, feedback"  # the view reads as they do
+    view = Warehouse(root).read_only_sql(f"SELECT {columns} FROM feedback ORDER BY ALL")
+    assert view.to_pylist() == \
+        read_feedback(root).select(columns.split(", ")).sort_by(
+            [(c, "ascending") for c in columns.split(", ")]).to_pylist()
 
 
 def test_round_metrics_are_typed_and_round_trip(root: DataRoot) -> None:

@@ -20,9 +20,9 @@ def installs(monkeypatch) -> list[tuple[bool, ...]]:
     seen: list[tuple[bool, ...]] = []
     real = catalog.install_views
 
-    def counting(con, root, present=None):
+    def counting(con, root, present=None, **options):
         seen.append(present)
-        return real(con, root, present)
+        return real(con, root, present, **options)
 
     monkeypatch.setattr(catalog, "install_views", counting)
     return seen

@@ -21,6 +21,7 @@ from evoeye.store.feedback import (
     write_round,
 )
 from evoeye.store.schema import (
+    DERIVED_TABLES,
     PARTITION_KEYS,
     TABLES,
     canonical_schema,
@@ -144,13 +145,19 @@ def test_every_view_and_macro_runs(filled_or_empty: str, request: pytest.Fixture
         views, macros = _user_views_and_macros(con)
         assert {"scenarios", "frames", "frame_features", "runtime_frames", "frame_labels",
                 "splits", "dataset_stats"} <= set(views)
-        assert set(macros) == set(MACRO_ARGS)
+        parts = {f"{table}_parts": table for table in DERIVED_TABLES}  # warehouse/parts.sql
+        assert set(macros) == set(MACRO_ARGS) | set(parts)
         for view in views:
             rows = con.execute(f"SELECT * FROM {view}").fetchall()
             assert (len(rows) > 0) == (filled_or_empty == "filled") or view == "dataset_stats"
         for macro, args in MACRO_ARGS.items():
             marks = ", ".join("?" * len(args))
             con.execute(f"SELECT * FROM {macro}({marks})", args).fetchall()
+        for macro, table in parts.items() if filled_or_empty == "filled" else ():
+            glob = str(root.table_dir(table) / "*.parquet")
+            rows = con.sql(f"SELECT * FROM {macro}($glob)", params={"glob": glob})
+            assert rows.to_arrow_table().to_pylist() == Warehouse(root).read_only_sql(
+                f"SELECT * FROM {table}").to_pylist() != []  # the user's view reads through it
     finally:
         con.close()
 

@@ -68,8 +68,8 @@ def old(root: DataRoot, add_run, as_layout_1) -> DataRoot:
 def test_an_old_warehouse_is_refused_with_the_fix(old: DataRoot, add_run) -> None:
     for read in (lambda: Warehouse(old).sql("SELECT count(*) FROM scenarios"),
                  lambda: load_windows(old)):
-        with pytest.raises(WarehouseLayoutError, match=f"layout 1; this evoeye reads layout "
-                                                        f"{LAYOUT_VERSION}.* re-ingest"):
+        refused = f"layout 1; this evoeye reads layout {LAYOUT_VERSION}.* re-ingest"
+        with pytest.raises(WarehouseLayoutError, match=refused):
             read()
     add_run("c", n_frames=6, seed=3)
     before = sorted(old.warehouse.rglob("*.parquet"))

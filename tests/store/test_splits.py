@@ -18,10 +18,11 @@ def _splits(ids: list[str], rounds: list[int] | None = None, seed: int = 0,
     """Run the real splits script over a stand-in `scenarios` table of `ids`."""
     con = duckdb.connect()
     con.execute("CREATE TABLE scenarios (scenario_id VARCHAR, logical_scenario VARCHAR, "
-                "round INTEGER, batch VARCHAR)")
-    rows = [(i, "s", r, b) for i, r, b in zip(ids, rounds or [0] * len(ids),
-                                               batches or ["b0"] * len(ids), strict=True)]
-    con.executemany("INSERT INTO scenarios VALUES (?, ?, ?, ?)", rows)
+                "round INTEGER, batch VARCHAR, label_source VARCHAR)")
+    rows = [(i, "s", r, b, "simulator") for i, r, b in zip(ids, rounds or [0] * len(ids),
+                                                            batches or ["b0"] * len(ids),
+                                                            strict=True)]
+    con.executemany("INSERT INTO scenarios VALUES (?, ?, ?, ?, ?)", rows)
     con.execute(dict(view_scripts())["06_splits"])
     result = con.execute("SELECT scenario_id, split FROM scenario_splits(?, ?, ?, "
                          "test_batch := ?)", [seed, train, val, test_batch]).fetchall()

@@ -1,4 +1,4 @@
 -- The runs monitor_scores holds for one monitor version, from the table's parts ($glob).
 SELECT DISTINCT scenario_id
-FROM read_parquet($glob)
+FROM monitor_scores_parts($glob)
 WHERE monitor_version = $version

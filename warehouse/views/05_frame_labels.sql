@@ -6,6 +6,8 @@
 -- tau_col (collision_time_s) is the time of the first frame whose ground truth has the ego in a
 -- collision (gt_ego_collision); NULL for runs without one. Frame times are floats on a 20 Hz
 -- grid, so the bound allows 1 microsecond of rounding.
+-- A run of label_source 'none' (a recording imported without ground truth) has no label: none
+-- of its frames is eligible, so it never enters a window, a calibration set or a metric.
 CREATE OR REPLACE VIEW eligible_frames AS
 SELECT scenario_id, frame, t_s, collision_time_s
 FROM (
@@ -16,6 +18,7 @@ FROM (
         min(t_s) FILTER (WHERE gt_ego_collision) OVER (PARTITION BY scenario_id)
             AS collision_time_s
     FROM frames
+    ANTI JOIN (SELECT scenario_id FROM scenarios WHERE label_source = 'none') USING (scenario_id)
 )
 WHERE collision_time_s IS NULL OR collision_time_s - t_s > 1e-6;
 

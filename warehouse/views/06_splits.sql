@@ -7,6 +7,7 @@
 -- training data, D_{r+1} = D_r ∪ D'_r (Definition 3): they never enter the held-out sets.
 -- test_batch (optional) names a round-0 batch simulated apart as a fixed Test Set: its runs are
 -- always 'test'; the other round-0 runs split by u as above.
+-- Unlabelled runs (label_source 'none') are in no split: they train, calibrate and test nothing.
 CREATE OR REPLACE MACRO scenario_splits(seed, train_frac, val_frac, test_batch := NULL) AS TABLE
 SELECT
     scenario_id,
@@ -28,6 +29,7 @@ FROM (
         ('0x' || md5(CAST(seed AS VARCHAR) || ':' || scenario_id)[1:8])::UBIGINT
             / 4294967296.0 AS u
     FROM scenarios
+    WHERE label_source <> 'none'
 );
 
 -- splits: seed 0 and the paper's proportions (6 h train; the other 6 h split val:test = 1:3).

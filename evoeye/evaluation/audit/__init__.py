@@ -1,18 +1,19 @@
 """`evoeye audit`: is a batch realistic? Kinematics, pass-through, pop-in, careful driver,
-attribution shares, collision times and the clock, each against the issue's threshold.
+attribution shares, collision times and the clock, each against its bound (`verdicts.py`).
 
 Per-run checks are pure functions on a run's ground-truth arrays (`tracks.Tracks`), one module
 per family; `summary.audit_root` ties them to the logs and the warehouse; `report` renders.
 """
 
 from evoeye.evaluation.audit.report import markdown_report, report_dir, write_report
-from evoeye.evaluation.audit.runs import AuditBounds, RunAudit, audit_run, find_logs
+from evoeye.evaluation.audit.runs import AuditBounds, NoLogsError, RunAudit, audit_run, find_logs
 from evoeye.evaluation.audit.summary import ScenarioAudit, audit_root
 from evoeye.evaluation.audit.verdicts import COLLISION_BANDS, Thresholds, Verdict
 
 __all__ = [
     "COLLISION_BANDS",
     "AuditBounds",
+    "NoLogsError",
     "RunAudit",
     "ScenarioAudit",
     "Thresholds",

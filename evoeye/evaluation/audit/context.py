@@ -4,7 +4,7 @@ The RQ1 context-only control (`evoeye.baselines.context`: gradient boosting on t
 start, the ego's speed and its x, y on the map, nothing a module publishes), scored out of fold
 with folds grouped by run, on the batch's pre-collision frames (labels: Definition 1, H = 3 s).
 
-Issue 10's RQ1 bound asks a monitor to beat this control by 5 AUROC points, so a batch whose
+RQ1 asks a monitor to beat this control by 5 AUROC points, so a batch whose
 control already scores above 0.95 leaves no room for that: the scenario script, not the ADS's
 messages, ranks its frames. On a batch of a few hundred runs the control trains on fewer runs
 than RQ1's (≥ 1 000), so this figure is a slight underestimate of RQ1's control: passing is

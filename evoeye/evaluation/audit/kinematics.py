@@ -17,7 +17,7 @@ from evoeye.evaluation.audit.tracks import Tracks
 
 @dataclass(frozen=True)
 class KinematicBounds:
-    """The issue's bounds on NPC motion."""
+    """The audit's bounds on NPC motion."""
 
     a_lat_mps2: float = 5.0
     a_lon_mps2: float = 9.5

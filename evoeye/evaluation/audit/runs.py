@@ -7,6 +7,7 @@ per-run results travel back.
 from __future__ import annotations
 
 import multiprocessing as mp
+from collections import Counter
 from collections.abc import Iterator
 from concurrent.futures import ProcessPoolExecutor
 from dataclasses import dataclass, field
@@ -63,11 +64,26 @@ class RunAudit:
 DEFAULT_BOUNDS = AuditBounds()
 
 
+class NoLogsError(LookupError):
+    """No finished run log under the data root matches the logical scenario and batch asked for."""
+
+
 def find_logs(root: DataRoot, scenario: str | None = None, batch: str | None = None
               ) -> list[Path]:
-    """Every finished log under runs/<scenario>/<batch>/, sorted (None: every one)."""
+    """Every finished log under runs/<scenario>/<batch>/, sorted (None: every one);
+    NoLogsError, naming the batches the root does hold, when there is none."""
     pattern = f"{scenario or '*'}/{batch or '*'}/*{LOG_SUFFIX}"
-    return sorted(root.runs.glob(pattern))
+    logs = sorted(root.runs.glob(pattern))
+    if not logs:
+        asked = " and ".join(f"{what} {name!r}" for what, name in (
+            ("logical scenario", scenario), ("batch", batch)) if name is not None)
+        held = Counter(f"{p.parent.parent.name}/{p.parent.name}"
+                       for p in root.runs.glob(f"*/*/*{LOG_SUFFIX}"))
+        raise NoLogsError(f"no run logs {f'of {asked} ' if asked else ''}under {root.runs}; "
+                          + ("it holds " + ", ".join(f"{k} ({n} logs)" for k, n in
+                                                     sorted(held.items()))
+                             if held else "it holds none"))
+    return logs
 
 
 def audit_run(path: str | Path, bounds: AuditBounds = AuditBounds()) -> RunAudit:

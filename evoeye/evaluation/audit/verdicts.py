@@ -1,4 +1,4 @@
-"""The audit's verdicts: each criterion of the issue's "Done when" against its threshold.
+"""The audit's verdicts: each realism criterion against its threshold (docs/audit.md).
 
 A verdict is passed / failed, or None when it cannot be judged yet (no ingested frames, no
 explained runs); `--strict` fails on a failed verdict only.

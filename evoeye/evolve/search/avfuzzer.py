@@ -1,4 +1,4 @@
-"""AV-Fuzzer (Li et al., ISSRE 2020) as an ask/tell acquisition baseline, per DESIGN.md §4.
+"""AV-Fuzzer (Li et al., ISSRE 2020) as an ask/tell acquisition baseline, per docs/avfuzzer.md.
 
 A genetic algorithm over whole concrete scenarios, following the paper authors' own
 re-implementation (Drivora `fuzzer/runner_avfuzzer.py`): population 4; each generation makes
@@ -17,9 +17,9 @@ budget. Deviations from Drivora, each to avoid simulating a scenario whose resul
 individuals a crossover left unchanged (both parents had the same genes for the swapped actor)
 are not re-simulated, and neither is the best copy kept at a restart. The best-so-far is updated
 on every simulated result, not only on the post-selection population. Where Drivora and
-DESIGN.md differ, DESIGN.md wins: stagnation means the best-so-far at generation g is no better
-than at g − 5 (Drivora compares the mean of the last 5 post-selection bests), and LIS starts at
-generation last_restart + 3 (Drivora: + 4).
+docs/avfuzzer.md differ, the specification wins: stagnation means the best-so-far at generation
+g is no better than at g − 5 (Drivora compares the mean of the last 5 post-selection bests), and
+LIS starts at generation last_restart + 3 (Drivora: + 4).
 """
 
 from __future__ import annotations

@@ -9,6 +9,7 @@ import pytest
 from typer.testing import CliRunner
 
 from evoeye.cli import app
+from evoeye.cli.errors import ExitCode
 from evoeye.paths import DataRoot
 from evoeye.store import Warehouse
 
@@ -90,3 +91,23 @@ def test_an_unreadable_log_is_reported_not_fatal(batch_root: DataRoot, tmp_path:
     (s,) = report["logical_scenarios"]
     assert code == 0 and s["unreadable_runs"] == 1
     assert "truncated" in s["per_run"][0]["error"]
+
+
+def test_a_batch_the_root_does_not_hold_is_refused_naming_those_it_does(
+        batch_root: DataRoot) -> None:
+    asked = RUNNER.invoke(app, ["audit", "--root", str(batch_root.path), "--batch", "demo"])
+    assert asked.exit_code == ExitCode.USER_ERROR
+    assert "no run logs of batch 'demo'" in asked.output
+    assert f"{S1}/uniform-seed3 (6 logs)" in asked.output  # what the root holds
+    assert not (batch_root.reports / "audit-all-demo").exists()  # no empty report
+    code, report = _audit(batch_root, "--batch", "uniform-seed3")  # the batch it does hold
+    assert code == 0 and [s["runs"] for s in report["logical_scenarios"]] == [6]
+    outside = RUNNER.invoke(app, ["audit", "--root", str(batch_root.path), "--batch", "../x"])
+    assert outside.exit_code == ExitCode.USER_ERROR and "not a plain name" in outside.output
+
+
+def test_an_empty_root_is_refused(tmp_path: Path) -> None:
+    root = DataRoot.resolve(tmp_path / "empty")
+    root.runs.mkdir(parents=True)
+    out = RUNNER.invoke(app, ["audit", "--root", str(root.path)])
+    assert out.exit_code == ExitCode.USER_ERROR and "it holds none" in out.output

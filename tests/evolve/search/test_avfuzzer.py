@@ -1,4 +1,5 @@
-"""AV-Fuzzer as DESIGN.md §4: operators, roulette, restart, local search, ask/tell, resume."""
+"""AV-Fuzzer as docs/avfuzzer.md specifies it: operators, roulette, restart, local search,
+ask/tell, resume."""
 
 import numpy as np
 import pytest
