@@ -174,7 +174,6 @@ def interval_chart(rows: Sequence[tuple[str, float | None, float | None, float |
     return f.svg(body, title)
 
 
-<<<<<<< HEAD
 
 def band_chart(series: Sequence[tuple[str, Sequence[float], Sequence[float], Sequence[float],
                                       Sequence[float]]], *,
@@ -205,7 +204,8 @@ def band_chart(series: Sequence[tuple[str, Sequence[float], Sequence[float], Seq
                     f'stroke-width="2" data-series="{escape(series[i][0])}"/>')
     body += _legend(f, [s[0] for s in series], f.x0 + 8, f.y1 + 14)
     return f.svg(body, title)
-=======
+
+
 STANDALONE_CSS = ("svg{font:11px sans-serif;background:#fafafa} .t{font-size:13px;"
                   "font-weight:600} .s{font-size:11px}")
 
@@ -216,4 +216,3 @@ def standalone(svg: str) -> str:
     head, rest = svg.split(">", 1)
     return (head.replace("<svg ", '<svg xmlns="http://www.w3.org/2000/svg" ', 1)
             + f"><style>{STANDALONE_CSS}</style>" + rest + "\n")
->>>>>>> main
