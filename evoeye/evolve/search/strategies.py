@@ -9,13 +9,9 @@
   removed: the potential of a seed is its own normalised feedback (S_δ(x) shrinks to {x}), so
   p(x) = (f̄(x) + ε) / (max_D f̄ + ε), regardless of how its neighbourhood was explored.
 * `uniform` — uniform samples of X (the paper's Uniform baseline).
-<<<<<<< HEAD
 
-AV-Fuzzer is in `evoeye.evolve.search.avfuzzer`, the strategies beyond the paper in their own
-modules; `evoeye.evolve.search.registry` names them all.
-=======
-* `avfuzzer` — the GA of docs/avfuzzer.md, see `evoeye.evolve.search.avfuzzer`.
->>>>>>> main
+AV-Fuzzer (the GA of docs/avfuzzer.md) is in `evoeye.evolve.search.avfuzzer`, the strategies
+beyond the paper in their own modules; `evoeye.evolve.search.registry` names them all.
 
 Proposal k of a density-aware or uniform strategy draws from `default_rng([seed, k])` only, so
 the same seed, counter and records give the same proposal; `replay` just restores the counter.
