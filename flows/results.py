@@ -59,6 +59,7 @@ class ResultsParams(BaseModel):
     feedback: str = D.feedback
     epochs: int | None = Field(None, ge=1)
     patience: int | None = Field(None, ge=1)
+    recipe: str = D.recipe  # the training recipe of every from-scratch monitor (ResultsConfig)
     workers: int = Field(D.workers, ge=1)
     # the sample-efficiency study (part "efficiency"): EfficiencyConfig's fields to change
     efficiency: dict[str, Any] = Field(default_factory=dict)

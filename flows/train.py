@@ -11,6 +11,7 @@ from prefect import flow, get_run_logger, task
 from pydantic import BaseModel, Field, field_validator
 
 from evoeye.monitor.inputs import parse_modules
+from evoeye.monitor.recipes import DEFAULT_RECIPE, recipe_params
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 
@@ -27,16 +28,23 @@ class TrainFlowParams(BaseModel):
     modules: str | None = None  # an ABLATIONS name or a comma list of MODULES; None: all
     seed: int = 0
     split_seed: int = 0
-    epochs: int = Field(40, ge=1)
-    patience: int = Field(8, ge=1)
-    batch_size: int = Field(256, ge=1)
-    lr: float = Field(1e-3, gt=0.0)
+    recipe: str = DEFAULT_RECIPE  # evoeye.monitor.recipes; the fields below override it
+    epochs: int | None = Field(None, ge=1)  # None: the recipe's
+    patience: int | None = Field(None, ge=1)
+    batch_size: int | None = Field(None, ge=1)
+    lr: float | None = Field(None, gt=0.0)
     init_from: str | None = None  # fine-tune this version
 
     @field_validator("modules")
     @classmethod
     def _known_modules(cls, value: str | None) -> str | None:
         parse_modules(value)  # raises ValueError naming the choices
+        return value
+
+    @field_validator("recipe")
+    @classmethod
+    def _known_recipe(cls, value: str) -> str:
+        recipe_params(value)  # raises ValueError naming the choices
         return value
 
 
@@ -50,8 +58,8 @@ def train_version(params: TrainFlowParams, root: DataRoot) -> str:
         modules=parse_modules(params.modules), seed=params.seed,
         splits=SplitSpec(seed=params.split_seed),
         train_runs=params.train_sql, val_runs=params.val_sql, init_from=params.init_from,
-        epochs=params.epochs, patience=params.patience, batch_size=params.batch_size,
-        lr=params.lr,
+        recipe=params.recipe, **{k: v for k in ("epochs", "patience", "batch_size", "lr")
+                                 if (v := getattr(params, k)) is not None},
     )
 
 

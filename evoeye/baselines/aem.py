@@ -14,7 +14,8 @@ from __future__ import annotations
 import hashlib
 import io
 import json
-from dataclasses import asdict, dataclass, field
+import math
+from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -23,6 +24,7 @@ import torch
 from torch import nn
 
 from evoeye.monitor.adam import Adam
+from evoeye.monitor.batching import step_lrs
 from evoeye.monitor.card import thresholds_from_card
 from evoeye.monitor.families import read_version
 from evoeye.monitor.protocol import Thresholds
@@ -42,17 +44,48 @@ MODEL_FILE, META_FILE = "model.pt", "meta.json"
 
 @dataclass(frozen=True)
 class AEMConfig:
-    """Autoencoder shape and training schedule."""
+    """Autoencoder shape and training schedule; the defaults are recipe "v1"."""
 
     context_len: int = 5
     hidden: tuple[int, ...] = (256, 64)
     latent: int = 16
     epochs: int = 25
     batch_size: int = 256
-    lr: float = 1e-3
+    lr: float = 1e-3  # the peak learning rate under a schedule
     weight_decay: float = 1e-5
     max_train_windows: int = 200_000
     seed: int = 0
+    # -- fields added with the recipes; `record` leaves them out where they are v1's
+    recipe: str = "v1"
+    schedule: str = "constant"  # evoeye.monitor.batching.SCHEDULES, over `epochs`' steps
+    warmup_epochs: float = 0.0
+
+    def record(self) -> dict[str, Any]:
+        """The config as versions, metadata and training keys record it: every field, but those
+        added with the recipes only where they differ from v1's (v1 keeps its ids)."""
+        return {k: v for k, v in asdict(self).items()
+                if k not in ADDED_FIELDS or v != getattr(AEM_RECIPES["v1"], k)}
+
+
+ADDED_FIELDS = ("recipe", "schedule", "warmup_epochs")
+# the FusionMonitor's recipe names (evoeye.monitor.recipes), the AEM's part of each: v2 trains
+# in batches of 1024 at a peak 3e-3 with a warm-up and a cosine decay over 8 epochs
+AEM_RECIPES = {
+    "v1": AEMConfig(),
+    "v2": AEMConfig(recipe="v2", epochs=8, batch_size=1024, lr=3e-3, schedule="cosine",
+                    warmup_epochs=0.5),
+}
+
+
+def aem_config(recipe: str | None = None, **overrides: Any) -> AEMConfig:
+    """The AEM part of a training recipe (default: the FusionMonitor's default recipe) with
+    `overrides` (AEMConfig fields); ValueError naming an unknown recipe."""
+    from evoeye.monitor.recipes import DEFAULT_RECIPE
+
+    name = recipe or DEFAULT_RECIPE
+    if name not in AEM_RECIPES:
+        raise ValueError(f"unknown training recipe {name!r}; known: {sorted(AEM_RECIPES)}")
+    return replace(AEM_RECIPES[name], **overrides)
 
 
 def window_vectors(windows: Windows, index: np.ndarray | slice | None = None) -> np.ndarray:
@@ -106,7 +139,7 @@ class AEMMonitor:
 
     @property
     def version(self) -> str:
-        h = hashlib.sha256(json.dumps(asdict(self.config), sort_keys=True).encode())
+        h = hashlib.sha256(json.dumps(self.config.record(), sort_keys=True).encode())
         for t in self.model.state_dict().values():
             h.update(t.detach().numpy().tobytes())
         h.update(self.mean.tobytes() + self.std.tobytes())
@@ -136,14 +169,14 @@ class AEMMonitor:
         out.mkdir(parents=True, exist_ok=True)
         buf = io.BytesIO()
         torch.save({
-            "config": asdict(self.config),
+            "config": self.config.record(),
             "state_dict": self.model.state_dict(),
             "mean": torch.from_numpy(self.mean),
             "std": torch.from_numpy(self.std),
             "error_scale": float(self.error_scale),
         }, buf)
         (out / MODEL_FILE).write_bytes(buf.getvalue())
-        info = {"version": self.version, "name": self.name, "config": asdict(self.config),
+        info = {"version": self.version, "name": self.name, "config": self.config.record(),
                 "model_sha256": hashlib.sha256(buf.getvalue()).hexdigest()}
         (out / META_FILE).write_text(json.dumps({**info, **(meta or {})}, indent=2) + "\n")
         return out
@@ -208,9 +241,14 @@ def _train(train: Windows, normal: np.ndarray, config: AEMConfig,
         model.load_state_dict(init.model.state_dict())
     opt = Adam(model.parameters(), lr=config.lr, weight_decay=config.weight_decay)
     gen = torch.Generator().manual_seed(config.seed)
+    lr_at = step_lrs(config.lr, config.schedule, config.warmup_epochs, config.epochs,
+                     math.ceil(len(xt) / config.batch_size))
+    step = 0
     model.train()
     for _ in range(config.epochs):
         for batch in torch.randperm(len(xt), generator=gen).split(config.batch_size):
+            opt.lr = lr_at(step)
+            step += 1
             xb = xt[batch]
             loss = ((model(xb) - xb) ** 2).mean()
             opt.zero_grad()

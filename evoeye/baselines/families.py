@@ -77,18 +77,19 @@ def fit_aem(root: DataRoot, scenario: str,
             splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
             config: AEMConfig | None = None, *,
             horizon_s: float = DEFAULT_HORIZON_S, seed: int | None = None,
-            runs: RunFilter | None = None) -> AEMMonitor:
+            runs: RunFilter | None = None, recipe: str | None = None) -> AEMMonitor:
     """The AEM of this scenario's train split (or of `runs`): loaded if trained before, else
-    trained and saved; `seed` replaces the config's.
+    trained and saved; `config` (default: the AEM part of the training `recipe`, see
+    `aem_config`) with `seed` in place of its own.
 
     Trained on the collision-free windows of the split: label 0 (all windows are before their
     run's collision, see `load_windows`)."""
-    from evoeye.baselines.aem import AEMConfig, train_aem
+    from evoeye.baselines.aem import aem_config, train_aem
 
-    config = _seeded(config or AEMConfig(), seed)
+    config = _seeded(config or aem_config(recipe), seed)
     runs = _train_runs(scenario, splits, runs)
     ids = _train_ids(root, runs)
-    key = training_key(scenario, asdict(splits), asdict(config), horizon_s, ids)
+    key = training_key(scenario, asdict(splits), config.record(), horizon_s, ids)
     if (version := AEM.find(root, key)) is not None:
         return AEM.load(root, version)
     train = _train_windows(root, runs, config.context_len, horizon_s)
@@ -127,21 +128,22 @@ def fit_context_only(root: DataRoot, scenario: str,
 def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_runs: Runs,
                       seed: int = 0, init_from: str | None = None, context_len: int | None = None,
                       horizon_s: float = DEFAULT_HORIZON_S, epochs: int | None = None,
-                      **_fusion_only: Any) -> str:
+                      recipe: str | None = None, **_fusion_only: Any) -> str:
     """Train (or fine-tune, `init_from`) an AEM on the collision-free windows of `train_runs`,
     calibrate its thresholds on `val_runs` (`calibrate_on_validation`), save it; its version. A
-    version with the same training key (selection, seed, recipe, parent) is reused.
-    FusionMonitor options (splits, patience, …) do not apply and are ignored."""
-    from evoeye.baselines.aem import AEMConfig, train_aem
+    version with the same training key (selection, seed, recipe, parent) is reused. From
+    scratch it trains by the AEM part of the training `recipe` (`aem_config`), fine-tuned by
+    its parent's. FusionMonitor options (splits, patience, …) do not apply and are ignored."""
+    from evoeye.baselines.aem import aem_config, train_aem
     from evoeye.monitor.calibration import calibrate_on_validation
     from evoeye.monitor.card import describe_selection, thresholds_to_card
 
     parent = AEM.load(root, init_from) if init_from else None
-    config = parent.config if parent else AEMConfig(
-        context_len=context_len or DEFAULT_CONTEXT_LEN)
+    config = parent.config if parent else aem_config(
+        recipe, context_len=context_len or DEFAULT_CONTEXT_LEN)
     config = replace(config, seed=seed, **({"epochs": epochs} if epochs else {}))
     selection = {"train": describe_selection(train_runs), "val": describe_selection(val_runs)}
-    key = training_key(scenario, selection, asdict(config), init_from, horizon_s)
+    key = training_key(scenario, selection, config.record(), init_from, horizon_s)
     if (version := AEM.find(root, key)) is not None:
         return version
     train = _train_windows(root, train_runs, config.context_len, horizon_s)
@@ -159,15 +161,16 @@ def train_aem_version(root: DataRoot, scenario: str, *, train_runs: Runs, val_ru
 
 
 def initial_aem(root: DataRoot, scenario: str, *, train_runs: Runs, val_runs: Runs,
-                horizon_s: float = DEFAULT_HORIZON_S) -> str:
-    """AEM-Evo's G_0: the AEM trained from scratch on D_init (seed 0), trained once."""
+                horizon_s: float = DEFAULT_HORIZON_S, recipe: str | None = None) -> str:
+    """AEM-Evo's G_0: the AEM trained from scratch on D_init (seed 0) by the campaign's
+    training recipe, trained once."""
     return train_aem_version(root, scenario, train_runs=list(train_runs), val_runs=val_runs,
-                             seed=0, horizon_s=horizon_s)
+                             seed=0, horizon_s=horizon_s, recipe=recipe)
 
 
 AEM = register_family(MonitorFamily(
     "aem", "AEM", "aem-", "baselines/aem", "model.pt", "meta.json", decode=_decode_aem,
-    train=train_aem_version, initial=initial_aem, fit=fit_aem,
+    train=train_aem_version, initial=initial_aem, fit=fit_aem, recipes=True,
 ))
 CONTEXT_ONLY = register_family(MonitorFamily(
     "context-only", "context-only control", "ctx-", "baselines/context-only", "model.pkl",

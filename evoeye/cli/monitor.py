@@ -10,9 +10,9 @@ import typer
 from evoeye.cli.app import app
 from evoeye.cli.defaults import ABLATION_NAMES as ABLATIONS
 from evoeye.cli.defaults import CONTEXT_LEN as DEFAULT_CONTEXT_LEN
+from evoeye.cli.defaults import DEFAULT_RECIPE, RECIPE_NAMES, SPLIT_SEED, TARGET_FPRS
 from evoeye.cli.defaults import HORIZON_S as DEFAULT_HORIZON_S
 from evoeye.cli.defaults import MODULE_NAMES as MODULES
-from evoeye.cli.defaults import SPLIT_SEED, TARGET_FPRS
 from evoeye.cli.errors import UserError
 from evoeye.cli.output import err, out, table
 from evoeye.paths import DataRoot
@@ -61,12 +61,22 @@ def train_command(
     seed: Annotated[int, typer.Option(help="Training seed.")] = 0,
     split_seed: Annotated[int, typer.Option(help="Seed of the train/val/test split.")] =
         SPLIT_SEED,
-    epochs: Annotated[int, typer.Option(min=1, help="At most this many epochs.")] = 40,
-    patience: Annotated[int, typer.Option(min=1, help="Early-stopping patience.")] = 8,
-    batch_size: Annotated[int, typer.Option(min=1)] = 256,
-    lr: Annotated[float, typer.Option(min=0.0, help="Adam learning rate.")] = 1e-3,
+    recipe: Annotated[str, typer.Option(
+        help=f"Training recipe, one of {', '.join(RECIPE_NAMES)}; the options below override "
+             "its values.")] = DEFAULT_RECIPE,
+    epochs: Annotated[int | None, typer.Option(
+        min=1, help="At most this many epochs (default: the recipe's).")] = None,
+    patience: Annotated[int | None, typer.Option(
+        min=1, help="Early-stopping patience (default: the recipe's).")] = None,
+    batch_size: Annotated[int | None, typer.Option(
+        min=1, help="Windows per step (default: the recipe's).")] = None,
+    lr: Annotated[float | None, typer.Option(
+        min=0.0, help="Adam's (peak) learning rate (default: the recipe's).")] = None,
     weight_decay: Annotated[float | None, typer.Option(
-        min=0.0, help="Adam weight decay (default: TrainParams').")] = None,
+        min=0.0, help="Adam weight decay (default: the recipe's).")] = None,
+    device: Annotated[str | None, typer.Option(
+        help="cpu, cuda or cuda:N (default: $EVOEYE_DEVICE, else a GPU if there is one).")
+    ] = None,
     dropout: Annotated[float | None, typer.Option(
         min=0.0, max=0.95, help="Dropout on frame features and the temporal MLP (default: "
         "none, or the parent's).")] = None,
@@ -89,20 +99,23 @@ def train_command(
                           f"val loss {row['val_loss']:.4f}  val AUROC {_pct(row['auroc'])}  "
                           f"val AUPRC {_pct(row['auprc'])}")
 
-    extra = {} if weight_decay is None else {"weight_decay": weight_decay}
+    given = {"epochs": epochs, "patience": patience, "batch_size": batch_size, "lr": lr,
+             "weight_decay": weight_decay}
     try:
         version = train_monitor(
             data, scenario, context_len=context_len, horizon_s=horizon_s,
             modules=parse_modules(modules), dropout=dropout, seed=seed,
-            splits=SplitSpec(seed=split_seed), init_from=init_from, epochs=epochs,
-            patience=patience, batch_size=batch_size, lr=lr, progress=progress, **extra)
+            splits=SplitSpec(seed=split_seed), init_from=init_from, progress=progress,
+            recipe=recipe, device=device, **{k: v for k, v in given.items() if v is not None})
     except ValueError as exc:
         raise UserError(str(exc), "check --scenario, and that `evoeye ingest` has run") from exc
     card = read_card(data, version)
     console.print(metrics_table(card))
     t = card["training"]
-    console.print(f"best epoch {t['best_epoch']} of {t['epochs_run']}, {t['time_s']:.1f} s, "
-                  f"{card['n_parameters']:,} parameters, L = {card['context_len']}")
+    console.print(f"recipe {card['recipe']}: best epoch {t['best_epoch']} of "
+                  f"{t['epochs_run']}, {t['time_s']:.1f} s ({t['cpu_s']:.1f} s CPU) on "
+                  f"{t['device']}, {card['n_parameters']:,} parameters, "
+                  f"L = {card['context_len']}")
     console.print(f"card: {version_dir(data, version) / CARD_FILE}")
     console.print(f"version: [bold]{version}[/]")
 

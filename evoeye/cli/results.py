@@ -13,6 +13,7 @@ from evoeye.paths import DataRoot
 from evoeye.results.config import (
     PAPER_INITIAL_RUNS,
     PARTS,
+    RECIPES,
     ResultsConfig,
     parse_initial_runs,
 )
@@ -121,6 +122,9 @@ def results_command(
     pool_runs: Annotated[int, typer.Option(
         min=1, help="Sample-efficiency study: uniform runs per regime to pick from.")] =
         E.pool_runs,
+    recipe: Annotated[str, typer.Option(
+        help=f"Training recipe of every monitor trained from scratch, one of "
+             f"{', '.join(RECIPES)} (campaign updates keep theirs).")] = D.recipe,
     workers: Annotated[int, typer.Option(
         min=1, help="Processes simulating the data, then running campaigns side by side.")
     ] = D.workers,
@@ -151,13 +155,14 @@ def results_command(
             context_lens=tuple(context_len or D.context_lens),
             inputs=tuple(inputs or D.inputs), methods=tuple(method or D.methods),
             budget_s=budget_s, n_round=n_round, update=update, feedback=feedback,
-            epochs=epochs, patience=patience, workers=workers,
+            epochs=epochs, patience=patience, recipe=recipe, workers=workers,
             efficiency=EfficiencyConfig(
                 regimes=tuple(regime or E.regimes),
                 strategies=tuple(dict.fromkeys((REFERENCE, *strategy))) if strategy
                 else E.strategies,
                 mode=mode, seeds=tuple(range(first_study_seed, first_study_seed + study_seeds)),
-                oracle=oracle, pool_runs=pool_runs, epochs=epochs, patience=patience
+                oracle=oracle, pool_runs=pool_runs, recipe=recipe, epochs=epochs,
+                patience=patience
             ).changed())
         config.check_names()
     except ValueError as exc:

@@ -1,6 +1,7 @@
 """Runtime monitors: the FusionMonitor and the protocol every monitor implements.
 
-    train_monitor(root, scenario=…, context_len=…, modules=…, seed=…) -> version
+    train_monitor(root, scenario=…, context_len=…, modules=…, seed=…, recipe=…) -> version
+    train_monitors(root, scenario=…, seeds=[…], …) -> versions    (the same, data loaded once)
     calibrate_on_validation(scores, val) -> Thresholds    (one calibration for every monitor)
     load_monitor(root, version) -> FusionMonitor    (score(windows) -> (B,) risks)
     RuntimeMonitor(monitor).step(frame_messages) -> RiskState
@@ -33,6 +34,8 @@ _LAZY = {
     "read_card": "evoeye.monitor.registry",
     "TrainParams": "evoeye.monitor.train",
     "train_monitor": "evoeye.monitor.train",
+    "train_monitors": "evoeye.monitor.train",
+    "RECIPES": "evoeye.monitor.recipes",
     "RiskState": "evoeye.monitor.runtime",
     "RuntimeMonitor": "evoeye.monitor.runtime",
     "replay": "evoeye.monitor.replay",

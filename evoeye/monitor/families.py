@@ -62,9 +62,11 @@ class SavedMonitor(Protocol):
 
 Decoder = Callable[[bytes, dict[str, Any], str], SavedMonitor]  # (checked weights, meta, version)
 Trainer = Callable[..., str]  # (root, scenario, *, train_runs, val_runs, seed, init_from, …) → id
-Initial = Callable[..., str]  # (root, scenario, *, train_runs, val_runs, horizon_s) → G_0's id
+Initial = Callable[..., str]  # (root, scenario, *, train_runs, val_runs, horizon_s, recipe)
+# → G_0's id (a G_0 the family trains itself trains by the training recipe `recipe`)
 Fitter = Callable[..., SavedMonitor]  # (root, scenario, splits, *, seed, runs) → trained on the
 # train split (or the RunFilter `runs`), with a training seed (None: the family's default)
+SeedsTrainer = Callable[..., list[str]]  # Trainer's arguments, `seeds` for `seed` → ids
 
 
 @dataclass(frozen=True)
@@ -81,6 +83,8 @@ class MonitorFamily:
     train: Trainer | None = None  # None: not evolvable
     initial: Initial | None = None  # None: a campaign must name its G_0
     fit: Fitter | None = None  # an RQ1 baseline trained on a scenario's train split
+    recipes: bool = False  # its train and fit take a training recipe by name (`recipe=`)
+    train_seeds: SeedsTrainer | None = None  # several seeds at once: the ids `train` gives
 
     @property
     def evolvable(self) -> bool:
@@ -240,8 +244,16 @@ def _train_fusion(root: DataRoot, scenario: str | None = None, **kwargs: Any) ->
     return train_monitor(root, scenario, **kwargs)
 
 
+def _train_fusion_seeds(root: DataRoot, scenario: str | None = None, **kwargs: Any
+                        ) -> list[str]:
+    from evoeye.monitor.train import train_monitors
+
+    return train_monitors(root, scenario, **kwargs)
+
+
 register_family(MonitorFamily(
     DEFAULT_FAMILY, "FusionMonitor", "fusion-", "monitors", "model.pt", "card.json",
-    decode=_decode_fusion, train=_train_fusion, initial=initial_monitor,
+    decode=_decode_fusion, train=_train_fusion, initial=initial_monitor, recipes=True,
+    train_seeds=_train_fusion_seeds,
 ))
 

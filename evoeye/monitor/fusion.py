@@ -11,6 +11,7 @@ the frame encoders are most of the network's work.
 
 from __future__ import annotations
 
+import copy
 import warnings
 from collections.abc import Callable
 from typing import Any
@@ -18,6 +19,7 @@ from typing import Any
 import numpy as np
 import torch
 
+from evoeye.monitor.device import pick_device
 from evoeye.monitor.model import FRAME_INPUTS, INPUTS, FusionNet, example_inputs
 from evoeye.monitor.protocol import Thresholds
 from evoeye.store.windows import WindowBatch, Windows
@@ -47,13 +49,16 @@ class FusionMonitor:
     name = "fusion"
 
     def __init__(self, net: FusionNet, version: str, thresholds: Thresholds,
-                 card: dict[str, Any] | None = None, *, trace: bool = True):
+                 card: dict[str, Any] | None = None, *, trace: bool = True,
+                 device: str | torch.device | None = None):
         self.net = net.eval()
         self.version = version
         self.thresholds = thresholds
         self.card = card or {}
+        self.device = pick_device(device)  # where `score` runs (`score_batch`: the net's)
         self._trace = trace
         self._forward: Callable[..., torch.Tensor] | None = None
+        self._device_net: FusionNet | None = None
 
     @property
     def context_len(self) -> int:
@@ -74,23 +79,36 @@ class FusionMonitor:
             return torch.sigmoid(self._forward(*net_inputs(batch))).numpy()
 
     def score(self, windows: Windows) -> np.ndarray:
-        """(B,) float32 risk scores, one per window, in chunks of SCORE_BATCH windows."""
+        """(B,) float32 risk scores, one per window, in chunks of SCORE_BATCH windows, each
+        distinct frame encoded once, on the monitor's device."""
         if windows.context_len != self.context_len:
             raise ValueError(f"monitor {self.version} takes contexts of L = {self.context_len} "
                              f"frames; these windows have L = {windows.context_len}")
         out = np.empty(len(windows), np.float32)
         features = windows.features.arrays()
+        net = self._scoring_net()
+        device = next(net.parameters()).device
         with torch.inference_mode():
             for start in range(0, len(windows), SCORE_BATCH):
                 index = slice(start, min(start + SCORE_BATCH, len(windows)))
-                rows, inverse = np.unique(windows.context[index], return_inverse=True)
-                z = self.net.encode_frames(*(torch.from_numpy(np.take(features[name], rows,
-                                                                      axis=0))
-                                             for name in FRAME_INPUTS))  # (U, D)
-                z = z[torch.from_numpy(inverse.reshape(windows.context[index].shape))]
-                mask = torch.from_numpy(windows.context_mask[index])
-                out[index] = torch.sigmoid(self.net.head(z, mask)).numpy()
+                rows, inverse = windows.distinct_frames(index)
+                frames = [torch.from_numpy(np.take(features[name], rows, axis=0)).to(device)
+                          for name in FRAME_INPUTS]  # (U, …)
+                logit = net.forward_frames(frames, torch.from_numpy(inverse).to(device),
+                                           torch.from_numpy(windows.context_mask[index])
+                                           .to(device))
+                out[index] = torch.sigmoid(logit).cpu().numpy()
         return out
+
+    def _scoring_net(self) -> FusionNet:
+        """The network on the device `score` runs on: the monitor's own where it already sits
+        on one (a network in training) or where that is the CPU, else a copy on the device."""
+        if self.device.type == "cpu" or next(self.net.parameters()).device != torch.device(
+                "cpu"):
+            return self.net
+        if self._device_net is None:
+            self._device_net = copy.deepcopy(self.net).to(self.device).eval()
+        return self._device_net
 
     def __repr__(self) -> str:
         return f"FusionMonitor({self.version!r}, L={self.context_len})"

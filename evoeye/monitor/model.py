@@ -219,6 +219,14 @@ class FusionNet(nn.Module):
                                plan_mask, plan_info, control)  # (B, L, D)
         return self.head(z, context_mask)
 
+    def forward_frames(self, frames: list[torch.Tensor], inverse: torch.Tensor,
+                       context_mask: torch.Tensor) -> torch.Tensor:
+        """`forward` with each distinct frame encoded once: (U, …) frame inputs (FRAME_INPUTS
+        order), the (B, L) row of each context slot among them and the (B, L) context mask →
+        (B,) logits, the same as `forward` on the gathered windows."""
+        z = self.encode_frames(*frames)  # (U, D)
+        return self.head(z[inverse], context_mask)  # (B, L, D) → (B,)
+
     def head(self, z: torch.Tensor, context_mask: torch.Tensor) -> torch.Tensor:
         """Temporal block: (B, L, D) frame features z_t and the (B, L) context mask → (B,)
         logits. Frames are encoded independently, so a frame shared by several windows may be

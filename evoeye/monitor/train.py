@@ -1,168 +1,60 @@
-"""Train a FusionMonitor on SQL-selected warehouse windows and save it as a version with a card.
+"""Train FusionMonitors on SQL-selected warehouse windows and save each as a version with a card.
 
 The windows are the eligible frames of the selected runs (`load_windows`): no frame at or after
-a run's collision enters training, `pos_weight`, early stopping or calibration.
-
-Loss: binary cross-entropy on the logit (`BCEWithLogitsLoss`) with `pos_weight` = negatives /
-positives of the training windows. Unsafe frames are rare (≈ 4 % in S1, ≈ 16 % in S2), so
-unweighted BCE is dominated by the easy safe frames; weighting the positives balances the two
-classes in expectation while every window is still seen exactly once per epoch (unlike
-re-sampling, which repeats a few positive windows and drops negatives). The weighting shifts the
-scores upwards, which does not matter for alarms: thresholds are calibrated on validation for a
-target FPR. Optimiser Adam (`evoeye.monitor.adam`: torch's, without its compiler import); early
-stopping on validation AUPRC (the best epoch's weights are kept). Seeded: the same seed, data
-and thread count give the same weights (and version).
+a run's collision enters training, `pos_weight`, early stopping or calibration. How a network
+learns from them — loss, batches, schedule, early stopping — is `evoeye.monitor.fit`, with the
+hyper-parameters of a named recipe (`evoeye.monitor.recipes`: "v2" by default, "v1" the one
+every earlier result was made with) and the caller's overrides; the card records both.
 
 `init_from=<version>` fine-tunes a parent: its weights, input normalisers and architecture are
 the starting point, and the card records the parent. Without it a monitor is trained from
 scratch, with normalisers fitted on the training frames.
+
+`train_monitors` trains several seeds of one recipe on the same data: the windows are loaded
+once and the seeds train side by side, one Python thread each (torch runs its kernels outside
+the interpreter lock), each with the one intra-op thread a seed trained alone has. A seed's
+computation is then the very sequence of kernels it runs alone, so its weights, and its version,
+are those `train_monitor` gives for that seed, bit for bit (tests/monitor/test_train_seeds.py).
+The seeds run on the device `evoeye.monitor.device` picks: a GPU when there is one.
 """
 
 from __future__ import annotations
 
 import copy
-import time
-from collections.abc import Callable, Sequence
-from contextlib import contextmanager
-from dataclasses import asdict, dataclass
+import os
+from collections.abc import Sequence
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass, replace
 from datetime import UTC, datetime
 from typing import Any
 
 import numpy as np
 import torch
-from torch import nn
 
 from evoeye import __version__
-from evoeye.monitor.adam import Adam
 from evoeye.monitor.calibration import calibrate_on_validation
 from evoeye.monitor.card import (
     data_summary,
     describe_selection,
-    ranking_metrics,
     split_metrics,
     thresholds_to_card,
 )
-from evoeye.monitor.fusion import FusionMonitor, net_inputs
+from evoeye.monitor.device import pick_device
+from evoeye.monitor.fit import FitResult, Progress, fit, kernels, reproducible
+from evoeye.monitor.fusion import FusionMonitor
 from evoeye.monitor.model import MODULES, FusionConfig, FusionNet
 from evoeye.monitor.protocol import Thresholds
+from evoeye.monitor.recipes import TrainParams, card_hyperparameters, recipe_params
 from evoeye.monitor.registry import load_monitor, save_version
-from evoeye.monitor.threads import MONITOR_THREADS, intra_op_threads
 from evoeye.paths import DataRoot
 from evoeye.store.catalog import Warehouse
 from evoeye.store.features import FrameFeatures
 from evoeye.store.selection import RunFilter, Runs, SplitSpec
 from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S, Windows, load_windows
 
-Progress = Callable[[dict[str, Any]], None]  # called after every epoch with its history row
-
-
-@dataclass(frozen=True)
-class TrainParams:
-    """Hyper-parameters of one training run (recorded in the card)."""
-
-    seed: int = 0
-    epochs: int = 40  # at most; early stopping usually ends sooner
-    patience: int = 8  # epochs without a better validation AUPRC before stopping
-    batch_size: int = 256
-    lr: float = 1e-3
-    weight_decay: float = 1e-5
-    grad_clip: float = 1.0
-    pos_weight: float | None = None  # None: negatives / positives of the training windows
-    threads: int = MONITOR_THREADS  # intra-op threads (evoeye.monitor.threads says why one)
-
-
-@dataclass
-class FitResult:
-    """The trained network (best validation epoch) and how training went."""
-
-    net: FusionNet
-    best_epoch: int
-    history: list[dict[str, Any]]
-    pos_weight: float
-    time_s: float
-
-
-def _deterministic(mode: bool) -> None:
-    """torch.use_deterministic_algorithms without its import of torch._inductor (≈ 1.4 s once
-    per process, to set a compiler flag for torch.compile, which evoeye never uses)."""
-    setter = getattr(torch._C, "_set_deterministic_algorithms", None)
-    if setter is None:  # another torch: the public call
-        torch.use_deterministic_algorithms(mode)
-    else:
-        setter(mode)
-
-
-@contextmanager
-def _reproducible(seed: int, threads: int):
-    """Seeded global RNG, deterministic kernels and a fixed thread count; all restored after."""
-    was_deterministic = torch.are_deterministic_algorithms_enabled()
-    with torch.random.fork_rng(devices=[]), intra_op_threads(threads):
-        torch.manual_seed(seed)
-        _deterministic(True)
-        try:
-            yield
-        finally:
-            _deterministic(was_deterministic)
-
-
-def _val_score(net: FusionNet, val: Windows) -> tuple[np.ndarray, float]:
-    """(val risks, val BCE) of the network in eval mode."""
-    scores = FusionMonitor(net, "training", None, trace=False).score(val)  # type: ignore
-    net.train()
-    p = np.clip(scores.astype(np.float64), 1e-7, 1 - 1e-7)
-    y = val.label.astype(np.float64)
-    return scores, float(-(y * np.log(p) + (1 - y) * np.log(1 - p)).mean())
-
-
-def fit(net: FusionNet, train: Windows, val: Windows, params: TrainParams = TrainParams(),
-        progress: Progress | None = None) -> FitResult:
-    """Train `net` in place on `train`, early-stopped on `val` AUPRC; the best epoch's net.
-
-    Call under `_reproducible` (train_monitor does) for seeded, repeatable weights.
-    """
-    if len(train) == 0 or len(val) == 0:
-        raise ValueError(f"need training and validation windows, got {len(train)} and "
-                         f"{len(val)}: check the run selection")
-    n_pos = int(train.label.sum())
-    if n_pos == 0 or n_pos == len(train):
-        raise ValueError(f"the training windows need both classes; {n_pos} of {len(train)} "
-                         "are unsafe")
-    pos_weight = params.pos_weight or (len(train) - n_pos) / n_pos
-    loss_fn = nn.BCEWithLogitsLoss(pos_weight=torch.tensor(pos_weight))
-    opt = Adam(net.parameters(), lr=params.lr, weight_decay=params.weight_decay)
-    gen = torch.Generator().manual_seed(params.seed)
-    # AUPRC needs both classes in validation; without, early stopping falls back to val loss
-    use_auprc = ranking_metrics(np.zeros(len(val)), val.label)["auprc"] is not None
-    best, best_state, best_epoch, history = -np.inf, copy.deepcopy(net.state_dict()), 0, []
-    t0 = time.perf_counter()
-    net.train()
-    for epoch in range(1, params.epochs + 1):
-        order = torch.randperm(len(train), generator=gen).numpy()
-        total = 0.0
-        for start in range(0, len(order), params.batch_size):
-            idx = np.sort(order[start:start + params.batch_size])  # sorted: faster gather
-            batch = train.batch(idx)
-            logit = net(*net_inputs(batch))
-            loss = loss_fn(logit, batch.label)
-            opt.zero_grad()
-            loss.backward()
-            nn.utils.clip_grad_norm_(net.parameters(), params.grad_clip)
-            opt.step()
-            total += float(loss.detach()) * len(idx)
-        scores, val_loss = _val_score(net, val)
-        metrics = ranking_metrics(scores, val.label)
-        row = {"epoch": epoch, "train_loss": total / len(train), "val_loss": val_loss, **metrics}
-        history.append(row)
-        criterion = metrics["auprc"] if use_auprc else -val_loss
-        if criterion > best + 1e-6:
-            best, best_epoch, best_state = criterion, epoch, copy.deepcopy(net.state_dict())
-        if progress is not None:
-            progress(row)
-        if epoch - best_epoch >= params.patience:
-            break
-    net.load_state_dict(best_state)
-    net.eval()
-    return FitResult(net, best_epoch, history, pos_weight, time.perf_counter() - t0)
+_reproducible = reproducible  # the name tests and older callers import
+__all__ = ["FitResult", "TrainParams", "Trained", "fit", "fit_windows", "train_monitor",
+           "train_monitors"]
 
 
 def _selections(scenario: str | None, splits: SplitSpec, train_runs: Runs, val_runs: Runs
@@ -191,6 +83,8 @@ def train_monitor(
     init_from: str | None = None,
     params: TrainParams | None = None,
     progress: Progress | None = None,
+    recipe: str | None = None,
+    device: str | torch.device | None = None,
     **overrides: Any,
 ) -> str:
     """Train (or fine-tune, with `init_from`) a FusionMonitor and save it; its version id.
@@ -198,30 +92,125 @@ def train_monitor(
     Default data: the `scenario` runs of the train / val splits of `splits`; `train_runs` /
     `val_runs` (a RunFilter, SQL returning scenario_id, or ids) select any other subsets.
     `context_len` (default 5), `modules` (default all four) and `dropout` (default
-    FusionConfig's) come from the parent when fine-tuning. `overrides` set TrainParams fields
-    (epochs=…, lr=…); a full `params` replaces both them and `seed`.
+    FusionConfig's) come from the parent when fine-tuning. The hyper-parameters are those of
+    `recipe` (default `recipes.DEFAULT_RECIPE`) with `overrides` (TrainParams fields: epochs=…,
+    lr=…); a full `params` replaces all three and `seed`. `device`: `pick_device`'s.
     """
-    params = params or TrainParams(seed=seed, **overrides)
+    seed = params.seed if params is not None else seed
+    return train_monitors(root, scenario, seeds=[seed], context_len=context_len,
+                          horizon_s=horizon_s, modules=modules, dropout=dropout, splits=splits,
+                          train_runs=train_runs, val_runs=val_runs, init_from=init_from,
+                          params=params, progress=progress, recipe=recipe, device=device,
+                          **overrides)[0]
+
+
+def train_monitors(
+    root: DataRoot,
+    scenario: str | None = None,
+    *,
+    seeds: Sequence[int],
+    context_len: int | None = None,
+    horizon_s: float = DEFAULT_HORIZON_S,
+    modules: Sequence[str] | None = None,
+    dropout: float | None = None,
+    splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
+    train_runs: Runs = None,
+    val_runs: Runs = None,
+    init_from: str | None = None,
+    params: TrainParams | None = None,
+    progress: Progress | None = None,
+    recipe: str | None = None,
+    device: str | torch.device | None = None,
+    parallel: int | None = None,
+    **overrides: Any,
+) -> list[str]:
+    """`train_monitor` once per seed, on data loaded once; the version ids, in `seeds`' order,
+    each the one `train_monitor` gives for that seed (module doc). `parallel` seeds train at a
+    time (default: as many as there are cores, at most one per seed); `progress` rows carry
+    their "seed". A network with dropout draws from the global RNG while it trains, so its
+    seeds train one after the other."""
+    if not seeds or len(set(seeds)) != len(seeds):
+        raise ValueError(f"give distinct training seeds, got {list(seeds)}")
+    base = params or recipe_params(recipe, **overrides)
     train_runs, val_runs = _selections(scenario, splits, train_runs, val_runs)
     parent = load_monitor(root, init_from) if init_from else None
+    config = _config(parent, context_len, modules, dropout)
+    warehouse = Warehouse(root)
+    train = load_windows(warehouse, train_runs, context_len=config.context_len,
+                         horizon_s=horizon_s)
+    val = load_windows(warehouse, val_runs, context_len=config.context_len, horizon_s=horizon_s)
+    where = pick_device(device)
+    frames = None if parent is not None else _frames_of(train)
+
+    def start(seed: int) -> FusionNet:
+        if parent is not None:
+            return copy.deepcopy(parent.net).to(where)
+        net = FusionNet(FusionConfig.for_spec(train.spec, **_sizes(config)))
+        net.fit_normalizers(frames)
+        return net.to(where)
+
+    def run(seed: int, net: FusionNet | None = None) -> Trained:
+        p = replace(base, seed=seed)
+        with reproducible(seed, p.threads, where.type == "cpu") if net is None else kernels(
+                p.threads, where.type == "cpu"):
+            net = net or start(seed)
+            result = fit(net, train, val, p, _tagged(progress, seed))
+            scores = FusionMonitor(result.net, "training", None,  # type: ignore[arg-type]
+                                   device=where).score(val)
+        return Trained(p, result, scores, calibrate_on_validation(scores, val))
+
+    width = min(len(seeds), parallel or os.cpu_count() or 1)
+    if width == 1 or config.dropout > 0:
+        trained = [run(seed) for seed in seeds]
+    else:
+        nets = []
+        for seed in seeds:  # each initialised under its seed, as alone
+            with reproducible(seed, base.threads):
+                nets.append(start(seed))
+        with ThreadPoolExecutor(width) as pool:
+            trained = list(pool.map(run, seeds, nets))
+    return [save_version(root, t.result.net.cpu(),
+                         _card(t, scenario, horizon_s, init_from, config, train, val,
+                               train_runs, val_runs, where))
+            for t in trained]
+
+
+@dataclass
+class Trained:
+    """A fit, its parameters, its validation scores and the thresholds calibrated on them."""
+
+    params: TrainParams
+    result: FitResult
+    scores: np.ndarray  # (B,) of the validation windows
+    thresholds: Thresholds
+
+
+def _tagged(progress: Progress | None, seed: int) -> Progress | None:
+    """`progress` called with each row and its seed."""
+    return None if progress is None else (lambda row: progress({**row, "seed": seed}))
+
+
+def _config(parent: FusionMonitor | None, context_len: int | None,
+            modules: Sequence[str] | None, dropout: float | None) -> FusionConfig:
+    """The network's config: the parent's (which the options must not contradict), or one
+    made of the options."""
     if parent is not None:
         config = parent.net.config
         if context_len not in (None, config.context_len) or dropout not in (
                 None, config.dropout) or (modules is not None and tuple(modules) != config.modules):
             raise ValueError(f"a fine-tuned monitor keeps its parent's L = {config.context_len}, "
                              f"modules {config.modules} and dropout {config.dropout}")
-    else:
-        extra = {} if dropout is None else {"dropout": dropout}
-        config = FusionConfig(context_len=context_len or DEFAULT_CONTEXT_LEN,
-                              modules=tuple(modules or MODULES), **extra)
-    warehouse = Warehouse(root)
-    train = load_windows(warehouse, train_runs, context_len=config.context_len,
-                         horizon_s=horizon_s)
-    val = load_windows(warehouse, val_runs, context_len=config.context_len, horizon_s=horizon_s)
-    trained = fit_windows(train, val, params, config=config,
-                          parent=None if parent is None else parent.net, progress=progress)
-    result, thresholds, scores = trained.result, trained.thresholds, trained.val_scores
-    card = {
+        return config
+    extra = {} if dropout is None else {"dropout": dropout}
+    return FusionConfig(context_len=context_len or DEFAULT_CONTEXT_LEN,
+                        modules=tuple(modules or MODULES), **extra)
+
+
+def _card(t: Trained, scenario: str | None, horizon_s: float, init_from: str | None,
+          config: FusionConfig, train: Windows, val: Windows, train_runs: Runs,
+          val_runs: Runs, device: torch.device) -> dict[str, Any]:
+    result = t.result
+    return {
         "name": FusionMonitor.name,
         "created_at": datetime.now(UTC).isoformat(timespec="seconds"),
         "software_version": __version__,
@@ -231,47 +220,44 @@ def train_monitor(
         "context_len": config.context_len,
         "modules": list(config.modules),
         "n_parameters": result.net.n_parameters(),
+        "recipe": t.params.recipe,
         "selection": {"train": describe_selection(train_runs),
                       "val": describe_selection(val_runs)},
         "data": {"train": data_summary(train), "val": data_summary(val)},
         "config": result.net.config.to_dict(),
-        "hyperparameters": {**asdict(params), "pos_weight": result.pos_weight,
+        "hyperparameters": {**card_hyperparameters(t.params), "pos_weight": result.pos_weight,
                             "loss": "BCEWithLogitsLoss(pos_weight)", "optimizer": "Adam",
                             "early_stopping": "val AUPRC"},
         "training": {"best_epoch": result.best_epoch, "epochs_run": len(result.history),
-                     "time_s": round(result.time_s, 2), "history": result.history},
-        **thresholds_to_card(thresholds),
-        "metrics": {"val": split_metrics(scores, val.label, thresholds)},
+                     "time_s": round(result.time_s, 2), "cpu_s": round(result.cpu_s, 2),
+                     "device": str(device), "phases": result.phases,
+                     "history": result.history},
+        **thresholds_to_card(t.thresholds),
+        "metrics": {"val": split_metrics(t.scores, val.label, t.thresholds)},
     }
-    return save_version(root, result.net, card)
 
 
-@dataclass
-class Trained:
-    """A fit, its thresholds calibrated on validation, and its validation scores."""
-
-    result: FitResult
-    thresholds: Thresholds
-    val_scores: np.ndarray  # (B_val,) float32
-
-
-def fit_windows(train: Windows, val: Windows, params: TrainParams = TrainParams(), *,
+def fit_windows(train: Windows, val: Windows, params: TrainParams | None = None, *,
                 config: FusionConfig | None = None, parent: FusionNet | None = None,
-                progress: Progress | None = None) -> Trained:
+                progress: Progress | None = None,
+                device: str | torch.device | None = None) -> Trained:
     """Train a new FusionNet of `config` (default sizes; normalisers fitted on the training
-    frames), or fine-tune a copy of `parent`, on windows in memory: early-stopped on `val`,
-    calibrated on it. Seeded by `params.seed`; nothing is saved (`train_monitor` saves)."""
-    with _reproducible(params.seed, params.threads):
+    frames), or fine-tune a copy of `parent`, on windows in memory, with `params` (default: the
+    default recipe's), and calibrate it on `val`. Seeded by `params.seed`; nothing is saved
+    (`train_monitor` saves)."""
+    params = params or recipe_params()
+    where = pick_device(device)
+    with reproducible(params.seed, params.threads, where.type == "cpu"):
         if parent is not None:
             net = copy.deepcopy(parent)
         else:
             net = FusionNet(FusionConfig.for_spec(train.spec,
                                                   **_sizes(config or FusionConfig())))
             net.fit_normalizers(_frames_of(train))
-        result = fit(net, train, val, params, progress)
-    with intra_op_threads(params.threads):
-        scores = FusionMonitor(result.net, "training", None).score(val)  # type: ignore[arg-type]
-    return Trained(result, calibrate_on_validation(scores, val), scores)
+        result = fit(net.to(where), train, val, params, progress)
+        scores = FusionMonitor(result.net, "training", None,  # type: ignore[arg-type]
+                               device=where).score(val)
+    return Trained(params, result, scores, calibrate_on_validation(scores, val))
 
 
 def _sizes(config: FusionConfig) -> dict[str, Any]:

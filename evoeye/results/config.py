@@ -51,6 +51,10 @@ MONITOR_PARTS = ("rq1", "ablation")  # the parts that train on RQ1's data
 PAPER_TEST_RUNS = {"highway-cut-in": 75, "unprotected-intersection": 132}
 # the paper's initial data: its train + validation runs per scenario (split 0.8 : 0.2)
 PAPER_INITIAL_RUNS = {"highway-cut-in": 107 + 25, "unprotected-intersection": 177 + 45}
+# training recipes (evoeye.monitor.recipes RECIPES, DEFAULT_RECIPE, LEGACY_RECIPE): a config
+# recorded before the recipe was one of its fields was trained with the legacy one
+RECIPES = ("v1", "v2")
+DEFAULT_RECIPE, LEGACY_RECIPE = "v2", "v1"
 RQ1_RUNS = 1300  # initial runs RQ1 and the monitor ablation train on, at least (module doc)
 TEST_SHARES = (0.8, 0.2)  # train, val shares of the initial runs when a test batch is held out
 DEFAULT_SHARES = (0.5, 0.125)  # evoeye.splits.SplitSpec() (no test batch)
@@ -111,6 +115,8 @@ class ResultsConfig:
     inputs: tuple[str, ...] = INPUTS
     epochs: int | None = None  # every training (None: each trainer's default)
     patience: int | None = None
+    recipe: str = DEFAULT_RECIPE  # RECIPES: how every monitor of RQ1, the ablation and the
+    # G_0s trains from scratch (campaign updates keep the campaign's own)
     # RQ2, the evolution ablations and AEM-Evo
     methods: tuple[str, ...] = METHODS
     budget_s: float | None = None  # None: the simulated time of the initial training data
@@ -152,6 +158,8 @@ class ResultsConfig:
                 raise ValueError(f"{name} must be >= {least}, got {getattr(self, name)}")
         if bad := {s: n for s in self.scenarios if (n := self.runs_of(s)) < 0}:
             raise ValueError(f"initial runs must be >= 0, got {bad}")
+        if self.recipe not in RECIPES:
+            raise ValueError(f"unknown training recipe {self.recipe!r}; known: {list(RECIPES)}")
         if self.test_runs and self.test_seed == self.sim_seed:
             raise ValueError("the test batch needs its own seed: --test-seed equals --sim-seed")
         if min(self.training_seeds + self.campaign_seeds + (self.sim_seed, self.test_seed)) < 0:
@@ -243,7 +251,9 @@ class ResultsConfig:
     @classmethod
     def from_dict(cls, data: Mapping) -> ResultsConfig:
         """The config a results JSON records (`to_dict`, through JSON); a field it lacks takes
-        its default, a key no field has is a ValueError naming it."""
+        its default — but the recipe, which a record made before it was a field lacks, is the
+        legacy one its monitors were trained with — and a key no field has is a ValueError
+        naming it."""
         if unknown := sorted(set(data) - {f.name for f in fields(cls)}):
             raise ValueError(f"unknown config key(s) {unknown}")
-        return cls(**data)
+        return cls(**{"recipe": LEGACY_RECIPE, **data})

@@ -7,6 +7,7 @@ s. The ablation trains every variant (L ∈ context_lens with every input; the i
 L = 5) with the same seeds; its "L=5" row is the RQ1 FusionMonitor (the same units), its
 reference rows are the RQ1 baselines that `ablation.REFERENCES` names. Methods and variants
 trained with the same seed on the same data are compared pair by pair (`evoeye.results.tables`).
+A recipe's seeds the ledger lacks train together (`units.trained_versions`): the same versions.
 """
 
 from __future__ import annotations
@@ -15,7 +16,7 @@ from evoeye.evaluation.ablation import REFERENCES, input_sets, variants
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.monitor.inputs import MODULES
 from evoeye.results.study import Study
-from evoeye.results.units import baseline, test_figures, trained_version, trains
+from evoeye.results.units import baseline, test_figures, trained_versions, trains
 
 FUSION_LABEL = FAMILIES[DEFAULT_FAMILY].label  # "FusionMonitor"
 FULL_CONTEXT_LEN = 5
@@ -25,9 +26,9 @@ def _fusion_rows(study: Study, scenario: str, context_len: int,
                  modules: tuple[str, ...]) -> dict:
     """One FusionMonitor recipe over the training seeds: versions and figures per seed."""
     fusion = FAMILIES[DEFAULT_FAMILY]
-    versions = [trained_version(study, scenario, DEFAULT_FAMILY, seed=seed,
-                                context_len=context_len, modules=list(modules))
-                for seed in study.config.training_seeds]
+    versions = trained_versions(study, scenario, DEFAULT_FAMILY,
+                                seeds=study.config.training_seeds, context_len=context_len,
+                                modules=list(modules))
     return {"versions": versions,
             "figures": [test_figures(study, scenario, fusion.load(study.root, v))
                         for v in versions]}

@@ -50,7 +50,7 @@ from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.monitor.inputs import MODULES
 from evoeye.results.rq1 import FULL_CONTEXT_LEN
 from evoeye.results.study import Study
-from evoeye.results.units import judge, set_figures, trained_version
+from evoeye.results.units import judge, set_figures, trained_versions
 from evoeye.store.feedback import read_rounds
 from evoeye.store.selection import RunFilter
 
@@ -128,12 +128,14 @@ def final_versions(study: Study, cfg: CampaignConfig, campaign_id: str,
             study.say(f"  {campaign_id}: G_0's recipe on its D_R ({len(ids)} runs), seed {seed}")
             return family.train(study.root, cfg.scenario, train_runs=ids, val_runs=val,
                                 seed=seed, splits=cfg.splits, horizon_s=cfg.horizon_s,
-                                **G0_RECIPE, **study.train_overrides)
+                                **G0_RECIPE, **study.train_overrides,
+                                **study.recipe_kwargs(cfg.family))
 
         return [study.ledger.remember(
             "final-retrain", {"campaign": campaign_id, "last": last.monitor_version,
                               "seed": seed, "recipe": G0_RECIPE,
-                              "overrides": study.train_overrides},
+                              "overrides": study.train_overrides,
+                              **study.recipe_key(cfg.family)},
             lambda seed=seed: retrain(seed), valid=exists)
             for seed in study.config.training_seeds[:k]]
     out = [last.monitor_version]
@@ -150,11 +152,11 @@ def rq2(study: Study, scenario: str) -> dict:
     """Run (or resume) every campaign of the scenario, then judge them (module doc)."""
     cfg = study.config
     k = cfg.final_seeds
-    g0s = [trained_version(study, scenario, DEFAULT_FAMILY, seed=s, **G0_RECIPE)
-           for s in cfg.training_seeds[:k]]  # the k re-seeded G_0s, G_0 first (module doc)
+    g0s = trained_versions(study, scenario, DEFAULT_FAMILY, seeds=cfg.training_seeds[:k],
+                           **G0_RECIPE)  # the k re-seeded G_0s, G_0 first (module doc)
     base = CampaignConfig(scenario, monitor=g0s[0], n_round=cfg.n_round, update=cfg.update,
                           feedback=cfg.feedback, epochs=cfg.epochs, patience=cfg.patience,
-                          horizon_s=cfg.horizon_s, splits=study.splits)
+                          horizon_s=cfg.horizon_s, splits=study.splits, recipe=cfg.recipe)
     study.say(f"{scenario}: RQ2 campaigns {list(cfg.methods)} × seeds {list(cfg.campaign_seeds)}")
     plan = plan_experiment(study.root, [scenario], base, strategies=cfg.methods,
                            seeds=cfg.campaign_seeds, budget_s=cfg.budget_s)
@@ -164,9 +166,8 @@ def rq2(study: Study, scenario: str) -> dict:
     sets = judge(study, scenario, g0s)
     n = len(cfg.campaign_seeds)
     families = [DEFAULT_FAMILY] + sorted({methods()[m][1] for m in cfg.methods} - {DEFAULT_FAMILY})
-    seeds_of = {f: g0s if f == DEFAULT_FAMILY else [
-        trained_version(study, scenario, f, seed=s, **G0_RECIPE) for s in cfg.training_seeds[:k]]
-        for f in families}
+    seeds_of = {f: g0s if f == DEFAULT_FAMILY else trained_versions(
+        study, scenario, f, seeds=cfg.training_seeds[:k], **G0_RECIPE) for f in families}
     rows: dict[str, dict] = {}
     campaigns = campaigns_of(study.root, plan)
     starts = {DEFAULT_FAMILY: g0s[0]}

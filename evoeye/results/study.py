@@ -24,7 +24,7 @@ from functools import cached_property
 
 from evoeye.evaluation.dataset import SplitWindows, load_split
 from evoeye.paths import LOG_SUFFIX, DataRoot
-from evoeye.results.config import ResultsConfig
+from evoeye.results.config import LEGACY_RECIPE, ResultsConfig
 from evoeye.results.ledger import Ledger
 from evoeye.store import RunFilter, SplitSpec, Warehouse, select_runs
 
@@ -58,6 +58,23 @@ class Study:
         """Training options every monitor of the study gets (epochs, patience)."""
         return {k: v for k, v in (("epochs", self.config.epochs),
                                   ("patience", self.config.patience)) if v is not None}
+
+    def recipe_key(self, family: str) -> dict[str, str]:
+        """What a unit training `family` adds to its ledger inputs for the study's training
+        recipe: nothing for the legacy recipe (units recorded before recipes had names keep
+        their keys) or a family that has no recipes, else {"training_recipe": name}."""
+        from evoeye.monitor.families import FAMILIES
+
+        if self.config.recipe == LEGACY_RECIPE or not FAMILIES[family].recipes:
+            return {}
+        return {"training_recipe": self.config.recipe}
+
+    def recipe_kwargs(self, family: str) -> dict[str, str]:
+        """The study's training recipe as an argument of `family`'s train and fit ({} for a
+        family that has no recipes)."""
+        from evoeye.monitor.families import FAMILIES
+
+        return {"recipe": self.config.recipe} if FAMILIES[family].recipes else {}
 
     @property
     def context_len(self) -> int:

@@ -30,17 +30,46 @@ def trained_version(study: Study, scenario: str, family: str, *, seed: int,
                     **recipe) -> str:
     """A version of `family` trained from scratch on the round-0 train split, early-stopped and
     calibrated on val, with this seed and recipe (e.g. context_len, modules)."""
+    return trained_versions(study, scenario, family, seeds=[seed], **recipe)[0]
+
+
+def trained_versions(study: Study, scenario: str, family: str, *, seeds: Sequence[int],
+                     **recipe) -> list[str]:
+    """`trained_version` of each seed; those the ledger lacks are trained together where the
+    family can (`MonitorFamily.train_seeds`: the same versions as one by one, bit for bit)."""
     fam = FAMILIES[family]
-    inputs = {"family": family, **study.data_key(scenario, "train", "val"), "seed": seed,
-              "recipe": recipe, "overrides": study.train_overrides}
+    data = study.data_key(scenario, "train", "val")
+    kwargs = {"train_runs": study.runs(scenario, "train"), "val_runs": study.runs(scenario, "val"),
+              "splits": study.splits, "horizon_s": study.config.horizon_s, **recipe,
+              **study.train_overrides, **study.recipe_kwargs(family)}
 
-    def train() -> str:
-        study.say(f"{scenario}: training {fam.label} seed {seed} {recipe or ''}".rstrip())
-        return fam.train(study.root, scenario, train_runs=study.runs(scenario, "train"),
-                         val_runs=study.runs(scenario, "val"), seed=seed, splits=study.splits,
-                         horizon_s=study.config.horizon_s, **recipe, **study.train_overrides)
+    def inputs(seed: int) -> dict:
+        return {"family": family, **data, "seed": seed, "recipe": recipe,
+                "overrides": study.train_overrides, **study.recipe_key(family)}
 
-    return study.ledger.remember("train", inputs, train, valid=_exists(study, fam))
+    def say(seeds: Sequence[int]) -> None:
+        study.say(f"{scenario}: training {fam.label} seed{'s' * (len(seeds) > 1)} "
+                  f"{', '.join(map(str, seeds))} {recipe or ''}".rstrip())
+
+    def found(seed: int) -> bool:
+        version = study.ledger.get("train", inputs(seed))
+        return version is not None and _exists(study, fam)(version)
+
+    missing = [s for s in seeds if not found(s)]
+    done: dict[int, str] = {}
+    if len(missing) > 1 and fam.train_seeds is not None:
+        say(missing)
+        done = dict(zip(missing, fam.train_seeds(study.root, scenario, seeds=missing, **kwargs),
+                        strict=True))
+
+    def train(seed: int) -> str:
+        if seed in done:
+            return done[seed]
+        say([seed])
+        return fam.train(study.root, scenario, seed=seed, **kwargs)
+
+    return [study.ledger.remember("train", inputs(s), lambda s=s: train(s),
+                                  valid=_exists(study, fam)) for s in seeds]
 
 
 def trains(name: str) -> bool:
@@ -54,13 +83,13 @@ def baseline(study: Study, scenario: str, name: str, seed: int) -> Monitor:
     if not trains(name):
         return BASELINES[name](study.root, scenario, study.splits)
     fam = FAMILIES[name]
-    inputs = {"baseline": name, **study.data_key(scenario, "train"), "seed": seed}
-
+    inputs = {"baseline": name, **study.data_key(scenario, "train"), "seed": seed,
+              **study.recipe_key(name)}
     def fit() -> str:
         study.say(f"{scenario}: fitting {name} seed {seed}")
         return fam.fit(study.root, scenario, study.splits, seed=seed,
                        runs=study.runs(scenario, "train"),
-                       horizon_s=study.config.horizon_s).version
+                       horizon_s=study.config.horizon_s, **study.recipe_kwargs(name)).version
 
     return fam.load(study.root, study.ledger.remember("fit", inputs, fit,
                                                       valid=_exists(study, fam)))

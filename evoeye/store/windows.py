@@ -104,6 +104,15 @@ class Windows:
         out["label"] = self.label[sel].astype(np.float32)
         return out
 
+    def distinct_frames(self, index: np.ndarray | slice | None = None
+                        ) -> tuple[np.ndarray, np.ndarray]:
+        """(rows, inverse) of the windows `index`: the (U,) sorted distinct rows of `features`
+        their contexts read, and the (b, L) position of each context slot among them — so a
+        model can encode each frame once however many windows share it."""
+        context = self.context[slice(None) if index is None else index]  # (b, L)
+        rows, inverse = np.unique(context, return_inverse=True)
+        return rows, inverse.reshape(context.shape)
+
     def batch(self, index: np.ndarray | slice | None = None) -> WindowBatch:
         """The windows `index` (default all) as torch tensors (b, L, …)."""
         import torch

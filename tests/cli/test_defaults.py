@@ -10,6 +10,7 @@ def test_help_defaults_equal_their_sources() -> None:
     from evoeye.evaluation.monitors import BASELINES
     from evoeye.monitor.inputs import ABLATIONS, MODULES
     from evoeye.monitor.protocol import TARGET_FPRS
+    from evoeye.monitor.recipes import DEFAULT_RECIPE, RECIPES
     from evoeye.scenarios import SCENARIOS
     from evoeye.store import SplitSpec
     from evoeye.store.ingest import DEFAULT_RUNS_PER_PART
@@ -23,6 +24,7 @@ def test_help_defaults_equal_their_sources() -> None:
         "TARGET_FPRS": TARGET_FPRS, "RUNS_PER_PART": DEFAULT_RUNS_PER_PART,
         "BASELINE_NAMES": tuple(BASELINES),
         "MODULE_NAMES": MODULES, "ABLATION_NAMES": tuple(ABLATIONS),
+        "RECIPE_NAMES": tuple(RECIPES), "DEFAULT_RECIPE": DEFAULT_RECIPE,
     }
     shown = {name: getattr(defaults, name) for name in pairs}
     assert shown == pairs

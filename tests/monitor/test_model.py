@@ -127,3 +127,17 @@ def test_module_names_parse_from_ablation_names_or_lists() -> None:
     assert parse_modules(None) is None
     with pytest.raises(ValueError, match="lidar"):
         parse_modules("perception,lidar")
+
+
+def test_forward_frames_equals_forward_on_the_gathered_windows() -> None:
+    net = FusionNet(FusionConfig(context_len=3)).train()
+    frames = {name: t[:, -1] for name, t in random_inputs(net, b=9, seed=2).items()
+              if name != "context_mask"}  # 9 distinct frames, (9, …)
+    inverse = torch.tensor([[0, 0, 1], [0, 1, 2], [6, 7, 8], [8, 8, 8]])  # (4 windows, L)
+    mask = torch.tensor([[False, False, True], [True, True, True], [True] * 3,
+                         [False, False, True]])
+    windows = [frames[name][inverse] for name in INPUTS[:-1]]  # each window's own copies
+    shared = net.forward_frames([frames[name] for name in INPUTS[:-1]], inverse, mask)
+    torch.testing.assert_close(shared, net(*windows, mask), rtol=0, atol=0)
+    shared.sum().backward()  # the gradient flows back through the shared frames
+    assert all(p.grad is not None for p in net.parameters())

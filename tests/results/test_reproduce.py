@@ -32,7 +32,9 @@ def test_a_config_survives_the_results_json() -> None:
                            training_seeds=(0, 1, 2), initial_runs={"unprotected-intersection": 7},
                            test_seed=5, baselines=("ttc-2d",), context_lens=(1, 5), workers=2)
     assert ResultsConfig.from_dict(json.loads(json.dumps(config.to_dict()))) == config
-    assert ResultsConfig.from_dict({}) == ResultsConfig()  # an older file: the defaults
+    # an older file: the defaults, but the recipe its monitors were trained with
+    assert ResultsConfig.from_dict({}) == ResultsConfig(recipe="v1") != ResultsConfig()
+    assert ResultsConfig().recipe == "v2"
     with pytest.raises(ValueError, match=r"unknown config key\(s\) \['colour'\]"):
         ResultsConfig.from_dict({"colour": 1})
 

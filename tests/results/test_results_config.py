@@ -19,6 +19,7 @@ def test_the_literal_defaults_are_their_sources() -> None:
     from evoeye.evaluation.monitors import BASELINES
     from evoeye.evolve.campaign.experiment import ABLATION, MAIN
     from evoeye.monitor.inputs import ABLATIONS
+    from evoeye.monitor.recipes import DEFAULT_RECIPE, LEGACY_RECIPE, RECIPES
     from evoeye.scenarios import SCENARIOS
     from evoeye.splits import SplitSpec
 
@@ -28,6 +29,8 @@ def test_the_literal_defaults_are_their_sources() -> None:
     assert tuple(ABLATIONS) == config.INPUTS
     assert config.METHODS == MAIN + ABLATION
     assert (SplitSpec().train_frac, SplitSpec().val_frac) == config.DEFAULT_SHARES
+    assert tuple(RECIPES) == config.RECIPES
+    assert (config.DEFAULT_RECIPE, config.LEGACY_RECIPE) == (DEFAULT_RECIPE, LEGACY_RECIPE)
 
 
 def test_the_config_module_imports_nothing_heavy() -> None:

@@ -23,6 +23,7 @@ from typing import TYPE_CHECKING, Any
 
 import numpy as np
 
+from evoeye.evolve.campaign.config import DEFAULT_RECIPE, LEGACY_RECIPE
 from evoeye.evolve.campaign.scoring import mode_scores
 from evoeye.evolve.search.feedback import ScenarioFeedback, scenario_disagreement
 from evoeye.paths import DataRoot
@@ -42,10 +43,11 @@ RECIPE = ("epochs", "patience", "batch_size", "lr", "weight_decay", "grad_clip")
 
 def from_scratch(root: DataRoot, scenario: str, ids: Sequence[str], val_runs: RunFilter,
                  seed: int, splits: SplitSpec, horizon_s: float,
-                 context_len: int | None = None, **params: Any) -> str:
-    """The FusionMonitor trained from scratch on runs `ids` with `seed` (and TrainParams
-    `params`, default the trainer's): a version already trained so (same scenario, runs, seed,
-    params and, if given, context length) is reused, else it is trained."""
+                 context_len: int | None = None, recipe: str = DEFAULT_RECIPE,
+                 **params: Any) -> str:
+    """The FusionMonitor trained from scratch on runs `ids` with `seed` (the training
+    `recipe` and TrainParams `params` over it): a version already trained so (same scenario,
+    runs, seed, recipe, params and, if given, context length) is reused, else it is trained."""
     from evoeye.monitor import list_versions, read_card, train_monitor
     from evoeye.monitor.card import describe_selection
 
@@ -56,10 +58,12 @@ def from_scratch(root: DataRoot, scenario: str, ids: Sequence[str], val_runs: Ru
                 and card.get("selection", {}).get("train") == selection
                 and card.get("hyperparameters", {}).get("seed") == seed
                 and context_len in (None, card.get("context_len"))
+                and card.get("recipe", LEGACY_RECIPE) == recipe
                 and all(card["hyperparameters"].get(k) == v for k, v in params.items())):
             return version
     return train_monitor(root, scenario, train_runs=list(ids), val_runs=val_runs, seed=seed,
-                         splits=splits, horizon_s=horizon_s, context_len=context_len, **params)
+                         splits=splits, horizon_s=horizon_s, context_len=context_len,
+                         recipe=recipe, **params)
 
 
 class Committee:
@@ -87,10 +91,11 @@ class Committee:
             raise LookupError(f"{c.campaign_id}: no committee stored for round {round_}")
         cfg, ids = c.config, [str(s) for s in c.initial["scenario_id"]]
         g0 = c.monitor(c.g0)
-        recipe = {k: v for k, v in (g0.card or {}).get("hyperparameters", {}).items()
-                  if k in RECIPE}
+        card = g0.card or {}
+        params = {k: v for k, v in card.get("hyperparameters", {}).items() if k in RECIPE}
         versions = [from_scratch(c.root, cfg.scenario, ids, c.val_runs, COMMITTEE_SEED + j,
-                                 cfg.splits, cfg.horizon_s, g0.context_len, **recipe)
+                                 cfg.splits, cfg.horizon_s, g0.context_len,
+                                 card.get("recipe", LEGACY_RECIPE), **params)
                     for j in range(1, self.k)]
         write_committee(c.root, c.campaign_id, 0, versions)
         return read_committee(c.root, c.campaign_id)[0]

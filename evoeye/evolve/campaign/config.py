@@ -33,6 +33,7 @@ FINETUNE_EPOCHS, FINETUNE_PATIENCE = 10, 4
 REPLAY_EPOCHS, REPLAY_PATIENCE = 2, 1  # per round: passes over the new runs and their replay
 REPLAY_RATIO = 1.0  # earlier runs replayed per new run of the round
 DEFAULT_FAMILY = "fusion"  # evoeye.monitor.families.DEFAULT_FAMILY
+DEFAULT_RECIPE, LEGACY_RECIPE = "v2", "v1"  # evoeye.monitor.recipes
 DEFAULT_DELTA = 0.2  # evoeye.scenarios.DEFAULT_DELTA
 DEFAULT_STRATEGY = "evoeye"  # of `evoeye evolve`, its flow and the nightly deployment
 COMMITTEE = 3  # monitors in the committee of the `disagreement` strategy
@@ -78,9 +79,16 @@ def _methods() -> Collection[str]:
     return methods()
 
 
+def _recipes() -> Collection[str]:
+    from evoeye.monitor.recipes import RECIPES
+
+    return RECIPES
+
+
 KNOWN: dict[str, Callable[[], Collection[str]]] = {  # the names a value of each kind may take
     "scenario": _scenarios, "strategy": _strategies, "update": lambda: UPDATE_MODES,
     "feedback": lambda: FEEDBACK_MODES, "family": _families, "method": _methods,
+    "recipe": _recipes,
 }
 
 
@@ -144,6 +152,9 @@ class CampaignConfig:
     committee: int = option(COMMITTEE, "Monitors whose disagreement the `disagreement` "
                             "strategy reads: G_r and committee − 1 companions trained beside "
                             "it (each round costs as many monitor updates).", ge=2)
+    recipe: str = option(DEFAULT_RECIPE, "Training recipe of the monitor updates (and of a G_0 "
+                         "the campaign trains itself): v1 (every campaign before recipes had "
+                         "names) or v2.", names="recipe")
     horizon_s: float = option(DEFAULT_HORIZON_S, "Label horizon H, s.", gt=0.0)
     splits: SplitSpec = option(factory=SplitSpec, help="The train/val/test split.")
     max_run_s: float = option(MAX_RUN_S, "No run lasts longer, s (the simulator's duration).",
@@ -198,6 +209,8 @@ def campaign_id(config: CampaignConfig, g0: str, initial_ids: Sequence[str], *,
         cfg.pop("family")
     if not committee:  # only a strategy that reads the disagreement trains a committee
         cfg.pop("committee")
+    if cfg["recipe"] == LEGACY_RECIPE:  # the recipe every campaign before it trained by
+        cfg.pop("recipe")
     cfg["monitor"] = g0
     cfg["initial"] = hashlib.sha256("\n".join(initial_ids).encode()).hexdigest()
     digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]

@@ -196,7 +196,7 @@ def reseeded_controls(root: DataRoot, cfg: CampaignConfig, k: int,
     out = []
     for seed in range(CONTROL_SEED, CONTROL_SEED + k):
         version = from_scratch(root, cfg.scenario, ids, campaign.val_runs, seed, cfg.splits,
-                               cfg.horizon_s)
+                               cfg.horizon_s, recipe=cfg.recipe)
         out.append(assess(version).as_dict())
     return out
 

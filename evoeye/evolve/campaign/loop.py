@@ -130,7 +130,8 @@ class Campaign:
             return cfg.monitor
         return self.family.initial(self.root, cfg.scenario,
                                    train_runs=list(self.initial["scenario_id"]),
-                                   val_runs=self.val_runs, horizon_s=cfg.horizon_s)
+                                   val_runs=self.val_runs, horizon_s=cfg.horizon_s,
+                                   recipe=cfg.recipe)
 
     @cached_property
     def reference(self) -> str:
@@ -308,7 +309,8 @@ class Campaign:
         return self._train(self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
                            horizon_s=cfg.horizon_s, seed=seed, splits=cfg.splits,
                            init_from=init_from, context_len=None if init_from else
-                           self.monitor(self.g0).context_len, **cfg.train_overrides())
+                           self.monitor(self.g0).context_len, recipe=cfg.recipe,
+                           **cfg.train_overrides())
 
     @intra_op_threads()
     def finish_round(self, state: CampaignState, new_ids: list[str], version: str,

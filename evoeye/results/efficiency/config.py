@@ -35,6 +35,7 @@ STRATEGIES = ("uniform", "sobol", "boundary", "disagreement", "evoeye-knn", "evo
 REFERENCE = "uniform"
 ORACLE = "oracle"
 DEFAULT_PROFILE = "default"  # evoeye.ads.profiles.DEFAULT_PROFILE
+RECIPES, DEFAULT_RECIPE = ("v1", "v2"), "v2"  # evoeye.monitor.recipes
 
 
 def parse_regime(regime: str) -> tuple[str, str]:
@@ -73,7 +74,8 @@ class EfficiencyConfig:
     boundary_steps: int = 4  # bisections per pair: the final bracket is 1/16 of the pair
     data_seed: int = 7_000  # pool; +1 test, +2 val, +3 oracle, +4 the boundary set's sources
     horizon_s: float = 3.0
-    epochs: int | None = None  # every training (None: the trainer's default)
+    recipe: str = DEFAULT_RECIPE  # the training recipe of every monitor of the study
+    epochs: int | None = None  # every training (None: the recipe's)
     patience: int | None = None
 
     @property
@@ -89,6 +91,8 @@ class EfficiencyConfig:
             parse_regime(regime)
         if self.mode not in MODES:
             raise ValueError(f"mode must be one of {MODES}, got {self.mode!r}")
+        if self.recipe not in RECIPES:
+            raise ValueError(f"unknown training recipe {self.recipe!r}; known: {list(RECIPES)}")
         if REFERENCE not in self.strategies:
             raise ValueError(f"the strategies must include the reference {REFERENCE!r}")
         if len(self.seeds) < 2 or len(set(self.seeds)) != len(self.seeds):

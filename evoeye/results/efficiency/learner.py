@@ -9,7 +9,7 @@ monitor.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, replace
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
@@ -17,7 +17,8 @@ from evoeye.evolve.campaign.assess import metrics_dict
 from evoeye.evolve.campaign.config import REPLAY_EPOCHS, REPLAY_PATIENCE, REPLAY_RATIO
 from evoeye.evolve.search.feedback import scenario_disagreement, scenario_feedback
 from evoeye.monitor.fusion import FusionMonitor
-from evoeye.monitor.train import TrainParams, fit_windows
+from evoeye.monitor.recipes import TrainParams, recipe_params
+from evoeye.monitor.train import fit_windows
 from evoeye.store.windows import Windows
 
 
@@ -27,7 +28,7 @@ class Learner:
 
     val: Windows
     judging: dict[str, Windows]  # set name → windows (the Test Set, the boundary set)
-    params: TrainParams = TrainParams()  # from scratch; the seed is given per call
+    params: TrainParams = field(default_factory=recipe_params)  # the seed is given per call
 
     @property
     def recipe(self) -> dict:

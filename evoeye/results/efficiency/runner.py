@@ -18,7 +18,7 @@ import numpy as np
 
 from evoeye.lifeline import die_with_parent
 from evoeye.monitor.threads import intra_op_threads
-from evoeye.monitor.train import TrainParams
+from evoeye.monitor.recipes import recipe_params
 from evoeye.paths import DataRoot
 from evoeye.results.efficiency.acquire import Bank, PoolAcquirer, SimAcquirer
 from evoeye.results.efficiency.config import ORACLE, EfficiencyConfig, parse_regime
@@ -83,7 +83,7 @@ def run_regime(root: DataRoot, regime: str, config: EfficiencyConfig, *, workers
     say(f"{regime}: loading its sets")
     data = RegimeData.load(data_root, config)
     learner = Learner(data.sets["val"], {k: data.sets[k] for k in JUDGING_SETS},
-                      TrainParams(**config.train_overrides))
+                      recipe_params(config.recipe, **config.train_overrides))
     _CONTEXT = Context(regime, get_scenario(parse_regime(regime)[0]), config, learner,
                        Bank(data), ledger or Ledger(root), sets_fingerprint(data), say)
     curves: dict[str, dict[str, dict]] = {}

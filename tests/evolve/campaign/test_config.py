@@ -22,14 +22,17 @@ from evoeye.splits import SplitSpec
 def test_literal_defaults_equal_their_sources() -> None:
     from evoeye.evolve.campaign import config
     from evoeye.monitor.families import DEFAULT_FAMILY
+    from evoeye.monitor.recipes import DEFAULT_RECIPE, LEGACY_RECIPE
     from evoeye.scenarios import DEFAULT_DELTA
     from evoeye.sim.runner import SimConfig
     from evoeye.store.windows import DEFAULT_HORIZON_S
 
     literal = {"delta": config.DEFAULT_DELTA, "horizon_s": config.DEFAULT_HORIZON_S,
-               "max_run_s": config.MAX_RUN_S, "family": config.DEFAULT_FAMILY}
+               "max_run_s": config.MAX_RUN_S, "family": config.DEFAULT_FAMILY,
+               "recipes": (config.DEFAULT_RECIPE, config.LEGACY_RECIPE)}
     assert literal == {"delta": DEFAULT_DELTA, "horizon_s": DEFAULT_HORIZON_S,
-                       "max_run_s": SimConfig().duration_s, "family": DEFAULT_FAMILY}
+                       "max_run_s": SimConfig().duration_s, "family": DEFAULT_FAMILY,
+                       "recipes": (DEFAULT_RECIPE, LEGACY_RECIPE)}
 
 
 def test_the_config_module_imports_nothing_heavy() -> None:

@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import pytest
 
+from evoeye.evolve.campaign import loop
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.experiment import campaigns_of
 from evoeye.evolve.campaign.loop import Campaign
@@ -20,7 +21,7 @@ def test_preparing_campaigns_stores_round_0_once_without_building_their_state(
     root = root_copy("prepare")
     cfg = CampaignConfig(scenario=SCENARIO, strategy="uniform", budget_s=50.0, seed=0,
                          monitor=seeded[1], n_round=2, epochs=1, splits=SPLITS)
-    monkeypatch.setattr(Campaign, "_acquired", lambda self, ids: pytest.fail("state built"))
+    monkeypatch.setattr(loop, "acquired_runs", lambda *a: pytest.fail("state built"))
     job = CampaignJob(str(root.path), cfg, "uniform seed 0")
     prepare_campaigns([job])
     first = read_rounds(root, Campaign(root, cfg).campaign_id)
@@ -49,7 +50,7 @@ def test_a_finished_campaign_is_not_resumed_by_its_worker(root_copy, seeded,
     state = Campaign(root, cfg).start()
     assert campaign.done(state) and campaign.finished()  # the same verdict, without a state
     assert state.spent_s == pytest.approx(rounds[-1].simulated_s)
-    monkeypatch.setattr(Campaign, "_acquired", lambda self, ids: pytest.fail("state built"))
+    monkeypatch.setattr(loop, "acquired_runs", lambda *a: pytest.fail("state built"))
     again = run_campaign(job)
     assert again.rounds == 0 and read_rounds(root, campaign.campaign_id) == rounds
 

@@ -66,7 +66,8 @@ def decode_toy(data: bytes, meta: dict[str, Any], version: str) -> ConstantRisk:
     return ConstantRisk(version, json.loads(data), thresholds_from_json(meta["thresholds"]), meta)
 
 
-def initial_toy(root: DataRoot, scenario: str, *, train_runs, val_runs, horizon_s: float) -> str:
+def initial_toy(root: DataRoot, scenario: str, *, train_runs, val_runs, horizon_s: float,
+                recipe: str | None = None) -> str:  # a toy has no training recipe
     return train_toy(root, scenario, train_runs=list(train_runs), val_runs=val_runs,
                      horizon_s=horizon_s)
 

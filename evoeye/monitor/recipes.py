@@ -1,0 +1,94 @@
+"""Training recipes: the hyper-parameters of a FusionMonitor training, by name.
+
+A recipe is a named `TrainParams`; `train_monitor(recipe=…)` starts from it and applies the
+caller's overrides (epochs=…, lr=…). Every figure a recipe produced reproduces with that recipe
+by name, so a recipe, once used, is never changed: a better one gets a new name.
+
+* "v1" — random windows in batches of 256, each window encoding its L frames; Adam at a constant
+  1e-3; at most 40 epochs, early-stopped after 8 without a better validation AUPRC. Every result
+  recorded before recipes had names was made with it.
+* "v2" (the default) — batches of 1024 windows made of chunks of 32 consecutive windows, so a
+  batch's windows share their frames and each frame is encoded once per batch (with L = 5 a
+  random batch encodes each window's 5 frames: ≈ 4.4× the encoder work); Adam at 3e-3 held
+  for 70 % of 20 epochs, then falling linearly to 0 ("hold-decay"); no early stop (the decay
+  is where a noisy plateau settles), the best validation epoch kept. A batch of chunks is
+  correlated, so it learns less per epoch than random windows; the higher learning rate and the
+  decay make up for it. BENCHMARKS.md has the measurements that chose it, and the paired
+  comparison with v1 on RQ1's data.
+
+Plain data without torch: the command line and the results config read it at start-up.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass, fields, replace
+from typing import Any
+
+from evoeye.monitor.threads import MONITOR_THREADS
+
+BATCHINGS = ("windows", "chunks")
+SCHEDULES = ("constant", "cosine", "hold-decay")
+
+
+@dataclass(frozen=True)
+class TrainParams:
+    """Hyper-parameters of one training run (recorded in the card). The defaults are "v1"."""
+
+    seed: int = 0
+    epochs: int = 40  # at most; early stopping usually ends sooner
+    patience: int = 8  # epochs without a better validation AUPRC before stopping
+    batch_size: int = 256  # windows per optimiser step
+    lr: float = 1e-3  # the peak learning rate under a schedule
+    weight_decay: float = 1e-5
+    grad_clip: float = 1.0
+    pos_weight: float | None = None  # None: negatives / positives of the training windows
+    threads: int = MONITOR_THREADS  # intra-op threads (evoeye.monitor.threads says why one)
+    # -- fields added with the recipes; a card records them only where they differ from v1's
+    recipe: str = "v1"  # the recipe these parameters started from
+    batching: str = "windows"  # BATCHINGS: random windows, or chunks of consecutive windows
+    chunk_windows: int = 1  # consecutive windows per chunk (batching "chunks")
+    schedule: str = "constant"  # SCHEDULES: the learning rate over the steps of `epochs`
+    warmup_epochs: float = 0.0  # linear warm-up from 0 to `lr`, in epochs
+
+    def __post_init__(self) -> None:
+        if self.batching not in BATCHINGS:
+            raise ValueError(f"unknown batching {self.batching!r}; known: {list(BATCHINGS)}")
+        if self.schedule not in SCHEDULES:
+            raise ValueError(f"unknown schedule {self.schedule!r}; known: {list(SCHEDULES)}")
+        for name, least in (("epochs", 1), ("patience", 1), ("batch_size", 1),
+                            ("chunk_windows", 1), ("threads", 1)):
+            if getattr(self, name) < least:
+                raise ValueError(f"{name} must be >= {least}, got {getattr(self, name)}")
+        if self.warmup_epochs < 0 or self.lr <= 0:
+            raise ValueError(f"need lr > 0 and warmup_epochs >= 0, got {self.lr} and "
+                             f"{self.warmup_epochs}")
+
+
+V1 = TrainParams()
+ADDED_FIELDS = ("recipe", "batching", "chunk_windows", "schedule", "warmup_epochs")
+RECIPES: dict[str, TrainParams] = {
+    "v1": V1,
+    "v2": replace(V1, recipe="v2", batching="chunks", chunk_windows=32, batch_size=1024,
+                  lr=3e-3, schedule="hold-decay", epochs=20, patience=20),
+}
+DEFAULT_RECIPE = "v2"
+LEGACY_RECIPE = "v1"  # what a record made before recipes had names was trained with
+
+
+def recipe_params(recipe: str | None = None, **overrides: Any) -> TrainParams:
+    """The recipe's TrainParams (default DEFAULT_RECIPE) with `overrides` (TrainParams fields);
+    ValueError naming an unknown recipe or field."""
+    name = recipe or DEFAULT_RECIPE
+    if name not in RECIPES:
+        raise ValueError(f"unknown training recipe {name!r}; known: {sorted(RECIPES)}")
+    known = {f.name for f in fields(TrainParams)} - {"recipe"}
+    if unknown := sorted(set(overrides) - known):
+        raise ValueError(f"unknown training parameter(s) {unknown}; known: {sorted(known)}")
+    return replace(RECIPES[name], **overrides)
+
+
+def card_hyperparameters(params: TrainParams) -> dict[str, Any]:
+    """The card's record of `params`: every field, but those added with the recipes only where
+    they differ from v1's — so a v1 training keeps the card, and the version id, it had."""
+    return {k: v for k, v in asdict(params).items()
+            if k not in ADDED_FIELDS or v != getattr(V1, k)}
