@@ -17,8 +17,8 @@ from concurrent.futures import ProcessPoolExecutor
 import numpy as np
 
 from evoeye.lifeline import die_with_parent
-from evoeye.monitor.threads import intra_op_threads
 from evoeye.monitor.recipes import recipe_params
+from evoeye.monitor.threads import intra_op_threads
 from evoeye.paths import DataRoot
 from evoeye.results.efficiency.acquire import Bank, PoolAcquirer, SimAcquirer
 from evoeye.results.efficiency.config import ORACLE, EfficiencyConfig, parse_regime
