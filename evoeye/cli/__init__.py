@@ -9,7 +9,7 @@ from evoeye.cli.app import app
 
 COMMAND_MODULES = (
     "simulate", "warehouse", "monitor", "evaluate", "evolve", "demo", "audit", "explain",
-    "results", "findings", "autoware", "watch",
+    "results", "findings", "autoware", "watch", "predictability",
 )
 
 for _name in COMMAND_MODULES:

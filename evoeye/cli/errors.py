@@ -60,6 +60,9 @@ KNOWN_ERRORS: dict[str, str] = {
     "evoeye.evaluation.audit.runs.NoLogsError": "name a batch the root holds (above), or "
                                                 "leave out --scenario and --batch to audit "
                                                 "them all; `evoeye simulate …` makes runs",
+    "evoeye.evolve.predictability.check.RegimeError": "simulate and ingest runs of the regime "
+                                                      "(`evoeye simulate …`, `evoeye ingest`), "
+                                                      "or narrow it with --batch / --ads",
     "evoeye.results.study.EmptySplitError": "simulate the data with the command (--initial-runs "
                                             "N --test-runs M), or check --test-batch and the "
                                             "shares",

@@ -62,6 +62,7 @@ QUERY_PARAMS = {
     "initial_records": {"scenario": "highway-cut-in", "seed": 0, "train_frac": 1.0,
                         "val_frac": 0.0, "test_batch": "b1"},
     "run_outcomes": {"logical_scenario": "highway-cut-in"},
+    "predictability_runs": {"scenario": "highway-cut-in", "batch": None, "ads": "default"},
     "logical_scenarios": {},
     # queries over a derived table's parts: $glob is bound to them (DERIVED_PARTS)
     "monitor_scores_rows": {"version": None},

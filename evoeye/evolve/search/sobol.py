@@ -8,13 +8,12 @@ not read. In pool mode each point is snapped to the nearest unused pool row
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 from scipy.stats import qmc
 
 from evoeye.evolve.search.protocol import Proposal
 from evoeye.evolve.search.records import Records
+from evoeye.evolve.search.strategies import CountedStrategy
 from evoeye.scenarios import LogicalScenario
 
 
@@ -24,15 +23,13 @@ def sobol_points(dim: int, m: int, seed: int | np.random.Generator) -> np.ndarra
     return qmc.Sobol(dim, scramble=True, seed=seed).random_base2(m)
 
 
-class SobolStrategy:
+class SobolStrategy(CountedStrategy):
     """Point k of the seeded scrambled Sobol' sequence as proposal k."""
 
     name = "sobol"
 
     def __init__(self, space: LogicalScenario, seed: int) -> None:
-        self.space = space
-        self.seed = seed
-        self.proposals = 0
+        super().__init__(space, seed)
         self._points = np.empty((0, space.dim))  # a prefix of the sequence, doubled as needed
 
     def propose(self, records: Records | None = None) -> Proposal:
@@ -43,12 +40,3 @@ class SobolStrategy:
         self.proposals += 1
         x = np.clip(self.space.denormalise(self._points[k]), self.space.low, self.space.high)
         return Proposal(x=x, kind="sobol")
-
-    def tell(self, x: np.ndarray, fitness: float) -> None:
-        """Nothing to learn: the sequence is fixed by the seed."""
-
-    def available(self) -> int:
-        return sys.maxsize
-
-    def replay(self, params: np.ndarray, fitness: np.ndarray) -> None:
-        self.proposals = len(np.asarray(params).reshape(-1, self.space.dim))

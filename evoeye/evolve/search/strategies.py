@@ -37,7 +37,7 @@ from evoeye.evolve.search.records import Records
 from evoeye.scenarios import DEFAULT_DELTA, LogicalScenario
 
 
-class _Counted:
+class CountedStrategy:
     """A strategy whose only state is how many proposals it made: proposal k uses rng([seed, k])."""
 
     name = ""
@@ -62,7 +62,7 @@ class _Counted:
         self.proposals = len(np.asarray(params).reshape(-1, self.space.dim))
 
 
-class UniformStrategy(_Counted):
+class UniformStrategy(CountedStrategy):
     """Uniform samples of the whole scenario space."""
 
     name = "uniform"
@@ -76,7 +76,7 @@ class UniformStrategy(_Counted):
         return Proposal(x=pool.rows[i].copy(), kind="uniform", pool_index=i)
 
 
-class DensityStrategy(_Counted):
+class DensityStrategy(CountedStrategy):
     """A random executed record as seed, mutated locally with probability p from its potential."""
 
     def __init__(

@@ -21,8 +21,6 @@ or not.
 
 from __future__ import annotations
 
-import sys
-
 import numpy as np
 from sklearn.cluster import kmeans_plusplus
 from sklearn.ensemble import ExtraTreesRegressor
@@ -31,6 +29,7 @@ from evoeye.evolve.search.pool import CandidatePool
 from evoeye.evolve.search.protocol import Proposal, StrategyError
 from evoeye.evolve.search.records import Records
 from evoeye.evolve.search.sobol import sobol_points
+from evoeye.evolve.search.strategies import CountedStrategy
 from evoeye.scenarios import LogicalScenario
 
 EXPLORE = 0.25  # share of each batch drawn uniformly
@@ -77,7 +76,7 @@ def diverse_top(u: np.ndarray, score: np.ndarray, n: int, rng: np.random.Generat
     return top[picked]
 
 
-class BatchedSurrogate:
+class BatchedSurrogate(CountedStrategy):
     """A strategy that fits a surrogate once per batch; subclasses define `score`."""
 
     name = ""
@@ -88,11 +87,9 @@ class BatchedSurrogate:
             raise StrategyError(f"{self.name}: batch must be >= 1, got {batch}")
         if not 0.0 <= explore <= 1.0:
             raise StrategyError(f"{self.name}: explore must be in [0, 1], got {explore}")
-        self.space = space
-        self.seed = seed
+        super().__init__(space, seed)
         self.batch = batch
         self.explore = explore
-        self.proposals = 0
         self._served: tuple[int, list[Proposal]] | None = None  # (batch index, its proposals)
 
     def score(self, records: Records, u: np.ndarray,
@@ -109,14 +106,8 @@ class BatchedSurrogate:
         """Pool mode: the batch is chosen among the rows unused when it started."""
         return self._serve(records, pool)
 
-    def tell(self, x: np.ndarray, fitness: float) -> None:
-        """Nothing to learn: the surrogate is fitted on the records."""
-
-    def available(self) -> int:
-        return sys.maxsize
-
     def replay(self, params: np.ndarray, fitness: np.ndarray) -> None:
-        self.proposals = len(np.asarray(params).reshape(-1, self.space.dim))
+        super().replay(params, fitness)
         self._served = None
 
     # -- batches ---------------------------------------------------------------------------------

@@ -75,6 +75,10 @@ def test_config_rejects_unknown_strategy_and_update() -> None:
     assert CampaignConfig(SCENARIO, update="finetune").train_overrides() == {
         "epochs": FINETUNE_EPOCHS, "patience": FINETUNE_PATIENCE}
     assert CampaignConfig(SCENARIO, update="retrain").train_overrides() == {}
+    with pytest.raises(ValueError, match="committee is of FusionMonitors"):
+        CampaignConfig(SCENARIO, strategy="disagreement", family="aem")
+    with pytest.raises(ValueError, match="committee must be >= 2"):
+        CampaignConfig(SCENARIO, strategy="disagreement", committee=1)
 
 
 def test_campaign_id_is_stable_and_ignores_the_budget(seeded) -> None:

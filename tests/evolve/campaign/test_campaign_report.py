@@ -252,3 +252,14 @@ def test_a_cell_with_a_finite_value_is_the_nanmean_one_it_was() -> None:
             values[rng.uniform(size=n) < rng.uniform(0, 0.8)] = np.nan
             values[rng.integers(n)] = rng.uniform(0, 1)
             assert _mean_std(list(values)) == _old_mean_std(list(values)), values
+
+
+def test_the_strategies_beyond_the_paper_are_rows_of_the_rq2_table() -> None:
+    res = {"uniform": [_run([0.3])], "sobol": [_run([0.35])], "boundary": [_run([0.4])],
+           "disagreement": [_run([0.45])], "evoeye-knn": [_run([0.2])]}
+    md = markdown({"highway-cut-in": res})
+    rq2 = md.split("## highway-cut-in — RQ2")[1].split("##")[0]
+    for name in ("sobol", "boundary", "disagreement", "evoeye-knn"):
+        assert f"| {name} |" in rq2
+    assert [r[0] for r in acquisition_rows(res)][:1] == ["uniform"]
+    assert {r[0] for r in acquisition_rows(res)} == set(res)
