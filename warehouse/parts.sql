@@ -16,6 +16,10 @@ SELECT * FROM read_parquet(files);
 CREATE OR REPLACE MACRO campaign_rounds_parts(files) AS TABLE
 SELECT * FROM read_parquet(files);
 
+-- committee: the companion monitors a `disagreement` campaign trained beside G_r, per round.
+CREATE OR REPLACE MACRO committee_parts(files) AS TABLE
+SELECT * FROM read_parquet(files);
+
 -- feedback: f_r(x) of a run under a monitor version. Parts written before the feedback_mode
 -- column existed keyed prior-corrected feedback `<version>+prior` in monitor_version: they read
 -- as (version, 'prior-corrected'), the others as 'raw'. The empty branch gives the column a type

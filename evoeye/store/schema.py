@@ -23,7 +23,7 @@ TABLES = ("scenarios", "frames", "frame_features")
 # Tables later stages append to, as flat parts under warehouse/<table>/ (no partitions): explain,
 # evaluate and the evolution campaign. Each is read through its macro `<table>_parts(files)`
 # (PARTS_SQL): every connection sees all its parts as the view `<table>`.
-DERIVED_TABLES = ("attribution", "monitor_scores", "feedback", "campaign_rounds")
+DERIVED_TABLES = ("attribution", "monitor_scores", "feedback", "campaign_rounds", "committee")
 PARTS_SQL = PROJECT_DIR / "warehouse" / "parts.sql"
 # Hive partition keys, in folder order: they are columns of the views, not of the files.
 PARTITION_KEYS = ("logical_scenario", "batch")

@@ -17,7 +17,13 @@ from evoeye.cli.app import app
 from evoeye.paths import DataRoot
 from evoeye.store import Warehouse
 from evoeye.store.attribution import AttributionRow, write_attribution
-from evoeye.store.feedback import FeedbackRows, RoundRow, write_feedback, write_round
+from evoeye.store.feedback import (
+    FeedbackRows,
+    RoundRow,
+    write_committee,
+    write_feedback,
+    write_round,
+)
 from evoeye.store.ingest import refresh_catalog
 from evoeye.store.schema import DERIVED_TABLES, declared_schema
 from evoeye.store.scores import ScoreRows, write_scores
@@ -75,6 +81,7 @@ def full(root: DataRoot, add_run: Callable[..., Path]) -> DataRoot:
     write_feedback(root, FeedbackRows("highway-cut-in", "fusion-a", "raw", ids, np.array([0.2]),
                                       np.array([10])))
     write_round(root, RoundRow("evo-1", "highway-cut-in", "evoeye", 0, 0, "fusion-a", [], 0, 0.0))
+    write_committee(root, "evo-1", 0, ["fusion-b", "fusion-c"])
     write_attribution(root, [AttributionRow("highway-cut-in", "doc-0", "0.0", variant, False,
                                             None, 1.0, None)
                              for variant in ("oracle_perception", "oracle_prediction",
@@ -109,7 +116,8 @@ def test_every_documented_relation_answers_evoeye_sql_and_duckdb(full: DataRoot)
         counts = {t: _count(con, t) for t in DERIVED_TABLES}
     finally:
         con.close()
-    assert counts == {"attribution": 4, "monitor_scores": 1, "feedback": 1, "campaign_rounds": 1}
+    assert counts == {"attribution": 4, "monitor_scores": 1, "feedback": 1, "campaign_rounds": 1,
+                      "committee": 1}
 
 
 def test_the_derived_views_have_the_declared_columns(full: DataRoot) -> None:

@@ -1,5 +1,5 @@
 -- Rows of committee (all, or one campaign), in campaign and round order, from the parts.
 SELECT *
-FROM read_parquet($glob)
+FROM committee_parts($glob)
 WHERE $campaign_id IS NULL OR campaign_id = $campaign_id
 ORDER BY campaign_id, round
