@@ -61,6 +61,8 @@ class ResultsParams(BaseModel):
     patience: int | None = Field(None, ge=1)
     recipe: str = D.recipe  # the training recipe of every from-scratch monitor (ResultsConfig)
     workers: int = Field(D.workers, ge=1)
+    # the sample-efficiency study (part "efficiency"): EfficiencyConfig's fields to change
+    efficiency: dict[str, Any] = Field(default_factory=dict)
     report_name: str = "results"
     docs: str | None = None  # also copy the tables here (docs/results)
     readme: str | None = None  # also rewrite this README's findings section
@@ -90,21 +92,38 @@ def part_task(root: DataRoot, config: ResultsConfig, scenario: str, part: str) -
     return PARTS[part](part_study(study, monitor_study(study), part), scenario)
 
 
+@task(task_run_name="efficiency-{regime}")
+def efficiency_task(root: DataRoot, config: ResultsConfig, regime: str) -> dict:
+    """The sample-efficiency study on one regime: its curves and summaries."""
+    from evoeye.results.efficiency.part import regime_part
+
+    return regime_part(root, regime, config.efficiency_config, workers=config.workers,
+                       say=print)
+
+
 @flow(name="evoeye-results", log_prints=True,
       flow_run_name=named(lambda p: (p or ResultsParams()).run_name()))
 def results_flow(params: ResultsParams | None = None) -> dict[str, Any]:
     """Run every part of every scenario, write the files, publish the findings."""
     params = params or ResultsParams()
     config, root = params.config(), DataRoot.resolve(params.root)
-    data_task(root, config)
     study = Study(root, config)
-    monitors = monitor_study(study)
     scenarios = {}
-    for scenario in config.scenarios:  # one after the other; a part's campaigns side by side
-        scenarios[scenario] = scenario_data(study, monitors, scenario)
-        for part in config.parts:
-            scenarios[scenario][part] = part_task(root, config, scenario, part)
-    results = assemble(study, scenarios)
+    if config.paper_parts:
+        data_task(root, config)
+        monitors = monitor_study(study)
+        for scenario in config.scenarios:  # one after the other; a part's campaigns side by side
+            scenarios[scenario] = scenario_data(study, monitors, scenario)
+            for part in config.paper_parts:
+                scenarios[scenario][part] = part_task(root, config, scenario, part)
+    efficiency = None
+    if "efficiency" in config.parts:
+        from evoeye.results.efficiency.part import study_results
+
+        eff = config.efficiency_config
+        efficiency = study_results(eff, {r: efficiency_task(root, config, r)
+                                         for r in eff.regimes})
+    results = assemble(study, scenarios, efficiency)
     folder = write_results(root, results, params.report_name,
                            docs=Path(params.docs) if params.docs else None,
                            readme=Path(params.readme) if params.readme else None)

@@ -17,8 +17,10 @@ from evoeye.results.config import (
     ResultsConfig,
     parse_initial_runs,
 )
+from evoeye.results.efficiency.config import MODES, REFERENCE, EfficiencyConfig
 
 D = ResultsConfig()  # the defaults --help shows (config.py imports nothing heavy)
+E = EfficiencyConfig()
 
 
 def _csv(text: str) -> tuple[str, ...]:
@@ -98,6 +100,28 @@ def results_command(
         min=1, help="Epochs of every training (default: each trainer's).")] = None,
     patience: Annotated[int | None, typer.Option(min=1, help="Early-stopping patience.")] =
         None,
+    regime: Annotated[list[str] | None, typer.Option(
+        "--regime", help="Sample-efficiency study (--part efficiency): a regime, SCENARIO or "
+                         "SCENARIO:ADS_PROFILE (repeatable; default "
+                         f"{', '.join(E.regimes)}).")] = None,
+    strategy: Annotated[list[str] | None, typer.Option(
+        "--strategy", help="Sample-efficiency study: the strategies whose curves it draws, "
+                           "beside Uniform's, the reference (repeatable; default "
+                           f"{', '.join(E.strategies)}).")] = None,
+    mode: Annotated[str, typer.Option(
+        help=f"Sample-efficiency study: {' or '.join(MODES)} (pick from the pre-simulated "
+             "pool, or simulate what each strategy proposes).")] = E.mode,
+    study_seeds: Annotated[int, typer.Option(
+        min=2, help="Sample-efficiency study: seeds, paired across strategies.")] =
+        len(E.seeds),
+    first_study_seed: Annotated[int, typer.Option(
+        min=0, help="Sample-efficiency study: its first seed (seeds K … K+N−1).")] = 0,
+    oracle: Annotated[bool, typer.Option(
+        help="Sample-efficiency study: draw the oracle ceiling's curves (pool mode).")] =
+        E.oracle,
+    pool_runs: Annotated[int, typer.Option(
+        min=1, help="Sample-efficiency study: uniform runs per regime to pick from.")] =
+        E.pool_runs,
     recipe: Annotated[str, typer.Option(
         help=f"Training recipe of every monitor trained from scratch, one of "
              f"{', '.join(RECIPES)} (campaign updates keep theirs).")] = D.recipe,
@@ -112,8 +136,10 @@ def results_command(
     readme: Annotated[Path | None, typer.Option(
         help="Also rewrite this README's findings section (between its markers).")] = None,
 ) -> None:
-    """Regenerate RQ1, the monitor ablation, RQ2, the evolution ablations and AEM-Evo, each
-    comparison with its mean, 95 % CI and p; re-running reuses every finished unit."""
+    """Regenerate RQ1, the monitor ablation, RQ2, the evolution ablations and AEM-Evo — and,
+    with --part efficiency, the sample-efficiency study (learning curves of acquisition
+    strategies against Uniform and an oracle ceiling) — each comparison with its mean, 95 % CI
+    and p; re-running reuses every finished unit."""
     from evoeye.results.run import run_results, write_results
 
     try:
@@ -129,11 +155,20 @@ def results_command(
             context_lens=tuple(context_len or D.context_lens),
             inputs=tuple(inputs or D.inputs), methods=tuple(method or D.methods),
             budget_s=budget_s, n_round=n_round, update=update, feedback=feedback,
-            epochs=epochs, patience=patience, recipe=recipe, workers=workers)
+            epochs=epochs, patience=patience, recipe=recipe, workers=workers,
+            efficiency=EfficiencyConfig(
+                regimes=tuple(regime or E.regimes),
+                strategies=tuple(dict.fromkeys((REFERENCE, *strategy))) if strategy
+                else E.strategies,
+                mode=mode, seeds=tuple(range(first_study_seed, first_study_seed + study_seeds)),
+                oracle=oracle, pool_runs=pool_runs, recipe=recipe, epochs=epochs,
+                patience=patience
+            ).changed())
         config.check_names()
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from None
-    simulates = any(map(config.runs_of, config.scenarios)) or test_runs
+    simulates = (any(map(config.runs_of, config.scenarios)) or test_runs
+                 or "efficiency" in config.parts)
     data = DataRoot.resolve(root) if simulates else DataRoot.existing(root)
     with StepBar("results") as bar:
         run = run_results(data, config, progress=bar)

@@ -39,7 +39,7 @@ class _Frame:
         return self.y0 - (v - lo) / ((hi - lo) or 1.0) * (self.y0 - self.y1)
 
     def axes(self, title: str, xlabel: str, ylabel: str, xticks: Sequence[float],
-             yticks: Sequence[float]) -> list[str]:
+             yticks: Sequence[float], xlabels: Sequence[str] | None = None) -> list[str]:
         out = [
             f'<rect x="{self.x0}" y="{self.y1}" width="{self.x1 - self.x0}" '
             f'height="{self.y0 - self.y1}" fill="#fff" stroke="#999"/>',
@@ -50,12 +50,13 @@ class _Frame:
             f'<text x="14" y="{(self.y0 + self.y1) / 2}" text-anchor="middle" '
             f'transform="rotate(-90 14 {(self.y0 + self.y1) / 2})">{escape(ylabel)}</text>',
         ]
-        for v in xticks:
+        for i, v in enumerate(xticks):
             x = self.x(v)
+            text = f"{v:g}" if xlabels is None else xlabels[i]
             out.append(f'<line x1="{x:.1f}" y1="{self.y0}" x2="{x:.1f}" y2="{self.y1}" '
                        'stroke="#eee"/>')
             out.append(f'<text x="{x:.1f}" y="{self.y0 + 15}" text-anchor="middle">'
-                       f"{v:g}</text>")
+                       f"{escape(text)}</text>")
         for v in yticks:
             y = self.y(v)
             out.append(f'<line x1="{self.x0}" y1="{y:.1f}" x2="{self.x1}" y2="{y:.1f}" '
@@ -222,6 +223,37 @@ def operating_chart(series: Sequence[tuple[str, Sequence[dict]]], *, title: str,
                             f'y2="{y:.1f}" stroke="{_color(i)}" stroke-opacity="0.5"/>')
             body.append(f'<circle cx="{x:.1f}" cy="{y:.1f}" r="3" fill="{_color(i)}"/>')
     body += _legend(f, [label for label, _ in series], f.x0 + 8, f.y1 + 14)
+    return f.svg(body, title)
+
+
+def band_chart(series: Sequence[tuple[str, Sequence[float], Sequence[float], Sequence[float],
+                                      Sequence[float]]], *,
+               title: str, xlabel: str, ylabel: str) -> str:
+    """Curves (label, xs, mean, low, high) with their confidence bands, x on a log2 axis
+    (ticks at the xs, labelled with them), y in percentage points scaled to the values; a NaN
+    point is left out of its curve and band."""
+    xs_all = sorted({float(x) for _, xs, *_ in series for x in xs})
+    ys_all = [v for _, _, m, lo, hi in series for v in (*m, *lo, *hi) if np.isfinite(v)]
+    if not xs_all or not ys_all:
+        return _Frame((0.0, 1.0), (0.0, 1.0)).svg([], title)
+    ylim = _nice_limits(ys_all, None)
+    logs = [float(np.log2(x)) for x in xs_all]
+    f = _Frame((logs[0], logs[-1]), ylim)
+    body = f.axes(title, xlabel, ylabel, logs, np.linspace(*ylim, 5).round(1).tolist(),
+                  xlabels=[f"{x:g}" for x in xs_all])
+    for i, (_, xs, mean, low, high) in enumerate(series):
+        lx = [float(np.log2(x)) for x in xs]
+        ok = [j for j in range(len(xs)) if np.isfinite(mean[j])]
+        band = [j for j in ok if np.isfinite(low[j]) and np.isfinite(high[j])]
+        if len(band) > 1:
+            up = " ".join(f"{f.x(lx[j]):.1f},{f.y(high[j]):.1f}" for j in band)
+            down = " ".join(f"{f.x(lx[j]):.1f},{f.y(low[j]):.1f}" for j in reversed(band))
+            body.append(f'<polygon points="{up} {down}" fill="{_color(i)}" fill-opacity="0.12" '
+                        'stroke="none"/>')
+        pts = " ".join(f"{f.x(lx[j]):.1f},{f.y(mean[j]):.1f}" for j in ok)
+        body.append(f'<polyline points="{pts}" fill="none" stroke="{_color(i)}" '
+                    f'stroke-width="2" data-series="{escape(series[i][0])}"/>')
+    body += _legend(f, [s[0] for s in series], f.x0 + 8, f.y1 + 14)
     return f.svg(body, title)
 
 

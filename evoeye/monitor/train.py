@@ -53,7 +53,8 @@ from evoeye.store.selection import RunFilter, Runs, SplitSpec
 from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S, Windows, load_windows
 
 _reproducible = reproducible  # the name tests and older callers import
-__all__ = ["FitResult", "TrainParams", "fit", "train_monitor", "train_monitors"]
+__all__ = ["FitResult", "TrainParams", "Trained", "fit", "fit_windows", "train_monitor",
+           "train_monitors"]
 
 
 def _selections(scenario: str | None, splits: SplitSpec, train_runs: Runs, val_runs: Runs
@@ -148,7 +149,7 @@ def train_monitors(
         net.fit_normalizers(frames)
         return net.to(where)
 
-    def run(seed: int, net: FusionNet | None = None) -> _Trained:
+    def run(seed: int, net: FusionNet | None = None) -> Trained:
         p = replace(base, seed=seed)
         with reproducible(seed, p.threads, where.type == "cpu") if net is None else kernels(
                 p.threads, where.type == "cpu"):
@@ -156,7 +157,7 @@ def train_monitors(
             result = fit(net, train, val, p, _tagged(progress, seed))
             scores = FusionMonitor(result.net, "training", None,  # type: ignore[arg-type]
                                    device=where).score(val)
-        return _Trained(p, result, scores, calibrate_on_validation(scores, val))
+        return Trained(p, result, scores, calibrate_on_validation(scores, val))
 
     width = min(len(seeds), parallel or os.cpu_count() or 1)
     if width == 1 or config.dropout > 0:
@@ -175,7 +176,9 @@ def train_monitors(
 
 
 @dataclass
-class _Trained:
+class Trained:
+    """A fit, its parameters, its validation scores and the thresholds calibrated on them."""
+
     params: TrainParams
     result: FitResult
     scores: np.ndarray  # (B,) of the validation windows
@@ -203,7 +206,7 @@ def _config(parent: FusionMonitor | None, context_len: int | None,
                         modules=tuple(modules or MODULES), **extra)
 
 
-def _card(t: _Trained, scenario: str | None, horizon_s: float, init_from: str | None,
+def _card(t: Trained, scenario: str | None, horizon_s: float, init_from: str | None,
           config: FusionConfig, train: Windows, val: Windows, train_runs: Runs,
           val_runs: Runs, device: torch.device) -> dict[str, Any]:
     result = t.result
@@ -232,6 +235,29 @@ def _card(t: _Trained, scenario: str | None, horizon_s: float, init_from: str | 
         **thresholds_to_card(t.thresholds),
         "metrics": {"val": split_metrics(t.scores, val.label, t.thresholds)},
     }
+
+
+def fit_windows(train: Windows, val: Windows, params: TrainParams | None = None, *,
+                config: FusionConfig | None = None, parent: FusionNet | None = None,
+                progress: Progress | None = None,
+                device: str | torch.device | None = None) -> Trained:
+    """Train a new FusionNet of `config` (default sizes; normalisers fitted on the training
+    frames), or fine-tune a copy of `parent`, on windows in memory, with `params` (default: the
+    default recipe's), and calibrate it on `val`. Seeded by `params.seed`; nothing is saved
+    (`train_monitor` saves)."""
+    params = params or recipe_params()
+    where = pick_device(device)
+    with reproducible(params.seed, params.threads, where.type == "cpu"):
+        if parent is not None:
+            net = copy.deepcopy(parent)
+        else:
+            net = FusionNet(FusionConfig.for_spec(train.spec,
+                                                  **_sizes(config or FusionConfig())))
+            net.fit_normalizers(_frames_of(train))
+        result = fit(net.to(where), train, val, params, progress)
+        scores = FusionMonitor(result.net, "training", None,  # type: ignore[arg-type]
+                               device=where).score(val)
+    return Trained(params, result, scores, calibrate_on_validation(scores, val))
 
 
 def _sizes(config: FusionConfig) -> dict[str, Any]:

@@ -58,7 +58,7 @@ def combine(paths: Sequence[Path]) -> dict:
     """{"sources": [{"path", "config", "tables"}], "tables", "findings"} over the runs."""
     if not paths:
         raise ResultsFileError("give at least one results file")
-    sources, tables, owner = [], [], {}
+    sources, tables, owner, studies = [], [], {}, []
     for path in paths:
         file = file_in(path)
         results = load_results(file)
@@ -74,7 +74,13 @@ def combine(paths: Sequence[Path]) -> dict:
             names.append(_table_name(table))
         sources.append({"path": str(file), "config": results.get("config", {}),
                         "tables": names})
-    return {"sources": sources, "tables": tables, "findings": check_findings(tables)}
+        if "efficiency" in results:  # each study run's claims stand on their own seeds
+            studies.append({"path": str(file), "config": results["efficiency"]["config"],
+                            "findings": results["efficiency"]["findings"]})
+    combined = {"sources": sources, "tables": tables, "findings": check_findings(tables)}
+    if studies:
+        combined["efficiency"] = studies
+    return combined
 
 
 def source_lines(sources: list[dict]) -> list[str]:
@@ -95,11 +101,16 @@ def source_lines(sources: list[dict]) -> list[str]:
 
 def combined_markdown(combined: dict, source: str) -> str:
     """findings.md of combined runs: the runs, then the findings as `evoeye results` shows them."""
+    from evoeye.results.efficiency.report import efficiency_findings_markdown, study_words
     from evoeye.results.markdown import findings_markdown
 
-    return findings_markdown(combined["findings"], source, command="evoeye findings",
+    text = findings_markdown(combined["findings"], source, command="evoeye findings",
                              runs=["Each table comes from one `evoeye results` run:", "",
                                    *source_lines(combined["sources"])])
+    for study in combined.get("efficiency", []):
+        text += (f"\n{efficiency_findings_markdown(study['findings'])}\n"
+                 f"From `{study['path']}`: {study_words(study['config'])}.\n")
+    return text
 
 
 def write_combined(combined: dict, out: Path | None = None, readme: Path | None = None) -> str:

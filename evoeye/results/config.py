@@ -28,7 +28,10 @@ Sizes, and why:
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass, field, fields, replace
+from typing import Any
+
+from evoeye.results.efficiency.config import EfficiencyConfig
 
 SCENARIOS = ("highway-cut-in", "unprotected-intersection")  # evoeye.scenarios.SCENARIOS
 BASELINES = ("ttc", "ttc-2d", "rss", "rss-2s", "aem",
@@ -38,7 +41,8 @@ INPUTS = ("perception", "perception+prediction", "perception+prediction+planning
           "all")  # evoeye.monitor.inputs.ABLATIONS
 METHODS = ("uniform", "avfuzzer", "evoeye", "no-feedback", "no-density",
            "aem-evo")  # evoeye.evolve.campaign.experiment MAIN + ABLATION
-PARTS = ("rq1", "ablation", "rq2")
+PAPER_PARTS = ("rq1", "ablation", "rq2")  # what `evoeye results` runs by default
+PARTS = (*PAPER_PARTS, "efficiency")  # + the sample-efficiency study (evoeye.results.efficiency)
 # how a campaign's k final monitors are made (evoeye.results.rq2): its last update again with
 # k seeds (what a user of the method deploys), or G_0's recipe trained from scratch on its D_R
 # with the k seeds of "G_0 (k seeds)" (what the data it acquired is worth, whatever the update)
@@ -92,7 +96,7 @@ class ResultsConfig:
     campaign_seeds: tuple[int, ...] = tuple(range(20))
     final_seeds: int = 3  # k: a final monitor is judged by the mean over k training seeds
     final: str = "update"  # FINALS: the k monitors are the last update again, or retrained
-    parts: tuple[str, ...] = PARTS
+    parts: tuple[str, ...] = PAPER_PARTS
     # data: simulated (or resumed) first, then ingested; 0 runs: use what the warehouse holds
     # round-0 runs, batch uniform-seed<sim_seed>: one count for every scenario, or per scenario
     initial_runs: int | Mapping[str, int] = 0
@@ -120,11 +124,14 @@ class ResultsConfig:
     update: str = "replay"
     feedback: str = "raw"
     workers: int = 1  # processes simulating the data batches, then running campaigns
+    # the sample-efficiency study: EfficiencyConfig's fields that differ from its defaults
+    efficiency: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for name in ("scenarios", "training_seeds", "campaign_seeds", "parts", "baselines",
                      "context_lens", "inputs", "methods"):
             object.__setattr__(self, name, tuple(getattr(self, name)))
+        object.__setattr__(self, "efficiency", self.efficiency_config.changed())
         if not self.scenarios:
             raise ValueError("give at least one logical scenario")
         if isinstance(self.initial_runs, Mapping):
@@ -184,6 +191,19 @@ class ResultsConfig:
         if bad := [n for n in self.context_lens if n < 1]:
             raise ValueError(f"context lengths must be >= 1, got {bad}")
         SplitSpec(self.split_seed, *self.shares, self.held_out_batch)  # shares and batch name
+        if "efficiency" in self.parts:
+            self.efficiency_config.check_names()
+
+    @property
+    def efficiency_config(self) -> EfficiencyConfig:
+        """The sample-efficiency study's config (ValueError naming a bad field)."""
+        return EfficiencyConfig.from_dict(self.efficiency)
+
+    @property
+    def paper_parts(self) -> tuple[str, ...]:
+        """The parts run per logical scenario on the study's initial data (all but the
+        sample-efficiency study, which has data of its own per regime)."""
+        return tuple(p for p in self.parts if p in PAPER_PARTS)
 
     @property
     def held_out_batch(self) -> str | None:

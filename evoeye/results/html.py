@@ -12,6 +12,7 @@ from html import escape
 
 from evoeye.evaluation.plots import interval_chart
 from evoeye.evaluation.report import CSS, Table
+from evoeye.results.efficiency.report import efficiency_html
 from evoeye.results.markdown import (
     FINDINGS_RULE,
     FLOOR_NOTE,
@@ -83,6 +84,8 @@ def results_html(results: dict, title: str = "evoeye results") -> str:
         if tables:
             body.append(f"<h2>{escape(name)}</h2>")
             body += [_table_html(t) for t in tables]
+    if "efficiency" in results:
+        body += efficiency_html(results["efficiency"])
     return ("<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">"
             f"<title>{escape(title)}</title><style>{CSS}</style></head><body>"
             + "".join(body) + "</body></html>\n")

@@ -24,6 +24,7 @@ from pathlib import Path
 
 from evoeye.paths import DataRoot
 from evoeye.results.config import MONITOR_PARTS, PAPER_TEST_RUNS, ResultsConfig
+from evoeye.results.efficiency.report import efficiency_findings_markdown, efficiency_markdown
 from evoeye.results.findings import check_findings
 from evoeye.results.html import results_html
 from evoeye.results.markdown import findings_markdown, part_markdown
@@ -35,7 +36,7 @@ from evoeye.results.tables import build_tables
 from evoeye.store import Warehouse
 
 PARTS: dict[str, Callable[[Study, str], dict]] = {"rq1": rq1, "ablation": ablation, "rq2": rq2}
-DOCS_FILES = ("rq1.md", "rq2.md", "findings.md", "results.json")
+DOCS_FILES = ("rq1.md", "rq2.md", "efficiency.md", "findings.md", "results.json")
 FINAL_WORDS = {"update": "of its last update",
                "retrain": "of G_0's recipe trained from scratch on its D_R (`--final retrain`: "
                           "what the acquired data is worth, whatever the update rule)"}
@@ -89,26 +90,38 @@ def scenario_data(study: Study, monitors: Study, scenario: str) -> dict:
 
 def run_results(root: DataRoot, config: ResultsConfig,
                 progress: Progress | None = None) -> ResultsRun:
-    """Prepare the data, run every part of every scenario, and assemble the results."""
-    study, monitors = prepare_studies(root, config, progress)
+    """Prepare the data, run every part of every scenario (and the sample-efficiency study
+    over its regimes), and assemble the results."""
+    study = monitors = Study(root, config, progress)
     scenarios = {}
-    for scenario in config.scenarios:
-        parts = scenario_data(study, monitors, scenario)
-        for part in config.parts:
-            parts[part] = PARTS[part](part_study(study, monitors, part), scenario)
-        scenarios[scenario] = parts
+    if config.paper_parts:
+        study, monitors = prepare_studies(root, config, progress)
+        for scenario in config.scenarios:
+            parts = scenario_data(study, monitors, scenario)
+            for part in config.paper_parts:
+                parts[part] = PARTS[part](part_study(study, monitors, part), scenario)
+            scenarios[scenario] = parts
+    efficiency = None
+    if "efficiency" in config.parts:
+        from evoeye.results.efficiency.part import run_efficiency
+
+        efficiency = run_efficiency(root, config.efficiency_config, workers=config.workers,
+                                    say=progress, ledger=study.ledger)
     ledgers = {id(s.ledger): s.ledger for s in (study, monitors)}.values()
-    return ResultsRun(assemble(study, scenarios),
+    return ResultsRun(assemble(study, scenarios, efficiency),
                       dict(sum((lg.found for lg in ledgers), Counter())),
                       dict(sum((lg.computed for lg in ledgers), Counter())))
 
 
-def assemble(study: Study, scenarios: dict[str, dict]) -> dict:
-    """The results JSON of a study's parts ({scenario: {"data", part: figures}}): the config,
-    the splits, the per-seed figures, every table and the findings (plain JSON types)."""
+def assemble(study: Study, scenarios: dict[str, dict], efficiency: dict | None = None) -> dict:
+    """The results JSON of a study's parts ({scenario: {"data", part: figures}}, and the
+    sample-efficiency study's): the config, the splits, the per-seed figures, every table and
+    the findings (plain JSON types)."""
     tables = build_tables(scenarios)
     results = {"config": study.config.to_dict(), "splits": asdict(study.splits),
                "scenarios": scenarios, "tables": tables, "findings": check_findings(tables)}
+    if efficiency is not None:
+        results["efficiency"] = efficiency
     return json.loads(json.dumps(results, default=float))
 
 
@@ -150,13 +163,13 @@ def _set_lines(results: dict) -> list[str]:
 
 def markdown_files(results: dict, source: str = "results.json") -> dict[str, str]:
     """File name → Markdown: rq1.md, rq2.md, findings.md (which names `source` as the file the
-    findings come from)."""
+    findings come from), and efficiency.md when the study ran."""
     rq2_intro = (_intro(results, "RQ2, the evolution ablation and AEM-Evo") + "\n\n"
                  "The sets RQ2 judges on (Hard: the unsafe test frames G_0 misses and the safe "
                  "frames of their runs; Robust Hard: the unsafe test frames a majority of the "
                  "re-seeded G_0s miss and every safe test frame):\n\n"
                  + "\n".join(_set_lines(results)))
-    return {
+    files = {
         "rq1.md": part_markdown("Monitoring effectiveness (RQ1) and the monitor ablation",
                                 _intro(results, "RQ1 and the monitor ablation", "rq1_data"),
                                 results["tables"], ("rq1", "ablation")),
@@ -166,6 +179,11 @@ def markdown_files(results: dict, source: str = "results.json") -> dict[str, str
                                                      "acquisition")),
         "findings.md": findings_markdown(results["findings"], source),
     }
+    if "efficiency" in results:
+        files["efficiency.md"] = efficiency_markdown(results["efficiency"])
+        files["findings.md"] += "\n" + efficiency_findings_markdown(
+            results["efficiency"]["findings"])
+    return files
 
 
 def write_results(root: DataRoot, results: dict, name: str = "results", *,
@@ -186,7 +204,8 @@ def write_results(root: DataRoot, results: dict, name: str = "results", *,
     if docs is not None:
         docs.mkdir(parents=True, exist_ok=True)
         for file in DOCS_FILES:
-            shutil.copyfile(folder / file, docs / file)
+            if (folder / file).is_file():
+                shutil.copyfile(folder / file, docs / file)
         write_figure(results["tables"], docs)
     if readme is not None:
         write_readme_section(readme, results["findings"], source,

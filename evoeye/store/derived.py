@@ -1,10 +1,11 @@
 """The tables later stages derive and append to: flat parts under `<root>/warehouse/<table>/`.
 
-monitor_scores (evaluation), feedback and campaign_rounds (evolution) and attribution (explain)
-are written one part per write — `part-<utc stamp>-<id>.parquet`, columns as the table's DDL
-declares them (temporary file, fsync, rename: a killed write leaves no partial part) — and read
-back with a query from `warehouse/queries/` whose `$glob` names the parts, every value bound,
-through the table's macro `<table>_parts` (`warehouse/parts.sql`), which the views use too.
+monitor_scores (evaluation), feedback, campaign_rounds and committee (evolution) and attribution
+(explain) are written one part per write — `part-<utc stamp>-<id>.parquet`, columns as the
+table's DDL declares them (temporary file, fsync, rename: a killed write leaves no partial
+part) — and read back with a query from `warehouse/queries/` whose `$glob` names the parts,
+every value bound, through the table's macro `<table>_parts` (`warehouse/parts.sql`), which
+the views use too.
 Each table's module keeps its own key and writes under the warehouse writer lock (`lock.py`).
 
 A part holding the rows of one key only (one monitor version's feedback or scores, one

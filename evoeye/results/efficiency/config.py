@@ -1,0 +1,152 @@
+"""What the sample-efficiency study runs, at what size: declared once and validated.
+
+Plain data (the command line reads it at start-up). Sizes, and why:
+
+* Regimes: a logical scenario and the ADS profile that drives it (`scenario` or
+  `scenario:profile`). Collisions are common under the default stack (≈ 25 % / 55 % of uniform
+  runs); where they are rare (2–10 %), Uniform spends most of its budget on runs with nothing
+  to learn. The cautious stack at the intersection is that regime (9 of 200 uniform runs
+  collided, 4.5 %, on the seed the profiles were chosen on; the cautious stack on the highway
+  collided in 2 of 200, too rare to learn from; the firm-yield stack at the intersection in
+  21 of 200, at the band's edge).
+* The pool: every screened strategy picks from the same pre-simulated uniform runs (5 000), so
+  strategies differ only in their choices and the oracle can look ahead.
+* The Test Set (1 000 uniform runs, its own seed) and the boundary set (pairs of a safe and a
+  colliding uniform run, bisected in θ under one run seed) are built once, by no strategy and no
+  monitor; the validation set (200 runs) early-stops and calibrates every monitor alike, and is
+  charged to no strategy's budget.
+* Learning curves start from 40 initial runs drawn from the pool (the same for every strategy
+  at a seed) and are measured at log-spaced budgets ×2, ×4, ×8 (80, 160, 320 runs, initial runs
+  included); Uniform goes on to ×16 so that the budget it needs to match a strategy can be read
+  off its own curve up to a factor of 2.
+* Acquisition comes in rounds of 20 runs, after each of which the product's update rule (the
+  replay fine-tune of `evoeye evolve`) updates the monitor the strategies' feedback comes from.
+  At a checkpoint the monitor is trained from scratch on everything acquired, with the training
+  seed of that seed and checkpoint shared by every strategy (the pairing absorbs it).
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+
+MODES = ("pool", "generative")
+STRATEGIES = ("uniform", "sobol", "boundary", "disagreement", "evoeye-knn", "evoeye")
+REFERENCE = "uniform"
+ORACLE = "oracle"
+DEFAULT_PROFILE = "default"  # evoeye.ads.profiles.DEFAULT_PROFILE
+RECIPES, DEFAULT_RECIPE = ("v1", "v2"), "v2"  # evoeye.monitor.recipes
+
+
+def parse_regime(regime: str) -> tuple[str, str]:
+    """"scenario" or "scenario:profile" → (scenario, profile)."""
+    scenario, _, profile = regime.partition(":")
+    if not scenario or ":" in profile:
+        raise ValueError(f"a regime is SCENARIO or SCENARIO:PROFILE, got {regime!r}")
+    return scenario, profile or DEFAULT_PROFILE
+
+
+def regime_name(scenario: str, profile: str) -> str:
+    """The regime's name: the scenario, and the profile unless it is the default."""
+    return scenario if profile == DEFAULT_PROFILE else f"{scenario}:{profile}"
+
+
+@dataclass(frozen=True)
+class EfficiencyConfig:
+    """Everything the study regenerates, and at what size (module doc)."""
+
+    regimes: tuple[str, ...] = ("highway-cut-in", "unprotected-intersection",
+                                "unprotected-intersection:cautious")
+    mode: str = "pool"  # pool: pick from the pre-simulated pool; generative: simulate
+    strategies: tuple[str, ...] = STRATEGIES
+    seeds: tuple[int, ...] = tuple(range(10))  # campaign seeds, paired across strategies
+    oracle: bool = True  # the greedy oracle ceiling (pool mode)
+    oracle_candidates: int = 6  # increments tried at each step of the oracle
+    initial_runs: int = 40
+    checkpoints: tuple[int, ...] = (80, 160, 320)  # total runs, initial runs included
+    reference_checkpoints: tuple[int, ...] = (640,)  # Uniform's further ones
+    n_round: int = 20
+    pool_runs: int = 5000
+    test_runs: int = 1000
+    val_runs: int = 200
+    oracle_runs: int = 500  # the set the oracle judges its candidates on (not the Test Set)
+    boundary_pairs: int = 150
+    boundary_steps: int = 4  # bisections per pair: the final bracket is 1/16 of the pair
+    data_seed: int = 7_000  # pool; +1 test, +2 val, +3 oracle, +4 the boundary set's sources
+    horizon_s: float = 3.0
+    recipe: str = DEFAULT_RECIPE  # the training recipe of every monitor of the study
+    epochs: int | None = None  # every training (None: the recipe's)
+    patience: int | None = None
+
+    @property
+    def train_overrides(self) -> dict[str, int]:
+        """TrainParams fields every from-scratch monitor of the study gets."""
+        return {k: v for k, v in (("epochs", self.epochs), ("patience", self.patience))
+                if v is not None}
+
+    def __post_init__(self) -> None:
+        for name in ("regimes", "strategies", "seeds", "checkpoints", "reference_checkpoints"):
+            object.__setattr__(self, name, tuple(getattr(self, name)))
+        for regime in self.regimes:
+            parse_regime(regime)
+        if self.mode not in MODES:
+            raise ValueError(f"mode must be one of {MODES}, got {self.mode!r}")
+        if self.recipe not in RECIPES:
+            raise ValueError(f"unknown training recipe {self.recipe!r}; known: {list(RECIPES)}")
+        if REFERENCE not in self.strategies:
+            raise ValueError(f"the strategies must include the reference {REFERENCE!r}")
+        if len(self.seeds) < 2 or len(set(self.seeds)) != len(self.seeds):
+            raise ValueError(f"need at least 2 distinct seeds, got {self.seeds}")
+        points = (self.initial_runs, *self.checkpoints, *self.reference_checkpoints)
+        if list(points) != sorted(set(points)) or self.initial_runs < 2:
+            raise ValueError(f"initial runs and checkpoints must increase, got {points}")
+        if any((c - self.initial_runs) % self.n_round for c in points[1:]):
+            raise ValueError(f"every checkpoint must be the initial runs plus whole rounds of "
+                             f"{self.n_round}, got {points}")
+        for name in ("pool_runs", "test_runs", "val_runs", "oracle_runs", "boundary_pairs",
+                     "boundary_steps", "oracle_candidates", "n_round"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if self.pool_runs < self.initial_runs + points[-1]:
+            raise ValueError(f"the pool ({self.pool_runs}) must hold the initial runs and the "
+                             f"largest budget ({points[-1]})")
+
+    def check_names(self) -> None:
+        """ValueError naming a scenario, ADS profile or strategy no registry knows (loads the
+        registries)."""
+        from evoeye.ads.profiles import ADS_PROFILES
+        from evoeye.evolve.search import STRATEGIES as KNOWN
+        from evoeye.scenarios import SCENARIOS
+
+        for regime in self.regimes:
+            scenario, profile = parse_regime(regime)
+            if scenario not in SCENARIOS or profile not in ADS_PROFILES:
+                raise ValueError(f"regime {regime!r}: scenarios are {sorted(SCENARIOS)}, ADS "
+                                 f"profiles {sorted(ADS_PROFILES)}")
+        if unknown := [s for s in self.strategies if s not in KNOWN]:
+            raise ValueError(f"unknown strategy {unknown}; known: {sorted(KNOWN)}")
+
+    @property
+    def budgets(self) -> tuple[int, ...]:
+        """Every checkpoint any strategy reaches (the reference's included)."""
+        return (*self.checkpoints, *self.reference_checkpoints)
+
+    def checkpoints_of(self, strategy: str) -> tuple[int, ...]:
+        return self.budgets if strategy == REFERENCE else self.checkpoints
+
+    def to_dict(self) -> dict:
+        return {f.name: getattr(self, f.name) for f in fields(self)}
+
+    def changed(self) -> dict:
+        """The fields that differ from the defaults, as JSON values (lists for tuples)."""
+        default = EfficiencyConfig()
+        return {f.name: list(v) if isinstance(v, tuple) else v for f in fields(self)
+                if (v := getattr(self, f.name)) != getattr(default, f.name)}
+
+    @classmethod
+    def from_dict(cls, data: Mapping) -> EfficiencyConfig:
+        if not isinstance(data, Mapping):
+            raise ValueError(f"the efficiency config must be a mapping, got {data!r}")
+        if unknown := sorted(set(data) - {f.name for f in fields(cls)}):
+            raise ValueError(f"unknown efficiency config key(s) {unknown}")
+        return cls(**data)

@@ -1,0 +1,205 @@
+"""One learning curve: a strategy acquires runs round by round from D_init, and at every
+checkpoint the monitor is trained from scratch on all of them and judged.
+
+The loop per round: the strategy proposes N_round runs one at a time, each is acquired (taken
+from the pool, or simulated: `acquire.py`) and told to it; then the product's update rule
+refreshes the monitor whose feedback the strategies read (and, for `disagreement`, the
+committee beside it), and every record's feedback is refreshed. At a checkpoint two monitors
+are judged on the sets no strategy shaped: one trained from scratch on everything acquired
+(the curve's figure — what the runs are worth), with the seed of that seed and checkpoint that
+every strategy shares, and the updated monitor (what the product would deploy).
+
+The same seed gives every strategy the same D_init (drawn from the pool), the same G_0 and the
+same training seed at each checkpoint, so strategies differ only in the runs they chose.
+A from-scratch training is a ledger unit keyed by the runs it read and its seed, and a finished
+curve is one too, so a re-run redoes neither; an unfinished curve replays its trajectory (the
+same picks, the same updates: everything is seeded).
+"""
+
+from __future__ import annotations
+
+import hashlib
+from collections.abc import Callable
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from evoeye.evolve.search.records import Records
+from evoeye.evolve.search.registry import READS_DISAGREEMENT, make_strategy, strategy_options
+from evoeye.monitor.fusion import FusionMonitor
+from evoeye.results.efficiency.acquire import Acquirer, Bank
+from evoeye.results.efficiency.config import EfficiencyConfig
+from evoeye.results.efficiency.learner import (
+    Learner,
+    replay_sample,
+    run_disagreement,
+    run_feedback,
+)
+from evoeye.results.ledger import Ledger
+from evoeye.scenarios import LogicalScenario
+
+COMMITTEE = 3  # members of the disagreement strategy's committee (the monitor and 2 more)
+Say = Callable[[str], None]
+
+
+def initial_rows(n_pool: int, n: int, seed: int) -> np.ndarray:
+    """The pool rows of a seed's D_init (sorted): the same for every strategy."""
+    return np.sort(np.random.default_rng([seed, 0]).choice(n_pool, size=n, replace=False))
+
+
+def training_seed(seed: int, budget: int) -> int:
+    """The training seed of a from-scratch monitor at a checkpoint: shared by the strategies."""
+    return seed * 100_003 + budget
+
+
+def ids_digest(ids) -> str:
+    return hashlib.sha256("\n".join(sorted(map(str, ids))).encode()).hexdigest()
+
+
+@dataclass
+class Context:
+    """What every curve of one regime shares."""
+
+    regime: str
+    space: LogicalScenario
+    config: EfficiencyConfig
+    learner: Learner
+    bank: Bank  # the windows and outcomes of every run a curve can hold
+    ledger: Ledger
+    fingerprint: str  # of the regime's sets: a unit that read them is keyed by it
+    say: Say = field(default=lambda msg: None)
+
+    def scratch_figures(self, ids, budget: int, seed: int,
+                        monitor: FusionMonitor | None = None) -> dict:
+        """{set: metrics} of the monitor trained from scratch on `ids` with the checkpoint's
+        seed (a ledger unit; `monitor`: that very monitor, if trained already)."""
+        tseed = training_seed(seed, budget)
+        inputs = {"regime": self.regime, "sets": self.fingerprint, "runs": ids_digest(ids),
+                  "n": len(ids), "seed": tseed, "recipe": self.learner.recipe}
+
+        def train() -> dict:
+            self.say(f"{self.regime}: from scratch on {len(ids)} runs, seed {tseed}")
+            trained = monitor or self.learner.scratch(self.bank.windows(ids), tseed)
+            return self.learner.judge(trained)
+
+        return self.ledger.remember("efficiency-scratch", inputs, train)
+
+
+@dataclass
+class Trajectory:
+    """A curve in progress: the records, the monitor (and committee) and what was picked."""
+
+    records: Records
+    monitor: FusionMonitor
+    committee: list[FusionMonitor]
+    kinds: list[str]  # how each acquired run was chosen (the proposal's kind)
+
+
+MARGIN_BINS_M = (0.5, 1.0, 2.0, 4.0, 7.0)  # upper edges of the safe runs' gap bins; then ≥ 7
+
+
+def acquired_summary(collided: np.ndarray, fitness: np.ndarray) -> dict:
+    """Where acquired runs fell: how many collided, how near the boundary the others came
+    (their criticality × 10 m is the footprint gap, capped at 10 m), and the safe runs per
+    gap bin (MARGIN_BINS_M)."""
+    collided = np.asarray(collided, bool)
+    gap = np.asarray(fitness, float) * 10.0
+    safe = ~collided
+    bins = np.bincount(np.searchsorted(MARGIN_BINS_M, gap[safe], side="right"),
+                       minlength=len(MARGIN_BINS_M) + 1)
+    return {"runs": int(len(collided)), "collided": int(collided.sum()),
+            "safe_by_gap": [int(b) for b in bins],
+            "near_miss_2m": int((safe & (gap < 2.0)).sum()),
+            "mean_gap_m": float(np.nanmean(np.where(safe, gap, np.nan))) if safe.any() else None}
+
+
+def run_curve(ctx: Context, strategy: str, seed: int, acquirer: Acquirer) -> dict:
+    """One strategy's learning curve at one seed (a ledger unit: found, or computed)."""
+    cfg = ctx.config
+    inputs = {"regime": ctx.regime, "sets": ctx.fingerprint, "strategy": strategy,
+              "seed": seed, "mode": acquirer.mode, "initial": cfg.initial_runs,
+              "budgets": list(cfg.checkpoints_of(strategy)), "n_round": cfg.n_round,
+              "recipe": ctx.learner.recipe}
+    return ctx.ledger.remember("efficiency-curve", inputs,
+                               lambda: _curve(ctx, strategy, seed, acquirer))
+
+
+def _start(ctx: Context, seed: int, reads_disagreement: bool) -> Trajectory:
+    bank, learner = ctx.bank, ctx.learner
+    rows = initial_rows(len(bank.pool), ctx.config.initial_runs, seed)
+    ids = bank.pool.scenario_id[rows]
+    records = Records(params=bank.pool.params[rows], feedback=np.full(len(rows), np.nan),
+                      fitness=bank.pool.fitness[rows], collided=bank.pool.collided[rows],
+                      duration_s=bank.pool.duration_s[rows], scenario_id=ids)
+    train = bank.windows(ids)
+    monitor = learner.scratch(train, training_seed(seed, ctx.config.initial_runs))
+    committee = [monitor, *(learner.scratch(train, training_seed(seed, 50_000 + j))
+                            for j in range(1, COMMITTEE))] if reads_disagreement else []
+    return _refreshed(ctx, Trajectory(records, monitor, committee, []))
+
+
+def _refreshed(ctx: Context, t: Trajectory) -> Trajectory:
+    """Every record's feedback (and disagreement) under the current monitor (committee)."""
+    windows = ctx.bank.windows(t.records.scenario_id)
+    fb = run_feedback(t.monitor, windows)
+    t.records = t.records.with_feedback(np.array([fb.get(s, np.nan)
+                                                  for s in t.records.scenario_id]))
+    if t.committee:
+        d = run_disagreement(t.committee, windows)
+        t.records = t.records.with_disagreement(np.array([d.get(s, np.nan)
+                                                          for s in t.records.scenario_id]))
+    return t
+
+
+def _update(ctx: Context, t: Trajectory, new: int, seed: int, round_: int) -> None:
+    """The product's replay update of the monitor (and each committee member) after a round."""
+    records = t.records
+    n_old = records.n - new
+    rng = np.random.default_rng([seed, round_, 7])
+    pick = replay_sample(records.scenario_id[:n_old], records.collided[:n_old], new,
+                         bool(records.collided[n_old:].any()), rng)
+    ids = [*records.scenario_id[pick], *records.scenario_id[n_old:]]
+    train = ctx.bank.windows(ids)
+    if not (train.label.any() and (~train.label.astype(bool)).any()):
+        return  # one class only: nothing an update can learn from; the monitor stays
+    useed = seed * 1000 + round_
+    t.monitor = ctx.learner.update(t.monitor, train, useed)
+    if t.committee:
+        t.committee = [t.monitor, *(ctx.learner.update(m, train, useed + 1_000_003 * j)
+                                    for j, m in enumerate(t.committee[1:], start=1))]
+    _refreshed(ctx, t)
+
+
+def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> dict:
+    cfg = ctx.config
+    reads = strategy_name in READS_DISAGREEMENT
+    t = _start(ctx, seed, reads)
+    strategy = make_strategy(strategy_name, ctx.space, seed, pool=acquirer.pool_params,
+                             **strategy_options(strategy_name, batch=cfg.n_round))
+    budgets = cfg.checkpoints_of(strategy_name)
+    g0 = ctx.scratch_figures(t.records.scenario_id, cfg.initial_runs, seed, t.monitor)
+    out: dict = {"budgets": {str(cfg.initial_runs): {"scratch": g0, "update": g0}}}
+    round_ = 0
+    while t.records.n < budgets[-1]:
+        round_ += 1
+        for _ in range(cfg.n_round):
+            prop = strategy.propose(t.records)
+            run = acquirer.acquire(prop, seed, t.records.n - cfg.initial_runs)
+            t.records = t.records.append(run.x, feedback=np.nan, fitness=run.fitness,
+                                         collided=run.collided, duration_s=run.duration_s,
+                                         scenario_id=run.scenario_id)
+            t.kinds.append(prop.kind)
+            strategy.tell(run.x, run.fitness)
+        _update(ctx, t, cfg.n_round, seed, round_)
+        if t.records.n in budgets:
+            ids = list(t.records.scenario_id)
+            ctx.say(f"{ctx.regime}: {strategy_name} seed {seed} at {len(ids)} runs")
+            out["budgets"][str(len(ids))] = {
+                "scratch": ctx.scratch_figures(ids, len(ids), seed),
+                "update": ctx.learner.judge(t.monitor),
+                "acquired": acquired_summary(t.records.collided[cfg.initial_runs:],
+                                             t.records.fitness[cfg.initial_runs:]),
+            }
+    out["acquired_ids"] = [str(s) for s in t.records.scenario_id[cfg.initial_runs:]]
+    out["kinds"] = t.kinds
+    return out

@@ -1,0 +1,94 @@
+"""What the sample-efficiency study shows, claim by claim, over its regimes.
+
+Each check is one strategy against Uniform on one regime, on the study's measure (Test Set
+AUPRC of the monitor trained from scratch, `summary.py`):
+* the area under the curve: **reproduces** when the mean paired difference is positive, its
+  95 % CI lies above 0 and the Wilcoxon p ≤ 0.05 (`evoeye.results.findings.check_verdict`),
+  **reversed** when all three say the opposite, otherwise **not shown**;
+* sample efficiency: **reproduces** when Uniform needs at least 1.5× the strategy's budget for
+  its final figure and the bootstrap CI of that factor lies above 1; **reversed** when the CI
+  lies below 1.
+
+The claims: a strategy beyond the paper (not Uniform, not Sobol — a better Uniform — not the
+paper's loop, not the oracle) beats Uniform on the area in at least two regimes; one reaches
+Uniform's final figure with at most 2/3 of its runs in at least one regime; the oracle's area
+lies above Uniform's (choosing runs can gain at all here); and the paper's loop beats Uniform.
+A claim over regimes reproduces when enough regimes reproduce; it is not run yet when the
+study has no check of it.
+"""
+
+from __future__ import annotations
+
+from evoeye.results.efficiency.config import ORACLE, REFERENCE
+from evoeye.results.findings import (
+    AGAINST,
+    NOT_RUN,
+    NOT_SHOWN,
+    REPRODUCES,
+    REVERSED,
+    check_verdict,
+)
+
+MEASURE = "test/scratch"
+EFFICIENCY = 1.5
+BASELINES = (REFERENCE, "sobol", "evoeye", ORACLE)  # not "strategies beyond the paper"
+
+
+def efficiency_verdict(e: dict | None) -> str:
+    """The verdict of one sample-efficiency factor (module doc)."""
+    if not e or e.get("factor") is None:
+        return NOT_SHOWN
+    if e["factor"] >= EFFICIENCY and e["low"] > 1.0:
+        return REPRODUCES
+    return REVERSED if e["high"] < 1.0 else NOT_SHOWN
+
+
+def _checks(results: dict) -> list[dict]:
+    out = []
+    for regime, r in results["regimes"].items():
+        for name, s in r["summaries"][MEASURE]["strategies"].items():
+            if name == REFERENCE or "area_vs_reference" not in s:
+                continue
+            area = s["area_vs_reference"]
+            out.append({"regime": regime, "strategy": name, "area": area,
+                        "area_verdict": check_verdict(area, "better"),
+                        "efficiency": s.get("efficiency"),
+                        "efficiency_verdict": efficiency_verdict(s.get("efficiency"))})
+    return out
+
+
+def _claim(id_: str, claim: str, checks: list[dict], key: str, need: int) -> dict:
+    """A claim that holds when one strategy reproduces in `need` regimes (none reversed)."""
+    if not checks:
+        return {"id": id_, "claim": claim, "checks": [], "verdict": NOT_RUN}
+    by_strategy: dict[str, list[str]] = {}
+    for c in checks:
+        by_strategy.setdefault(c["strategy"], []).append(c[key])
+    best = max(sum(v == REPRODUCES for v in vs) for vs in by_strategy.values())
+    if best >= need:
+        verdict = REPRODUCES
+    elif all(v == REVERSED for vs in by_strategy.values() for v in vs):
+        verdict = AGAINST
+    else:
+        verdict = NOT_SHOWN
+    return {"id": id_, "claim": claim, "checks": checks, "verdict": verdict}
+
+
+def efficiency_findings(results: dict) -> list[dict]:
+    """The study's claims with their checks and verdicts (module doc)."""
+    checks = _checks(results)
+    new = [c for c in checks if c["strategy"] not in BASELINES]
+    return [
+        _claim("efficiency-area", "A strategy beyond the paper beats Uniform on the area under "
+               "the Test-Set AUPRC curve in at least two regimes", new, "area_verdict", 2),
+        _claim("efficiency-factor", "A strategy beyond the paper reaches Uniform's final AUPRC "
+               f"with at most 2/3 of its runs (≥ {EFFICIENCY}×) in at least one regime", new,
+               "efficiency_verdict", 1),
+        _claim("efficiency-ceiling", "Choosing runs can gain over Uniform: the oracle's area "
+               "lies above Uniform's (in every regime)",
+               [c for c in checks if c["strategy"] == ORACLE], "area_verdict",
+               len(results["regimes"])),
+        _claim("efficiency-paper", "The paper's loop (evoeye) beats Uniform on the area (in "
+               "at least two regimes)", [c for c in checks if c["strategy"] == "evoeye"],
+               "area_verdict", 2),
+    ]

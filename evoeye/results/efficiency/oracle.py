@@ -1,0 +1,97 @@
+"""The oracle ceiling: a greedy chooser that knows every pool run's outcome and picks by true
+benefit, so its curve bounds what any choice of runs from this pool can gain over Uniform.
+
+At each step from one budget to the next it tries `oracle_candidates` increments of the step's
+size from the unused pool and keeps the one whose from-scratch monitor scores the highest
+AUPRC on the oracle set (uniform runs of their own, neither the Test Set nor the pool):
+* uniform draws (the reference's own kind of choice), all but three of the candidates;
+* the runs the current monitor errs on most (true per-run error, on a sample of the unused
+  pool scored with the step's monitor);
+* near misses and collisions (true margins: every collision of the sample and the safe runs
+  that passed closest, half and half);
+* half of each of the last two with uniform draws.
+The kept monitor is the checkpoint's: trained with the seed every strategy's checkpoint
+monitor gets, so it is judged on the Test and boundary sets like theirs. The oracle's choices
+use the outcomes and errors of runs before they are acquired, which no strategy can know: it
+is a ceiling, not a strategy. It is greedy (one step at a time) and tries a handful of
+increments, so it is a lower bound of the true optimum — a ceiling that Uniform already
+reaches says that choosing runs cannot help much here.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from evoeye.evolve.campaign.assess import metrics_dict
+from evoeye.results.efficiency.config import ORACLE
+from evoeye.results.efficiency.curves import Context, acquired_summary, initial_rows, training_seed
+from evoeye.results.efficiency.learner import run_feedback
+
+SAMPLE = 1000  # unused pool runs the error and margin candidates are chosen from
+
+
+def _candidates(ctx: Context, monitor, used: np.ndarray, size: int,
+                rng: np.random.Generator) -> list[tuple[str, np.ndarray]]:
+    pool = ctx.bank.pool
+    free = np.flatnonzero(~used)
+    sample = np.sort(rng.choice(free, size=min(SAMPLE, len(free)), replace=False))
+    errors = run_feedback(monitor, ctx.bank.windows(pool.scenario_id[sample]))
+    err = np.array([errors.get(str(s), -1.0) for s in pool.scenario_id[sample]])
+    by_error = sample[np.argsort(-err, kind="stable")]
+    gap = np.where(pool.collided[sample], -1.0, np.nan_to_num(pool.min_distance_m[sample],
+                                                              nan=np.inf))
+    by_margin = sample[np.argsort(np.abs(gap), kind="stable")]
+
+    def uniform(k: int, exclude=()) -> np.ndarray:
+        left = np.setdiff1d(free, exclude)
+        return rng.choice(left, size=k, replace=False)
+
+    half = size // 2
+    out = [("uniform", uniform(size)) for _ in range(max(1, ctx.config.oracle_candidates - 3))]
+    out += [("error", by_error[:size]), ("margin", by_margin[:size])]
+    mixed = np.concatenate([by_error[: half - half // 2], by_margin[: half // 2]])
+    mixed = np.unique(mixed)
+    out.append(("mixed", np.concatenate([mixed, uniform(size - len(mixed), mixed)])))
+    return out
+
+
+def run_oracle(ctx: Context, seed: int) -> dict:
+    """The oracle's learning curve at one seed (a ledger unit)."""
+    cfg = ctx.config
+    inputs = {"regime": ctx.regime, "sets": ctx.fingerprint, "strategy": ORACLE, "seed": seed,
+              "initial": cfg.initial_runs, "budgets": list(cfg.checkpoints),
+              "candidates": cfg.oracle_candidates, "recipe": ctx.learner.recipe}
+    return ctx.ledger.remember("efficiency-curve", inputs, lambda: _oracle(ctx, seed))
+
+
+def _oracle(ctx: Context, seed: int) -> dict:
+    cfg, pool, learner = ctx.config, ctx.bank.pool, ctx.learner
+    oracle_set = ctx.bank.data.sets["oracle"]
+    used = np.zeros(len(pool), bool)
+    used[initial_rows(len(pool), cfg.initial_runs, seed)] = True
+    monitor = learner.scratch(ctx.bank.windows(pool.scenario_id[used]),
+                              training_seed(seed, cfg.initial_runs))
+    g0 = ctx.scratch_figures(pool.scenario_id[used], cfg.initial_runs, seed, monitor)
+    out: dict = {"budgets": {str(cfg.initial_runs): {"scratch": g0}}, "kinds": []}
+    for step, budget in enumerate(cfg.checkpoints):
+        rng = np.random.default_rng([seed, 99, step])
+        size = budget - int(used.sum())
+        best = None
+        for kind, rows in _candidates(ctx, monitor, used, size, rng):
+            ids = [*pool.scenario_id[used], *pool.scenario_id[rows]]
+            candidate = learner.scratch(ctx.bank.windows(ids), training_seed(seed, budget))
+            auprc = metrics_dict(candidate.score(oracle_set), oracle_set.label,
+                                 candidate.thresholds)["auprc"]
+            ctx.say(f"{ctx.regime}: oracle seed {seed} at {budget}: {kind} {auprc:.3f}")
+            if best is None or auprc > best[0]:
+                best = (auprc, kind, rows, candidate)
+        auprc, kind, rows, monitor = best
+        used[rows] = True
+        out["kinds"].append(kind)
+        init = np.zeros(len(pool), bool)
+        init[initial_rows(len(pool), cfg.initial_runs, seed)] = True
+        acq = used & ~init
+        out["budgets"][str(budget)] = {
+            "scratch": learner.judge(monitor), "chosen": kind, "oracle_auprc": auprc,
+            "acquired": acquired_summary(pool.collided[acq], pool.fitness[acq])}
+    return out

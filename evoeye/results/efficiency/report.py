@@ -1,0 +1,148 @@
+"""The study's Markdown (efficiency.md, and its claims in findings.md) and its charts.
+
+Every cell renders like the other results tables (`evoeye.results.markdown`): a strategy's
+cell is its mean over seeds and the Student-t 95 % CI in points (AUPRC × 100); a comparison
+is the mean paired difference with Uniform, its BCa bootstrap 95 % CI and the Wilcoxon p.
+"""
+
+from __future__ import annotations
+
+from html import escape
+
+from evoeye.evaluation.plots import band_chart
+from evoeye.results.efficiency.config import ORACLE, REFERENCE, parse_regime
+from evoeye.results.efficiency.curves import MARGIN_BINS_M
+from evoeye.results.markdown import _md, diff_cell, mean_cell, pct
+
+SET_WORDS = {"test": "the Test Set", "boundary": "the boundary set"}
+KIND_WORDS = {"scratch": "the monitor trained from scratch on the runs acquired so far",
+              "update": "the product's monitor, updated every round by its replay rule"}
+INTRO = (
+    "Learning curves: from {initial} initial uniform runs (the same for every strategy at a "
+    "seed), each strategy acquires runs in rounds of {n_round} ({mode}); at {budgets} runs a "
+    "monitor is trained from scratch on everything acquired, with the training seed every "
+    "strategy gets at that seed and budget, and judged on sets no strategy shaped. Seeds "
+    "{seeds}, paired across strategies. *Area*: the curve's mean height on a log-budget axis. "
+    "*Uniform's budget ×*: the budget Uniform's mean curve needs to reach the strategy's final "
+    "mean, over the strategy's budget (≥ 1.5: Uniform needs 1.5× the runs; censored \">\" "
+    "past Uniform's last point), with its bootstrap 95 % CI. The oracle picks by true benefit "
+    "(outcomes and errors it could not know): the ceiling of what choosing runs can gain.")
+MODE_WORDS = {"pool": "picked from a pool of pre-simulated uniform runs",
+              "generative": "simulating what it proposes"}
+
+
+def _label(name: str) -> str:
+    return {ORACLE: "oracle (ceiling)", REFERENCE: "uniform (reference)"}.get(name, name)
+
+
+def _efficiency(e: dict | None) -> str:
+    if not e or e.get("factor") is None:
+        return "–"
+    return f"{'> ' if e['censored'] else ''}{e['factor']:.2f} [{e['low']:.2f}, {e['high']:.2f}]"
+
+
+def curve_table(summary: dict) -> list[str]:
+    """Mean [95 % CI] per budget, the area, and each strategy against Uniform."""
+    budgets = summary["reference_budgets"]
+    header = ["strategy", *(f"{b} runs" for b in budgets), "area", f"area {chr(8722)} Uniform",
+              f"final {chr(8722)} Uniform", "Uniform's budget ×"]
+    rows = []
+    for name, s in summary["strategies"].items():
+        cells = [mean_cell(m, "auprc", m["n"]) for m in s["mean"]]
+        cells += [""] * (len(budgets) - len(cells))
+        vs = s.get("area_vs_reference")
+        rows.append([_label(name), *cells, mean_cell(s["area"], "auprc", s["area"]["n"]),
+                     diff_cell(vs) if vs else "", diff_cell(s["final_vs_reference"]) if vs
+                     else "", _efficiency(s.get("efficiency"))])
+    return _md(header, rows)
+
+
+def where_table(where: dict) -> list[str]:
+    """Per strategy, where its acquired runs fell (the mean over seeds at its last common
+    budget): the share that collided, then the safe ones by their smallest gap to another
+    road user."""
+    edges = ["0", *(f"{e:g}" for e in MARGIN_BINS_M)]
+    bins = [f"gap {a}–{b} m" for a, b in zip(edges[:-1], edges[1:], strict=True)]
+    rows = [[_label(name), f"{w['runs']:.0f}", pct(w["collided"]),
+             *(pct(v) for v in w["by_gap"])] for name, w in where.items()]
+    return _md(["strategy", "acquired runs", "collided (%)", *(f"{b} (%)" for b in bins),
+                f"gap ≥ {edges[-1]} m (%)"], rows)
+
+
+def chart(summary: dict, title: str) -> str:
+    """The learning curves with their 95 % bands, in points."""
+    series = []
+    for name, s in summary["strategies"].items():
+        def col(key: str, s=s) -> list[float]:
+            return [float("nan") if m[key] is None else 100 * m[key] for m in s["mean"]]
+
+        series.append((_label(name), summary["reference_budgets"][: len(s["mean"])],
+                       col("mean"), col("low"), col("high")))
+    return band_chart(series, title=title, xlabel="runs (log scale)", ylabel="AUPRC (%)")
+
+
+def regime_markdown(regime: str, result: dict) -> str:
+    """One regime's section: its sets, a table per summary, where each strategy sampled."""
+    scenario, profile = parse_regime(regime)
+    sets = result["sets"]
+    lines = [f"## {scenario}, {profile} ADS", "",
+             f"Pool: {sets['pool']['runs']} uniform runs, {sets['pool']['collisions']} of them "
+             f"collide. Test Set: {sets['test']['runs']} runs ({sets['test']['frames']:,} "
+             f"frames, {sets['test']['unsafe']:,} unsafe). Boundary set: "
+             f"{sets['boundary']['runs']} runs. Validation: {sets['val']['runs']} runs. "
+             f"Oracle set: {sets['oracle']['runs']} runs.", ""]
+    for key, summary in result["summaries"].items():
+        set_name, kind = key.split("/")
+        lines += [f"### AUPRC on {SET_WORDS[set_name]}: {KIND_WORDS[kind]}", "",
+                  *curve_table(summary), ""]
+    lines += ["### Where each strategy sampled", "", *where_table(result["where"]), ""]
+    return "\n".join(lines)
+
+
+def efficiency_markdown(efficiency: dict) -> str:
+    """efficiency.md: the intro, then every regime."""
+    cfg = efficiency["config"]
+    intro = INTRO.format(initial=cfg["initial_runs"], n_round=cfg["n_round"],
+                         mode=MODE_WORDS[cfg["mode"]],
+                         budgets=", ".join(map(str, cfg["checkpoints"])),
+                         seeds=f"{cfg['seeds'][0]}–{cfg['seeds'][-1]}")
+    body = [regime_markdown(r, result) for r, result in efficiency["regimes"].items()]
+    return "\n".join(["# Sample efficiency: does choosing runs teach the monitor faster?", "",
+                      "Generated by `evoeye results --part efficiency`. " + intro, "",
+                      *body])
+
+
+def efficiency_findings_markdown(findings: list[dict]) -> str:
+    """The study's claims, their verdicts and their checks (for findings.md)."""
+    out = ["### Does acquisition earn its budget?", "",
+           *_md(["claim", "verdict"], [[f["claim"], f"**{f['verdict']}**"] for f in findings],
+                numbers=False), ""]
+    for f in findings:
+        if f["checks"]:
+            rows = [[c["regime"], c["strategy"], diff_cell(c["area"]), c["area_verdict"],
+                     _efficiency(c["efficiency"]), c["efficiency_verdict"]]
+                    for c in f["checks"]]
+            out += [f"**{f['claim']}** — {f['verdict']}", "",
+                    *_md(["regime", "strategy", f"area {chr(8722)} Uniform [95 % CI] p",
+                          "verdict", "Uniform's budget ×", "verdict"], rows, numbers=False),
+                    ""]
+    return "\n".join(out)
+
+
+def efficiency_html(efficiency: dict) -> list[str]:
+    """The study's part of results.html: per regime, a chart of each summary's curves."""
+    out = ["<h2>Sample efficiency</h2>"]
+    for regime, result in efficiency["regimes"].items():
+        scenario, profile = parse_regime(regime)
+        out.append(f"<h3>{escape(scenario)}, {escape(profile)} ADS</h3>")
+        for key, summary in result["summaries"].items():
+            set_name, kind = key.split("/")
+            out.append(chart(summary, f"{SET_WORDS[set_name]}, {kind}"))
+    return out
+
+
+def study_words(cfg: dict) -> str:
+    """What a study run was, in a few words: its mode and seeds."""
+    seeds = cfg["seeds"]
+    return (f"{MODE_WORDS[cfg['mode']]}, {len(seeds)} seeds ({seeds[0]}–{seeds[-1]}), "
+            f"regimes {', '.join(cfg['regimes'])}")

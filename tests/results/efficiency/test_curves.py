@@ -1,0 +1,58 @@
+"""Learning curves in pool mode: paired starts, the pool's runs, determinism, resume."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from evoeye.results.efficiency.acquire import PoolAcquirer
+from evoeye.results.efficiency.curves import initial_rows, run_curve
+from evoeye.results.efficiency.oracle import run_oracle
+from evoeye.results.efficiency.sets import concat_windows
+
+
+def test_every_strategy_starts_from_the_seeds_initial_runs_and_picks_unused_pool_runs(
+        context) -> None:
+    pool_ids = set(context.bank.pool.scenario_id)
+    init = set(context.bank.pool.scenario_id[initial_rows(len(pool_ids), 6, 0)])
+    assert init != set(context.bank.pool.scenario_id[initial_rows(len(pool_ids), 6, 1)])
+    curves = {s: run_curve(context, s, 0, PoolAcquirer(context.bank))
+              for s in ("uniform", "boundary")}
+    for name, curve in curves.items():
+        acquired = curve["acquired_ids"]
+        assert len(acquired) == len(set(acquired)) == max(context.config.checkpoints_of(name)) - 6
+        assert set(acquired) <= pool_ids - init
+        assert list(curve["budgets"]) == [str(b) for b in (6, *context.config.checkpoints_of(name))]
+        assert curve["budgets"]["6"] == curves["uniform"]["budgets"]["6"]  # the same G_0
+        assert curve["budgets"]["10"]["acquired"]["runs"] == 4
+    assert set(curves["uniform"]["budgets"]) - set(curves["boundary"]["budgets"]) == {"18"}
+
+
+def test_a_curve_is_deterministic_and_a_rerun_finds_it(context) -> None:
+    first = run_curve(context, "evoeye", 1, PoolAcquirer(context.bank))
+    found = context.ledger.found["efficiency-curve"]
+    again = run_curve(context, "evoeye", 1, PoolAcquirer(context.bank))
+    assert again == first and context.ledger.found["efficiency-curve"] == found + 1
+    for entry in context.ledger.folder.glob("efficiency-curve-*.json"):
+        entry.unlink()
+    assert run_curve(context, "evoeye", 1, PoolAcquirer(context.bank)) == first
+
+
+def test_the_oracle_picks_by_its_set_and_keeps_its_choice(context) -> None:
+    curve = run_oracle(context, 0)
+    assert len(curve["kinds"]) == len(context.config.checkpoints)
+    for b in context.config.checkpoints:
+        entry = curve["budgets"][str(b)]
+        assert entry["chosen"] in ("uniform", "error", "margin", "mixed")
+        assert entry["acquired"]["runs"] == b - context.config.initial_runs
+        assert set(entry["scratch"]) == {"test", "boundary"}
+
+
+def test_concatenated_windows_equal_the_pool_view(context) -> None:
+    ids = list(context.bank.pool.scenario_id[:5])
+    view = context.bank.data.take(ids)
+    parts = [context.bank.data.take([i]) for i in ids]
+    joined = concat_windows(parts)
+    np.testing.assert_array_equal(joined.label, view.label)
+    np.testing.assert_array_equal(joined.scenario_id, view.scenario_id)
+    for name, arr in view.arrays().items():
+        np.testing.assert_array_equal(joined.arrays()[name], arr, err_msg=name)

@@ -1,0 +1,44 @@
+"""The study as a part of `evoeye results`: workers, summaries, claims, files, resume."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+
+from evoeye.results.config import ResultsConfig
+from evoeye.results.efficiency import runner
+from evoeye.results.efficiency.part import run_efficiency
+from evoeye.results.ledger import Ledger
+from evoeye.results.run import assemble, write_results
+from evoeye.results.study import Study
+
+
+def test_the_study_runs_in_workers_resumes_and_writes_its_files(tiny_regime, tiny_config,
+                                                                 monkeypatch) -> None:
+    root, data = tiny_regime
+    monkeypatch.setattr(runner, "prepare_regime", lambda *a, **k: data)  # no simulation
+    config = replace(tiny_config, strategies=("uniform", "boundary"))
+    ledger = Ledger(root)
+    first = run_efficiency(root, config, workers=2, ledger=ledger)
+    regime = first["regimes"][config.regimes[0]]
+    measure = regime["summaries"]["test/scratch"]["strategies"]
+    assert set(measure) == {"uniform", "boundary", "oracle"}
+    assert [m["n"] for m in measure["uniform"]["mean"]] == [2, 2, 2, 2]  # 6, 10, 14, 18 runs
+    assert measure["boundary"]["area_vs_reference"]["n"] == 2
+    assert "oracle" not in regime["summaries"]["test/update"]["strategies"]  # no update rule
+    assert regime["where"]["boundary"]["runs"] == 14 - 6
+    assert [f["id"] for f in first["findings"]] == ["efficiency-area", "efficiency-factor",
+                                                    "efficiency-ceiling", "efficiency-paper"]
+
+    again = run_efficiency(root, config, workers=1, ledger=ledger)  # every curve found
+    assert again == first and ledger.computed["efficiency-curve"] == 0
+    assert ledger.found["efficiency-curve"] == 6  # 2 strategies and the oracle, 2 seeds
+
+    results = ResultsConfig(parts=("efficiency",), efficiency=config.changed())
+    folder = write_results(root, assemble(Study(root, results), {}, first), "study")
+    text = (folder / "efficiency.md").read_text()
+    assert "## highway-cut-in, default ADS" in text and "uniform (reference)" in text
+    assert "Does acquisition earn its budget?" in (folder / "findings.md").read_text()
+    assert (folder / "results.html").read_text().count("<svg") == 3  # one chart per summary
+    assert json.loads((folder / "results.json").read_text())["efficiency"]["config"][
+        "strategies"] == ["uniform", "boundary"]
