@@ -167,7 +167,9 @@ def train_monitors(
         for seed in seeds:  # each initialised under its seed, as alone
             with reproducible(seed, base.threads):
                 nets.append(start(seed))
-        with ThreadPoolExecutor(width) as pool:
+        # the kernels' global settings held around the threads: each thread's own `kernels`
+        # then saves and restores the same values, so no interleaving leaves them changed
+        with kernels(base.threads, where.type == "cpu"), ThreadPoolExecutor(width) as pool:
             trained = list(pool.map(run, seeds, nets))
     return [save_version(root, t.result.net.cpu(),
                          _card(t, scenario, horizon_s, init_from, config, train, val,

@@ -12,7 +12,7 @@ from html import escape
 from evoeye.evaluation.plots import band_chart
 from evoeye.results.efficiency.config import ORACLE, REFERENCE, parse_regime
 from evoeye.results.efficiency.curves import MARGIN_BINS_M
-from evoeye.results.markdown import _md, diff_cell, mean_cell, pct
+from evoeye.results.markdown import diff_cell, md_table, mean_cell, pct
 
 SET_WORDS = {"test": "the Test Set", "boundary": "the boundary set"}
 KIND_WORDS = {"scratch": "the monitor trained from scratch on the runs acquired so far",
@@ -54,7 +54,7 @@ def curve_table(summary: dict) -> list[str]:
         rows.append([_label(name), *cells, mean_cell(s["area"], "auprc", s["area"]["n"]),
                      diff_cell(vs) if vs else "", diff_cell(s["final_vs_reference"]) if vs
                      else "", _efficiency(s.get("efficiency"))])
-    return _md(header, rows)
+    return md_table(header, rows)
 
 
 def where_table(where: dict) -> list[str]:
@@ -65,7 +65,7 @@ def where_table(where: dict) -> list[str]:
     bins = [f"gap {a}–{b} m" for a, b in zip(edges[:-1], edges[1:], strict=True)]
     rows = [[_label(name), f"{w['runs']:.0f}", pct(w["collided"]),
              *(pct(v) for v in w["by_gap"])] for name, w in where.items()]
-    return _md(["strategy", "acquired runs", "collided (%)", *(f"{b} (%)" for b in bins),
+    return md_table(["strategy", "acquired runs", "collided (%)", *(f"{b} (%)" for b in bins),
                 f"gap ≥ {edges[-1]} m (%)"], rows)
 
 
@@ -115,7 +115,7 @@ def efficiency_markdown(efficiency: dict) -> str:
 def efficiency_findings_markdown(findings: list[dict]) -> str:
     """The study's claims, their verdicts and their checks (for findings.md)."""
     out = ["### Does acquisition earn its budget?", "",
-           *_md(["claim", "verdict"], [[f["claim"], f"**{f['verdict']}**"] for f in findings],
+           *md_table(["claim", "verdict"], [[f["claim"], f"**{f['verdict']}**"] for f in findings],
                 numbers=False), ""]
     for f in findings:
         if f["checks"]:
@@ -123,7 +123,7 @@ def efficiency_findings_markdown(findings: list[dict]) -> str:
                      _efficiency(c["efficiency"]), c["efficiency_verdict"]]
                     for c in f["checks"]]
             out += [f"**{f['claim']}** — {f['verdict']}", "",
-                    *_md(["regime", "strategy", f"area {chr(8722)} Uniform [95 % CI] p",
+                    *md_table(["regime", "strategy", f"area {chr(8722)} Uniform [95 % CI] p",
                           "verdict", "Uniform's budget ×", "verdict"], rows, numbers=False),
                     ""]
     return "\n".join(out)

@@ -272,7 +272,7 @@ def test_the_strategies_beyond_the_paper_are_rows_of_the_rq2_table() -> None:
     res = {"uniform": [_run([0.3])], "sobol": [_run([0.35])], "boundary": [_run([0.4])],
            "disagreement": [_run([0.45])], "evoeye-knn": [_run([0.2])]}
     md = markdown({"highway-cut-in": res})
-    rq2 = md.split("## highway-cut-in — RQ2")[1].split("##")[0]
+    rq2 = md.split("## highway-cut-in: Acquisition methods compared (RQ2)")[1].split("##")[0]
     for name in ("sobol", "boundary", "disagreement", "evoeye-knn"):
         assert f"| {name} |" in rq2
     assert [r[0] for r in acquisition_rows(res)][:1] == ["uniform"]
