@@ -76,11 +76,18 @@ def test_sigkill_on_the_parent_ends_its_workers_and_a_rerun_cleans_up(tmp_path) 
     assert "removed the unfinished log" in rerun.stdout
 
 
+def _default_sigint() -> None:
+    signal.signal(signal.SIGINT, signal.SIG_DFL)
+
+
 def test_ctrl_c_stops_the_workers_says_what_was_kept_and_a_rerun_resumes(tmp_path) -> None:
     root = tmp_path / "data"
     batch = DataRoot.resolve(root).batch_dir("highway-cut-in", "uniform-seed0")
+    # as from a shell: SIGINT at its default, so Python turns it into KeyboardInterrupt (a
+    # pytest-xdist worker ignores SIGINT, and a child would inherit that)
     parent = subprocess.Popen(_simulate(root, 40, 2), stdout=subprocess.PIPE,
-                              stderr=subprocess.PIPE, text=True, start_new_session=True)
+                              stderr=subprocess.PIPE, text=True, start_new_session=True,
+                              preexec_fn=_default_sigint)
     workers: list[int] = []
     try:
         assert _poll(lambda: len(list(batch.glob("*.mcap"))) >= 2, 300.0), "no run finished"
