@@ -35,7 +35,7 @@ STRATEGIES = ("uniform", "sobol", "boundary", "disagreement", "evoeye-knn", "evo
 REFERENCE = "uniform"
 ORACLE = "oracle"
 DEFAULT_PROFILE = "default"  # evoeye.ads.profiles.DEFAULT_PROFILE
-RECIPES, DEFAULT_RECIPE = ("v1", "v2"), "v2"  # evoeye.monitor.recipes
+RECIPES, DEFAULT_RECIPE = ("v1", "v2"), "v2"  # evoeye.monitor.recipes; importing it loads torch
 
 
 def parse_regime(regime: str) -> tuple[str, str]:
