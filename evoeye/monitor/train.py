@@ -11,17 +11,17 @@ the starting point, and the card records the parent. Without it a monitor is tra
 scratch, with normalisers fitted on the training frames.
 
 `train_monitors` trains several seeds of one recipe on the same data: the windows are loaded
-once and the seeds train side by side, one Python thread each (torch runs its kernels outside
-the interpreter lock), each with the one intra-op thread a seed trained alone has. A seed's
-computation is then the very sequence of kernels it runs alone, so its weights, and its version,
-are those `train_monitor` gives for that seed, bit for bit (tests/monitor/test_train_seeds.py).
-The seeds run on the device `evoeye.monitor.device` picks: a GPU when there is one.
+once and the seeds train side by side, on the CPU each in a process forked after the loading
+(`evoeye.monitor.side_by_side`), on a GPU each in a thread, each with the one intra-op thread a
+seed trained alone has. A seed's computation is then the very sequence of kernels it runs alone,
+so its weights, and its version, are those `train_monitor` gives for that seed, bit for bit
+(tests/monitor/test_train_seeds.py). The seeds run on the device `evoeye.monitor.device` picks:
+a GPU when there is one.
 """
 
 from __future__ import annotations
 
 import copy
-import os
 from collections.abc import Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
@@ -46,6 +46,7 @@ from evoeye.monitor.model import MODULES, FusionConfig, FusionNet
 from evoeye.monitor.protocol import Thresholds
 from evoeye.monitor.recipes import TrainParams, card_hyperparameters, recipe_params
 from evoeye.monitor.registry import load_monitor, save_version
+from evoeye.monitor.side_by_side import can_fork, map_forked
 from evoeye.paths import DataRoot
 from evoeye.store.catalog import Warehouse
 from evoeye.store.features import FrameFeatures
@@ -126,9 +127,10 @@ def train_monitors(
 ) -> list[str]:
     """`train_monitor` once per seed, on data loaded once; the version ids, in `seeds`' order,
     each the one `train_monitor` gives for that seed (module doc). `parallel` seeds train at a
-    time (default: as many as there are cores, at most one per seed); `progress` rows carry
-    their "seed". A network with dropout draws from the global RNG while it trains, so its
-    seeds train one after the other."""
+    time (default: all; time-shared, k seeds on n cores take ≈ k / n of one seed's time);
+    `progress` rows carry their "seed". A network with dropout draws from the global RNG while
+    it trains, so in threads (a GPU, or a platform without fork) its seeds train one after the
+    other."""
     if not seeds or len(set(seeds)) != len(seeds):
         raise ValueError(f"give distinct training seeds, got {list(seeds)}")
     base = params or recipe_params(recipe, **overrides)
@@ -149,19 +151,24 @@ def train_monitors(
         net.fit_normalizers(frames)
         return net.to(where)
 
-    def run(seed: int, net: FusionNet | None = None) -> Trained:
+    def run(seed: int, net: FusionNet | None = None, report: Progress | None = None) -> Trained:
         p = replace(base, seed=seed)
         with reproducible(seed, p.threads, where.type == "cpu") if net is None else kernels(
                 p.threads, where.type == "cpu"):
             net = net or start(seed)
-            result = fit(net, train, val, p, _tagged(progress, seed))
+            result = fit(net, train, val, p, report)
             scores = FusionMonitor(result.net, "training", None,  # type: ignore[arg-type]
                                    device=where).score(val)
         return Trained(p, result, scores, calibrate_on_validation(scores, val))
 
-    width = min(len(seeds), parallel or os.cpu_count() or 1)
-    if width == 1 or config.dropout > 0:
-        trained = [run(seed) for seed in seeds]
+    width = min(len(seeds), parallel or len(seeds))
+    if width > 1 and where.type == "cpu" and can_fork():
+        # each seed in a process forked from this one: initialised there under its seed, as alone
+        trained = map_forked(lambda seed, send: run(seed, report=send), seeds, width=width,
+                             on_message=None if progress is None else (
+                                 lambda seed, row: progress({**row, "seed": seed})))
+    elif width == 1 or config.dropout > 0:
+        trained = [run(seed, report=_tagged(progress, seed)) for seed in seeds]
     else:
         nets = []
         for seed in seeds:  # each initialised under its seed, as alone
@@ -170,7 +177,8 @@ def train_monitors(
         # the kernels' global settings held around the threads: each thread's own `kernels`
         # then saves and restores the same values, so no interleaving leaves them changed
         with kernels(base.threads, where.type == "cpu"), ThreadPoolExecutor(width) as pool:
-            trained = list(pool.map(run, seeds, nets))
+            trained = list(pool.map(lambda seed, net: run(seed, net, _tagged(progress, seed)),
+                                    seeds, nets))
     return [save_version(root, t.result.net.cpu(),
                          _card(t, scenario, horizon_s, init_from, config, train, val,
                                train_runs, val_runs, where))
