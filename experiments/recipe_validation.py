@@ -1,14 +1,15 @@
 """A training recipe against the RQ1 figures docs/results recorded, paired over training seeds.
 
     python -m experiments.recipe_validation --root DIR --results docs/results/rq1-S.json \\
-        [--recipe v2] [--seeds 0,1,2,3,4,5] [--out FILE.json]
+        [--recipe v2] [--method FusionMonitor|aem] [--seeds 0,1,2,3,4,5] [--out FILE.json]
 
 DIR holds the run's RQ1 data regenerated (`evoeye.results.study.prepare_data` with the recorded
 config's seeds and sizes: the same seeds give the same runs). The script first checks that it is
 the recorded data — every split's runs, violations, frames and unsafe frames, and the TTC rule's
-test figures, equal to the recorded ones — then trains the FusionMonitor of the recipe at the
-seeds through the results' own units (`units.trained_versions`: RQ1's ledger, seeds together)
-and judges each as RQ1 does (`units.test_figures`). It prints, per seed, the recorded and the new
+test figures, equal to the recorded ones — then trains the FusionMonitor (or, with `--method
+aem`, the AEM baseline) of the recipe at the seeds through the results' own units
+(`units.trained_versions`: RQ1's ledger, seeds together; `units.baseline` for the AEM) and
+judges each as RQ1 does (`units.test_figures`). It prints, per seed, the recorded and the new
 figures, and per metric the paired difference new − recorded: mean, 95 % BCa bootstrap CI and
 Wilcoxon p (`evoeye.evaluation.stats.compare_paired`), with the recorded mean's t interval and
 whether the new mean lies inside it; and per seed the training's epochs, wall and CPU seconds
@@ -59,6 +60,8 @@ def main() -> None:
     ap.add_argument("--root", required=True)
     ap.add_argument("--results", required=True, help="a docs/results rq1-*.json")
     ap.add_argument("--recipe", default="v2")
+    ap.add_argument("--method", default=FUSION_LABEL, choices=(FUSION_LABEL, "aem"),
+                    help="the recorded method to train again by the recipe")
     ap.add_argument("--seeds", default=None, help="comma list (default: the recorded seeds)")
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
@@ -69,19 +72,25 @@ def main() -> None:
     recorded = record["scenarios"][scenario]
     seeds = [int(s) for s in args.seeds.split(",")] if args.seeds else recorded["rq1"]["seeds"]
     old = {s: f["test"] for s, f in zip(recorded["rq1"]["seeds"],
-                                        recorded["rq1"]["methods"][FUSION_LABEL]["figures"],
+                                        recorded["rq1"]["methods"][args.method]["figures"],
                                         strict=True)}
     study = Study(DataRoot.resolve(args.root), config, print)
     check_data(study, scenario, recorded)
     load = os.getloadavg()
     t0, c0 = time.perf_counter(), time.process_time()
-    versions = units.trained_versions(study, scenario, DEFAULT_FAMILY, seeds=seeds,
-                                      context_len=FULL_CONTEXT_LEN, modules=list(MODULES))
+    if args.method == FUSION_LABEL:
+        versions = units.trained_versions(study, scenario, DEFAULT_FAMILY, seeds=seeds,
+                                          context_len=FULL_CONTEXT_LEN, modules=list(MODULES))
+        monitors = [FAMILIES[DEFAULT_FAMILY].load(study.root, v) for v in versions]
+    else:
+        monitors = [units.baseline(study, scenario, args.method, s) for s in seeds]
+        versions = [m.version for m in monitors]
     wall_s, cpu_s = time.perf_counter() - t0, time.process_time() - c0
-    new = {s: units.test_figures(study, scenario, FAMILIES[DEFAULT_FAMILY].load(
-        study.root, v))["test"] for s, v in zip(seeds, versions, strict=True)}
-    cards = {s: read_card(study.root, v) for s, v in zip(seeds, versions, strict=True)}
-    out = {"scenario": scenario, "recipe": args.recipe, "seeds": seeds,
+    new = {s: units.test_figures(study, scenario, m)["test"]
+           for s, m in zip(seeds, monitors, strict=True)}
+    cards = {s: read_card(study.root, v) if args.method == FUSION_LABEL else {}
+             for s, v in zip(seeds, versions, strict=True)}  # the AEM keeps no training record
+    out = {"scenario": scenario, "method": args.method, "recipe": args.recipe, "seeds": seeds,
            "versions": dict(zip(map(str, seeds), versions, strict=True)),
            "load_average": load, "wall_s": wall_s, "cpu_s": cpu_s, "per_seed": {},
            "paired": {}}
@@ -90,8 +99,9 @@ def main() -> None:
           + " | epochs (best) | wall s | CPU s |")
     print("|---|" + "---:|" * (len(METRICS) + 3))
     for s in seeds:
-        t = cards[s]["training"]
-        frames = cards[s]["data"]["train"]["frames"]
+        t = cards[s].get("training") or dict.fromkeys(
+            ("epochs_run", "best_epoch", "time_s", "cpu_s"), float("nan"))
+        frames = cards[s]["data"]["train"]["frames"] if cards[s] else float("nan")
         out["per_seed"][s] = {"old": {m: old[s][m] for m in METRICS},
                               "new": {m: new[s][m] for m in METRICS},
                               "epochs_run": t["epochs_run"], "best_epoch": t["best_epoch"],

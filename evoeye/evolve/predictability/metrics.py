@@ -19,6 +19,10 @@ MIN_RUNS = 20  # fewer runs (or, for AUROC, fewer than FOLDS of either class): n
 # as ±0.19, and spearmanr's p, which treats the folds' predictions as independent, is too small.
 RHO_MIN = 0.2
 P_MAX = 0.05
+# ... and a significant ρ whose out-of-fold R² stays below R2_MIN ranks a little but explains
+# almost none of the error: a strategy steering by it gains little (S1's default ADS: ρ 0.27,
+# R² 0.04, and no strategy above Uniform).
+R2_MIN = 0.1
 AUROC_MIN = 0.6
 BOOTSTRAP = 1000  # resamples of the runs for the AUROC's 95 % interval
 
@@ -147,10 +151,15 @@ def verdict(collision: Classified, error: Regressed | None, noise: Flips | None 
                      "there is no boundary in θ to seek.")
     if error is None:
         lines.append("No monitor error measured (no monitor, or no run it did not train on).")
+    elif error.predictive and (error.r2 is None or error.r2 < R2_MIN):
+        lines.append(f"θ predicts the monitor's error only weakly (Spearman {error.spearman:.2f}, "
+                     f"p = {error.spearman_p:.2g}, but R² {_r2(error)}): it ranks runs a "
+                     "little and explains almost none of the error, so a strategy that chooses "
+                     "θ can gain little over Uniform at finding where this monitor errs.")
     elif error.predictive:
         lines.append(f"θ predicts the monitor's error (Spearman {error.spearman:.2f}, "
-                     f"p = {error.spearman_p:.2g}): a strategy that chooses θ can steer toward "
-                     "where the monitor errs.")
+                     f"p = {error.spearman_p:.2g}, R² {_r2(error)}): a strategy that chooses θ "
+                     "can steer toward where the monitor errs.")
     else:
         rho = "–" if error.spearman is None else f"{error.spearman:.2f}"
         lines.append(f"θ does not predict the monitor's error (Spearman {rho}): no strategy "
@@ -165,6 +174,10 @@ def verdict(collision: Classified, error: Regressed | None, noise: Flips | None 
                          ": there, that much of the outcome is chance no choice of θ removes."
                          if flips_of.flip_share > 0 else ": the outcome is a function of θ."))
     return lines
+
+
+def _r2(error: Regressed) -> str:
+    return "–" if error.r2 is None else f"{error.r2:.2f}"
 
 
 def as_dict(figure: Classified | Regressed | Flips | None) -> dict | None:

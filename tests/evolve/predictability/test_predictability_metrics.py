@@ -118,3 +118,13 @@ def test_the_verdict_says_plainly_when_theta_cannot_steer():
     assert "0 % of the outcomes of θ drawn uniformly" in good[2] and "function of θ" in good[2]
     assert "10 % of the outcomes of the θ nearest the failure boundary" in good[3]
     assert "chance" in good[3]
+
+
+def test_a_significant_rank_that_explains_little_of_the_error_is_called_weak():
+    weak = metrics.Regressed(400, 0.04, 0.27, 1e-7)
+    assert weak.predictive
+    line = metrics.verdict(metrics.Classified(400, 100, 0.82), weak)[1]
+    assert "only weakly" in line and "R² 0.04" in line and "can gain little" in line
+    strong = metrics.verdict(metrics.Classified(400, 100, 0.82),
+                             metrics.Regressed(400, metrics.R2_MIN, 0.5, 1e-9))[1]
+    assert "only weakly" not in strong and "can steer toward" in strong
