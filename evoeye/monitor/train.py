@@ -142,13 +142,13 @@ def train_monitors(
                          horizon_s=horizon_s)
     val = load_windows(warehouse, val_runs, context_len=config.context_len, horizon_s=horizon_s)
     where = pick_device(device)
-    frames = None if parent is not None else _frames_of(train)
+    norms = None if parent is not None else _fitted_normalizers(train, config)
 
     def start(seed: int) -> FusionNet:
         if parent is not None:
             return copy.deepcopy(parent.net).to(where)
         net = FusionNet(FusionConfig.for_spec(train.spec, **_sizes(config)))
-        net.fit_normalizers(frames)
+        net.norm.load_state_dict(norms)  # the same for every seed: fitted once
         return net.to(where)
 
     def run(seed: int, net: FusionNet | None = None, report: Progress | None = None) -> Trained:
@@ -277,6 +277,16 @@ def _sizes(config: FusionConfig) -> dict[str, Any]:
         d.pop(key)
     d["modules"] = tuple(d["modules"])
     return d
+
+
+def _fitted_normalizers(train: Windows, config: FusionConfig) -> dict[str, torch.Tensor]:
+    """The input normalisers' state of a network of `config` fitted on the training frames:
+    seed-independent, so fitted once for every seed (a network made aside, the caller's random
+    generator left as it was)."""
+    with torch.random.fork_rng(devices=[]):
+        net = FusionNet(FusionConfig.for_spec(train.spec, **_sizes(config)))
+    net.fit_normalizers(_frames_of(train))
+    return net.norm.state_dict()
 
 
 def _frames_of(windows: Windows) -> FrameFeatures:
