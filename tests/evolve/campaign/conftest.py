@@ -7,13 +7,11 @@ from collections.abc import Callable
 from pathlib import Path
 
 import pytest
+from campaign_helpers import SCENARIO, SPLITS
 
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.paths import DataRoot
-from evoeye.store import SplitSpec, ingest
-
-SCENARIO = "unprotected-intersection"  # ~half its runs collide: both classes in tiny splits
-SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
+from evoeye.store import ingest
 
 
 @pytest.fixture(scope="session")

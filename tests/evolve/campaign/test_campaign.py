@@ -7,6 +7,7 @@ import shutil
 
 import numpy as np
 import pytest
+from campaign_helpers import SCENARIO, SPLITS, config, snapshot
 
 from evoeye.evolve.campaign import loop as campaign_mod
 from evoeye.evolve.campaign.config import (
@@ -19,35 +20,9 @@ from evoeye.evolve.campaign.config import (
 from evoeye.evolve.campaign.loop import Campaign
 from evoeye.monitor.families import FAMILIES
 from evoeye.paths import DataRoot
-from evoeye.store import SplitSpec, Warehouse, load_windows
-from evoeye.store.feedback import read_committee, read_feedback, read_rounds
+from evoeye.store import Warehouse, load_windows
+from evoeye.store.feedback import read_feedback, read_rounds
 from evoeye.store.log_windows import read_logged_run
-
-SCENARIO = "unprotected-intersection"  # of the `seeded` data root (conftest.py)
-SPLITS = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
-
-
-def config(g0: str, **kw) -> CampaignConfig:
-    base = dict(scenario=SCENARIO, strategy="evoeye", budget_s=1000.0, seed=0, monitor=g0,
-                n_round=2, epochs=1, splits=SPLITS)
-    return CampaignConfig(**{**base, **kw})
-
-
-def snapshot(root: DataRoot, c: Campaign) -> dict:
-    """Everything a finished campaign left behind that must not depend on interruptions."""
-    rounds = read_rounds(root, c.campaign_id)
-    fb = read_feedback(root)
-    logs = sorted(p.name for p in (root.runs / SCENARIO / c.campaign_id).glob("*"))
-    return {
-        "rounds": [(r.round, r.monitor_version, list(r.scenario_ids), r.n_records,
-                    r.simulated_s) for r in rounds],
-        "logs": logs,
-        "feedback": sorted(zip(fb.column("monitor_version").to_pylist(),
-                               fb.column("feedback_mode").to_pylist(),
-                               fb.column("scenario_id").to_pylist(),
-                               fb.column("feedback").to_pylist(), strict=True)),
-        "committee": read_committee(root, c.campaign_id),
-    }
 
 
 def test_log_windows_equal_the_warehouse_windows(seeded) -> None:
@@ -204,7 +179,6 @@ def test_killed_mid_round_resumes_to_the_same_records(root_copy, seeded, clean_r
 def test_killed_during_training_resumes_to_the_same_records(root_copy, seeded, clean_runs,
                                                             family: str, strategy: str) -> None:
     """(disagreement: killed between the two companions of round 1's committee)"""
-    from evoeye.monitor.families import FAMILIES
 
     cfg = family_config(seeded[1], family, strategy=strategy)
     calls = {"n": 0}
@@ -349,85 +323,3 @@ def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_cop
         assert fb[one] == pytest.approx(np.abs(risk[k] - w.label[k]).mean())
     hard = rows[1].metrics.hard
     assert hard["frames"] == assess(seeded[1]).hard["frames"] > 0
-
-
-# -- the replay update: each round trains on its runs and a seeded sample of as many earlier --
-
-def capture_training(root, cfg, log: list[list[str]]) -> Campaign:
-    """A campaign whose monitor updates are real, with the runs each one trained on logged."""
-    def train(*args, train_runs, **kwargs) -> str:
-        log.append(list(train_runs))
-        return FAMILIES["fusion"].train(*args, train_runs=train_runs, **kwargs)
-    return Campaign(root, cfg, train=train)
-
-
-def test_replay_trains_on_the_rounds_runs_and_as_many_earlier_ones(root_copy, seeded) -> None:
-    root = root_copy("replay")
-    cfg = config(seeded[1], strategy="uniform", n_round=3)
-    trained: list[list[str]] = []
-    c = capture_training(root, cfg, trained)
-    state = c.run(max_rounds=2)
-    initial = set(c.initial["scenario_id"])
-    assert len(trained) == 2 and len(initial) > 3
-    earlier = set(initial)
-    for row, ids in zip(state.rounds[1:], trained, strict=True):
-        new = [s for s, ok in zip(state.records.scenario_id, state.ok, strict=True)
-               if ok and s in row.scenario_ids]
-        assert len(new) == 3 and ids[-3:] == new  # the round's own runs, in order, last
-        replayed = ids[:-3]
-        assert len(replayed) == 3 and len(set(replayed)) == 3 and set(replayed) <= earlier
-        collided = dict(zip(state.records.scenario_id, state.records.collided, strict=True))
-        assert any(collided[s] for s in ids)  # both classes to learn from
-        earlier |= set(row.scenario_ids)
-
-    again: list[list[str]] = []  # the same campaign elsewhere draws the same samples
-    capture_training(root_copy("replay-again"), cfg, again).run(max_rounds=2)
-    assert again == trained
-
-
-def test_finetune_trains_on_every_record(root_copy, seeded) -> None:
-    trained: list[list[str]] = []
-    c = capture_training(root_copy("finetune"), config(seeded[1], strategy="uniform",
-                                                       update="finetune"), trained)
-    state = c.run(max_rounds=1)
-    ok = [s for s, good in zip(state.records.scenario_id, state.ok, strict=True) if good]
-    assert trained == [ok] and len(ok) == len(c.initial["scenario_id"]) + 2
-
-
-def test_a_round_without_an_ok_run_keeps_its_monitor(root_copy, seeded) -> None:
-    c = Campaign(root_copy("failed"), config(seeded[1], strategy="uniform"))
-    state = c.start()
-    c.acquire(state)
-    state.ok[:] = np.arange(len(state.ok)) < len(c.initial["scenario_id"])  # the round failed
-    assert state.training_runs(c.config.update, c.config.seed) == []
-    assert c.update_monitor(state) == (state.monitor, 0.0)
-
-
-def test_disagreement_campaign_keeps_a_committee_and_each_runs_spread(root_copy, seeded) -> None:
-    """K = 3: two companions per round, found again by later campaigns for round 0, and every
-    record's disagreement is the spread of the committee's scores on its warehouse windows."""
-    from evoeye.evolve.search.feedback import scenario_disagreement
-
-    root = root_copy("committee")
-    c = Campaign(root, config(seeded[1], strategy="disagreement", committee=3))
-    state = c.run(max_rounds=2)
-    committee = read_committee(root, c.campaign_id)
-    assert sorted(committee) == [0, 1, 2] and all(len(v) == 2 for v in committee.values())
-    assert len({*committee[0], *committee[1], *committee[2], *(r.monitor_version
-                                                              for r in state.rounds)}) == 9
-    ok = state.records.scenario_id[state.ok]
-    w = load_windows(root, list(ok), context_len=5, horizon_s=3.0)
-    members = [state.monitor, *committee[2]]
-    expected = scenario_disagreement(np.stack([c.monitor(v).score(w) for v in members]),
-                                     w.scenario_id)
-    np.testing.assert_allclose(state.records.disagreement[state.ok],
-                               expected.aligned(ok), rtol=1e-6)
-    assert np.isfinite(state.records.disagreement[state.ok]).all()
-    # another campaign of the same G_0 and D_init shares round 0's companions
-    other = Campaign(root, config(seeded[1], strategy="disagreement", committee=3, seed=1))
-    assert other.committee.companions(0) == committee[0]
-    # the committee's size is part of a disagreement campaign's id, of no other
-    assert Campaign(root, config(seeded[1], strategy="disagreement", committee=4)).campaign_id \
-        != c.campaign_id
-    assert Campaign(root, config(seeded[1], committee=4)).campaign_id \
-        == Campaign(root, config(seeded[1])).campaign_id

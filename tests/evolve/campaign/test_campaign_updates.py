@@ -1,0 +1,92 @@
+"""The campaign's monitor updates: the runs each rule trains on, a failed round, the committee."""
+
+from __future__ import annotations
+
+import numpy as np
+from campaign_helpers import config
+
+from evoeye.evolve.campaign.loop import Campaign
+from evoeye.monitor.families import FAMILIES
+from evoeye.store import load_windows
+from evoeye.store.feedback import read_committee
+
+# -- the replay update: each round trains on its runs and a seeded sample of as many earlier --
+
+def capture_training(root, cfg, log: list[list[str]]) -> Campaign:
+    """A campaign whose monitor updates are real, with the runs each one trained on logged."""
+    def train(*args, train_runs, **kwargs) -> str:
+        log.append(list(train_runs))
+        return FAMILIES["fusion"].train(*args, train_runs=train_runs, **kwargs)
+    return Campaign(root, cfg, train=train)
+
+
+def test_replay_trains_on_the_rounds_runs_and_as_many_earlier_ones(root_copy, seeded) -> None:
+    root = root_copy("replay")
+    cfg = config(seeded[1], strategy="uniform", n_round=3)
+    trained: list[list[str]] = []
+    c = capture_training(root, cfg, trained)
+    state = c.run(max_rounds=2)
+    initial = set(c.initial["scenario_id"])
+    assert len(trained) == 2 and len(initial) > 3
+    earlier = set(initial)
+    for row, ids in zip(state.rounds[1:], trained, strict=True):
+        new = [s for s, ok in zip(state.records.scenario_id, state.ok, strict=True)
+               if ok and s in row.scenario_ids]
+        assert len(new) == 3 and ids[-3:] == new  # the round's own runs, in order, last
+        replayed = ids[:-3]
+        assert len(replayed) == 3 and len(set(replayed)) == 3 and set(replayed) <= earlier
+        collided = dict(zip(state.records.scenario_id, state.records.collided, strict=True))
+        assert any(collided[s] for s in ids)  # both classes to learn from
+        earlier |= set(row.scenario_ids)
+
+    again: list[list[str]] = []  # the same campaign elsewhere draws the same samples
+    capture_training(root_copy("replay-again"), cfg, again).run(max_rounds=2)
+    assert again == trained
+
+
+def test_finetune_trains_on_every_record(root_copy, seeded) -> None:
+    trained: list[list[str]] = []
+    c = capture_training(root_copy("finetune"), config(seeded[1], strategy="uniform",
+                                                       update="finetune"), trained)
+    state = c.run(max_rounds=1)
+    ok = [s for s, good in zip(state.records.scenario_id, state.ok, strict=True) if good]
+    assert trained == [ok] and len(ok) == len(c.initial["scenario_id"]) + 2
+
+
+def test_a_round_without_an_ok_run_keeps_its_monitor(root_copy, seeded) -> None:
+    c = Campaign(root_copy("failed"), config(seeded[1], strategy="uniform"))
+    state = c.start()
+    c.acquire(state)
+    state.ok[:] = np.arange(len(state.ok)) < len(c.initial["scenario_id"])  # the round failed
+    assert state.training_runs(c.config.update, c.config.seed) == []
+    assert c.update_monitor(state) == (state.monitor, 0.0)
+
+
+def test_disagreement_campaign_keeps_a_committee_and_each_runs_spread(root_copy, seeded) -> None:
+    """K = 3: two companions per round, found again by later campaigns for round 0, and every
+    record's disagreement is the spread of the committee's scores on its warehouse windows."""
+    from evoeye.evolve.search.feedback import scenario_disagreement
+
+    root = root_copy("committee")
+    c = Campaign(root, config(seeded[1], strategy="disagreement", committee=3))
+    state = c.run(max_rounds=2)
+    committee = read_committee(root, c.campaign_id)
+    assert sorted(committee) == [0, 1, 2] and all(len(v) == 2 for v in committee.values())
+    assert len({*committee[0], *committee[1], *committee[2], *(r.monitor_version
+                                                              for r in state.rounds)}) == 9
+    ok = state.records.scenario_id[state.ok]
+    w = load_windows(root, list(ok), context_len=5, horizon_s=3.0)
+    members = [state.monitor, *committee[2]]
+    expected = scenario_disagreement(np.stack([c.monitor(v).score(w) for v in members]),
+                                     w.scenario_id)
+    np.testing.assert_allclose(state.records.disagreement[state.ok],
+                               expected.aligned(ok), rtol=1e-6)
+    assert np.isfinite(state.records.disagreement[state.ok]).all()
+    # another campaign of the same G_0 and D_init shares round 0's companions
+    other = Campaign(root, config(seeded[1], strategy="disagreement", committee=3, seed=1))
+    assert other.committee.companions(0) == committee[0]
+    # the committee's size is part of a disagreement campaign's id, of no other
+    assert Campaign(root, config(seeded[1], strategy="disagreement", committee=4)).campaign_id \
+        != c.campaign_id
+    assert Campaign(root, config(seeded[1], committee=4)).campaign_id \
+        == Campaign(root, config(seeded[1])).campaign_id
