@@ -131,9 +131,9 @@ class CampaignConfig:
                                  "trained from scratch on the scenario, or its initial "
                                  "version).")
     n_round: int = option(20, "Runs per round (N_round).", ge=1)
-    update: str = option("replay", "Monitor update per round: replay (fine-tune G_r on the "
-                         "round's runs and as many earlier ones), finetune (on every record) or "
-                         "retrain (from scratch on every record).", names="update")
+    update: str = option("retrain", "Monitor update per round: retrain (from scratch on every "
+                         "record), replay (fine-tune G_r on the round's runs and as many earlier "
+                         "ones) or finetune (G_r on every record).", names="update")
     epochs: int | None = option(None, "Epochs per monitor update (default: 2 with replay, 10 "
                                 "fine-tuning, the trainer's when retraining).", ge=1)
     patience: int | None = option(None, "Early-stopping patience per update (default: 1 with "

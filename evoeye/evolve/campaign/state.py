@@ -75,16 +75,16 @@ class CampaignState:
     def training_runs(self, update: str, seed: int) -> list[str]:
         """The runs of D_r the monitor update trains on: every ok record, or with `update`
         "replay" the round's new ok runs after a sample of as many earlier ones (seeded by the
-        campaign `seed` and the round; empty when the round has no ok run)."""
+        campaign `seed` and the round); none when the round has no ok run (G_r stays)."""
         ok = self.records.scenario_id[self.ok]
-        if update != "replay":
-            return [str(s) for s in ok]
         seen = {*self.records.scenario_id[:self.n_init],
                 *(s for r in self.rounds for s in r.scenario_ids)}
         is_new = np.array([s not in seen for s in ok], dtype=bool)
         new, earlier = ok[is_new], ok[~is_new]
         if len(new) == 0:
             return []
+        if update != "replay":
+            return [str(s) for s in ok]
         rng = np.random.default_rng([seed, self.round + 1])
         k = min(len(earlier), int(round(REPLAY_RATIO * len(new))))
         pick = np.sort(rng.choice(len(earlier), size=k, replace=False))

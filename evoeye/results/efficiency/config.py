@@ -19,8 +19,8 @@ Plain data (the command line reads it at start-up). Sizes, and why:
   at a seed) and are measured at log-spaced budgets ×2, ×4, ×8 (80, 160, 320 runs, initial runs
   included); Uniform goes on to ×16 so that the budget it needs to match a strategy can be read
   off its own curve up to a factor of 2.
-* Acquisition comes in rounds of 20 runs, after each of which the product's update rule (the
-  replay fine-tune of `evoeye evolve`) updates the monitor the strategies' feedback comes from.
+* Acquisition comes in rounds of 20 runs, after each of which the replay update (the paper's loop,
+  `evoeye evolve --update replay`) updates the monitor the strategies' feedback comes from.
   At a checkpoint the monitor is trained from scratch on everything acquired, with the training
   seed of that seed and checkpoint shared by every strategy (the pairing absorbs it).
 """

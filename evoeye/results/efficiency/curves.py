@@ -2,12 +2,13 @@
 checkpoint the monitor is trained from scratch on all of them and judged.
 
 The loop per round: the strategy proposes N_round runs one at a time, each is acquired (taken
-from the pool, or simulated: `acquire.py`) and told to it; then the product's update rule
-refreshes the monitor whose feedback the strategies read (and, for `disagreement`, the
-committee beside it), and every record's feedback is refreshed. At a checkpoint two monitors
-are judged on the sets no strategy shaped: one trained from scratch on everything acquired
-(the curve's figure — what the runs are worth), with the seed of that seed and checkpoint that
-every strategy shares, and the updated monitor (what the product would deploy).
+from the pool, or simulated: `acquire.py`) and told to it; then the replay update (the paper's
+loop, `evoeye evolve --update replay`) refreshes the monitor whose feedback the strategies
+read (and, for `disagreement`, the committee beside it), and every record's feedback is
+refreshed. At a checkpoint two monitors are judged on the sets no strategy shaped: one
+trained from scratch on everything acquired (the curve's figure — what the runs are worth, and
+what `evoeye evolve` deploys by default), with the seed of that seed and checkpoint that every
+strategy shares, and the replay-updated monitor (what the paper's loop would deploy).
 
 The same seed gives every strategy the same D_init (drawn from the pool), the same G_0 and the
 same training seed at each checkpoint, so strategies differ only in the runs they chose.

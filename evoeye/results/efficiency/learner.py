@@ -41,7 +41,7 @@ class Learner:
                              f"scratch-{seed}")
 
     def update(self, parent: FusionMonitor, train: Windows, seed: int) -> FusionMonitor:
-        """The product's update rule (`evoeye evolve --update replay`): `parent` fine-tuned for
+        """The paper's update rule (`evoeye evolve --update replay`): `parent` fine-tuned for
         at most REPLAY_EPOCHS on `train` (the round's runs and their replay sample)."""
         params = replace(self.params, seed=seed, epochs=REPLAY_EPOCHS, patience=REPLAY_PATIENCE)
         return self._monitor(fit_windows(train, self.val, params, parent=parent.net),

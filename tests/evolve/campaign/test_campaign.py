@@ -44,9 +44,9 @@ def test_config_rejects_unknown_strategy_and_update() -> None:
         CampaignConfig(SCENARIO, strategy="random-walk")
     with pytest.raises(ValueError, match="update"):
         CampaignConfig(SCENARIO, update="warm")
-    assert CampaignConfig(SCENARIO).update == "replay"
-    assert CampaignConfig(SCENARIO).train_overrides() == {"epochs": REPLAY_EPOCHS,
-                                                          "patience": REPLAY_PATIENCE}
+    assert CampaignConfig(SCENARIO).update == "retrain"
+    assert CampaignConfig(SCENARIO, update="replay").train_overrides() == {
+        "epochs": REPLAY_EPOCHS, "patience": REPLAY_PATIENCE}
     assert CampaignConfig(SCENARIO, update="finetune").train_overrides() == {
         "epochs": FINETUNE_EPOCHS, "patience": FINETUNE_PATIENCE}
     assert CampaignConfig(SCENARIO, update="retrain").train_overrides() == {}
@@ -297,7 +297,7 @@ def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_cop
         config(seeded[1], family="aem")
     root = root_copy("aem")
     assess = Assessor(root, SCENARIO, seeded[1], splits=SPLITS)  # the FusionMonitor's Hard Set
-    cfg = config(None, family="aem", strategy="uniform")
+    cfg = config(None, family="aem", strategy="uniform", update="replay")  # the paper's loop
     c = Campaign(root, cfg, assess=assess)
     assert c.campaign_id.startswith("evo-aem-uniform-s0-")
     g0 = c.g0

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 from campaign_helpers import config
 
 from evoeye.evolve.campaign.loop import Campaign
@@ -22,7 +23,7 @@ def capture_training(root, cfg, log: list[list[str]]) -> Campaign:
 
 def test_replay_trains_on_the_rounds_runs_and_as_many_earlier_ones(root_copy, seeded) -> None:
     root = root_copy("replay")
-    cfg = config(seeded[1], strategy="uniform", n_round=3)
+    cfg = config(seeded[1], strategy="uniform", n_round=3, update="replay")
     trained: list[list[str]] = []
     c = capture_training(root, cfg, trained)
     state = c.run(max_rounds=2)
@@ -53,8 +54,24 @@ def test_finetune_trains_on_every_record(root_copy, seeded) -> None:
     assert trained == [ok] and len(ok) == len(c.initial["scenario_id"]) + 2
 
 
-def test_a_round_without_an_ok_run_keeps_its_monitor(root_copy, seeded) -> None:
-    c = Campaign(root_copy("failed"), config(seeded[1], strategy="uniform"))
+def test_retrain_the_default_trains_from_scratch_on_every_record(root_copy, seeded) -> None:
+    calls: list[tuple[list[str], str | None]] = []
+
+    def train(*args, train_runs, init_from, **kwargs) -> str:
+        calls.append((list(train_runs), init_from))
+        return FAMILIES["fusion"].train(*args, train_runs=train_runs, init_from=init_from,
+                                        **kwargs)
+
+    c = Campaign(root_copy("retrain"), config(seeded[1], strategy="uniform"), train=train)
+    assert c.config.update == "retrain"
+    state = c.run(max_rounds=1)
+    ok = [s for s, good in zip(state.records.scenario_id, state.ok, strict=True) if good]
+    assert calls == [(ok, None)] and len(ok) == len(c.initial["scenario_id"]) + 2
+
+
+@pytest.mark.parametrize("update", ["retrain", "replay", "finetune"])
+def test_a_round_without_an_ok_run_keeps_its_monitor(root_copy, seeded, update: str) -> None:
+    c = Campaign(root_copy("failed"), config(seeded[1], strategy="uniform", update=update))
     state = c.start()
     c.acquire(state)
     state.ok[:] = np.arange(len(state.ok)) < len(c.initial["scenario_id"])  # the round failed
