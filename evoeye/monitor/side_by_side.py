@@ -29,8 +29,10 @@ Send = Callable[[Any], None]  # a job's channel to the parent's `on_message`
 
 
 def can_fork() -> bool:
-    """Whether this platform starts processes by fork (Linux does; macOS and Windows spawn)."""
-    return "fork" in mp.get_all_start_methods()
+    """Whether jobs can run in forked processes here: the platform forks (Linux does; macOS and
+    Windows spawn), and this process is not a daemon (a multiprocessing.Pool worker), which may
+    not start processes of its own."""
+    return "fork" in mp.get_all_start_methods() and not mp.current_process().daemon
 
 
 def map_forked(job: Callable[[T, Send], R], items: Sequence[T], *, width: int | None = None,

@@ -60,6 +60,12 @@ def test_a_job_error_is_raised_with_its_traceback_and_stops_the_others() -> None
     assert mp.active_children() == []
 
 
+def test_a_daemonic_process_cannot_fork_jobs_so_says_it_cannot() -> None:
+    with mp.get_context("fork").Pool(1) as pool:  # a Pool's workers are daemons
+        assert pool.apply(can_fork) is False
+    assert can_fork()
+
+
 def test_a_job_that_dies_without_a_result_is_named() -> None:
     def job(k: int, send) -> int:
         if k == "b":
