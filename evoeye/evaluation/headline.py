@@ -146,10 +146,45 @@ def verdict(ours: Figures, rule: Figures) -> str:
                           [i in rule.warned_ids for i in universe])
     if p >= ALPHA:
         return (f"no clear difference in collisions warned of (paired test over the same "
-                f"{n} collision runs: p = {p:.2f})")
+                f"{n} collision runs: p = {p:.2f})" + _otherwise(ours, rule))
     word = "more" if ours.warned > rule.warned else "fewer"
     return (f"{label(ours.name)} warns of {word} collisions than {label(rule.name)} "
             f"(paired test over the same {n} collision runs: p = {p:.3f})")
+
+
+def _otherwise(ours: Figures, rule: Figures) -> str:
+    """Where two monitors that warn alike differ: false alarms per hour and the median lead,
+    each only when their 95 % intervals lie apart (a conservative test)."""
+    said = []
+    ours_fa, rule_fa = ours.false_alarms["per_h"], rule.false_alarms["per_h"]
+    if _below(ours_fa, rule_fa) or _below(rule_fa, ours_fa):
+        word = "fewer" if _below(ours_fa, rule_fa) else "more"
+        said.append(f"{label(ours.name)} raises {word} false alarms per hour than "
+                    f"{label(rule.name)} ({with_ci(ours_fa)} against {with_ci(rule_fa)})")
+    if _below(rule.lead, ours.lead) or _below(ours.lead, rule.lead):
+        word = "earlier" if _below(rule.lead, ours.lead) else "later"
+        said.append(f"{label(ours.name)} warns {word} (median lead {with_ci(ours.lead)} s "
+                    f"against {with_ci(rule.lead)} s)")
+    if not said:
+        return ""
+    return "; " + " and ".join(said) + ", their 95 % intervals apart"
+
+
+def _below(a: dict, b: dict) -> bool:
+    """Whether estimate `a`'s 95 % interval lies wholly below `b`'s (False without both)."""
+    ia, ib = _interval(a), _interval(b)
+    return ia is not None and ib is not None and ia[1] < ib[0]
+
+
+def _interval(est: dict) -> tuple[float, float] | None:
+    """An `Estimate.to_dict()`'s 95 % interval (no event: from 0); None without one."""
+    if est["value"] is None:
+        return None
+    if est.get("method") == "poisson-zero":
+        return 0.0, est["high"]
+    if est.get("low") is None or est.get("high") is None:
+        return None
+    return est["low"], est["high"]
 
 
 def summary(report: dict) -> list[str]:

@@ -18,9 +18,10 @@ HOUR_PER_RUN = 0.005  # 18 s of safe driving per run
 
 
 def monitor(name: str, warned: int, collisions: int, false_per_run: list[int],
-            reachable: bool = True) -> dict:
+            reachable: bool = True, lead0_s: float = 1.0) -> dict:
     ids = [f"v{i}" for i in range(collisions)]
-    lead = LeadTimes(warned, collisions, [1.0 + 0.1 * i for i in range(warned)], ids[:warned])
+    lead = LeadTimes(warned, collisions, [lead0_s + 0.1 * i for i in range(warned)],
+                     ids[:warned])
     fa = FalseAlarms(sum(false_per_run), len(false_per_run), sum(e > 0 for e in false_per_run),
                      HOUR_PER_RUN * len(false_per_run), false_per_run,
                      [HOUR_PER_RUN] * len(false_per_run))
@@ -70,6 +71,21 @@ def test_a_small_difference_is_not_called_one() -> None:
     r = report(monitor("fusion", 12, n, [0] * 10), monitor("ttc", 11, n, [0] * 10),
                collisions=n, safe=10)
     assert "no clear difference" in "\n".join(summary(r))
+
+
+def test_monitors_that_warn_alike_are_told_apart_by_false_alarms_only_when_clear() -> None:
+    n = 20
+    quiet, noisy = monitor("fusion", n, n, [0] * 40), monitor("ttc", n, n, [3] * 40)
+    text = "\n".join(summary(report(quiet, noisy, collisions=n, safe=40)))
+    assert "no clear difference in collisions warned of" in text
+    assert "FusionMonitor raises fewer false alarms per hour than TTC" in text
+    assert "their 95 % intervals apart" in text and "warns earlier" not in text  # same leads
+    close = monitor("ttc", n, n, [0] * 39 + [1])  # one false alarm: intervals overlap
+    text = "\n".join(summary(report(quiet, close, collisions=n, safe=40)))
+    assert "no clear difference" in text and "false alarms per hour than" not in text
+    late = monitor("ttc", n, n, [0] * 39 + [1], lead0_s=-1.5)  # every warning 2.5 s later
+    text = "\n".join(summary(report(quiet, late, collisions=n, safe=40)))
+    assert "FusionMonitor warns earlier (median lead" in text
 
 
 def test_the_best_rule_warns_of_most_then_raises_fewest_false_alarms() -> None:
