@@ -95,9 +95,10 @@ def main() -> None:
            "load_average": load, "wall_s": wall_s, "cpu_s": cpu_s, "per_seed": {},
            "paired": {}}
     print(f"\n{scenario}, recipe {args.recipe} − recorded, per seed (%):")
+    trained = args.method == FUSION_LABEL  # the AEM keeps no training record to show
     print("| seed | " + " | ".join(f"{m} old → new" for m in METRICS)
-          + " | epochs (best) | wall s | CPU s |")
-    print("|---|" + "---:|" * (len(METRICS) + 3))
+          + (" | epochs (best) | wall s | CPU s |" if trained else " |"))
+    print("|---|" + "---:|" * (len(METRICS) + 3 * trained))
     for s in seeds:
         t = cards[s].get("training") or dict.fromkeys(
             ("epochs_run", "best_epoch", "time_s", "cpu_s"), float("nan"))
@@ -110,8 +111,8 @@ def main() -> None:
                               if t.get("cpu_s") else None}
         print(f"| {s} | " + " | ".join(f"{100 * old[s][m]:.1f} → {100 * new[s][m]:.1f}"
                                        for m in METRICS)
-              + f" | {t['epochs_run']} ({t['best_epoch']}) | {t['time_s']:.0f} | "
-                f"{t.get('cpu_s', float('nan')):.0f} |")
+              + (f" | {t['epochs_run']} ({t['best_epoch']}) | {t['time_s']:.0f} | "
+                 f"{t.get('cpu_s', float('nan')):.0f} |" if trained else " |"))
     print("\n| metric | recorded mean [95 % CI] | new mean | inside | new − recorded [95 % CI] "
           "| p |")
     print("|---|---:|---:|---|---:|---:|")
