@@ -10,7 +10,9 @@ shared), per frame, median over the runs of each run's best repeat. Two supervis
   braking    threshold 0: the fallback acts from the first alarm to the end of the run
 
 The monitor is `--monitor VERSION` of `--root`, or an untrained network with normalisers fitted
-on the features of the runs (the cost does not depend on the weights).
+on the features of the runs (the cost does not depend on the weights). `--parts` adds where the
+watching cost goes: CPU time around the features (`FrameInputs.of`) and the scorer (context
+buffers and ONNX Runtime) inside the loop, against the same frames in a tight loop.
 """
 
 from __future__ import annotations
@@ -52,6 +54,37 @@ def cpu_ms_per_frame(fn) -> float:
     return (time.process_time() - t0) * 1e3 / len(episode.frames)
 
 
+def parts(scorer: FusionScorer, specs: list, version: str) -> None:
+    """Per frame: features and scorer timed inside the loop, then in a tight loop."""
+    spent = {"features": 0.0, "scorer": 0.0}
+    frames: list = []
+
+    def timed(messages) -> float:
+        t0 = time.process_time()
+        inputs = FrameInputs.of(messages)
+        t1 = time.process_time()
+        score = scorer.score(inputs)
+        spent["features"] += t1 - t0
+        spent["scorer"] += time.process_time() - t1
+        frames.append(messages)
+        return score
+
+    for spec in specs:
+        scorer.reset()
+        run_supervised(spec, timed, Trigger("fusion", version, (1.0,)))
+    n = len(frames)
+    t0 = time.process_time()
+    inputs = [FrameInputs.of(m) for m in frames]
+    t1 = time.process_time()
+    scorer.reset()
+    for f in inputs:
+        scorer.score(f)
+    t2 = time.process_time()
+    print(f"parts ({n} frames, ms/frame): in the loop features {1e3 * spent['features'] / n:.3f}"
+          f", scorer {1e3 * spent['scorer'] / n:.3f}; tight loop features "
+          f"{1e3 * (t1 - t0) / n:.3f}, scorer {1e3 * (t2 - t1) / n:.3f}")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
@@ -60,6 +93,7 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=6, help="runs per logical scenario")
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--seed", type=int, default=0)
+    ap.add_argument("--parts", action="store_true", help="also time features and scorer")
     args = ap.parse_args()
     torch.set_num_threads(1)
     specs = {s: plan_uniform(s, args.runs, args.seed) for s in SCENARIOS}
@@ -98,6 +132,10 @@ def main() -> None:
                            for c in CASES)
         ok = "yes" if max(med.values()) <= TARGET_MS else "**no**"
         print(f"| {scenario} | {statistics.median(plain):.3f} | {cells} | {ok} |")
+    if args.parts:
+        for scenario, ss in specs.items():
+            print(scenario, end=": ")
+            parts(scorer, ss, monitor.version)
 
 
 if __name__ == "__main__":
