@@ -43,9 +43,20 @@ COMMITTEE = 3  # members of the disagreement strategy's committee (the monitor a
 Say = Callable[[str], None]
 
 
-def initial_rows(n_pool: int, n: int, seed: int) -> np.ndarray:
-    """The pool rows of a seed's D_init (sorted): the same for every strategy."""
-    return np.sort(np.random.default_rng([seed, 0]).choice(n_pool, size=n, replace=False))
+def initial_rows(collided: np.ndarray, n: int, seed: int) -> np.ndarray:
+    """The pool rows of a seed's D_init (sorted): the same for every strategy. `n` rows drawn
+    uniformly from the pool (`collided`: its runs' outcomes), drawn again from the same seeded
+    stream until one of them collided — no monitor trains on a set without a collision, which
+    in the rare-failure regime is about one draw of 40 in four (a seed whose first draw had a
+    collision keeps it). ValueError if the pool has none."""
+    collided = np.asarray(collided, bool)
+    if not collided.any():
+        raise ValueError("the pool holds no collision run: no initial set can train a monitor")
+    rng = np.random.default_rng([seed, 0])
+    while True:
+        rows = np.sort(rng.choice(len(collided), size=n, replace=False))
+        if collided[rows].any():
+            return rows
 
 
 def training_seed(seed: int, budget: int) -> int:
@@ -127,7 +138,7 @@ def run_curve(ctx: Context, strategy: str, seed: int, acquirer: Acquirer) -> dic
 
 def _start(ctx: Context, seed: int, reads_disagreement: bool) -> Trajectory:
     bank, learner = ctx.bank, ctx.learner
-    rows = initial_rows(len(bank.pool), ctx.config.initial_runs, seed)
+    rows = initial_rows(bank.pool.collided, ctx.config.initial_runs, seed)
     ids = bank.pool.scenario_id[rows]
     records = Records(params=bank.pool.params[rows], feedback=np.full(len(rows), np.nan),
                       fitness=bank.pool.fitness[rows], collided=bank.pool.collided[rows],

@@ -68,7 +68,7 @@ def _oracle(ctx: Context, seed: int) -> dict:
     cfg, pool, learner = ctx.config, ctx.bank.pool, ctx.learner
     oracle_set = ctx.bank.data.sets["oracle"]
     used = np.zeros(len(pool), bool)
-    used[initial_rows(len(pool), cfg.initial_runs, seed)] = True
+    used[initial_rows(pool.collided, cfg.initial_runs, seed)] = True
     monitor = learner.scratch(ctx.bank.windows(pool.scenario_id[used]),
                               training_seed(seed, cfg.initial_runs))
     g0 = ctx.scratch_figures(pool.scenario_id[used], cfg.initial_runs, seed, monitor)
@@ -89,7 +89,7 @@ def _oracle(ctx: Context, seed: int) -> dict:
         used[rows] = True
         out["kinds"].append(kind)
         init = np.zeros(len(pool), bool)
-        init[initial_rows(len(pool), cfg.initial_runs, seed)] = True
+        init[initial_rows(pool.collided, cfg.initial_runs, seed)] = True
         acq = used & ~init
         out["budgets"][str(budget)] = {
             "scratch": learner.judge(monitor), "chosen": kind, "oracle_auprc": auprc,

@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from evoeye.results.efficiency.acquire import PoolAcquirer
 from evoeye.results.efficiency.curves import initial_rows, run_curve
@@ -13,8 +14,9 @@ from evoeye.results.efficiency.sets import concat_windows
 def test_every_strategy_starts_from_the_seeds_initial_runs_and_picks_unused_pool_runs(
         context) -> None:
     pool_ids = set(context.bank.pool.scenario_id)
-    init = set(context.bank.pool.scenario_id[initial_rows(len(pool_ids), 6, 0)])
-    assert init != set(context.bank.pool.scenario_id[initial_rows(len(pool_ids), 6, 1)])
+    collided = context.bank.pool.collided
+    init = set(context.bank.pool.scenario_id[initial_rows(collided, 6, 0)])
+    assert init != set(context.bank.pool.scenario_id[initial_rows(collided, 6, 1)])
     curves = {s: run_curve(context, s, 0, PoolAcquirer(context.bank))
               for s in ("uniform", "boundary")}
     for name, curve in curves.items():
@@ -56,3 +58,18 @@ def test_concatenated_windows_equal_the_pool_view(context) -> None:
     np.testing.assert_array_equal(joined.scenario_id, view.scenario_id)
     for name, arr in view.arrays().items():
         np.testing.assert_array_equal(joined.arrays()[name], arr, err_msg=name)
+
+
+def test_an_initial_set_always_holds_a_collision_and_keeps_a_first_draw_that_has_one() -> None:
+    collided = np.zeros(1000, bool)
+    collided[::40] = True  # 2.5 %: a draw of 40 misses every collision about one time in three
+    first = {s: np.sort(np.random.default_rng([s, 0]).choice(1000, size=40, replace=False))
+             for s in range(30)}
+    for seed, rows in first.items():
+        init = initial_rows(collided, 40, seed)
+        assert collided[init].any() and len(set(init)) == 40
+        if collided[rows].any():
+            np.testing.assert_array_equal(init, rows)  # unchanged where it needed no redraw
+    assert any(not collided[rows].any() for rows in first.values())  # the case is exercised
+    with pytest.raises(ValueError, match="no collision run"):
+        initial_rows(np.zeros(100, bool), 10, 0)
