@@ -10,14 +10,9 @@ left.
 
 Monitor update (Algorithm 1, line 12: Train(G_r, D_r)). A round with no new run to learn from
 keeps G_r.
-* `update="retrain"` (the default): from scratch on every run of D_r, by G_0's recipe. The
-  cheaper updates below drift: over 20 paired campaigns the replayed monitor ended below G_0 on
-  the Test Set (AUROC −1.6 points in S1, −0.5 in S2, CIs below 0) where monitors retrained on
-  the same campaigns' runs ended above it, and in the rare-failure regime the replayed monitor
-  scored half the AUPRC of one trained from scratch on the same runs (docs/evolution.md).
-  Training is fast enough for it (a FusionMonitor on 1 000 runs in ≈ 1.5 min on one core).
-  It learns only from D_r: a G_0 trained on runs the root does not hold (a shipped monitor)
-  is evolved by `replay`, which starts from its weights.
+* `update="retrain"` (the default): from scratch on every run of D_r, by G_0's recipe; the
+  cheaper updates below drift (docs/evolution.md has the measurements). It learns only from
+  D_r: a G_0 trained on runs the root does not hold (a shipped monitor) is evolved by `replay`.
 * `update="replay"` (the paper's, and RQ2's): G_{r+1} starts from G_r's weights and input
   normalisers and trains at most two epochs on the round's new runs plus a seeded sample of as
   many earlier runs of D_r (experience replay). Its cost grows with N_round, not with D_r. At
