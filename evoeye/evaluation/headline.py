@@ -157,12 +157,14 @@ def _otherwise(ours: Figures, rule: Figures) -> str:
     each only when their 95 % intervals lie apart (a conservative test)."""
     said = []
     ours_fa, rule_fa = ours.false_alarms["per_h"], rule.false_alarms["per_h"]
-    if _below(ours_fa, rule_fa) or _below(rule_fa, ours_fa):
-        word = "fewer" if _below(ours_fa, rule_fa) else "more"
-        said.append(f"{label(ours.name)} raises {word} false alarms per hour than "
-                    f"{label(rule.name)} ({with_ci(ours_fa)} against {with_ci(rule_fa)})")
-    if _below(rule.lead, ours.lead) or _below(ours.lead, rule.lead):
-        word = "earlier" if _below(rule.lead, ours.lead) else "later"
+    fewer, more = _below(ours_fa, rule_fa), _below(rule_fa, ours_fa)
+    if fewer or more:
+        said.append(f"{label(ours.name)} raises {'fewer' if fewer else 'more'} false alarms per "
+                    f"hour than {label(rule.name)} ({with_ci(ours_fa)} against "
+                    f"{with_ci(rule_fa)})")
+    earlier, later = _below(rule.lead, ours.lead), _below(ours.lead, rule.lead)
+    if earlier or later:
+        word = "earlier" if earlier else "later"
         said.append(f"{label(ours.name)} warns {word} (median lead {with_ci(ours.lead)} s "
                     f"against {with_ci(rule.lead)} s)")
     if not said:
