@@ -34,6 +34,8 @@ MODES = ("pool", "generative")
 STRATEGIES = ("uniform", "sobol", "boundary", "disagreement", "evoeye-knn", "evoeye")
 REFERENCE = "uniform"
 ORACLE = "oracle"
+ORACLE_UNIFORM = "oracle-uniform"  # the oracle's control: it chooses among uniform draws only
+CEILINGS = (ORACLE, ORACLE_UNIFORM)  # curves that know outcomes: no strategy, no update rule
 DEFAULT_PROFILE = "default"  # evoeye.ads.profiles.DEFAULT_PROFILE
 RECIPES, DEFAULT_RECIPE = ("v1", "v2"), "v2"  # evoeye.monitor.recipes; importing it loads torch
 
@@ -60,7 +62,7 @@ class EfficiencyConfig:
     mode: str = "pool"  # pool: pick from the pre-simulated pool; generative: simulate
     strategies: tuple[str, ...] = STRATEGIES
     seeds: tuple[int, ...] = tuple(range(10))  # campaign seeds, paired across strategies
-    oracle: bool = True  # the greedy oracle ceiling (pool mode)
+    oracle: bool = True  # the greedy oracle ceiling and its uniform-only control (pool mode)
     oracle_candidates: int = 6  # increments tried at each step of the oracle
     initial_runs: int = 40
     checkpoints: tuple[int, ...] = (80, 160, 320)  # total runs, initial runs included

@@ -16,6 +16,12 @@ use the outcomes and errors of runs before they are acquired, which no strategy 
 is a ceiling, not a strategy. It is greedy (one step at a time) and tries a handful of
 increments, so it is a lower bound of the true optimum — a ceiling that Uniform already
 reaches says that choosing runs cannot help much here.
+
+Its control, `oracle-uniform`, is the same greedy search with every candidate a uniform draw:
+as many candidates, judged on the same set. A best-of-k choice among equally likely increments
+gains on its own, from the spread of what a monitor learns from a few runs (its training is
+chaotic: one run more or less changes it); the control measures that part. The oracle's gain
+over its control is what choosing the *kind* of run (errors, near misses, collisions) adds.
 """
 
 from __future__ import annotations
@@ -23,7 +29,7 @@ from __future__ import annotations
 import numpy as np
 
 from evoeye.evolve.campaign.assess import metrics_dict
-from evoeye.results.efficiency.config import ORACLE
+from evoeye.results.efficiency.config import ORACLE, ORACLE_UNIFORM
 from evoeye.results.efficiency.curves import Context, acquired_summary, initial_rows, training_seed
 from evoeye.results.efficiency.learner import run_feedback
 
@@ -31,9 +37,12 @@ SAMPLE = 1000  # unused pool runs the error and margin candidates are chosen fro
 
 
 def _candidates(ctx: Context, monitor, used: np.ndarray, size: int,
-                rng: np.random.Generator) -> list[tuple[str, np.ndarray]]:
+                rng: np.random.Generator, control: bool) -> list[tuple[str, np.ndarray]]:
     pool = ctx.bank.pool
     free = np.flatnonzero(~used)
+    if control:
+        return [("uniform", rng.choice(free, size=size, replace=False))
+                for _ in range(ctx.config.oracle_candidates)]
     sample = np.sort(rng.choice(free, size=min(SAMPLE, len(free)), replace=False))
     errors = run_feedback(monitor, ctx.bank.windows(pool.scenario_id[sample]))
     err = np.array([errors.get(str(s), -1.0) for s in pool.scenario_id[sample]])
@@ -55,16 +64,19 @@ def _candidates(ctx: Context, monitor, used: np.ndarray, size: int,
     return out
 
 
-def run_oracle(ctx: Context, seed: int) -> dict:
-    """The oracle's learning curve at one seed (a ledger unit)."""
+def run_oracle(ctx: Context, seed: int, control: bool = False) -> dict:
+    """The oracle's learning curve at one seed (a ledger unit); with `control`, its
+    uniform-only control's (module doc)."""
     cfg = ctx.config
-    inputs = {"regime": ctx.regime, "sets": ctx.fingerprint, "strategy": ORACLE, "seed": seed,
+    name = ORACLE_UNIFORM if control else ORACLE
+    inputs = {"regime": ctx.regime, "sets": ctx.fingerprint, "strategy": name, "seed": seed,
               "initial": cfg.initial_runs, "budgets": list(cfg.checkpoints),
               "candidates": cfg.oracle_candidates, "recipe": ctx.learner.recipe}
-    return ctx.ledger.remember("efficiency-curve", inputs, lambda: _oracle(ctx, seed))
+    return ctx.ledger.remember("efficiency-curve", inputs, lambda: _oracle(ctx, seed, control))
 
 
-def _oracle(ctx: Context, seed: int) -> dict:
+def _oracle(ctx: Context, seed: int, control: bool) -> dict:
+    name = ORACLE_UNIFORM if control else ORACLE
     cfg, pool, learner = ctx.config, ctx.bank.pool, ctx.learner
     oracle_set = ctx.bank.data.sets["oracle"]
     used = np.zeros(len(pool), bool)
@@ -77,12 +89,12 @@ def _oracle(ctx: Context, seed: int) -> dict:
         rng = np.random.default_rng([seed, 99, step])
         size = budget - int(used.sum())
         best = None
-        for kind, rows in _candidates(ctx, monitor, used, size, rng):
+        for kind, rows in _candidates(ctx, monitor, used, size, rng, control):
             ids = [*pool.scenario_id[used], *pool.scenario_id[rows]]
             candidate = learner.scratch(ctx.bank.windows(ids), training_seed(seed, budget))
             auprc = metrics_dict(candidate.score(oracle_set), oracle_set.label,
                                  candidate.thresholds)["auprc"]
-            ctx.say(f"{ctx.regime}: oracle seed {seed} at {budget}: {kind} {auprc:.3f}")
+            ctx.say(f"{ctx.regime}: {name} seed {seed} at {budget}: {kind} {auprc:.3f}")
             if best is None or auprc > best[0]:
                 best = (auprc, kind, rows, candidate)
         auprc, kind, rows, monitor = best

@@ -13,7 +13,7 @@ from collections.abc import Callable
 import numpy as np
 
 from evoeye.paths import DataRoot
-from evoeye.results.efficiency.config import ORACLE, EfficiencyConfig
+from evoeye.results.efficiency.config import CEILINGS, EfficiencyConfig
 from evoeye.results.efficiency.findings import efficiency_findings
 from evoeye.results.efficiency.runner import run_regime
 from evoeye.results.efficiency.summary import summarise
@@ -47,7 +47,7 @@ def regime_results(result: dict, config: EfficiencyConfig) -> dict:
               for name, seeds in result["curves"].items()}
     summaries = {}
     for set_name, kind in SUMMARIES:
-        chosen = {k: v for k, v in curves.items() if kind == "scratch" or k != ORACLE}
+        chosen = {k: v for k, v in curves.items() if kind == "scratch" or k not in CEILINGS}
         summaries[f"{set_name}/{kind}"] = summarise(
             chosen, config.seeds, config.initial_runs, config.checkpoints,
             config.reference_checkpoints, kind, (set_name, "auprc"))

@@ -10,7 +10,7 @@ from __future__ import annotations
 from html import escape
 
 from evoeye.evaluation.plots import band_chart
-from evoeye.results.efficiency.config import ORACLE, REFERENCE, parse_regime
+from evoeye.results.efficiency.config import ORACLE, ORACLE_UNIFORM, REFERENCE, parse_regime
 from evoeye.results.efficiency.curves import MARGIN_BINS_M
 from evoeye.results.markdown import diff_cell, md_table, mean_cell, pct
 
@@ -26,13 +26,17 @@ INTRO = (
     "*Uniform's budget ×*: the budget Uniform's mean curve needs to reach the strategy's final "
     "mean, over the strategy's budget (≥ 1.5: Uniform needs 1.5× the runs; censored \">\" "
     "past Uniform's last point), with its bootstrap 95 % CI. The oracle picks by true benefit "
-    "(outcomes and errors it could not know): the ceiling of what choosing runs can gain.")
+    "(outcomes and errors it could not know): the ceiling of what choosing runs can gain. Its "
+    "control chooses the same way among uniform draws only: what a best-of-k choice gains "
+    "from the spread of small-data monitors alone. The oracle's gain over its control is what "
+    "choosing the kind of run adds.")
 MODE_WORDS = {"pool": "picked from a pool of pre-simulated uniform runs",
               "generative": "simulating what it proposes"}
 
 
 def _label(name: str) -> str:
-    return {ORACLE: "oracle (ceiling)", REFERENCE: "uniform (reference)"}.get(name, name)
+    return {ORACLE: "oracle (ceiling)", ORACLE_UNIFORM: "oracle-uniform (its control)",
+            REFERENCE: "uniform (reference)"}.get(name, name)
 
 
 def _efficiency(e: dict | None) -> str:
@@ -54,7 +58,13 @@ def curve_table(summary: dict) -> list[str]:
         rows.append([_label(name), *cells, mean_cell(s["area"], "auprc", s["area"]["n"]),
                      diff_cell(vs) if vs else "", diff_cell(s["final_vs_reference"]) if vs
                      else "", _efficiency(s.get("efficiency"))])
-    return md_table(header, rows)
+    lines = md_table(header, rows)
+    control = summary["strategies"].get(ORACLE, {}).get("area_vs_control")
+    if control:
+        final = summary["strategies"][ORACLE]["final_vs_control"]
+        lines += ["", f"Oracle {chr(8722)} its uniform-only control: area {diff_cell(control)}, "
+                      f"final {diff_cell(final)}."]
+    return lines
 
 
 def where_table(where: dict) -> list[str]:
@@ -119,11 +129,13 @@ def efficiency_findings_markdown(findings: list[dict]) -> str:
                 numbers=False), ""]
     for f in findings:
         if f["checks"]:
-            rows = [[c["regime"], c["strategy"], diff_cell(c["area"]), c["area_verdict"],
+            rows = [[c["regime"], c["strategy"], c.get("against", REFERENCE),
+                     diff_cell(c["area"]), c["area_verdict"],
                      _efficiency(c["efficiency"]), c["efficiency_verdict"]]
                     for c in f["checks"]]
             out += [f"**{f['claim']}** — {f['verdict']}", "",
-                    *md_table(["regime", "strategy", f"area {chr(8722)} Uniform [95 % CI] p",
+                    *md_table(["regime", "strategy", "against",
+                               f"area {chr(8722)} against's [95 % CI] p",
                           "verdict", "Uniform's budget ×", "verdict"], rows, numbers=False),
                     ""]
     return "\n".join(out)

@@ -1,5 +1,6 @@
-"""The study over its regimes: each regime's data, then every curve (strategy × seed, and the
-oracle's) in worker processes, seed-major so a study stopped early has whole seeds.
+"""The study over its regimes: each regime's data, then every curve (strategy × seed, the
+oracle's and its control's) in worker processes, seed-major so a study stopped early has
+whole seeds.
 
 A regime's sets are loaded once in the parent; the workers are forked from it and read them
 without a copy (the frame features are numpy arrays the children never write). Every curve is
@@ -21,7 +22,12 @@ from evoeye.monitor.recipes import recipe_params
 from evoeye.monitor.threads import intra_op_threads
 from evoeye.paths import DataRoot
 from evoeye.results.efficiency.acquire import Bank, PoolAcquirer, SimAcquirer
-from evoeye.results.efficiency.config import ORACLE, EfficiencyConfig, parse_regime
+from evoeye.results.efficiency.config import (
+    CEILINGS,
+    ORACLE_UNIFORM,
+    EfficiencyConfig,
+    parse_regime,
+)
 from evoeye.results.efficiency.curves import Context, run_curve
 from evoeye.results.efficiency.data import prepare_regime
 from evoeye.results.efficiency.learner import Learner
@@ -59,8 +65,8 @@ def _unit(unit: tuple[str, int]) -> tuple[str, int, dict]:
     ctx = _CONTEXT
     assert ctx is not None, "a worker needs the regime's context"
     with intra_op_threads():
-        if strategy == ORACLE:
-            return strategy, seed, run_oracle(ctx, seed)
+        if strategy in CEILINGS:
+            return strategy, seed, run_oracle(ctx, seed, control=strategy == ORACLE_UNIFORM)
         if ctx.config.mode == "pool":
             acquirer = PoolAcquirer(ctx.bank)
         else:
@@ -69,8 +75,8 @@ def _unit(unit: tuple[str, int]) -> tuple[str, int, dict]:
 
 
 def units(config: EfficiencyConfig) -> list[tuple[str, int]]:
-    """Every curve of a regime, seed-major; the oracle's in pool mode only."""
-    extra = (ORACLE,) if config.oracle and config.mode == "pool" else ()
+    """Every curve of a regime, seed-major; the oracle's and its control's in pool mode only."""
+    extra = CEILINGS if config.oracle and config.mode == "pool" else ()
     return [(s, seed) for seed in config.seeds for s in (*config.strategies, *extra)]
 
 

@@ -14,6 +14,8 @@ efficiency), and each as a paired difference with Uniform over the seeds.
   Uniform's runs for the same figure. A strategy above Uniform's last point is censored
   ("> factor"). Its CI comes from a bootstrap over seeds (both curves resampled by the same
   seeds), 2.5 and 97.5 percentiles.
+* The oracle against its uniform-only control (`oracle.py`): the paired difference of their
+  areas and final figures, what choosing the kind of run adds to a best-of-k choice.
 """
 
 from __future__ import annotations
@@ -24,7 +26,7 @@ from collections.abc import Sequence
 import numpy as np
 
 from evoeye.evaluation.stats import compare_paired, mean_ci
-from evoeye.results.efficiency.config import REFERENCE
+from evoeye.results.efficiency.config import ORACLE, ORACLE_UNIFORM, REFERENCE
 
 N_BOOT = 2000
 CURVE_METRIC = ("test", "auprc")
@@ -117,4 +119,10 @@ def summarise(curves: dict[str, dict[str, dict]], seeds: Sequence[int], initial_
                                                          ref[:, len(budgets) - 1]).to_dict()
             entry["efficiency"] = efficiency(common[:, -1], ref, ref_budgets, budgets[-1], rng)
         out["strategies"][name] = entry
+    if ORACLE in rows and ORACLE_UNIFORM in rows:
+        oracle, control = rows[ORACLE], rows[ORACLE_UNIFORM]
+        out["strategies"][ORACLE]["area_vs_control"] = compare_paired(
+            area(oracle, budgets), area(control, budgets)).to_dict()
+        out["strategies"][ORACLE]["final_vs_control"] = compare_paired(
+            oracle[:, -1], control[:, -1]).to_dict()
     return out

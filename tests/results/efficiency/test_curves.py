@@ -49,6 +49,19 @@ def test_the_oracle_picks_by_its_set_and_keeps_its_choice(context) -> None:
         assert set(entry["scratch"]) == {"test", "boundary"}
 
 
+def test_the_oracles_control_chooses_among_uniform_draws_only_and_is_a_unit_of_its_own(
+        context) -> None:
+    oracle = run_oracle(context, 0)
+    computed = context.ledger.computed["efficiency-curve"]
+    control = run_oracle(context, 0, control=True)
+    assert context.ledger.computed["efficiency-curve"] == computed + 1  # not the oracle's unit
+    assert control["kinds"] == ["uniform"] * len(context.config.checkpoints)
+    assert control["budgets"][str(context.config.initial_runs)] == oracle["budgets"][
+        str(context.config.initial_runs)]  # the same G_0
+    for b in context.config.checkpoints:
+        assert control["budgets"][str(b)]["acquired"]["runs"] == b - context.config.initial_runs
+
+
 def test_concatenated_windows_equal_the_pool_view(context) -> None:
     ids = list(context.bank.pool.scenario_id[:5])
     view = context.bank.data.take(ids)

@@ -22,22 +22,29 @@ def test_the_study_runs_in_workers_resumes_and_writes_its_files(tiny_regime, tin
     first = run_efficiency(root, config, workers=2, ledger=ledger)
     regime = first["regimes"][config.regimes[0]]
     measure = regime["summaries"]["test/scratch"]["strategies"]
-    assert set(measure) == {"uniform", "boundary", "oracle"}
+    assert set(measure) == {"uniform", "boundary", "oracle", "oracle-uniform"}
     assert [m["n"] for m in measure["uniform"]["mean"]] == [2, 2, 2, 2]  # 6, 10, 14, 18 runs
     assert measure["boundary"]["area_vs_reference"]["n"] == 2
-    assert "oracle" not in regime["summaries"]["test/update"]["strategies"]  # no update rule
+    assert measure["oracle"]["area_vs_control"]["n"] == 2  # paired with its control
+    assert "area_vs_control" not in measure["boundary"]
+    update = regime["summaries"]["test/update"]["strategies"]
+    assert not {"oracle", "oracle-uniform"} & set(update)  # no update rule
     assert regime["where"]["boundary"]["runs"] == 14 - 6
     assert [f["id"] for f in first["findings"]] == ["efficiency-area", "efficiency-factor",
-                                                    "efficiency-ceiling", "efficiency-paper"]
+                                                    "efficiency-ceiling", "efficiency-choice",
+                                                    "efficiency-paper"]
+    choice = first["findings"][3]["checks"]
+    assert [(c["strategy"], c["against"]) for c in choice] == [("oracle", "oracle-uniform")]
 
     again = run_efficiency(root, config, workers=1, ledger=ledger)  # every curve found
     assert again == first and ledger.computed["efficiency-curve"] == 0
-    assert ledger.found["efficiency-curve"] == 6  # 2 strategies and the oracle, 2 seeds
+    assert ledger.found["efficiency-curve"] == 8  # 2 strategies, the oracle, its control; 2 seeds
 
     results = ResultsConfig(parts=("efficiency",), efficiency=config.changed())
     folder = write_results(root, assemble(Study(root, results), {}, first), "study")
     text = (folder / "efficiency.md").read_text()
     assert "## highway-cut-in, default ADS" in text and "uniform (reference)" in text
+    assert "Oracle − its uniform-only control: area" in text
     assert "Does acquisition earn its budget?" in (folder / "findings.md").read_text()
     assert (folder / "results.html").read_text().count("<svg") == 3  # one chart per summary
     assert json.loads((folder / "results.json").read_text())["efficiency"]["config"][
