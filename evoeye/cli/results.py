@@ -140,6 +140,7 @@ def results_command(
     with --part efficiency, the sample-efficiency study (learning curves of acquisition
     strategies against Uniform and an oracle ceiling) — each comparison with its mean, 95 % CI
     and p; re-running reuses every finished unit."""
+    from evoeye.results.efficiency.part import failed_units
     from evoeye.results.run import run_results, write_results
 
     try:
@@ -177,3 +178,10 @@ def results_command(
     found, done = sum(run.found.values()), sum(run.computed.values())
     typer.echo(f"units: {found} found done, {done} done now ({run.computed or 'nothing new'})")
     typer.echo(f"report: {folder / 'results.html'} (tables: rq1.md, rq2.md, results.json)")
+    failed = failed_units(run.results["efficiency"]) if "efficiency" in run.results else []
+    if failed:  # every other curve is in the report; the command still fails
+        typer.echo(f"{len(failed)} curve(s) failed and are left out (re-run to retry them):",
+                   err=True)
+        for line in failed:
+            typer.echo(f"  {line}", err=True)
+        raise typer.Exit(1)

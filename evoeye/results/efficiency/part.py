@@ -52,7 +52,8 @@ def regime_results(result: dict, config: EfficiencyConfig) -> dict:
             chosen, config.seeds, config.initial_runs, config.checkpoints,
             config.reference_checkpoints, kind, (set_name, "auprc"))
     return {"sets": result["sets"], "curves": curves, "summaries": summaries,
-            "where": where_sampled(curves, config.checkpoints[-1])}
+            "where": where_sampled(curves, config.checkpoints[-1]),
+            "failed": result.get("failed", [])}
 
 
 def regime_part(root: DataRoot, regime: str, config: EfficiencyConfig, *, workers: int = 1,
@@ -60,6 +61,12 @@ def regime_part(root: DataRoot, regime: str, config: EfficiencyConfig, *, worker
     """One regime's data, curves and summaries."""
     return regime_results(run_regime(root, regime, config, workers=workers, say=say,
                                      ledger=ledger), config)
+
+
+def failed_units(results: dict) -> list[str]:
+    """"regime: strategy seed k: error" of every curve that failed, over the regimes."""
+    return [f"{regime}: {f['strategy']} seed {f['seed']}: {f['error']}"
+            for regime, r in results["regimes"].items() for f in r.get("failed", [])]
 
 
 def study_results(config: EfficiencyConfig, regimes: dict[str, dict]) -> dict:

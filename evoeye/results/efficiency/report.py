@@ -106,6 +106,11 @@ def regime_markdown(regime: str, result: dict) -> str:
         lines += [f"### AUPRC on {SET_WORDS[set_name]}: {KIND_WORDS[kind]}", "",
                   *curve_table(summary), ""]
     lines += ["### Where each strategy sampled", "", *where_table(result["where"]), ""]
+    if result.get("failed"):
+        lines += ["### Curves that failed", "", "Left out of every table above; a re-run of the "
+                  "same command retries them alone.", "",
+                  *(f"* {f['strategy']}, seed {f['seed']}: {f['error']}"
+                    for f in result["failed"]), ""]
     return "\n".join(lines)
 
 

@@ -5,6 +5,8 @@ whole seeds.
 A regime's sets are loaded once in the parent; the workers are forked from it and read them
 without a copy (the frame features are numpy arrays the children never write). Every curve is
 a ledger unit (`curves.py`), so a killed study resumes with the curves it had not finished.
+A curve that raises is named with its error and left out (its seed missing from that
+strategy's summaries); the other curves go on, and a re-run retries it alone.
 """
 
 from __future__ import annotations
@@ -61,7 +63,15 @@ def set_sizes(data: RegimeData) -> dict[str, dict[str, int]]:
 
 
 def _unit(unit: tuple[str, int]) -> tuple[str, int, dict]:
+    """(strategy, seed, curve), or the curve {"error": …} when it raised (module doc)."""
     strategy, seed = unit
+    try:
+        return _curve(strategy, seed)
+    except Exception as exc:  # noqa: BLE001 — one curve's failure must not stop the others
+        return strategy, seed, {"error": f"{type(exc).__name__}: {exc}"}
+
+
+def _curve(strategy: str, seed: int) -> tuple[str, int, dict]:
     ctx = _CONTEXT
     assert ctx is not None, "a worker needs the regime's context"
     with intra_op_threads():
@@ -82,7 +92,8 @@ def units(config: EfficiencyConfig) -> list[tuple[str, int]]:
 
 def run_regime(root: DataRoot, regime: str, config: EfficiencyConfig, *, workers: int = 1,
                say: Say | None = None, ledger: Ledger | None = None) -> dict:
-    """A regime's data and every curve: {"sets": sizes, "curves": {strategy: {seed: curve}}}."""
+    """A regime's data and every curve: {"sets": sizes, "curves": {strategy: {seed: curve}},
+    "failed": [{"strategy", "seed", "error"}]}."""
     global _CONTEXT
     say = say or (lambda msg: None)
     data_root = prepare_regime(root, regime, config, workers=workers, say=say)
@@ -93,17 +104,25 @@ def run_regime(root: DataRoot, regime: str, config: EfficiencyConfig, *, workers
     _CONTEXT = Context(regime, get_scenario(parse_regime(regime)[0]), config, learner,
                        Bank(data), ledger or Ledger(root), sets_fingerprint(data), say)
     curves: dict[str, dict[str, dict]] = {}
+    failed: list[dict] = []
+
+    def keep(strategy: str, seed: int, curve: dict) -> None:
+        if "error" in curve:
+            failed.append({"strategy": strategy, "seed": seed, "error": curve["error"]})
+            say(f"{regime}: {strategy} seed {seed} FAILED: {curve['error']}")
+        else:
+            curves.setdefault(strategy, {})[str(seed)] = curve
+
     try:
         if workers == 1:
-            done = map(_unit, units(config))
-            for strategy, seed, curve in done:
-                curves.setdefault(strategy, {})[str(seed)] = curve
+            for done in map(_unit, units(config)):
+                keep(*done)
         else:
             with ProcessPoolExecutor(workers, mp_context=mp.get_context("fork"),
                                      initializer=die_with_parent,
                                      initargs=(os.getpid(),)) as pool:
-                for strategy, seed, curve in pool.map(_unit, units(config)):
-                    curves.setdefault(strategy, {})[str(seed)] = curve
+                for done in pool.map(_unit, units(config)):
+                    keep(*done)
     finally:
         _CONTEXT = None
-    return {"regime": regime, "sets": set_sizes(data), "curves": curves}
+    return {"regime": regime, "sets": set_sizes(data), "curves": curves, "failed": failed}

@@ -7,7 +7,8 @@ from dataclasses import replace
 
 from evoeye.results.config import ResultsConfig
 from evoeye.results.efficiency import runner
-from evoeye.results.efficiency.part import run_efficiency
+from evoeye.results.efficiency.part import failed_units, run_efficiency
+from evoeye.results.efficiency.report import regime_markdown
 from evoeye.results.ledger import Ledger
 from evoeye.results.run import assemble, write_results
 from evoeye.results.study import Study
@@ -49,3 +50,31 @@ def test_the_study_runs_in_workers_resumes_and_writes_its_files(tiny_regime, tin
     assert (folder / "results.html").read_text().count("<svg") == 3  # one chart per summary
     assert json.loads((folder / "results.json").read_text())["efficiency"]["config"][
         "strategies"] == ["uniform", "boundary"]
+
+
+def test_a_curve_that_fails_is_named_left_out_and_retried_alone(tiny_regime, tiny_config,
+                                                                monkeypatch) -> None:
+    root, data = tiny_regime
+    monkeypatch.setattr(runner, "prepare_regime", lambda *a, **k: data)
+    config = replace(tiny_config, strategies=("uniform",), seeds=(3, 4), oracle=False)
+    real = runner.run_curve
+
+    def planted(ctx, strategy, seed, acquirer):
+        if seed == 4:
+            raise RuntimeError("planted")
+        return real(ctx, strategy, seed, acquirer)
+
+    monkeypatch.setattr(runner, "run_curve", planted)
+    first = run_efficiency(root, config, workers=2, ledger=Ledger(root))
+    regime = first["regimes"][config.regimes[0]]
+    assert regime["failed"] == [{"strategy": "uniform", "seed": 4,
+                                 "error": "RuntimeError: planted"}]
+    assert failed_units(first) == [f"{config.regimes[0]}: uniform seed 4: RuntimeError: planted"]
+    assert list(regime["curves"]["uniform"]) == ["3"]  # the other seed went through
+    assert "uniform, seed 4: RuntimeError: planted" in regime_markdown(config.regimes[0], regime)
+
+    monkeypatch.setattr(runner, "run_curve", real)
+    ledger = Ledger(root)
+    again = run_efficiency(root, config, workers=1, ledger=ledger)
+    assert again["regimes"][config.regimes[0]]["failed"] == [] and not failed_units(again)
+    assert ledger.computed["efficiency-curve"] == 1 and ledger.found["efficiency-curve"] == 1
