@@ -14,6 +14,7 @@ from __future__ import annotations
 import hashlib
 import multiprocessing as mp
 import os
+from collections import Counter
 from collections.abc import Callable
 from concurrent.futures import ProcessPoolExecutor
 
@@ -62,26 +63,29 @@ def set_sizes(data: RegimeData) -> dict[str, dict[str, int]]:
     return out
 
 
-def _unit(unit: tuple[str, int]) -> tuple[str, int, dict]:
-    """(strategy, seed, curve), or the curve {"error": …} when it raised (module doc)."""
+def _unit(unit: tuple[str, int]) -> tuple[str, int, dict, Counter, Counter]:
+    """(strategy, seed, curve, ledger units found, computed), the curve {"error": …} when it
+    raised (module doc). The counts let a parent add up what its forked workers did."""
     strategy, seed = unit
-    try:
-        return _curve(strategy, seed)
-    except Exception as exc:  # noqa: BLE001 — one curve's failure must not stop the others
-        return strategy, seed, {"error": f"{type(exc).__name__}: {exc}"}
-
-
-def _curve(strategy: str, seed: int) -> tuple[str, int, dict]:
     ctx = _CONTEXT
     assert ctx is not None, "a worker needs the regime's context"
+    found, computed = Counter(ctx.ledger.found), Counter(ctx.ledger.computed)
+    try:
+        curve = _curve(ctx, strategy, seed)
+    except Exception as exc:  # noqa: BLE001 — one curve's failure must not stop the others
+        curve = {"error": f"{type(exc).__name__}: {exc}"}
+    return strategy, seed, curve, ctx.ledger.found - found, ctx.ledger.computed - computed
+
+
+def _curve(ctx: Context, strategy: str, seed: int) -> dict:
     with intra_op_threads():
         if strategy in CEILINGS:
-            return strategy, seed, run_oracle(ctx, seed, control=strategy == ORACLE_UNIFORM)
+            return run_oracle(ctx, seed, control=strategy == ORACLE_UNIFORM)
         if ctx.config.mode == "pool":
             acquirer = PoolAcquirer(ctx.bank)
         else:
             acquirer = SimAcquirer(ctx.bank, ctx.regime, strategy, 5, ctx.config.horizon_s)
-        return strategy, seed, run_curve(ctx, strategy, seed, acquirer)
+        return run_curve(ctx, strategy, seed, acquirer)
 
 
 def units(config: EfficiencyConfig) -> list[tuple[str, int]]:
@@ -101,12 +105,15 @@ def run_regime(root: DataRoot, regime: str, config: EfficiencyConfig, *, workers
     data = RegimeData.load(data_root, config)
     learner = Learner(data.sets["val"], {k: data.sets[k] for k in JUDGING_SETS},
                       recipe_params(config.recipe, **config.train_overrides))
-    _CONTEXT = Context(regime, get_scenario(parse_regime(regime)[0]), config, learner,
-                       Bank(data), ledger or Ledger(root), sets_fingerprint(data), say)
+    _CONTEXT = ctx = Context(regime, get_scenario(parse_regime(regime)[0]), config, learner,
+                             Bank(data), ledger or Ledger(root), sets_fingerprint(data), say)
     curves: dict[str, dict[str, dict]] = {}
     failed: list[dict] = []
 
-    def keep(strategy: str, seed: int, curve: dict) -> None:
+    def keep(strategy: str, seed: int, curve: dict, found: Counter, computed: Counter) -> None:
+        if workers > 1:  # a forked worker counted in its own copy of the ledger
+            ctx.ledger.found.update(found)
+            ctx.ledger.computed.update(computed)
         if "error" in curve:
             failed.append({"strategy": strategy, "seed": seed, "error": curve["error"]})
             say(f"{regime}: {strategy} seed {seed} FAILED: {curve['error']}")
