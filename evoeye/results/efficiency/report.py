@@ -16,7 +16,8 @@ from evoeye.results.markdown import diff_cell, md_table, mean_cell, pct
 
 SET_WORDS = {"test": "the Test Set", "boundary": "the boundary set"}
 KIND_WORDS = {"scratch": "the monitor trained from scratch on the runs acquired so far",
-              "update": "the product's monitor, updated every round by its replay rule"}
+              "update": "the per-round monitor, fine-tuned every round by the paper's replay "
+                        "rule (the one feedback-reading strategies steer by)"}
 INTRO = (
     "Learning curves: from {initial} initial uniform runs (the same for every strategy at a "
     "seed), each strategy acquires runs in rounds of {n_round} ({mode}); at {budgets} runs a "
