@@ -17,7 +17,7 @@ from evoeye.results.config import (
     ResultsConfig,
     parse_initial_runs,
 )
-from evoeye.results.efficiency.config import MODES, REFERENCE, EfficiencyConfig
+from evoeye.results.efficiency.config import MODES, REFERENCE, UPDATES, EfficiencyConfig
 
 D = ResultsConfig()  # the defaults --help shows (config.py imports nothing heavy)
 E = EfficiencyConfig()
@@ -117,8 +117,12 @@ def results_command(
     first_study_seed: Annotated[int, typer.Option(
         min=0, help="Sample-efficiency study: its first seed (seeds K … K+N−1).")] = 0,
     oracle: Annotated[bool, typer.Option(
-        help="Sample-efficiency study: draw the oracle ceiling's curves (pool mode).")] =
-        E.oracle,
+        help="Sample-efficiency study: draw the oracle ceiling's curves and its control's "
+             "(pool mode).")] = E.oracle,
+    study_update: Annotated[str, typer.Option(
+        help=f"Sample-efficiency study: how the per-round monitor the strategies' feedback "
+             f"comes from is updated, {' or '.join(UPDATES)} (fine-tuned, or trained again "
+             "from scratch every round).")] = E.update,
     pool_runs: Annotated[int, typer.Option(
         min=1, help="Sample-efficiency study: uniform runs per regime to pick from.")] =
         E.pool_runs,
@@ -161,7 +165,8 @@ def results_command(
                 regimes=tuple(regime or E.regimes),
                 strategies=tuple(dict.fromkeys((REFERENCE, *strategy))) if strategy
                 else E.strategies,
-                mode=mode, seeds=tuple(range(first_study_seed, first_study_seed + study_seeds)),
+                mode=mode, update=study_update,
+                seeds=tuple(range(first_study_seed, first_study_seed + study_seeds)),
                 oracle=oracle, pool_runs=pool_runs, recipe=recipe, epochs=epochs,
                 patience=patience
             ).changed())

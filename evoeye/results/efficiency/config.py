@@ -19,8 +19,12 @@ Plain data (the command line reads it at start-up). Sizes, and why:
   at a seed) and are measured at log-spaced budgets ×2, ×4, ×8 (80, 160, 320 runs, initial runs
   included); Uniform goes on to ×16 so that the budget it needs to match a strategy can be read
   off its own curve up to a factor of 2.
-* Acquisition comes in rounds of 20 runs, after each of which the replay update (the paper's loop,
-  `evoeye evolve --update replay`) updates the monitor the strategies' feedback comes from.
+* Acquisition comes in rounds of 20 runs, after each of which the per-round monitor the
+  strategies' feedback comes from is updated: by the replay fine-tune (`update="replay"`, the
+  paper's loop, `evoeye evolve --update replay`) or trained again from scratch on every run so
+  far (`update="retrain"`, what `evoeye evolve` does by default; only for the strategies that
+  read feedback — for the others nothing reads it, and the deployed monitor at a checkpoint is
+  the checkpoint's from-scratch one).
   At a checkpoint the monitor is trained from scratch on everything acquired, with the training
   seed of that seed and checkpoint shared by every strategy (the pairing absorbs it).
 """
@@ -31,6 +35,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass, fields
 
 MODES = ("pool", "generative")
+UPDATES = ("replay", "retrain")  # the per-round monitor's update rule
 STRATEGIES = ("uniform", "sobol", "boundary", "disagreement", "evoeye-knn", "evoeye")
 REFERENCE = "uniform"
 ORACLE = "oracle"
@@ -60,6 +65,7 @@ class EfficiencyConfig:
     regimes: tuple[str, ...] = ("highway-cut-in", "unprotected-intersection",
                                 "unprotected-intersection:cautious")
     mode: str = "pool"  # pool: pick from the pre-simulated pool; generative: simulate
+    update: str = "replay"  # the per-round monitor: fine-tuned (replay) or trained again
     strategies: tuple[str, ...] = STRATEGIES
     seeds: tuple[int, ...] = tuple(range(10))  # campaign seeds, paired across strategies
     oracle: bool = True  # the greedy oracle ceiling and its uniform-only control (pool mode)
@@ -93,6 +99,8 @@ class EfficiencyConfig:
             parse_regime(regime)
         if self.mode not in MODES:
             raise ValueError(f"mode must be one of {MODES}, got {self.mode!r}")
+        if self.update not in UPDATES:
+            raise ValueError(f"update must be one of {UPDATES}, got {self.update!r}")
         if self.recipe not in RECIPES:
             raise ValueError(f"unknown training recipe {self.recipe!r}; known: {list(RECIPES)}")
         if REFERENCE not in self.strategies:

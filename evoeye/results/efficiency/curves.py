@@ -2,13 +2,19 @@
 checkpoint the monitor is trained from scratch on all of them and judged.
 
 The loop per round: the strategy proposes N_round runs one at a time, each is acquired (taken
-from the pool, or simulated: `acquire.py`) and told to it; then the replay update (the paper's
-loop, `evoeye evolve --update replay`) refreshes the monitor whose feedback the strategies
-read (and, for `disagreement`, the committee beside it), and every record's feedback is
-refreshed. At a checkpoint two monitors are judged on the sets no strategy shaped: one
-trained from scratch on everything acquired (the curve's figure — what the runs are worth, and
-what `evoeye evolve` deploys by default), with the seed of that seed and checkpoint that every
-strategy shares, and the replay-updated monitor (what the paper's loop would deploy).
+from the pool, or simulated: `acquire.py`) and told to it; then the per-round monitor whose
+feedback the strategies read (and, for `disagreement`, the committee beside it) is updated —
+by the replay fine-tune (the paper's loop, `evoeye evolve --update replay`), or with
+`update="retrain"` trained again from scratch on every run so far, with the seed a checkpoint
+at that many runs gets (so at a checkpoint it is the checkpoint's monitor) — and every
+record's feedback is refreshed. Under `retrain` a strategy that reads no feedback keeps no
+per-round monitor: nothing would read it.
+
+At a checkpoint two monitors are judged on the sets no strategy shaped: one trained from
+scratch on everything acquired (the curve's figure — what the runs are worth, and what
+`evoeye evolve` deploys by default), with the seed of that seed and checkpoint that every
+strategy shares, and the per-round monitor (under `replay` what the paper's loop would deploy;
+under `retrain` the same monitor as the first).
 
 The same seed gives every strategy the same D_init (drawn from the pool), the same G_0 and the
 same training seed at each checkpoint, so strategies differ only in the runs they chose.
@@ -26,7 +32,12 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from evoeye.evolve.search.records import Records
-from evoeye.evolve.search.registry import READS_DISAGREEMENT, make_strategy, strategy_options
+from evoeye.evolve.search.registry import (
+    FEEDBACK_BLIND,
+    READS_DISAGREEMENT,
+    make_strategy,
+    strategy_options,
+)
 from evoeye.monitor.fusion import FusionMonitor
 from evoeye.results.efficiency.acquire import Acquirer, Bank
 from evoeye.results.efficiency.config import EfficiencyConfig
@@ -132,6 +143,8 @@ def run_curve(ctx: Context, strategy: str, seed: int, acquirer: Acquirer) -> dic
               "seed": seed, "mode": acquirer.mode, "initial": cfg.initial_runs,
               "budgets": list(cfg.checkpoints_of(strategy)), "n_round": cfg.n_round,
               "recipe": ctx.learner.recipe}
+    if cfg.update != "replay":  # replay curves keep the keys they were ledgered under
+        inputs["update"] = cfg.update
     return ctx.ledger.remember("efficiency-curve", inputs,
                                lambda: _curve(ctx, strategy, seed, acquirer))
 
@@ -163,8 +176,20 @@ def _refreshed(ctx: Context, t: Trajectory) -> Trajectory:
     return t
 
 
+def _retrain(ctx: Context, t: Trajectory, seed: int) -> None:
+    """The per-round monitor (and each committee member) trained again from scratch on every
+    run so far, with the seed a checkpoint at that many runs gets (members: offset seeds)."""
+    ids = list(t.records.scenario_id)
+    train, tseed = ctx.bank.windows(ids), training_seed(seed, len(ids))
+    t.monitor = ctx.learner.scratch(train, tseed)
+    if t.committee:
+        t.committee = [t.monitor, *(ctx.learner.scratch(train, tseed + 1_000_003 * j)
+                                    for j in range(1, len(t.committee)))]
+    _refreshed(ctx, t)
+
+
 def _update(ctx: Context, t: Trajectory, new: int, seed: int, round_: int) -> None:
-    """The product's replay update of the monitor (and each committee member) after a round."""
+    """The paper's replay update of the monitor (and each committee member) after a round."""
     records = t.records
     n_old = records.n - new
     rng = np.random.default_rng([seed, round_, 7])
@@ -185,6 +210,8 @@ def _update(ctx: Context, t: Trajectory, new: int, seed: int, round_: int) -> No
 def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> dict:
     cfg = ctx.config
     reads = strategy_name in READS_DISAGREEMENT
+    retrain = cfg.update == "retrain"
+    keeps_monitor = not (retrain and strategy_name in FEEDBACK_BLIND)
     t = _start(ctx, seed, reads)
     strategy = make_strategy(strategy_name, ctx.space, seed, pool=acquirer.pool_params,
                              **strategy_options(strategy_name, batch=cfg.n_round))
@@ -202,13 +229,18 @@ def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> d
                                          scenario_id=run.scenario_id)
             t.kinds.append(prop.kind)
             strategy.tell(run.x, run.fitness)
-        _update(ctx, t, cfg.n_round, seed, round_)
+        if retrain and keeps_monitor:
+            _retrain(ctx, t, seed)
+        elif not retrain:
+            _update(ctx, t, cfg.n_round, seed, round_)
         if t.records.n in budgets:
             ids = list(t.records.scenario_id)
             ctx.say(f"{ctx.regime}: {strategy_name} seed {seed} at {len(ids)} runs")
+            scratch = ctx.scratch_figures(ids, len(ids), seed,
+                                          t.monitor if retrain and keeps_monitor else None)
             out["budgets"][str(len(ids))] = {
-                "scratch": ctx.scratch_figures(ids, len(ids), seed),
-                "update": ctx.learner.judge(t.monitor),
+                "scratch": scratch,
+                "update": scratch if retrain else ctx.learner.judge(t.monitor),
                 "acquired": acquired_summary(t.records.collided[cfg.initial_runs:],
                                              t.records.fitness[cfg.initial_runs:]),
             }

@@ -2,13 +2,17 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
+from evoeye.paths import DataRoot
 from evoeye.results.efficiency.acquire import PoolAcquirer
-from evoeye.results.efficiency.curves import initial_rows, run_curve
+from evoeye.results.efficiency.curves import initial_rows, run_curve, training_seed
 from evoeye.results.efficiency.oracle import run_oracle
 from evoeye.results.efficiency.sets import concat_windows
+from evoeye.results.ledger import Ledger
 
 
 def test_every_strategy_starts_from_the_seeds_initial_runs_and_picks_unused_pool_runs(
@@ -37,6 +41,36 @@ def test_a_curve_is_deterministic_and_a_rerun_finds_it(context) -> None:
     for entry in context.ledger.folder.glob("efficiency-curve-*.json"):
         entry.unlink()
     assert run_curve(context, "evoeye", 1, PoolAcquirer(context.bank)) == first
+
+
+def test_retrain_trains_the_per_round_monitor_again_only_where_feedback_is_read(
+        context, tmp_path, monkeypatch) -> None:
+    """Under `update="retrain"` the per-round monitor is trained from scratch every round for a
+    feedback reader (and is the checkpoint's monitor), and not at all for a blind strategy,
+    whose picks and from-scratch figures are the replay curve's."""
+    ctx = replace(context, config=replace(context.config, update="retrain", n_round=2),
+                  ledger=Ledger(DataRoot.resolve(tmp_path / "fresh")))  # rounds between checkpoints
+    trainings = []
+    real = ctx.learner.scratch
+    monkeypatch.setattr(ctx.learner, "scratch",
+                        lambda train, seed: trainings.append(seed) or real(train, seed))
+    blind = run_curve(ctx, "uniform", 0, PoolAcquirer(ctx.bank))
+    checkpoints = len(ctx.config.checkpoints_of("uniform"))
+    assert len(trainings) == 1 + checkpoints  # G_0 and one per checkpoint: no per-round ones
+    replayed = run_curve(context, "uniform", 0, PoolAcquirer(context.bank))
+    assert blind["acquired_ids"] == replayed["acquired_ids"]
+    for budget, entry in blind["budgets"].items():
+        assert entry["update"] == entry["scratch"] == replayed["budgets"][budget]["scratch"]
+
+    trainings.clear()
+    reader = run_curve(ctx, "evoeye", 0, PoolAcquirer(ctx.bank))
+    rounds = (max(ctx.config.checkpoints) - ctx.config.initial_runs) // 2
+    assert len(trainings) == 1 + rounds  # G_0, then one a round; a checkpoint reuses its round's
+    assert trainings[1:] == [training_seed(0, ctx.config.initial_runs + 2 * r)
+                             for r in range(1, rounds + 1)]
+    for entry in reader["budgets"].values():
+        assert entry["update"] == entry["scratch"]
+    assert ctx.ledger.computed["efficiency-curve"] == 2  # not found under the replay keys
 
 
 def test_the_oracle_picks_by_its_set_and_keeps_its_choice(context) -> None:

@@ -24,6 +24,7 @@ def test_regimes_name_a_scenario_and_a_profile() -> None:
 
 @pytest.mark.parametrize(("change", "message"), [
     ({"mode": "live"}, "mode must be one of"),
+    ({"update": "finetune"}, "update must be one of"),
     ({"strategies": ("boundary",)}, "must include the reference 'uniform'"),
     ({"seeds": (3,)}, "at least 2 distinct seeds"),
     ({"checkpoints": (80, 70)}, "must increase"),
