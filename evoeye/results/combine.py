@@ -83,10 +83,14 @@ def combine(paths: Sequence[Path]) -> dict:
     return combined
 
 
-def source_lines(sources: list[dict]) -> list[str]:
-    """One Markdown bullet per run: its file, the tables it gave and the sizes they rest on."""
+def source_lines(sources: list[dict], studies: frozenset[str] = frozenset()) -> list[str]:
+    """One Markdown bullet per run: its file, the tables it gave and the sizes they rest on
+    (`studies`: the paths of sample-efficiency study runs, whose paper settings mean nothing)."""
     out = []
     for s in sources:
+        if not s["tables"] and s["path"] in studies:
+            out.append(f"* `{s['path']}`: the sample-efficiency study — its claims are below")
+            continue
         cfg = s["config"]
         campaigns = "rq2" in cfg.get("parts", ("rq2",))  # RQ1-only runs have none
         sizes = [f"{label} {len(cfg[key])}" for key, label in (
@@ -106,7 +110,8 @@ def combined_markdown(combined: dict, source: str) -> str:
 
     text = findings_markdown(combined["findings"], source, command="evoeye findings",
                              runs=["Each table comes from one `evoeye results` run:", "",
-                                   *source_lines(combined["sources"])])
+                                   *source_lines(combined["sources"], frozenset(
+                                       s["path"] for s in combined.get("efficiency", [])))])
     for study in combined.get("efficiency", []):
         text += (f"\n{efficiency_findings_markdown(study['findings'])}\n"
                  f"From `{study['path']}`: {study_words(study['config'])}.\n")
@@ -129,5 +134,5 @@ def write_combined(combined: dict, out: Path | None = None, readme: Path | None 
     if readme is not None:
         write_readme_section(readme, combined["findings"], source,
                              None if out is None else out / "findings.md",
-                             command="evoeye findings")
+                             command="evoeye findings", studies=combined.get("efficiency", []))
     return text

@@ -209,5 +209,6 @@ def write_results(root: DataRoot, results: dict, name: str = "results", *,
         write_figure(results["tables"], docs)
     if readme is not None:
         write_readme_section(readme, results["findings"], source,
-                             (docs if docs is not None else folder) / "findings.md")
+                             (docs if docs is not None else folder) / "findings.md",
+                             studies=[results["efficiency"]] if "efficiency" in results else [])
     return folder

@@ -126,3 +126,26 @@ def test_the_command_writes_the_files_and_the_readme_section(tmp_path: Path) -> 
     bad.write_text("{", encoding="utf-8")
     res = runner.invoke(app, ["findings", str(a), str(bad)])
     assert res.exit_code == ExitCode.USER_ERROR and "bad.json: not a results JSON" in res.output
+
+
+def test_a_study_run_is_listed_as_the_study_with_its_claims(tmp_path: Path) -> None:
+    rq1 = _write(tmp_path / "a", {"s1": {"rq1": _rq1(0.1)}})
+    claims = [{"id": "efficiency-area", "claim": "A strategy beats Uniform", "checks": [],
+               "verdict": "not run yet"}]
+    study = tmp_path / "study.json"
+    study.write_text(json.dumps({"config": {"training_seeds": [0]}, "tables": [], "findings": [],
+                                 "efficiency": {"config": {"mode": "pool", "seeds": [0, 1],
+                                                           "regimes": ["r:cautious"]},
+                                                "findings": claims}}))
+    combined = combine([rq1, study])
+    assert [s["path"] for s in combined["sources"]] == [str(rq1), str(study)]  # reproducible
+    text = write_combined(combined)
+    assert f"* `{study}`: the sample-efficiency study — its claims are below" in text
+    assert "training seeds 1" not in text  # the paper settings a study run does not use
+    assert "Does acquisition earn its budget?" in text and "r:cautious" in text
+    readme = tmp_path / "README.md"
+    readme.write_text(f"# x\n\n{README_BEGIN}\nold\n{README_END}\n")
+    write_combined(combined, readme=readme)
+    section = readme.read_text()
+    assert "| A strategy beats Uniform | **not run yet** |" in section
+    assert "regimes r:cautious" in section and "old" not in section
