@@ -21,9 +21,10 @@ def _section() -> str:
     """What the README's section must be: from docs/results/findings.json when the findings
     combine several runs, else from the one run's results.json."""
     if COMBINED.exists():
-        return readme_section(json.loads(COMBINED.read_text())["findings"],
-                              "docs/results/findings.json", command="evoeye findings",
-                              details="docs/results/findings.md")
+        combined = json.loads(COMBINED.read_text())
+        return readme_section(combined["findings"], "docs/results/findings.json",
+                              command="evoeye findings", details="docs/results/findings.md",
+                              studies=combined.get("efficiency", []))
     findings = (json.loads(RESULTS.read_text())["findings"] if RESULTS.exists()
                 else check_findings([]))  # before the first run: every finding "not run yet"
     return readme_section(findings, "docs/results/results.json",
