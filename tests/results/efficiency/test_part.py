@@ -7,7 +7,7 @@ from dataclasses import replace
 
 from evoeye.results.config import ResultsConfig
 from evoeye.results.efficiency import runner
-from evoeye.results.efficiency.part import failed_units, run_efficiency
+from evoeye.results.efficiency.part import failed_units, regime_results, run_efficiency
 from evoeye.results.efficiency.report import regime_markdown
 from evoeye.results.ledger import Ledger
 from evoeye.results.run import assemble, write_results
@@ -42,6 +42,9 @@ def test_the_study_runs_in_workers_resumes_and_writes_its_files(tiny_regime, tin
     again = run_efficiency(root, config, workers=1, ledger=found)  # every curve found
     assert again == first and found.computed["efficiency-curve"] == 0
     assert found.found["efficiency-curve"] == 8  # 2 strategies, the oracle, its control; 2 seeds
+    raw = runner.run_regime(root, config.regimes[0], config, ledger=found)
+    retrained = regime_results(raw, replace(config, update="retrain"))["summaries"]
+    assert set(retrained) == {"test/scratch", "boundary/scratch"}  # the update one is scratch
 
     results = ResultsConfig(parts=("efficiency",), efficiency=config.changed())
     folder = write_results(root, assemble(Study(root, results), {}, first), "study")
