@@ -211,7 +211,7 @@ def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> d
     cfg = ctx.config
     reads = strategy_name in READS_DISAGREEMENT
     retrain = cfg.update == "retrain"
-    keeps_monitor = not (retrain and strategy_name in FEEDBACK_BLIND)
+    retrains = retrain and strategy_name not in FEEDBACK_BLIND  # someone reads its monitor
     t = _start(ctx, seed, reads)
     strategy = make_strategy(strategy_name, ctx.space, seed, pool=acquirer.pool_params,
                              **strategy_options(strategy_name, batch=cfg.n_round))
@@ -229,7 +229,7 @@ def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> d
                                          scenario_id=run.scenario_id)
             t.kinds.append(prop.kind)
             strategy.tell(run.x, run.fitness)
-        if retrain and keeps_monitor:
+        if retrains:
             _retrain(ctx, t, seed)
         elif not retrain:
             _update(ctx, t, cfg.n_round, seed, round_)
@@ -237,7 +237,7 @@ def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> d
             ids = list(t.records.scenario_id)
             ctx.say(f"{ctx.regime}: {strategy_name} seed {seed} at {len(ids)} runs")
             scratch = ctx.scratch_figures(ids, len(ids), seed,
-                                          t.monitor if retrain and keeps_monitor else None)
+                                          t.monitor if retrains else None)
             out["budgets"][str(len(ids))] = {
                 "scratch": scratch,
                 "update": scratch if retrain else ctx.learner.judge(t.monitor),

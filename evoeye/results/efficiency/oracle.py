@@ -72,15 +72,15 @@ def run_oracle(ctx: Context, seed: int, control: bool = False) -> dict:
     inputs = {"regime": ctx.regime, "sets": ctx.fingerprint, "strategy": name, "seed": seed,
               "initial": cfg.initial_runs, "budgets": list(cfg.checkpoints),
               "candidates": cfg.oracle_candidates, "recipe": ctx.learner.recipe}
-    return ctx.ledger.remember("efficiency-curve", inputs, lambda: _oracle(ctx, seed, control))
+    return ctx.ledger.remember("efficiency-curve", inputs, lambda: _oracle(ctx, seed, name))
 
 
-def _oracle(ctx: Context, seed: int, control: bool) -> dict:
-    name = ORACLE_UNIFORM if control else ORACLE
+def _oracle(ctx: Context, seed: int, name: str) -> dict:
     cfg, pool, learner = ctx.config, ctx.bank.pool, ctx.learner
     oracle_set = ctx.bank.data.sets["oracle"]
-    used = np.zeros(len(pool), bool)
-    used[initial_rows(pool.collided, cfg.initial_runs, seed)] = True
+    init = np.zeros(len(pool), bool)
+    init[initial_rows(pool.collided, cfg.initial_runs, seed)] = True
+    used = init.copy()
     monitor = learner.scratch(ctx.bank.windows(pool.scenario_id[used]),
                               training_seed(seed, cfg.initial_runs))
     g0 = ctx.scratch_figures(pool.scenario_id[used], cfg.initial_runs, seed, monitor)
@@ -89,7 +89,7 @@ def _oracle(ctx: Context, seed: int, control: bool) -> dict:
         rng = np.random.default_rng([seed, 99, step])
         size = budget - int(used.sum())
         best = None
-        for kind, rows in _candidates(ctx, monitor, used, size, rng, control):
+        for kind, rows in _candidates(ctx, monitor, used, size, rng, name == ORACLE_UNIFORM):
             ids = [*pool.scenario_id[used], *pool.scenario_id[rows]]
             candidate = learner.scratch(ctx.bank.windows(ids), training_seed(seed, budget))
             auprc = metrics_dict(candidate.score(oracle_set), oracle_set.label,
@@ -100,8 +100,6 @@ def _oracle(ctx: Context, seed: int, control: bool) -> dict:
         auprc, kind, rows, monitor = best
         used[rows] = True
         out["kinds"].append(kind)
-        init = np.zeros(len(pool), bool)
-        init[initial_rows(pool.collided, cfg.initial_runs, seed)] = True
         acq = used & ~init
         out["budgets"][str(budget)] = {
             "scratch": learner.judge(monitor), "chosen": kind, "oracle_auprc": auprc,
