@@ -141,7 +141,7 @@ def efficiency_findings_markdown(findings: list[dict]) -> str:
                     for c in f["checks"]]
             out += [f"**{f['claim']}** — {f['verdict']}", "",
                     *md_table(["regime", "strategy", "against",
-                               f"area {chr(8722)} against's [95 % CI] p",
+                               "area difference [95 % CI] p",
                           "verdict", "Uniform's budget ×", "verdict"], rows, numbers=False),
                     ""]
     return "\n".join(out)
