@@ -17,6 +17,7 @@ import json
 from collections.abc import Sequence
 from pathlib import Path
 
+from evoeye.results.efficiency.findings import StudyMergeError, merge_studies
 from evoeye.results.findings import check_findings
 
 RESULTS_FILE = "results.json"
@@ -74,12 +75,14 @@ def combine(paths: Sequence[Path]) -> dict:
             names.append(_table_name(table))
         sources.append({"path": str(file), "config": results.get("config", {}),
                         "tables": names})
-        if "efficiency" in results:  # each study run's claims stand on their own seeds
-            studies.append({"path": str(file), "config": results["efficiency"]["config"],
-                            "findings": results["efficiency"]["findings"]})
+        if "efficiency" in results:
+            studies.append({"path": str(file), **results["efficiency"]})
     combined = {"sources": sources, "tables": tables, "findings": check_findings(tables)}
     if studies:
-        combined["efficiency"] = studies
+        try:  # a study run regime by regime is checked over all of them
+            combined["efficiency"] = merge_studies(studies)
+        except StudyMergeError as exc:
+            raise ResultsFileError(str(exc)) from None
     return combined
 
 
@@ -111,10 +114,12 @@ def combined_markdown(combined: dict, source: str) -> str:
     text = findings_markdown(combined["findings"], source, command="evoeye findings",
                              runs=["Each table comes from one `evoeye results` run:", "",
                                    *source_lines(combined["sources"], frozenset(
-                                       s["path"] for s in combined.get("efficiency", [])))])
+                                       p for s in combined.get("efficiency", [])
+                                       for p in s["paths"]))])
     for study in combined.get("efficiency", []):
+        paths = ", ".join(f"`{p}`" for p in study["paths"])
         text += (f"\n{efficiency_findings_markdown(study['findings'])}\n"
-                 f"From `{study['path']}`: {study_words(study['config'])}.\n")
+                 f"From {paths}: {study_words(study['config'])}.\n")
     return text
 
 

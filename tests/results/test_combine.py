@@ -14,6 +14,7 @@ from evoeye.cli import app
 from evoeye.cli.errors import ExitCode
 from evoeye.results.combine import ResultsFileError, combine, write_combined
 from evoeye.results.config import BASELINES
+from evoeye.results.efficiency.findings import MEASURE, efficiency_findings
 from evoeye.results.findings import check_findings
 from evoeye.results.markdown import README_BEGIN, README_END
 from evoeye.results.readme import FIGURE, readme_section, rq1_figure
@@ -149,3 +150,45 @@ def test_a_study_run_is_listed_as_the_study_with_its_claims(tmp_path: Path) -> N
     section = readme.read_text()
     assert "| A strategy beats Uniform | **not run yet** |" in section
     assert "regimes r:cautious" in section and "old" not in section
+
+
+def _study(path: Path, regime: str, seeds: list[int], *, gain: bool, mode: str = "pool") -> Path:
+    """A study run over one regime whose `boundary` beats Uniform on the area (`gain`) or not."""
+    cell = ({"mean_diff": 3.0, "ci_low": 1.0, "ci_high": 5.0, "p_value": 0.002, "min_p": 0.002} if gain else
+            {"mean_diff": 0.5, "ci_low": -1.0, "ci_high": 2.0, "p_value": 0.4, "min_p": 0.002})
+    regimes = {regime: {"summaries": {MEASURE: {"strategies": {
+        "uniform": {}, "boundary": {"area_vs_reference": cell, "efficiency": None}}}}}}
+    config = {"mode": mode, "initial_runs": 40, "seeds": seeds, "regimes": [regime],
+              "strategies": ["uniform", "boundary"]}
+    path.write_text(json.dumps({"config": {}, "tables": [], "findings": [], "efficiency": {
+        "config": config, "regimes": regimes,
+        "findings": efficiency_findings({"regimes": regimes})}}))
+    return path
+
+
+def _verdict(findings: list[dict], id_: str) -> str:
+    return next(f["verdict"] for f in findings if f["id"] == id_)
+
+
+def test_a_study_run_regime_by_regime_is_checked_over_all_its_regimes(tmp_path: Path) -> None:
+    a = _study(tmp_path / "a.json", "highway-cut-in", list(range(10)), gain=True)
+    b = _study(tmp_path / "b.json", "unprotected-intersection", [0, 1, 2, 3], gain=True)
+    alone = combine([a])["efficiency"]
+    assert _verdict(alone[0]["findings"], "efficiency-area") == "not shown"  # one regime of two
+    (study,) = combine([a, b])["efficiency"]
+    assert study["paths"] == [str(a), str(b)]
+    assert _verdict(study["findings"], "efficiency-area") == "reproduces"
+    assert study["config"]["seeds"] == {"highway-cut-in": list(range(10)),
+                                        "unprotected-intersection": [0, 1, 2, 3]}
+    assert ("regimes highway-cut-in (10 seeds (0–9)), unprotected-intersection (4 seeds (0–3))"
+            in write_combined(combine([a, b])))
+    flat = _study(tmp_path / "c.json", "unprotected-intersection", [0, 1], gain=False)
+    assert _verdict(combine([a, flat])["efficiency"][0]["findings"],
+                    "efficiency-area") == "not shown"
+    # another protocol is another study; the same regime twice in one study is refused
+    other = _study(tmp_path / "d.json", "highway-cut-in", [100, 101], gain=True,
+                   mode="generative")
+    assert [s["paths"] for s in combine([a, b, other])["efficiency"]] == [
+        [str(a), str(b)], [str(other)]]
+    with pytest.raises(ResultsFileError, match="regime highway-cut-in is also in .*a.json"):
+        combine([a, b, _study(tmp_path / "e.json", "highway-cut-in", [0, 1], gain=True)])

@@ -17,9 +17,17 @@ uniform-only control's (choosing the kind of run gains more than a best-of-k cho
 uniform draws); and the paper's loop beats Uniform.
 A claim over regimes reproduces when enough regimes reproduce; it is not run yet when the
 study has no check of it.
+
+A study too big for one session runs regime by regime: runs with the same protocol (their
+config but for regimes, seeds and strategies) are one study, and `merge_studies` checks its
+claims over all their regimes. Each regime's checks stay paired over that regime's own seeds,
+so a regime may have more seeds than another; a regime in two runs of one study is refused by
+name (which of the two counts would be a choice).
 """
 
 from __future__ import annotations
+
+import json
 
 from evoeye.results.efficiency.config import ORACLE, ORACLE_UNIFORM, REFERENCE
 from evoeye.results.findings import (
@@ -34,6 +42,11 @@ from evoeye.results.findings import (
 MEASURE = "test/scratch"
 EFFICIENCY = 1.5
 BASELINES = (REFERENCE, "sobol", "evoeye", ORACLE, ORACLE_UNIFORM)  # not "beyond the paper"
+FREE = ("regimes", "seeds", "strategies")  # what the runs of one study may differ in
+
+
+class StudyMergeError(ValueError):
+    """Runs of one study that cannot be checked together (module doc)."""
 
 
 def efficiency_verdict(e: dict | None) -> str:
@@ -111,3 +124,38 @@ def efficiency_findings(results: dict) -> list[dict]:
                "at least two regimes)", [c for c in checks if c["strategy"] == "evoeye"],
                "area_verdict", 2),
     ]
+
+
+def merge_studies(runs: list[dict]) -> list[dict]:
+    """Runs ({"path", "config", "findings", "regimes"}: a results JSON's `efficiency` part and
+    its file) as studies ({"paths", "config", "findings"}): runs of one protocol merged, their
+    claims checked over every regime (module doc). A study of one run keeps its own findings;
+    a merged one's config lists each regime's seeds (`{regime: seeds}`)."""
+    groups: dict[str, list[dict]] = {}
+    for run in runs:
+        protocol = {k: v for k, v in run["config"].items() if k not in FREE}
+        groups.setdefault(json.dumps(protocol, sort_keys=True, default=str), []).append(run)
+    out = []
+    for group in groups.values():
+        if len(group) == 1:
+            out.append({"paths": [group[0]["path"]], "config": group[0]["config"],
+                        "findings": group[0]["findings"]})
+            continue
+        regimes, owner, seeds, strategies = {}, {}, {}, []
+        for run in group:
+            if not run.get("regimes"):
+                raise StudyMergeError(f"{run['path']}: the study's regimes are missing (it "
+                                      "cannot be checked with the study's other runs)")
+            for regime, result in run["regimes"].items():
+                if regime in owner:
+                    raise StudyMergeError(f"{run['path']}: regime {regime} is also in "
+                                          f"{owner[regime]}; give each regime of a study from "
+                                          "one run only")
+                owner[regime], regimes[regime] = run["path"], result
+                seeds[regime] = run["config"]["seeds"]
+            strategies += [s for s in run["config"].get("strategies", []) if s not in strategies]
+        config = {**group[0]["config"], "regimes": list(regimes), "strategies": strategies,
+                  "seeds": seeds}
+        out.append({"paths": [run["path"] for run in group], "config": config,
+                    "findings": efficiency_findings({"regimes": regimes})})
+    return out

@@ -160,7 +160,14 @@ def efficiency_html(efficiency: dict) -> list[str]:
 
 
 def study_words(cfg: dict) -> str:
-    """What a study run was, in a few words: its mode and seeds."""
+    """What a study run was, in a few words: its mode and seeds (per regime when a study's
+    regimes ran with seeds of their own, `merge_studies`)."""
+    def seeds_words(seeds: list[int]) -> str:
+        return f"{len(seeds)} seeds ({seeds[0]}–{seeds[-1]})"
+
     seeds = cfg["seeds"]
-    return (f"{MODE_WORDS[cfg['mode']]}, {len(seeds)} seeds ({seeds[0]}–{seeds[-1]}), "
+    if isinstance(seeds, dict):
+        return (f"{MODE_WORDS[cfg['mode']]}, regimes "
+                + ", ".join(f"{r} ({seeds_words(s)})" for r, s in seeds.items()))
+    return (f"{MODE_WORDS[cfg['mode']]}, {seeds_words(seeds)}, "
             f"regimes {', '.join(cfg['regimes'])}")
