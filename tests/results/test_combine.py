@@ -176,6 +176,9 @@ def test_a_study_run_regime_by_regime_is_checked_over_all_its_regimes(tmp_path: 
     b = _study(tmp_path / "b.json", "unprotected-intersection", [0, 1, 2, 3], gain=True)
     alone = combine([a])["efficiency"]
     assert _verdict(alone[0]["findings"], "efficiency-area") == "not shown"  # one regime of two
+    recorded = json.loads(b.read_text())
+    recorded["efficiency"]["config"]["update"] = "replay"  # a key later runs record
+    b.write_text(json.dumps(recorded))
     (study,) = combine([a, b])["efficiency"]
     assert study["paths"] == [str(a), str(b)]
     assert _verdict(study["findings"], "efficiency-area") == "reproduces"

@@ -43,6 +43,8 @@ MEASURE = "test/scratch"
 EFFICIENCY = 1.5
 BASELINES = (REFERENCE, "sobol", "evoeye", ORACLE, ORACLE_UNIFORM)  # not "beyond the paper"
 FREE = ("regimes", "seeds", "strategies")  # what the runs of one study may differ in
+# config keys added after studies were recorded, with the value every earlier run had
+ADDED = {"update": "replay"}
 
 
 class StudyMergeError(ValueError):
@@ -133,7 +135,7 @@ def merge_studies(runs: list[dict]) -> list[dict]:
     a merged one's config lists each regime's seeds (`{regime: seeds}`)."""
     groups: dict[str, list[dict]] = {}
     for run in runs:
-        protocol = {k: v for k, v in run["config"].items() if k not in FREE}
+        protocol = {k: v for k, v in {**ADDED, **run["config"]}.items() if k not in FREE}
         groups.setdefault(json.dumps(protocol, sort_keys=True, default=str), []).append(run)
     out = []
     for group in groups.values():
