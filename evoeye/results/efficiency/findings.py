@@ -29,7 +29,12 @@ from __future__ import annotations
 
 import json
 
-from evoeye.results.efficiency.config import ORACLE, ORACLE_UNIFORM, REFERENCE
+from evoeye.results.efficiency.config import (
+    ORACLE,
+    ORACLE_UNIFORM,
+    REFERENCE,
+    EfficiencyConfig,
+)
 from evoeye.results.findings import (
     AGAINST,
     NOT_RUN,
@@ -43,8 +48,6 @@ MEASURE = "test/scratch"
 EFFICIENCY = 1.5
 BASELINES = (REFERENCE, "sobol", "evoeye", ORACLE, ORACLE_UNIFORM)  # not "beyond the paper"
 FREE = ("regimes", "seeds", "strategies")  # what the runs of one study may differ in
-# config keys added after studies were recorded, with the value every earlier run had
-ADDED = {"update": "replay"}
 
 
 class StudyMergeError(ValueError):
@@ -133,10 +136,12 @@ def merge_studies(runs: list[dict]) -> list[dict]:
     its file) as studies ({"paths", "config", "findings"}): runs of one protocol merged, their
     claims checked over every regime (module doc). A study of one run keeps its own findings;
     a merged one's config lists each regime's seeds (`{regime: seeds}`)."""
+    # a field added since a run was recorded reads as its default: the behaviour that run had
+    default = EfficiencyConfig().to_dict()
     groups: dict[str, list[dict]] = {}
     for run in runs:
-        protocol = {k: v for k, v in {**ADDED, **run["config"]}.items() if k not in FREE}
-        groups.setdefault(json.dumps(protocol, sort_keys=True, default=str), []).append(run)
+        protocol = {k: v for k, v in {**default, **run["config"]}.items() if k not in FREE}
+        groups.setdefault(json.dumps(protocol, sort_keys=True), []).append(run)
     out = []
     for group in groups.values():
         if len(group) == 1:
