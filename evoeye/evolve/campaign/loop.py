@@ -22,20 +22,18 @@ keeps G_r.
 State and resume. Everything a campaign knows is in the data root: run logs under
 `runs/<scenario>/<campaign id>/`, the feedback table (f_r per run and monitor version) and the
 campaign_rounds table (per round: G_r and the runs acquired, in order). `start()` rebuilds D_r
-(the runs' outcomes from the warehouse, no log read again) and the strategy (`replay`) from the
-last stored round; a round interrupted anywhere (mid-run,
-mid-round, mid-training) is re-done from its start — its proposals are deterministic (the
-strategy's, and run seed k for proposal k), logs already on disk are read instead of simulated,
-so no run is lost, duplicated or charged twice. A campaign writes only its own keys (its
-batch's partition, its rounds, its monitor versions' feedback: `evoeye.store.lock`), so
-campaigns run side by side (`experiment.py`). A run is started only if the budget left is at
-least the longest run (`max_run_s`), so the budget is never overspent.
+(outcomes from the warehouse, no log read again) and the strategy (`replay`) from the last
+stored round; a round interrupted anywhere (mid-run, mid-round, mid-training) is re-done from
+its start — its proposals are deterministic (the strategy's, and run seed k for proposal k),
+logs already on disk are read instead of simulated, so no run is lost, duplicated or charged
+twice. A campaign writes only its own keys (its batch's partition, rounds, monitor versions'
+feedback: `evoeye.store.lock`), so campaigns run side by side (`experiment.py`). A run starts
+only if the budget left is at least the longest run (`max_run_s`): no budget is overspent.
 
 A strategy that reads the records' disagreement (`disagreement`) has a committee
 (`committee.py`): K − 1 companions updated beside G_r, whose spread of scores is stored per run.
 
-Deviation from Algorithm 1: a last round cut short by the budget still updates the monitor (its
-runs were paid for; training costs no simulated time).
+Deviation from Algorithm 1: a last round cut short by the budget still updates G on its paid runs.
 """
 
 from __future__ import annotations
@@ -379,8 +377,7 @@ class Campaign:
 
     def write_feedback(self, version: str, ids, values, n_contexts=None,
                        mode: str | None = None) -> None:
-        """Store per-run values (the finite ones) under `version` in `mode` (default: the
-        campaign's feedback mode)."""
+        """Store per-run values (the finite ones) under `version` in `mode` (default: ours)."""
         ids, values = np.asarray(ids, dtype=object), np.asarray(values, float)
         keep = np.isfinite(values)
         n = np.zeros(len(ids), int) if n_contexts is None else np.asarray(n_contexts)
