@@ -62,3 +62,19 @@ def test_the_section_summarises_each_finding_and_links_to_its_checks(tmp_path: P
     rows = [line for line in text.splitlines() if line.startswith("| ") and "**" in line]
     assert [r.split(" | ")[0][2:] for r in rows] == [f["claim"] for f in findings]
     assert all(r.endswith(f"**{f['verdict']}** |") for r, f in zip(rows, findings, strict=True))
+
+
+def test_several_studies_share_one_heading_each_with_its_own_table() -> None:
+    def study(seeds: list[int], verdict: str) -> dict:
+        return {"config": {"mode": "pool", "seeds": seeds, "regimes": ["r:cautious"]},
+                "findings": [{"claim": "A strategy beats Uniform", "verdict": verdict}]}
+
+    section = readme_section(check_findings([]), "x.json",
+                             studies=[study([0, 1], "not shown"), study([100, 101], "reproduces")])
+    assert section.count("### Does acquisition earn its budget?") == 1
+    assert section.count("| claim | verdict |") == 2
+    first = section.index("Study 1 of 2: picked from a pool of pre-simulated uniform runs, "
+                          "2 seeds (0–1)")
+    second = section.index("Study 2 of 2: picked from a pool of pre-simulated uniform runs, "
+                           "2 seeds (100–101)")
+    assert first < section.index("**not shown**") < second < section.index("**reproduces**")
