@@ -15,6 +15,7 @@ import hashlib
 import io
 import json
 import math
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field, replace
 from pathlib import Path
 from typing import Any
@@ -69,11 +70,14 @@ class AEMConfig:
 
 ADDED_FIELDS = ("recipe", "schedule", "warmup_epochs")
 # the FusionMonitor's recipe names (evoeye.monitor.recipes), the AEM's part of each: v2 trains
-# in batches of 1024 at a peak 3e-3 with a warm-up and a cosine decay over 8 epochs
+# in batches of 1024 at a peak 3e-3 with a warm-up and a cosine decay over 8 epochs; v3 in
+# batches of 32 at v1's constant 1e-3 for 3 epochs: v1's optimiser steps (its ranking follows
+# the steps, not the epochs: docs/training.md) for 28 % of its CPU time
 AEM_RECIPES = {
     "v1": AEMConfig(),
     "v2": AEMConfig(recipe="v2", epochs=8, batch_size=1024, lr=3e-3, schedule="cosine",
                     warmup_epochs=0.5),
+    "v3": AEMConfig(recipe="v3", epochs=3, batch_size=32),
 }
 
 
@@ -203,17 +207,23 @@ class AEMMonitor:
         return cls.decode(*read_version(version_dir, MODEL_FILE, META_FILE))
 
 
+AfterEpoch = Callable[[int, "AEMMonitor"], None]  # (epoch, the AEM as it stands: rank by errors)
+
+
 def train_aem(train: Windows, normal: np.ndarray, config: AEMConfig = AEMConfig(), *,
-              init: AEMMonitor | None = None, threads: int = 1) -> AEMMonitor:
+              init: AEMMonitor | None = None, threads: int = 1,
+              after_epoch: AfterEpoch | None = None) -> AEMMonitor:
     """Fit the autoencoder on the windows `normal` (bool (B,)) of `train`; seeded by config
     (the same seed, data and thread count give the same weights). With `init`, fine-tune it:
-    its weights and input standardisation are the start, only the error scale is re-measured."""
+    its weights and input standardisation are the start, only the error scale is re-measured.
+    `after_epoch(epoch, aem)` sees the AEM after every epoch (its error scale NaN, not yet
+    measured), e.g. to follow a schedule's validation ranking; it changes no weight."""
     with intra_op_threads(threads):
-        return _train(train, normal, config, init)
+        return _train(train, normal, config, init, after_epoch)
 
 
 def _train(train: Windows, normal: np.ndarray, config: AEMConfig,
-           init: AEMMonitor | None = None) -> AEMMonitor:
+           init: AEMMonitor | None = None, after_epoch: AfterEpoch | None = None) -> AEMMonitor:
     if init is not None and (init.config.hidden, init.config.latent) != (config.hidden,
                                                                          config.latent):
         raise ValueError("a fine-tuned AEM keeps its parent's layer sizes")
@@ -244,8 +254,8 @@ def _train(train: Windows, normal: np.ndarray, config: AEMConfig,
     lr_at = step_lrs(config.lr, config.schedule, config.warmup_epochs, config.epochs,
                      math.ceil(len(xt) / config.batch_size))
     step = 0
-    model.train()
-    for _ in range(config.epochs):
+    for epoch in range(1, config.epochs + 1):
+        model.train()
         for batch in torch.randperm(len(xt), generator=gen).split(config.batch_size):
             opt.lr = lr_at(step)
             step += 1
@@ -254,6 +264,8 @@ def _train(train: Windows, normal: np.ndarray, config: AEMConfig,
             opt.zero_grad()
             loss.backward()
             opt.step()
+        if after_epoch is not None:
+            after_epoch(epoch, AEMMonitor(config, model, mean.astype(np.float32), std, math.nan))
     model.eval()
     with torch.inference_mode():
         err = torch.cat([((model(c) - c) ** 2).mean(dim=1) for c in xt.split(CHUNK)])

@@ -3,7 +3,7 @@
 The windows are the eligible frames of the selected runs (`load_windows`): no frame at or after
 a run's collision enters training, `pos_weight`, early stopping or calibration. How a network
 learns from them — loss, batches, schedule, early stopping — is `evoeye.monitor.fit`, with the
-hyper-parameters of a named recipe (`evoeye.monitor.recipes`: "v2" by default, "v1" the one
+hyper-parameters of a named recipe (`evoeye.monitor.recipes`: "v3" by default, "v1" the one
 every earlier result was made with) and the caller's overrides; the card records both.
 
 `init_from=<version>` fine-tunes a parent: its weights, input normalisers and architecture are

@@ -53,8 +53,8 @@ PAPER_TEST_RUNS = {"highway-cut-in": 75, "unprotected-intersection": 132}
 PAPER_INITIAL_RUNS = {"highway-cut-in": 107 + 25, "unprotected-intersection": 177 + 45}
 # training recipes (evoeye.monitor.recipes RECIPES, DEFAULT_RECIPE, LEGACY_RECIPE): a config
 # recorded before the recipe was one of its fields was trained with the legacy one
-RECIPES = ("v1", "v2")
-DEFAULT_RECIPE, LEGACY_RECIPE = "v2", "v1"
+RECIPES = ("v1", "v2", "v3")
+DEFAULT_RECIPE, LEGACY_RECIPE = "v3", "v1"
 RQ1_RUNS = 1300  # initial runs RQ1 and the monitor ablation train on, at least (module doc)
 TEST_SHARES = (0.8, 0.2)  # train, val shares of the initial runs when a test batch is held out
 DEFAULT_SHARES = (0.5, 0.125)  # evoeye.splits.SplitSpec() (no test batch)

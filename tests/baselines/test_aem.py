@@ -70,6 +70,22 @@ def test_seeded_save_and_load(windows_of, obs, tmp_path: Path) -> None:
     assert loaded.version == a.version and np.allclose(loaded.score(probe), a.score(probe))
 
 
+def test_after_epoch_sees_each_epoch_s_aem_and_changes_no_weight(windows_of, obs) -> None:
+    train, probe = traffic(300, 0, windows_of, obs), traffic(100, 2, windows_of, obs, odd=True)
+    config = AEMConfig(**{**SMALL.__dict__, "epochs": 3})
+    seen: list[tuple[int, float, float]] = []
+
+    def after_epoch(epoch: int, aem: AEMMonitor) -> None:
+        seen.append((epoch, float(aem.errors(probe).mean()), aem.error_scale))
+
+    plain = train_aem(train, np.ones(len(train), bool), config)
+    followed = train_aem(train, np.ones(len(train), bool), config, after_epoch=after_epoch)
+    assert followed.version == plain.version
+    assert [e for e, _, _ in seen] == [1, 2, 3] and all(np.isnan(s) for _, _, s in seen)
+    assert seen[-1][1] == pytest.approx(float(plain.errors(probe).mean()), rel=1e-6)
+    assert len({err for _, err, _ in seen}) == 3  # the weights it sees move between epochs
+
+
 def test_load_checks_the_sha256_in_meta(windows_of, obs, tmp_path: Path) -> None:
     import json
 

@@ -3,7 +3,7 @@
 from __future__ import annotations
 
 import math
-from dataclasses import asdict, fields
+from dataclasses import asdict, fields, replace
 
 import numpy as np
 import pytest
@@ -33,15 +33,17 @@ def test_a_v1_card_records_what_it_did_before_recipes_had_names() -> None:
     assert set(ADDED_FIELDS) == {f.name for f in fields(TrainParams)} - V1_CARD_KEYS
 
 
-def test_the_default_recipe_is_v2_and_overrides_apply_on_top() -> None:
+def test_the_default_recipe_is_v3_and_overrides_apply_on_top() -> None:
     params = recipe_params(epochs=3, lr=0.5)
-    assert params.recipe == recipes.DEFAULT_RECIPE == "v2"
+    assert params.recipe == recipes.DEFAULT_RECIPE == "v3"
     assert (params.epochs, params.lr, params.batch_size) == (3, 0.5, RECIPES["v2"].batch_size)
     assert recipe_params("v1") == TrainParams() == RECIPES[recipes.LEGACY_RECIPE]
+    # v3 trains the FusionMonitor as v2 does: only its name, and the AEM's part, differ
+    assert replace(RECIPES["v3"], recipe="v2") == RECIPES["v2"]
 
 
 @pytest.mark.parametrize(("recipe", "overrides", "message"), [
-    ("v9", {}, r"unknown training recipe 'v9'; known: \['v1', 'v2'\]"),
+    ("v9", {}, r"unknown training recipe 'v9'; known: \['v1', 'v2', 'v3'\]"),
     ("v2", {"learning_rate": 1.0}, r"unknown training parameter\(s\) \['learning_rate'\]"),
     ("v2", {"batching": "runs"}, "unknown batching 'runs'"),
     ("v2", {"schedule": "step"}, "unknown schedule 'step'"),

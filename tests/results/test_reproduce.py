@@ -34,7 +34,7 @@ def test_a_config_survives_the_results_json() -> None:
     assert ResultsConfig.from_dict(json.loads(json.dumps(config.to_dict()))) == config
     # an older file: the defaults, but the recipe its monitors were trained with
     assert ResultsConfig.from_dict({}) == ResultsConfig(recipe="v1") != ResultsConfig()
-    assert ResultsConfig().recipe == "v2"
+    assert ResultsConfig().recipe == "v3"
     with pytest.raises(ValueError, match=r"unknown config key\(s\) \['colour'\]"):
         ResultsConfig.from_dict({"colour": 1})
 

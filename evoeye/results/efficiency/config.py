@@ -42,7 +42,8 @@ ORACLE = "oracle"
 ORACLE_UNIFORM = "oracle-uniform"  # the oracle's control: it chooses among uniform draws only
 CEILINGS = (ORACLE, ORACLE_UNIFORM)  # curves that know outcomes: no strategy, no update rule
 DEFAULT_PROFILE = "default"  # evoeye.ads.profiles.DEFAULT_PROFILE
-RECIPES, DEFAULT_RECIPE = ("v1", "v2"), "v2"  # evoeye.monitor.recipes; importing it loads torch
+# evoeye.monitor.recipes (importing it loads torch)
+RECIPES, DEFAULT_RECIPE = ("v1", "v2", "v3"), "v3"
 
 
 def parse_regime(regime: str) -> tuple[str, str]:
