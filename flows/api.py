@@ -55,7 +55,18 @@ def one_api_server() -> Iterator[str]:
     try:
         yield from _export(server.api_url)
     finally:
+        _send_queued_logs()
         server.stop()
+
+
+def _send_queued_logs(timeout_s: float = 10.0) -> None:
+    """Send the logs Prefect still queues for the API (it sends them in batches, in the
+    background) while the temporary server runs: left queued, they were sent at exit, to a
+    stopped server, and the run ended on "--- Error logging to API --- All connection attempts
+    failed" under its summary."""
+    from prefect.logging.handlers import APILogWorker
+
+    APILogWorker.drain_all(timeout=timeout_s)
 
 
 @contextmanager
