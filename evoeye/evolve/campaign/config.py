@@ -154,7 +154,8 @@ class CampaignConfig:
                             "it (each round costs as many monitor updates).", ge=2)
     recipe: str = option(DEFAULT_RECIPE, "Training recipe of the monitor updates (and of a G_0 "
                          "the campaign trains itself): v1 (every campaign before recipes had "
-                         "names) or v2.", names="recipe")
+                         "names), v2, or v3 (v2's FusionMonitor training, a faster AEM).",
+                         names="recipe")
     horizon_s: float = option(DEFAULT_HORIZON_S, "Label horizon H, s.", gt=0.0)
     splits: SplitSpec = option(factory=SplitSpec, help="The train/val/test split.")
     max_run_s: float = option(MAX_RUN_S, "No run lasts longer, s (the simulator's duration).",
