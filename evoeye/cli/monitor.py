@@ -82,6 +82,9 @@ def train_command(
         "none, or the parent's).")] = None,
     init_from: Annotated[str | None, typer.Option(
         "--init-from", help="Fine-tune this version instead of training from scratch.")] = None,
+    keep_parent: Annotated[bool, typer.Option(
+        "--keep-parent", help="With --init-from: keep the parent unless an epoch of the "
+        "fine-tune beats it on the validation split.")] = False,
     quiet: Annotated[bool, typer.Option("--quiet", help="No per-epoch lines.")] = False,
 ) -> None:
     """Train a FusionMonitor on the scenario's train split, calibrate it on val, save a version."""
@@ -106,9 +109,13 @@ def train_command(
             data, scenario, context_len=context_len, horizon_s=horizon_s,
             modules=parse_modules(modules), dropout=dropout, seed=seed,
             splits=SplitSpec(seed=split_seed), init_from=init_from, progress=progress,
-            recipe=recipe, device=device, **{k: v for k, v in given.items() if v is not None})
+            recipe=recipe, device=device, keep_parent=keep_parent,
+            **{k: v for k, v in given.items() if v is not None})
     except ValueError as exc:
         raise UserError(str(exc), "check --scenario, and that `evoeye ingest` has run") from exc
+    if init_from is not None and version == init_from:
+        console.print(f"no epoch of the fine-tune beat {init_from} on the validation split: "
+                      "the parent is kept (its card below)")
     card = read_card(data, version)
     console.print(metrics_table(card))
     t = card["training"]

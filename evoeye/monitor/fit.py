@@ -109,9 +109,10 @@ def check_windows(train: Windows, val: Windows) -> int:
 
 def fit(net: FusionNet, train: Windows, val: Windows,
         params: TrainParams = TrainParams(),  # noqa: B008 (frozen dataclass)
-        progress: Progress | None = None) -> FitResult:
+        progress: Progress | None = None, *, keep_start: bool = False) -> FitResult:
     """Train `net` in place on `train`, on the device it sits on, early-stopped on `val`
-    AUPRC; the best epoch's net.
+    AUPRC; the best epoch's net. `keep_start`: the weights it starts from are epoch 0, kept
+    (best_epoch 0) unless an epoch beats them — a fine-tune that only loses keeps its parent.
 
     Call under `reproducible` (train_monitor does) for seeded, repeatable weights; without
     dropout the loop draws no number from the global RNG, so `kernels` is enough.
@@ -129,6 +130,10 @@ def fit(net: FusionNet, train: Windows, val: Windows,
     best, best_state, best_epoch, history = -np.inf, copy.deepcopy(net.state_dict()), 0, []
     clock = PhaseClock(FIT_PHASES, time.thread_time)
     t0, c0 = time.perf_counter(), time.thread_time()
+    if keep_start:
+        with clock("validation"):
+            scores, val_loss = _val_score(net, val)
+            best = ranking_metrics(scores, val.label)["auprc"] if use_auprc else -val_loss
     step = 0
     net.train()
     for epoch in range(1, params.epochs + 1):

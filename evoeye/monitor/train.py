@@ -156,7 +156,8 @@ def train_monitors(
         with reproducible(seed, p.threads, where.type == "cpu") if net is None else kernels(
                 p.threads, where.type == "cpu"):
             net = net or start(seed)
-            result = fit(net, train, val, p, report)
+            result = fit(net, train, val, p, report,
+                         keep_start=p.keep_parent and parent is not None)
             scores = FusionMonitor(result.net, "training", None,  # type: ignore[arg-type]
                                    device=where).score(val)
         return Trained(p, result, scores, calibrate_on_validation(scores, val))
@@ -179,7 +180,8 @@ def train_monitors(
         with kernels(base.threads, where.type == "cpu"), ThreadPoolExecutor(width) as pool:
             trained = list(pool.map(lambda seed, net: run(seed, net, _tagged(progress, seed)),
                                     seeds, nets))
-    return [save_version(root, t.result.net.cpu(),
+    return [init_from if init_from and t.result.best_epoch == 0 else  # no epoch beat the parent
+            save_version(root, t.result.net.cpu(),
                          _card(t, scenario, horizon_s, init_from, config, train, val,
                                train_runs, val_runs, where))
             for t in trained]
@@ -264,7 +266,8 @@ def fit_windows(train: Windows, val: Windows, params: TrainParams | None = None,
             net = FusionNet(FusionConfig.for_spec(train.spec,
                                                   **_sizes(config or FusionConfig())))
             net.fit_normalizers(_frames_of(train))
-        result = fit(net.to(where), train, val, params, progress)
+        result = fit(net.to(where), train, val, params, progress,
+                     keep_start=params.keep_parent and parent is not None)
         scores = FusionMonitor(result.net, "training", None,  # type: ignore[arg-type]
                                device=where).score(val)
     return Trained(params, result, scores, calibrate_on_validation(scores, val))

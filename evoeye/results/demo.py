@@ -80,12 +80,14 @@ def evaluate_shipped(root: DataRoot, scenario: str) -> dict:
 def campaign_config(root: DataRoot, scenario: str, runs: int = EVOLVE_RUNS) -> CampaignConfig:
     """The demo's evolution round: BlindSpotEvolver from the shipped monitor, `runs` runs,
     fine-tuned by the replay update (the shipped monitor learned from runs this root does not
-    hold, which a retraining on this root's runs would forget)."""
+    hold, which a retraining on this root's runs would forget), kept unless the update beats it
+    on validation (docs/evolution.md: one round on a handful of runs can wreck it)."""
     from evoeye.evolve.campaign.config import MAX_RUN_S
 
     return CampaignConfig(scenario, strategy="evoeye", seed=EVOLVE_SEED,
                           monitor=shipped_monitor(root, scenario), n_round=runs,
-                          budget_s=MAX_RUN_S * runs, splits=SPLITS, update="replay")
+                          budget_s=MAX_RUN_S * runs, splits=SPLITS, update="replay",
+                          keep_parent=True)
 
 
 def write_summary(result: DemoResult) -> None:

@@ -37,3 +37,14 @@ def test_train_command_reports_bad_input_without_a_traceback(tiny) -> None:
     missing = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path / "nowhere"),
                                        "--scenario", tiny.scenario])
     assert missing.exit_code == ExitCode.USER_ERROR and "no data root at" in missing.output
+
+
+def test_a_fine_tune_that_loses_says_it_kept_the_parent(tiny, trained: str) -> None:
+    result = CliRunner().invoke(app, [
+        "train", "--root", str(tiny.root.path), "--scenario", tiny.scenario,
+        "--horizon-s", str(tiny.horizon_s), "--init-from", trained, "--epochs", "1",
+        "--lr", "5.0", "--keep-parent",  # the learning rate wrecks whatever it touches
+    ], env={"COLUMNS": "200"})
+    assert result.exit_code == 0, result.output
+    assert f"no epoch of the fine-tune beat {trained} on the validation split" in result.output
+    assert result.output.split("version: ")[-1].strip() == trained

@@ -99,6 +99,21 @@ def test_fine_tune_starts_from_the_parent_and_records_it(tiny, trained: str) -> 
     assert 0 < float(diff.detach()) < 1e-3
 
 
+def test_a_fine_tune_that_only_loses_keeps_its_parent(tiny, trained: str) -> None:
+    def fine_tune(**keep) -> str:  # a learning rate that wrecks whatever it touches
+        return train_monitor(tiny.root, tiny.scenario, horizon_s=tiny.horizon_s, seed=0,
+                             init_from=trained, epochs=2, patience=2, lr=5.0, **keep)
+
+    val = load_windows(tiny.root, tiny.ids["val"], context_len=5, horizon_s=tiny.horizon_s)
+
+    def val_auprc(version: str) -> float:
+        return ranking_metrics(load_monitor(tiny.root, version).score(val), val.label)["auprc"]
+
+    wrecked = fine_tune()  # the default: the best of its own epochs, as Algorithm 1 trains
+    assert wrecked != trained and val_auprc(wrecked) < val_auprc(trained)
+    assert fine_tune(keep_parent=True) == trained  # no epoch beat it on val: kept
+
+
 def test_fine_tune_refuses_a_different_architecture(tiny, trained: str) -> None:
     with pytest.raises(ValueError, match="parent"):
         train_monitor(tiny.root, tiny.scenario, horizon_s=tiny.horizon_s, init_from=trained,

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import pytest
 
 from evoeye.evaluation.scenario import FalseAlarms, LeadTimes
@@ -99,3 +101,13 @@ def test_the_demo_runs_are_never_the_shipped_monitors_training_runs() -> None:
                                                   batch=demo_monitors.BATCH)}
         fresh = {s.params for s in plan_uniform(scenario, 120, 0, batch=demo.BATCH)}
         assert not shipped & fresh
+
+
+def test_a_round_that_kept_g0_says_so_not_that_it_replaced_it() -> None:
+    from evoeye.evolve.campaign.report import change_words
+
+    g0, round1 = _rounds()
+    kept = change_words([g0, replace(round1, monitor_version=g0.monitor_version)])
+    assert "and kept G_0 fusion-a (no update beat it on the validation split" in kept
+    assert "replaced" not in kept and "replaced G_0 fusion-a by fusion-b" in change_words(
+        [g0, round1])

@@ -149,6 +149,9 @@ class CampaignConfig:
                          "Set).", names="family")
     reference: str | None = option(None, "Another family than fusion: the FusionMonitor G_0 "
                                    "whose Hard Set judges (default: the newest).")
+    keep_parent: bool = option(False, "A fine-tuned update (replay, finetune) keeps G_r unless "
+                               "one of its epochs beats G_r on the validation split (off: "
+                               "Algorithm 1's update, which always replaces it).")
     committee: int = option(COMMITTEE, "Monitors whose disagreement the `disagreement` "
                             "strategy reads: G_r and committee − 1 companions trained beside "
                             "it (each round costs as many monitor updates).", ge=2)
@@ -181,7 +184,7 @@ class CampaignConfig:
                 raise ValueError(f"G_0 {self.monitor} is a {of} monitor, but the campaign "
                                  f"evolves the {self.family} family")
 
-    def train_overrides(self) -> dict[str, int]:
+    def train_overrides(self) -> dict[str, int | bool]:
         """TrainParams fields of one monitor update."""
         out = {}
         default = {"finetune": (FINETUNE_EPOCHS, FINETUNE_PATIENCE),
@@ -191,6 +194,8 @@ class CampaignConfig:
             out["epochs"] = epochs
         if patience:
             out["patience"] = patience
+        if self.keep_parent and self.update != "retrain":
+            out["keep_parent"] = True
         return out
 
 
@@ -210,6 +215,8 @@ def campaign_id(config: CampaignConfig, g0: str, initial_ids: Sequence[str], *,
         cfg.pop("family")
     if not committee:  # only a strategy that reads the disagreement trains a committee
         cfg.pop("committee")
+    if not cfg["keep_parent"]:  # Algorithm 1's update, every campaign's before the option
+        cfg.pop("keep_parent")
     if cfg["recipe"] == LEGACY_RECIPE:  # the recipe every campaign before it trained by
         cfg.pop("recipe")
     cfg["monitor"] = g0

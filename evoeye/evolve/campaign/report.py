@@ -287,8 +287,13 @@ def change_words(rows: Sequence[RoundRow]) -> str:
         return "No acquisition round yet: the monitor is still G_0."
     g0, last = rows[0], rows[-1]
     new = sum(len(r.scenario_ids) for r in rows[1:])
+    kept = last.monitor_version == g0.monitor_version  # no update beat it on validation
     text = (f"{len(rows) - 1} round(s) added {new} runs ({last.simulated_s - g0.simulated_s:.0f}"
-            f" s simulated) and replaced G_0 {g0.monitor_version} by {last.monitor_version}")
+            f" s simulated) and " + (f"kept G_0 {g0.monitor_version} (no update beat it on the "
+                                     "validation split, or none had a run to learn from)"
+                                     if kept else
+                                     f"replaced G_0 {g0.monitor_version} by "
+                                     f"{last.monitor_version}"))
     a, b = g0.metrics, last.metrics
     if a is None or b is None:
         return text + " (not assessed: run with --assess to see its effect)."

@@ -2,6 +2,8 @@
 
 from __future__ import annotations
 
+import dataclasses
+import hashlib
 import inspect
 import json
 import subprocess
@@ -12,6 +14,7 @@ import pytest
 
 from evoeye.evolve.campaign.config import (
     CampaignConfig,
+    campaign_id,
     campaign_options,
     config_from,
     option_values,
@@ -97,3 +100,22 @@ def test_the_cli_commands_and_the_flows_take_every_option() -> None:
     help_of = {p.name: p.help for p in commands["evolve"].params}
     assert help_of["budget_s"] == inspect.cleandoc(
         next(o.help for o in campaign_options() if o.name == "budget_s"))
+
+
+def test_keep_parent_reaches_a_fine_tuned_update_only_and_keeps_old_ids() -> None:
+    base = CampaignConfig("highway-cut-in", update="replay")
+    kept = replace(base, keep_parent=True)
+    assert "keep_parent" not in base.train_overrides()
+    assert kept.train_overrides() == {**base.train_overrides(), "keep_parent": True}
+    assert "keep_parent" not in replace(kept, update="retrain").train_overrides()
+
+    def cid(config: CampaignConfig) -> str:
+        return campaign_id(config, "fusion-x", ["a", "b"], feedback_blind=False, committee=False)
+
+    # off, the id is the one every campaign had before the option existed
+    legacy = {k: v for k, v in dataclasses.asdict(base).items()
+              if k not in ("budget_s", "reference", "feedback", "family", "committee",
+                           "keep_parent")}
+    legacy.update(monitor="fusion-x", initial=hashlib.sha256(b"a\nb").hexdigest())
+    digest = hashlib.sha256(json.dumps(legacy, sort_keys=True).encode()).hexdigest()[:10]
+    assert cid(base) == f"evo-evoeye-s0-{digest}" != cid(kept)
