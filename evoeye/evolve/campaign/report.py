@@ -295,6 +295,8 @@ def change_words(rows: Sequence[RoundRow]) -> str:
                                      f"replaced G_0 {g0.monitor_version} by "
                                      f"{last.monitor_version}"))
     a, b = g0.metrics, last.metrics
+    if kept:  # the same monitor: its figures are G_0's
+        return text + "."
     if a is None or b is None:
         return text + " (not assessed: run with --assess to see its effect)."
     return (f"{text}: Test-Set F1@0.05 {_rate(a.test, 'f1@0.05')} → {_rate(b.test, 'f1@0.05')} "
