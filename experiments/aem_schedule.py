@@ -16,7 +16,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import math
 import time
 from pathlib import Path
 
@@ -59,8 +58,6 @@ def main() -> None:
     train = study.windows(scenario, "train").windows
     val = study.windows(scenario, "val").windows
     normal = train.label == 0
-    steps_per_epoch = math.ceil(min(int(normal.sum()), config.max_train_windows)
-                                / config.batch_size)
     at = set(range(1, config.epochs + 1)) if args.at is None else {
         int(e) for e in args.at.split(",")}
     print(f"{scenario}, AEM {config.record()}\n")
@@ -69,14 +66,14 @@ def main() -> None:
     spent = {"eval": 0.0}
     c0 = time.process_time()
 
-    def after_epoch(epoch: int, aem: AEMMonitor) -> None:
+    def after_epoch(epoch: int, steps: int, aem: AEMMonitor) -> None:
         if epoch not in at:
             return
         cpu = time.process_time() - c0 - spent["eval"]  # so far, the evaluations left out
         e0 = time.process_time()
         m = ranking_metrics(aem.errors(val), val.label)  # the score is monotone in the error
         spent["eval"] += time.process_time() - e0
-        print(f"| {epoch} | {epoch * steps_per_epoch} | {cpu:.0f} | {100 * m['auroc']:.2f} | "
+        print(f"| {epoch} | {steps} | {cpu:.0f} | {100 * m['auroc']:.2f} | "
               f"{100 * m['auprc']:.2f} |", flush=True)
 
     train_aem(train, np.asarray(normal), config, after_epoch=after_epoch)

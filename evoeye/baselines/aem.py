@@ -207,7 +207,7 @@ class AEMMonitor:
         return cls.decode(*read_version(version_dir, MODEL_FILE, META_FILE))
 
 
-AfterEpoch = Callable[[int, "AEMMonitor"], None]  # (epoch, the AEM as it stands: rank by errors)
+AfterEpoch = Callable[[int, int, "AEMMonitor"], None]  # epoch, optimiser steps, the AEM now
 
 
 def train_aem(train: Windows, normal: np.ndarray, config: AEMConfig = AEMConfig(), *,
@@ -216,8 +216,9 @@ def train_aem(train: Windows, normal: np.ndarray, config: AEMConfig = AEMConfig(
     """Fit the autoencoder on the windows `normal` (bool (B,)) of `train`; seeded by config
     (the same seed, data and thread count give the same weights). With `init`, fine-tune it:
     its weights and input standardisation are the start, only the error scale is re-measured.
-    `after_epoch(epoch, aem)` sees the AEM after every epoch (its error scale NaN, not yet
-    measured), e.g. to follow a schedule's validation ranking; it changes no weight."""
+    `after_epoch(epoch, steps, aem)` sees the AEM after every epoch and the optimiser steps
+    taken (its error scale NaN, not yet measured: rank by `errors`), e.g. to follow a schedule's
+    validation ranking; it changes no weight."""
     with intra_op_threads(threads):
         return _train(train, normal, config, init, after_epoch)
 
@@ -265,7 +266,8 @@ def _train(train: Windows, normal: np.ndarray, config: AEMConfig,
             loss.backward()
             opt.step()
         if after_epoch is not None:
-            after_epoch(epoch, AEMMonitor(config, model, mean.astype(np.float32), std, math.nan))
+            after_epoch(epoch, step,
+                        AEMMonitor(config, model, mean.astype(np.float32), std, math.nan))
     model.eval()
     with torch.inference_mode():
         err = torch.cat([((model(c) - c) ** 2).mean(dim=1) for c in xt.split(CHUNK)])

@@ -93,6 +93,9 @@ def train_command(
     from evoeye.monitor.train import train_monitor
     from evoeye.store import SplitSpec
 
+    if keep_parent and init_from is None:
+        raise UserError("--keep-parent keeps the version a fine-tune starts from",
+                        "give it with --init-from")
     data = DataRoot.existing(root)
     console = out()
 

@@ -109,10 +109,11 @@ def check_windows(train: Windows, val: Windows) -> int:
 
 def fit(net: FusionNet, train: Windows, val: Windows,
         params: TrainParams = TrainParams(),  # noqa: B008 (frozen dataclass)
-        progress: Progress | None = None, *, keep_start: bool = False) -> FitResult:
+        progress: Progress | None = None) -> FitResult:
     """Train `net` in place on `train`, on the device it sits on, early-stopped on `val`
-    AUPRC; the best epoch's net. `keep_start`: the weights it starts from are epoch 0, kept
-    (best_epoch 0) unless an epoch beats them — a fine-tune that only loses keeps its parent.
+    AUPRC; the best epoch's net. With `params.keep_parent` the weights it starts from are
+    epoch 0, kept (best_epoch 0) unless an epoch beats them: a fine-tune that only loses keeps
+    its parent.
 
     Call under `reproducible` (train_monitor does) for seeded, repeatable weights; without
     dropout the loop draws no number from the global RNG, so `kernels` is enough.
@@ -130,10 +131,15 @@ def fit(net: FusionNet, train: Windows, val: Windows,
     best, best_state, best_epoch, history = -np.inf, copy.deepcopy(net.state_dict()), 0, []
     clock = PhaseClock(FIT_PHASES, time.thread_time)
     t0, c0 = time.perf_counter(), time.thread_time()
-    if keep_start:
+
+    def validate() -> tuple[dict[str, Any], float, float]:  # metrics, loss, stopping criterion
+        scores, val_loss = _val_score(net, val)
+        metrics = ranking_metrics(scores, val.label)
+        return metrics, val_loss, metrics["auprc"] if use_auprc else -val_loss
+
+    if params.keep_parent:  # the starting weights are epoch 0
         with clock("validation"):
-            scores, val_loss = _val_score(net, val)
-            best = ranking_metrics(scores, val.label)["auprc"] if use_auprc else -val_loss
+            best = validate()[2]
     step = 0
     net.train()
     for epoch in range(1, params.epochs + 1):
@@ -155,12 +161,10 @@ def fit(net: FusionNet, train: Windows, val: Windows,
                 opt.step()
                 total += float(loss.detach()) * len(idx)
         with clock("validation"):
-            scores, val_loss = _val_score(net, val)
-            metrics = ranking_metrics(scores, val.label)
+            metrics, val_loss, criterion = validate()
             row = {"epoch": epoch, "train_loss": total / len(train), "val_loss": val_loss,
                    **metrics}
             history.append(row)
-            criterion = metrics["auprc"] if use_auprc else -val_loss
             if criterion > best + 1e-6:
                 best, best_epoch, best_state = criterion, epoch, copy.deepcopy(net.state_dict())
         if progress is not None:

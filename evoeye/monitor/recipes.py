@@ -18,9 +18,9 @@ by name, so a recipe, once used, is never changed: a better one gets a new name.
 * "v3" (the default) — v2's FusionMonitor training, unchanged (the same weights; the card
   names v3); what changed is the AEM baseline's part (`evoeye.baselines.aem.AEM_RECIPES`).
 
-`keep_parent` is no recipe's choice but a caller's (a campaign's `keep_parent` option): a
-fine-tune (`init_from`) then keeps its parent's weights unless one of its epochs beats them on
-the validation split — the parent is epoch 0 of its early stopping.
+`keep_parent` is no recipe's choice but a caller's (a campaign's `keep_parent` option): the
+weights a training starts from — a fine-tune's (`init_from`) parent — are epoch 0 of its early
+stopping, kept unless one of its epochs beats them on the validation split.
 
 Plain data without torch: the command line and the results config read it at start-up.
 """
@@ -55,7 +55,7 @@ class TrainParams:
     chunk_windows: int = 1  # consecutive windows per chunk (batching "chunks")
     schedule: str = "constant"  # SCHEDULES: the learning rate over the steps of `epochs`
     warmup_epochs: float = 0.0  # linear warm-up from 0 to `lr`, in epochs
-    keep_parent: bool = False  # a fine-tune keeps its parent unless an epoch beats it (doc)
+    keep_parent: bool = False  # the starting weights are epoch 0 of early stopping (doc)
 
     def __post_init__(self) -> None:
         if self.batching not in BATCHINGS:

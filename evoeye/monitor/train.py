@@ -156,8 +156,7 @@ def train_monitors(
         with reproducible(seed, p.threads, where.type == "cpu") if net is None else kernels(
                 p.threads, where.type == "cpu"):
             net = net or start(seed)
-            result = fit(net, train, val, p, report,
-                         keep_start=p.keep_parent and parent is not None)
+            result = fit(net, train, val, p, report)
             scores = FusionMonitor(result.net, "training", None,  # type: ignore[arg-type]
                                    device=where).score(val)
         return Trained(p, result, scores, calibrate_on_validation(scores, val))
@@ -266,8 +265,7 @@ def fit_windows(train: Windows, val: Windows, params: TrainParams | None = None,
             net = FusionNet(FusionConfig.for_spec(train.spec,
                                                   **_sizes(config or FusionConfig())))
             net.fit_normalizers(_frames_of(train))
-        result = fit(net.to(where), train, val, params, progress,
-                     keep_start=params.keep_parent and parent is not None)
+        result = fit(net.to(where), train, val, params, progress)
         scores = FusionMonitor(result.net, "training", None,  # type: ignore[arg-type]
                                device=where).score(val)
     return Trained(params, result, scores, calibrate_on_validation(scores, val))

@@ -74,8 +74,10 @@ def test_after_epoch_sees_each_epoch_s_aem_and_changes_no_weight(windows_of, obs
     train, probe = traffic(300, 0, windows_of, obs), traffic(100, 2, windows_of, obs, odd=True)
     config = AEMConfig(**{**SMALL.__dict__, "epochs": 3})
     seen: list[tuple[int, float, float]] = []
+    steps_per_epoch = -(-len(train) // config.batch_size)  # every window normal, none dropped
 
-    def after_epoch(epoch: int, aem: AEMMonitor) -> None:
+    def after_epoch(epoch: int, steps: int, aem: AEMMonitor) -> None:
+        assert steps == epoch * steps_per_epoch
         seen.append((epoch, float(aem.errors(probe).mean()), aem.error_scale))
 
     plain = train_aem(train, np.ones(len(train), bool), config)

@@ -33,6 +33,9 @@ def test_train_command_reports_bad_input_without_a_traceback(tiny) -> None:
     result = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path), "--scenario",
                                       tiny.scenario, "--init-from", "fusion-000000000000"])
     assert result.exit_code == ExitCode.USER_ERROR and "no monitor version" in result.output
+    result = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path), "--scenario",
+                                      tiny.scenario, "--keep-parent"])
+    assert result.exit_code == ExitCode.USER_ERROR and "--init-from" in result.output
     assert "Traceback" not in result.output
     missing = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path / "nowhere"),
                                        "--scenario", tiny.scenario])
