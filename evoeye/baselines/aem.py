@@ -149,8 +149,10 @@ class AEMMonitor:
         h.update(self.mean.tobytes() + self.std.tobytes())
         return f"aem-{h.hexdigest()[:12]}"
 
+    @intra_op_threads()
     def errors(self, windows: Windows) -> np.ndarray:
-        """(B,) mean squared reconstruction error of each standardised window."""
+        """(B,) mean squared reconstruction error of each standardised window (one intra-op
+        thread: exact scores, `evoeye.monitor.threads`)."""
         out = np.empty(len(windows), np.float64)
         self.model.eval()
         with torch.inference_mode():

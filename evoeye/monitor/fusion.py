@@ -22,6 +22,7 @@ import torch
 from evoeye.monitor.device import pick_device
 from evoeye.monitor.model import FRAME_INPUTS, INPUTS, FusionNet, example_inputs
 from evoeye.monitor.protocol import Thresholds
+from evoeye.monitor.threads import intra_op_threads
 from evoeye.store.windows import WindowBatch, Windows
 
 SCORE_BATCH = 8192  # windows gathered and scored at a time (bounds memory, not results)
@@ -70,17 +71,20 @@ class FusionMonitor:
         """H the monitor was trained for (None if unknown)."""
         return self.card.get("horizon_s")
 
+    @intra_op_threads()
     def score_batch(self, batch: WindowBatch | dict[str, torch.Tensor]) -> np.ndarray:
         """(b,) float32 risks of one batch of (b, L, …) tensors; no grad, eval mode (set at
-        construction: a network being trained elsewhere must not be scored mid-step)."""
+        construction: a network being trained elsewhere must not be scored mid-step); on one
+        intra-op thread (`evoeye.monitor.threads`: exact scores)."""
         if self._forward is None:
             self._forward = traced(self.net) if self._trace else self.net
         with torch.inference_mode():
             return torch.sigmoid(self._forward(*net_inputs(batch))).numpy()
 
+    @intra_op_threads()
     def score(self, windows: Windows) -> np.ndarray:
         """(B,) float32 risk scores, one per window, in chunks of SCORE_BATCH windows, each
-        distinct frame encoded once, on the monitor's device."""
+        distinct frame encoded once, on the monitor's device, on one intra-op thread."""
         if windows.context_len != self.context_len:
             raise ValueError(f"monitor {self.version} takes contexts of L = {self.context_len} "
                              f"frames; these windows have L = {windows.context_len}")

@@ -22,6 +22,7 @@ without supervision is the only reference all triggers share.
 
 from __future__ import annotations
 
+import threading
 from dataclasses import dataclass, replace
 from pathlib import Path
 
@@ -44,7 +45,10 @@ FALLBACK_MODES = ("braking", "holding")  # an intervention: the fallback drives 
 # the jerk of a step into the final stop is left out: a stop's own, the same for any stop (the
 # ADS's too: braking that no longer finds speed to take off)
 STOPPING_MPS = 0.5
-_SCORERS: dict[tuple, OnlineScorer] = {}  # this process's, by (root, scenario, splits, source)
+# this thread's scorers, by (root, scenario, splits, source, ref): a scorer streams one run, so
+# two runs supervised at once in threads of one process (Prefect's default task runner) each
+# need their own; sharing one interleaved their frames and broke the pairing
+_LOCAL = threading.local()
 
 
 class ReproductionError(RuntimeError):
@@ -64,16 +68,17 @@ class RunJob:
 
 
 def scorer(root: DataRoot, settings: Settings, trigger: TriggerSpec) -> OnlineScorer:
-    """The trigger's online scorer, loaded once per process and reset."""
+    """The trigger's online scorer, loaded once per thread and reset."""
     key = (str(root.path), settings.scenario, settings.splits, trigger.source, trigger.ref)
-    if key not in _SCORERS:
+    cache: dict[tuple, OnlineScorer] = _LOCAL.__dict__.setdefault("scorers", {})
+    if key not in cache:
         monitor = load_monitor(root, settings.scenario, settings.splits, trigger.source,
                                trigger.ref)
         if monitor.version != trigger.version:
             raise ReproductionError(f"trigger {trigger.name} loads as {monitor.version}, "
                                     f"calibrated as {trigger.version}")
-        _SCORERS[key] = online_scorer(monitor)
-    found = _SCORERS[key]
+        cache[key] = online_scorer(monitor)
+    found = cache[key]
     found.reset()
     return found
 
