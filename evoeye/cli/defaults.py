@@ -20,6 +20,8 @@ SWEEP_RECALLS = (0.2, 0.1, 0.05)  # evoeye.evaluation.supervision.triggers.RECAL
 SUPERVISE_BASELINES = ("ttc", "ttc-2d", "rss", "aem",
                        "context-only")  # evoeye.evaluation.supervision.triggers
 SUPERVISE_BUDGETS = (0.5, 1.0, 2.0)  # evoeye.evaluation.supervision.summary.BUDGETS_PER_H
+ORACLE_LEADS_S = (0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5,
+                  3.0)  # evoeye.evaluation.supervision.triggers.ORACLE_LEADS_S
 LOG_POLICIES = ("none", "collided", "all")  # evoeye.evaluation.supervision.settings.LOG_POLICIES
 FALLBACK = {"decel_mps2": 6.0, "jerk_mps3": 10.0, "onset_s": 0.1, "hold_s": 1.0,
             "standstill_mps": 0.1}  # dataclasses.asdict(evoeye.sim.supervisor.FallbackConfig())

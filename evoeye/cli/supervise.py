@@ -14,6 +14,7 @@ from evoeye.cli.defaults import (
     FALLBACK,
     HORIZON_S,
     LOG_POLICIES,
+    ORACLE_LEADS_S,
     SCENARIO_NAMES,
     SPLIT_SEED,
     SUPERVISE_BASELINES,
@@ -87,6 +88,13 @@ def supervise_command(
     budgets: Annotated[str, typer.Option(help="False interventions per hour the triggers are "
                                          "compared at.")] =
         ",".join(f"{b:g}" for b in SUPERVISE_BUDGETS),
+    select_batch: Annotated[str | None, typer.Option(
+        callback=plain_batch, help="A batch of other held-out runs, supervised too, on which "
+        "each trigger's operating point at a budget is chosen (validation runs); without it "
+        "the point is chosen on --batch itself and the report says so.")] = None,
+    oracle_leads: Annotated[str, typer.Option(
+        help="The oracle's leads τ, s: it engages τ s before each known collision, the ceiling "
+        "every report draws ('none' for none).")] = ",".join(f"{t:g}" for t in ORACLE_LEADS_S),
     workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 1,
     limit: Annotated[int | None, typer.Option(min=1, help="Only the batch's first N runs.")] =
         None,
@@ -132,16 +140,20 @@ def supervise_command(
                            fallback=fallback,
                            consecutive=consecutive, horizon_s=horizon_s, logs=logs,
                            logs_into_runs=logs_into_runs, workers=workers, limit=limit,
-                           progress=bar)
-        for sid, reason in result.errors:
+                           progress=bar, select_batch=select_batch,
+                           oracle_leads_s=() if oracle_leads == "none"
+                           else parse_floats(oracle_leads, "--oracle-leads"))
+        errors = result.errors + (result.select.errors if result.select else [])
+        for sid, reason in errors:
             err().print(f"[yellow]error[/] {sid}: {reason}")
         summary = summarise_supervision(result.settings, result.records,
-                                        parse_floats(budgets, "--budgets"))
+                                        parse_floats(budgets, "--budgets"),
+                                        select=result.select.records if result.select else None)
     except (ValueError, KeyError) as exc:
         raise UserError(str(exc).strip("'\""), "check --scenario, --batch, --monitor and the "
                         "split options, and that `evoeye ingest` has run") from exc
     summary["folder"] = str(result.folder)
-    summary["errors"] = [{"scenario_id": s, "reason": r} for s, r in result.errors]
+    summary["errors"] = [{"scenario_id": s, "reason": r} for s, r in errors]
     files = write_report(data, [summary], name)
     written = write_docs(docs, summary) if docs else []
     if as_json:
@@ -150,7 +162,7 @@ def supervise_command(
         _print_summary(summary, result.done_before)
         for path in [files.html, *written]:
             out().print(f"report: {path}")
-    exit_with(ExitCode.PARTIAL if result.errors else ExitCode.OK)
+    exit_with(ExitCode.PARTIAL if errors else ExitCode.OK)
 
 
 def _print_summary(summary: dict, done_before: int) -> None:
@@ -158,11 +170,14 @@ def _print_summary(summary: dict, done_before: int) -> None:
 
     budget = headline_budget(summary)
     t = table(f"supervise {summary['scenario']}: at ≤ {budget:g} false intervention/h",
-              ["trigger", "prevented % [CI]", "false int./h", "caused", "threshold"],
-              left=("trigger",))
+              ["trigger", "prevented % [CI]", "false int./h", "false alarms/h", "lead s",
+               "of oracle", "caused", "threshold"], left=("trigger",))
     for r in (r for r in summary["at_budget"] if r["budget_per_h"] == budget):
         t.add_row(r["label"], f"{100 * r['prevented_share']:.1f}{ci(r['prevented_ci'])}",
-                  f"{r['false_interventions_per_h']:.2f}", str(r["collisions_caused"]),
+                  f"{r['false_interventions_per_h']:.2f}", f"{r['false_alarms_per_h']:.2f}",
+                  "–" if r["lead_s"] is None else f"{r['lead_s']:.2f}",
+                  "–" if r["share_of_oracle"] is None else f"{100 * r['share_of_oracle']:.0f} %",
+                  str(r["collisions_caused"]),
                   "off" if r["threshold"] is None else f"{r['threshold']:.4g}")
     out().print(t)
     out().print(headline(summary, budget).replace("**", ""))

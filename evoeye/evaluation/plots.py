@@ -226,6 +226,37 @@ def operating_chart(series: Sequence[tuple[str, Sequence[dict]]], *, title: str,
     return f.svg(body, title)
 
 
+def lead_chart(ceiling: Sequence[dict], series: Sequence[tuple[str, Sequence[dict]]], *,
+               title: str) -> str:
+    """Collisions prevented (%) against the warning lead (s): the oracle's curve (`ceiling`:
+    {"lead_s", "prevented_share"}, drawn black and dashed, from 0 at τ = 0) and, per series
+    (label, points), each threshold's point at its median lead ({"lead_s",
+    "prevented_share"}; points without a lead are left out)."""
+    leads = [o["lead_s"] for o in ceiling] + [p["lead_s"] for _, pts in series for p in pts
+                                             if p["lead_s"] is not None]
+    top = float(np.ceil(max([*leads, 1.0])))
+    f = _Frame((0.0, top), (0.0, 100.0), height=HEIGHT + 40)
+    body = f.axes(title, "warning lead (s): median, first true intervention to contact",
+                  "collisions prevented (%)", list(np.arange(0.0, top + 1e-9, 0.5)),
+                  [0, 20, 40, 60, 80, 100])
+    if ceiling:
+        line = " ".join(f"{f.x(t):.1f},{f.y(100 * v):.1f}" for t, v in
+                        [(0.0, 0.0)] + [(o["lead_s"], o["prevented_share"] or 0.0)
+                                        for o in ceiling])
+        body.append(f'<polyline points="{line}" fill="none" stroke="#000" stroke-width="1.5" '
+                    'stroke-dasharray="5 3" data-series="oracle"/>')
+    for i, (label, pts) in enumerate(series):
+        for p in pts:
+            if p["lead_s"] is not None and p["prevented_share"] is not None:
+                body.append(f'<circle cx="{f.x(p["lead_s"]):.1f}" '
+                            f'cy="{f.y(100 * p["prevented_share"]):.1f}" r="3" '
+                            f'fill="{_color(i)}" data-series="{escape(label)}"/>')
+    body += _legend(f, [label for label, _ in series], f.x0 + 8, f.y1 + 14)
+    body.append(f'<text x="{f.x1 - 8}" y="{f.y1 + 14}" text-anchor="end">- - oracle '
+                '(engages τ s before contact)</text>')
+    return f.svg(body, title)
+
+
 def band_chart(series: Sequence[tuple[str, Sequence[float], Sequence[float], Sequence[float],
                                       Sequence[float]]], *,
                title: str, xlabel: str, ylabel: str) -> str:

@@ -314,6 +314,20 @@ def rate_ci(events: Sequence[int] | np.ndarray, exposure: Sequence[float] | np.n
     return Estimate(value, low, high, len(e), "bootstrap")
 
 
+def poisson_ci(count: int, exposure: float, confidence: float = CONFIDENCE
+               ) -> tuple[float | None, float | None]:
+    """The exact (Garwood) two-sided interval of a Poisson rate: `count` events over `exposure`
+    (e.g. hours); (None, None) without exposure. At 0 events the low end is 0 and the high end
+    χ²(1 − α/2; 2)/2 / exposure: 3.69 / exposure at 95 %."""
+    _check_confidence(confidence)
+    if exposure <= 0:
+        return None, None
+    alpha = 1.0 - confidence
+    low = float(stats.chi2.ppf(alpha / 2, 2 * count) / 2) if count > 0 else 0.0
+    high = float(stats.chi2.ppf(1 - alpha / 2, 2 * count + 2) / 2)
+    return low / exposure, high / exposure
+
+
 def median_ci(values: Sequence[float] | np.ndarray, *, confidence: float = CONFIDENCE,
               n_resamples: int = N_RESAMPLES, seed: int = 0) -> Estimate:
     """The median of per-run values (e.g. lead times) with a percentile bootstrap interval

@@ -35,12 +35,18 @@ def test_supervise_help_defaults_equal_their_sources() -> None:
 
     from evoeye.evaluation.supervision.settings import LOG_POLICIES
     from evoeye.evaluation.supervision.summary import BUDGETS_PER_H
-    from evoeye.evaluation.supervision.triggers import DEFAULT_BASELINES, RECALLS, SWEEP_FPRS
+    from evoeye.evaluation.supervision.triggers import (
+        DEFAULT_BASELINES,
+        ORACLE_LEADS_S,
+        RECALLS,
+        SWEEP_FPRS,
+    )
     from evoeye.sim.supervisor import FallbackConfig
 
     assert defaults.SWEEP_FPRS == SWEEP_FPRS and defaults.SWEEP_RECALLS == RECALLS
     assert defaults.SUPERVISE_BASELINES == DEFAULT_BASELINES
     assert defaults.SUPERVISE_BUDGETS == BUDGETS_PER_H
+    assert defaults.ORACLE_LEADS_S == ORACLE_LEADS_S
     assert defaults.LOG_POLICIES == LOG_POLICIES
     assert asdict(FallbackConfig()) == defaults.FALLBACK
 

@@ -9,10 +9,17 @@ against false interventions per hour of safe driving) with paired bootstrap CIs.
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable, Sequence
+from dataclasses import replace
 
 from evoeye.evaluation.supervision.batch import SupervisionResult, batch_runs, run_supervision
 from evoeye.evaluation.supervision.settings import Settings
-from evoeye.evaluation.supervision.triggers import RECALLS, SWEEP_FPRS, calibrate_triggers
+from evoeye.evaluation.supervision.triggers import (
+    ORACLE_LEADS_S,
+    RECALLS,
+    SWEEP_FPRS,
+    calibrate_triggers,
+    oracle_trigger,
+)
 from evoeye.paths import DataRoot
 from evoeye.sim.supervisor import FallbackConfig
 from evoeye.store import RunFilter, SplitSpec, Warehouse, select_runs
@@ -26,17 +33,33 @@ def supervise(root: DataRoot, scenario: str, batch: str, sources: Sequence[tuple
               consecutive: int = 1, horizon_s: float = DEFAULT_HORIZON_S,
               logs: str = "collided", logs_into_runs: bool = False, workers: int = 1,
               limit: int | None = None,
-              progress: Callable[[Iterable], Iterable] | None = None) -> SupervisionResult:
+              progress: Callable[[Iterable], Iterable] | None = None,
+              oracle_leads_s: Sequence[float] = ORACLE_LEADS_S,
+              select_batch: str | None = None) -> SupervisionResult:
     """Calibrate the triggers (`sources`: ("version", id) or ("baseline", name)) on the
-    scenario's validation split, then supervise every run of `batch` (resuming a killed one);
-    with `logs_into_runs` the supervised runs' logs go where `evoeye ingest` takes them in.
-    ValueError if a run of the batch is in the train or validation split: a trigger must not
-    be judged on the runs it learned or was calibrated on."""
+    scenario's validation split, add the oracle (at `oracle_leads_s`; none if empty), then
+    supervise every run of `batch` (resuming a killed one); with `logs_into_runs` the
+    supervised runs' logs go where `evoeye ingest` takes them in. With `select_batch`, its runs
+    are supervised too, under the same triggers and thresholds (`.select`): the runs operating
+    points are chosen on. ValueError if a run of either batch is in the train or validation
+    split — a trigger must not be judged on the runs it learned or was calibrated on — or if
+    the two batches are one."""
     check_held_out(root, scenario, batch, splits)
+    if select_batch is not None:
+        if select_batch == batch:
+            raise ValueError(f"--select-batch {select_batch} is the batch reported on: choose "
+                             "operating points on other runs")
+        check_held_out(root, scenario, select_batch, splits)
     triggers = calibrate_triggers(root, scenario, sources, splits, fprs, horizon_s, recalls)
+    if oracle_leads_s:
+        triggers.append(oracle_trigger(oracle_leads_s))
     settings = Settings(scenario, batch, tuple(triggers), fallback, consecutive, horizon_s,
                         splits, logs, logs_into_runs=logs_into_runs)
-    return run_supervision(root, settings, workers=workers, progress=progress, limit=limit)
+    select = None if select_batch is None else run_supervision(
+        root, replace(settings, batch=select_batch), workers=workers, progress=progress,
+        limit=limit)
+    result = run_supervision(root, settings, workers=workers, progress=progress, limit=limit)
+    return replace(result, select=select)
 
 
 def check_held_out(root: DataRoot, scenario: str, batch: str, splits: SplitSpec) -> None:

@@ -62,6 +62,7 @@ class SupervisionResult:
     errors: list[tuple[str, str]] = field(default_factory=list)  # (scenario id, reason)
     done_before: int = 0  # runs whose record was on disk already
     wall_s: float = 0.0
+    select: SupervisionResult | None = None  # the runs operating points are chosen on
 
 
 def record_path(folder: Path, scenario_id: str) -> Path:

@@ -23,6 +23,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from evoeye import __version__
+from evoeye.evaluation.supervision.criticality import Criticality
 from evoeye.evaluation.supervision.triggers import TriggerSpec
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.sim.supervisor import FallbackConfig
@@ -51,6 +52,7 @@ class Settings:
     logs: str = "collided"  # LOG_POLICIES
     software_version: str = __version__
     logs_into_runs: bool = False  # the logs go where `evoeye ingest` takes them in
+    criticality: Criticality = field(default_factory=Criticality)  # what justifies a brake
 
     def __post_init__(self) -> None:
         check_batch_name(self.batch)
@@ -67,14 +69,14 @@ class Settings:
                 "fallback": asdict(self.fallback), "consecutive": self.consecutive,
                 "horizon_s": self.horizon_s, "splits": asdict(self.splits), "logs": self.logs,
                 "software_version": self.software_version,
-                "logs_into_runs": self.logs_into_runs}
+                "logs_into_runs": self.logs_into_runs, "criticality": self.criticality.to_dict()}
 
     @classmethod
     def of(cls, d: dict) -> Settings:
         return cls(d["scenario"], d["batch"], tuple(TriggerSpec.of(t) for t in d["triggers"]),
                    FallbackConfig(**d["fallback"]), d["consecutive"], d["horizon_s"],
                    SplitSpec(**d["splits"]), d["logs"], d["software_version"],
-                   d.get("logs_into_runs", False))
+                   d.get("logs_into_runs", False), Criticality(**d.get("criticality", {})))
 
     @property
     def key(self) -> str:

@@ -7,15 +7,28 @@ Per trigger and threshold, over the runs (each paired with its unsupervised run)
   the unsupervised collisions (a collision that only changes partner, e.g. to a car running
   into the braking ego from behind, is not prevented);
 * collisions caused: supervised collisions of runs that had none (rear-end ones apart);
-* false interventions per hour of safe driving: false interventions (`sweep`) over the hours of
-  the unsupervised runs' eligible frames labelled 0 — one denominator for every trigger;
+* false interventions per hour of safe driving: false interventions (`sweep`: unneeded — no
+  collision within H, nor a critical approach — and changing the applied command) over the
+  hours of the unsupervised runs' eligible frames where an intervention would not be justified,
+  one denominator for every trigger; with an exact Poisson interval (Garwood) beside the
+  bootstrap one, and per safe hazardous encounter (`criticality`);
+* false alarms per hour, the earlier measure, beside it: every intervention at a frame labelled
+  0, over the hours of eligible frames labelled 0;
 * time in fallback per hour driven, the peak deceleration and the peak jerk of the runs that
   intervened (means over them), and the lead time of the first true intervention (median).
 
 At a budget β the trigger runs at its threshold that prevents the most collisions with at most
 β false interventions per hour (supervision off, preventing none, always meets it): the
 collisions it prevents there (recall at a false-alarm budget), and at that threshold its false
-interventions per hour and lead time.
+interventions per hour and lead time. With `select` — the records of a supervision of other
+runs (validation runs) under the same triggers and thresholds — that threshold is chosen on
+them and only reported on these: no operating point is chosen on the runs it is reported on.
+Without, it is chosen on these runs, and the summary says so (`operating_points`).
+
+The oracle (`triggers.oracle_trigger`) is no trigger to choose: it is left out of the budgets
+and the differences, and drawn as the ceiling — collisions prevented against its lead τ — and
+each trigger at a budget is put beside it: the oracle's prevented share at the trigger's own
+median lead (interpolated in τ, 0 at τ = 0), and the trigger's share of it.
 
 CIs: 95 % percentile bootstrap over runs, B resamples (seeded). Every trigger's and threshold's
 figures come from the same resamples — the comparison is paired run by run — computed at once
@@ -33,15 +46,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from evoeye.evaluation.stats import poisson_ci
 from evoeye.evaluation.supervision.settings import Settings
-from evoeye.evaluation.supervision.triggers import TriggerSpec
+from evoeye.evaluation.supervision.triggers import FRAME_S, ORACLE, TriggerSpec
 from evoeye.monitor.families import DEFAULT_FAMILY
 
 BUDGETS_PER_H = (0.5, 1.0, 2.0)
 RESAMPLES = 4999
 CONFIDENCE = 0.95
 ROW_FIELDS = ("trigger", "threshold", "runs", "collisions_unsupervised", "collisions_prevented",
-              "collisions_caused", "false_interventions_per_h")
+              "collisions_caused", "false_interventions_per_h", "false_alarms_per_h")
 
 
 @dataclass(frozen=True)
@@ -50,10 +64,13 @@ class RunTable:
 
     trigger: TriggerSpec
     collided0: np.ndarray  # (R,) bool
-    safe_s: np.ndarray  # (R,)
+    safe_s: np.ndarray  # (R,) eligible seconds labelled 0 (false alarms' denominator)
+    calm_s: np.ndarray  # (R,) eligible seconds where no intervention is justified
+    encounters: np.ndarray  # (R,) safe hazardous encounters
     collided: np.ndarray  # (R, Θ) bool
     rear_end: np.ndarray  # (R, Θ) bool: collided, struck from behind
     false: np.ndarray  # (R, Θ) false interventions
+    false_alarms: np.ndarray  # (R, Θ) interventions at frames labelled 0
     interventions: np.ndarray  # (R, Θ)
     fallback_s: np.ndarray  # (R, Θ)
     duration_s: np.ndarray  # (R, Θ)
@@ -65,9 +82,12 @@ class RunTable:
     def of(cls, trigger: TriggerSpec, records: list[dict]) -> RunTable:
         n = len(trigger.thresholds)
         unsup = [r["unsupervised"] for r in records]
-        cols: dict[str, list] = {k: [] for k in ("collided", "rear_end", "false", "interventions",
-                                                 "fallback_s", "duration_s", "decel", "jerk",
-                                                 "lead")}
+        cols: dict[str, list] = {k: [] for k in ("collided", "rear_end", "false", "alarms",
+                                                 "interventions", "fallback_s", "duration_s",
+                                                 "decel", "jerk", "lead")}
+        if unsup and "calm_s" not in unsup[0]:
+            raise ValueError("these records predate the false-intervention measure of "
+                             "criticality.py: supervise the batch again")
         for r, u in zip(records, unsup, strict=True):
             t = r["triggers"][trigger.name]
             if len(t["sim_of"]) != n:
@@ -81,6 +101,7 @@ class RunTable:
                     u["collided"] and u["struck_from_behind"] for s in sims]
             cols["rear_end"].append(rear)
             cols["false"].append(col("false_interventions", 0))
+            cols["alarms"].append(col("false_alarms", 0))
             cols["interventions"].append(col("interventions", 0))
             cols["fallback_s"].append(col("fallback_s", 0.0))
             cols["duration_s"].append(col("duration_s", u["duration_s"]))
@@ -88,9 +109,11 @@ class RunTable:
             cols["jerk"].append(col("peak_jerk_mps3", 0.0))
             cols["lead"].append([np.nan if v is None else v for v in col("first_lead_s", None)])
         a = {k: np.array(v, dtype=float).reshape(len(records), n) for k, v in cols.items()}
-        return cls(trigger, np.array([u["collided"] for u in unsup], bool),
-                   np.array([u["safe_s"] for u in unsup], float), a["collided"] > 0,
-                   a["rear_end"] > 0, a["false"], a["interventions"], a["fallback_s"],
+        def per_run(key: str) -> np.ndarray:
+            return np.array([u[key] for u in unsup], float)
+        return cls(trigger, per_run("collided") > 0, per_run("safe_s"), per_run("calm_s"),
+                   per_run("safe_encounters"), a["collided"] > 0, a["rear_end"] > 0,
+                   a["false"], a["alarms"], a["interventions"], a["fallback_s"],
                    a["duration_s"], a["decel"], a["jerk"], a["lead"])
 
     @property
@@ -162,11 +185,13 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
     """The curve points of one trigger, and its resampled (B, Θ) prevented share and FI/h."""
     t = table.trigger
     c0, prevented, caused = table.collided0, table.prevented, table.caused
-    safe_h = table.safe_s.sum() / 3600.0
+    calm_h, safe_h = table.calm_s.sum() / 3600.0, table.safe_s.sum() / 3600.0
+    encounters = table.encounters.sum()
     p_share = _ratio(prevented.sum(axis=0), np.full(len(t.thresholds), c0.sum()))
-    fi = _ratio(table.false.sum(axis=0), np.full(len(t.thresholds), safe_h))
+    fi = _ratio(table.false.sum(axis=0), np.full(len(t.thresholds), calm_h))
+    fa = _ratio(table.false_alarms.sum(axis=0), np.full(len(t.thresholds), safe_h))
     bp = _ratio(weights @ prevented, (weights @ c0)[:, None])  # (B, Θ)
-    bf = _ratio(weights @ table.false, (weights @ table.safe_s)[:, None] / 3600.0)
+    bf = _ratio(weights @ table.false, (weights @ table.calm_s)[:, None] / 3600.0)
     p_ci, f_ci = _ci(bp), _ci(bf)
     acted = table.interventions > 0
     once = np.ones((1, len(c0)))
@@ -181,6 +206,10 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
             "prevented_share": _finite(p_share[j]),
             "prevented_ci": p_ci[j], "false_interventions_per_h": _finite(fi[j]),
             "false_interventions_ci": f_ci[j],
+            "false_interventions_poisson_ci": list(poisson_ci(int(table.false[:, j].sum()),
+                                                              calm_h, CONFIDENCE)),
+            "false_per_encounter": _finite(_ratio(table.false[:, j].sum(), encounters)),
+            "false_alarms_per_h": _finite(fa[j]),
             "collisions_prevented": int(prevented[:, j].sum()),
             "collisions_caused": int(caused[:, j].sum()),
             "caused_rear_end": int((caused[:, j] & table.rear_end[:, j]).sum()),
@@ -196,38 +225,87 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
     return points, bp, bf
 
 
-def summarise_supervision(settings: Settings, records: list[dict],
-                          budgets: tuple[float, ...] = BUDGETS_PER_H,
-                          resamples: int = RESAMPLES, seed: int = 0) -> dict:
-    """The supervision's figures (module doc) as one JSON-serialisable dict; `rows` holds, per
-    trigger and threshold, exactly ROW_FIELDS."""
+def _simulated(records: list[dict]) -> list[dict]:
     ok = [r for r in records if r["status"] == "ok"]
     if not ok:
         raise ValueError("no run of this supervision simulated: nothing to summarise")
+    return ok
+
+
+def oracle_curve(points: list[dict]) -> list[dict]:
+    """The oracle's prevented share (and CI) per lead τ, ascending; [] without an oracle."""
+    out = [{"lead_s": round(-p["threshold"] - FRAME_S / 2, 6),
+            "prevented_share": p["prevented_share"], "prevented_ci": p["prevented_ci"],
+            "collisions_caused": p["collisions_caused"]}
+           for p in points if p["trigger"] == ORACLE]
+    return sorted(out, key=lambda o: o["lead_s"])
+
+
+def oracle_share_at(ceiling: list[dict], lead_s: float | None) -> float | None:
+    """The oracle's prevented share at a lead (linear in τ between its leads, 0 at τ = 0, its
+    longest lead's beyond it); None without an oracle or a lead."""
+    if not ceiling or lead_s is None:
+        return None
+    tau = [0.0] + [o["lead_s"] for o in ceiling]
+    share = [0.0] + [o["prevented_share"] or 0.0 for o in ceiling]
+    return float(np.interp(lead_s, tau, share))
+
+
+def beside_oracle(ceiling: list[dict], point: dict) -> dict:
+    """The oracle's share at the point's median lead, and the point's share of it."""
+    at = oracle_share_at(ceiling, point["lead_s"])
+    mine = point["prevented_share"] or 0.0
+    return {"oracle_at_lead": at,
+            "share_of_oracle": mine / at if at else None}
+
+
+def summarise_supervision(settings: Settings, records: list[dict],
+                          budgets: tuple[float, ...] = BUDGETS_PER_H,
+                          resamples: int = RESAMPLES, seed: int = 0,
+                          select: list[dict] | None = None) -> dict:
+    """The supervision's figures (module doc) as one JSON-serialisable dict; `rows` holds, per
+    trigger and threshold, exactly ROW_FIELDS. `select`: the records operating points are
+    chosen on (module doc)."""
+    ok = _simulated(records)
     weights = resampling_counts(len(ok), resamples, seed)
     tables = [RunTable.of(t, ok) for t in settings.triggers]
     points, curves = [], {}
     for table in tables:
         pts, bp, bf = trigger_points(table, weights)
         points += pts
-        curves[table.trigger.name] = (pts, bp, bf)
+        if not table.trigger.oracle:
+            curves[table.trigger.name] = (pts, bp, bf)
+    sel = None if select is None else _simulated(select)
+    picked = None if sel is None else {
+        t.name: trigger_points(RunTable.of(t, sel), np.ones((1, len(sel))))[0]
+        for t in settings.triggers if not t.oracle}
+    ceiling = oracle_curve(points)
     c0 = tables[0].collided0
     budget_rows, differences = [], []
     for b in budgets:
-        chosen = {}
+        chosen, share = {}, {}
         for name, (pts, bp, bf) in curves.items():
-            chosen[name] = at_budget(bp, bf, b)  # (B,)
-            best = _operating_point(pts, b)
+            if picked is None:
+                chosen[name] = at_budget(bp, bf, b)  # (B,)
+                best = _operating_point(pts, b)
+            else:
+                j = _operating_index(picked[name], b)
+                chosen[name] = (np.zeros(len(bp)) if j is None
+                                else np.nan_to_num(bp[:, j], nan=0.0))
+                best = _point_fields(None if j is None else pts[j])
+                best["val_false_interventions_per_h"] = (
+                    0.0 if j is None else picked[name][j]["false_interventions_per_h"])
+            share[name] = best["prevented_share"] or 0.0
             budget_rows.append({"budget_per_h": b, "trigger": name,
                                 "label": settings.trigger(name).label,
-                                "prevented_ci": _ci(chosen[name]), **best})
+                                "prevented_ci": _ci(chosen[name]), **best,
+                                **beside_oracle(ceiling, best)})
         if DEFAULT_FAMILY in chosen:
             for name in chosen:
                 if name == DEFAULT_FAMILY:
                     continue
                 d = chosen[DEFAULT_FAMILY] - chosen[name]
-                point = (_share_at(curves[DEFAULT_FAMILY][0], b)
-                         - _share_at(curves[name][0], b))
+                point = share[DEFAULT_FAMILY] - share[name]
                 differences.append({"budget_per_h": b, "a": DEFAULT_FAMILY, "b": name,
                                     "rule_based": settings.trigger(name).rule_based,
                                     "difference": point, "ci": _ci(d)})
@@ -238,12 +316,17 @@ def summarise_supervision(settings: Settings, records: list[dict],
         "scenario": settings.scenario, "batch": settings.batch, "runs": len(ok),
         "failed_runs": len(records) - len(ok),
         "collisions_unsupervised": int(c0.sum()),
-        "safe_h": float(tables[0].safe_s.sum() / 3600.0),
+        "safe_h": float(tables[0].calm_s.sum() / 3600.0),  # no intervention justified
+        "label_safe_h": float(tables[0].safe_s.sum() / 3600.0),  # labelled 0 (false alarms')
+        "safe_encounters": int(tables[0].encounters.sum()),
         "rows": [dict(zip(ROW_FIELDS, (p["trigger"], p["threshold"], len(ok), int(c0.sum()),
                                        p["collisions_prevented"], p["collisions_caused"],
-                                       p["false_interventions_per_h"]), strict=True))
-                 for p in points],
+                                       p["false_interventions_per_h"], p["false_alarms_per_h"]),
+                          strict=True))
+                 for p in points if p["trigger"] != ORACLE],
         "points": points, "at_budget": budget_rows, "differences": differences,
+        "oracle": ceiling, "operating_points": "test" if select is None else "validation",
+        "selection_runs": None if sel is None else len(sel),
         "simulations": {"shared": sims + len(ok), "alarmed": alarmed + len(ok),
                         "naive": len(ok) * (1 + sum(len(t.thresholds) for t in settings.triggers))},
         "resamples": resamples, "confidence": CONFIDENCE, "budgets_per_h": list(budgets),
@@ -251,20 +334,32 @@ def summarise_supervision(settings: Settings, records: list[dict],
     }
 
 
-def _operating_point(points: list[dict], budget: float) -> dict:
-    """The threshold a trigger runs at within the budget (most prevented, then fewest false
-    interventions), or supervision off."""
-    ok = [p for p in points if p["false_interventions_per_h"] is not None
+POINT_FIELDS = ("threshold", "prevented_share", "false_interventions_per_h",
+                "false_interventions_ci", "false_interventions_poisson_ci", "false_alarms_per_h",
+                "collisions_caused", "lead_s", "lead_ci")
+
+
+def _operating_index(points: list[dict], budget: float) -> int | None:
+    """The index of the threshold a trigger runs at within the budget (most prevented, then
+    fewest false interventions), or None: supervision off."""
+    ok = [j for j, p in enumerate(points) if p["false_interventions_per_h"] is not None
           and p["false_interventions_per_h"] <= budget + 1e-12]
     if not ok:
+        return None
+    return max(ok, key=lambda j: (points[j]["prevented_share"] or 0.0,
+                                  -points[j]["false_interventions_per_h"]))
+
+
+def _point_fields(p: dict | None) -> dict:
+    """An operating point's figures; supervision off for None."""
+    if p is None:
         return {"threshold": None, "prevented_share": 0.0, "false_interventions_per_h": 0.0,
-                "false_interventions_ci": [0.0, 0.0], "collisions_caused": 0, "lead_s": None,
+                "false_interventions_ci": [0.0, 0.0], "false_interventions_poisson_ci": [0.0, 0.0],
+                "false_alarms_per_h": 0.0, "collisions_caused": 0, "lead_s": None,
                 "lead_ci": [None, None]}
-    p = max(ok, key=lambda p: (p["prevented_share"] or 0.0, -p["false_interventions_per_h"]))
-    return {k: p[k] for k in ("threshold", "prevented_share", "false_interventions_per_h",
-                              "false_interventions_ci", "collisions_caused", "lead_s",
-                              "lead_ci")}
+    return {k: p[k] for k in POINT_FIELDS}
 
 
-def _share_at(points: list[dict], budget: float) -> float:
-    return _operating_point(points, budget)["prevented_share"] or 0.0
+def _operating_point(points: list[dict], budget: float) -> dict:
+    j = _operating_index(points, budget)
+    return _point_fields(None if j is None else points[j])

@@ -12,12 +12,17 @@
 3. Each simulation is checked to be the unsupervised run up to its first alarm: the same scores
    at every frame before it and the alarm at the frame the scoring pass found.
 
-An intervention (an engagement of the fallback) is *false* when the unsupervised run was safe
-then: its frame is eligible (before the unsupervised collision) and labelled 0 (no collision
-within H, Definition 1); *true* when labelled 1; *late* at or after the unsupervised collision
-(it counts as neither). A later intervention is judged against the unsupervised run at the same
-time: after the first one the supervised world has diverged, and what would have happened
-without supervision is the only reference all triggers share.
+An intervention (an engagement of the fallback) is judged against the unsupervised run at its
+frame: *late* at or after the unsupervised collision (it counts as nothing); *true* when the
+frame is labelled 1 (a collision within H, Definition 1); *justified* when labelled 0 but the
+unsupervised run comes critically close within H (`criticality`: ground-truth TTC < 1.5 s or a
+required deceleration > 4 m/s²); otherwise *unneeded*. An unneeded intervention is *false* only
+if it changed the applied command at some frame of its engagement — one that rode along with
+the ADS's own harder braking changed nothing a passenger could feel. The earlier definition —
+every intervention at a frame labelled 0, a *false alarm* — is recorded beside it
+(`false_alarms`). A later intervention is judged against the unsupervised run at the same time:
+after the first one the supervised world has diverged, and what would have happened without
+supervision is the only reference all triggers share.
 """
 
 from __future__ import annotations
@@ -29,8 +34,14 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.atomic import atomic_file
+from evoeye.evaluation.supervision.criticality import (
+    Criticality,
+    frame_risk,
+    justified_frames,
+    safe_encounters,
+)
 from evoeye.evaluation.supervision.settings import Settings
-from evoeye.evaluation.supervision.triggers import TriggerSpec, load_monitor
+from evoeye.evaluation.supervision.triggers import FRAME_S, TriggerSpec, load_monitor
 from evoeye.log.writer import Supervision, write_episode
 from evoeye.monitor.online import FrameInputs, OnlineScorer, online_scorer
 from evoeye.paths import DataRoot
@@ -67,8 +78,33 @@ class RunJob:
     logged: dict  # the log's run metadata (status, collided, collision_time_s)
 
 
-def scorer(root: DataRoot, settings: Settings, trigger: TriggerSpec) -> OnlineScorer:
-    """The trigger's online scorer, loaded once per thread and reset."""
+class OracleScorer:
+    """The oracle trigger's score (`triggers.oracle_trigger`): minus the seconds left to the
+    unsupervised run's collision, in whole frames; −inf in a run without one."""
+
+    def __init__(self, collision_time_s: float | None) -> None:
+        self.collision_frame = (None if collision_time_s is None
+                                else round(collision_time_s / FRAME_S))
+        self._k = 0
+
+    def reset(self) -> None:
+        self._k = 0
+
+    def score(self, frame: FrameInputs) -> float:
+        k, self._k = self._k, self._k + 1
+        if self.collision_frame is None:
+            return float("-inf")
+        return -(self.collision_frame - k) * FRAME_S
+
+
+def scorer(root: DataRoot, settings: Settings, trigger: TriggerSpec,
+           job: RunJob | None = None) -> OnlineScorer:
+    """The trigger's online scorer, loaded once per thread and reset (the oracle's: built for
+    `job`'s run, from the collision its log records)."""
+    if trigger.oracle:
+        if job is None:
+            raise ValueError("the oracle scores a known run: give its job")
+        return OracleScorer(job.logged.get("collision_time_s"))
     key = (str(root.path), settings.scenario, settings.splits, trigger.source, trigger.ref)
     cache: dict[tuple, OnlineScorer] = _LOCAL.__dict__.setdefault("scorers", {})
     if key not in cache:
@@ -112,27 +148,53 @@ class Reference:
 
     eligible: int  # frames before its collision (all, without one)
     label: np.ndarray  # (eligible,) int8, y_t with horizon H
+    justified: np.ndarray  # (eligible,) bool: an intervention there is justified (module doc)
     collision_time_s: float | None
     dt_s: float
+    safe_encounters: int = 0  # hazardous encounters that ended safely (`criticality`)
 
     @classmethod
-    def of(cls, episode: Episode, horizon_s: float) -> Reference:
+    def of(cls, episode: Episode, horizon_s: float,
+           criticality: Criticality = Criticality()) -> Reference:  # noqa: B008 (frozen)
         t = np.array([f.scene.t_s for f in episode.frames])
         hit = np.array([f.scene.ego_collision for f in episode.frames], dtype=bool)
         keep = eligible_frames(t, hit)
-        return cls(int(keep.sum()), frame_labels(t, hit, horizon_s)[keep],
-                   episode.outcome.collision_time_s, 1.0 / episode.rate_hz)
+        label = frame_labels(t, hit, horizon_s)[keep]
+        risk = frame_risk([f.scene for f in episode.frames])
+        dt_s = 1.0 / episode.rate_hz
+        justified = justified_frames(label, risk.critical(criticality),
+                                     int(round(horizon_s / dt_s)))
+        return cls(int(keep.sum()), label, justified, episode.outcome.collision_time_s, dt_s,
+                   safe_encounters(risk.conflict(criticality), justified))
 
     @property
     def safe_s(self) -> float:
-        """Seconds of safe driving: its eligible frames labelled 0."""
+        """Seconds of safe driving by the label: eligible frames labelled 0."""
         return float((self.label == 0).sum()) * self.dt_s
 
+    @property
+    def calm_s(self) -> float:
+        """Seconds of safe driving: eligible frames where an intervention is not justified."""
+        return float((~self.justified).sum()) * self.dt_s
+
     def judge(self, frame: int) -> str:
-        """'false', 'true' or 'late' for an intervention at `frame` (module doc)."""
+        """'late', 'true', 'justified' or 'unneeded' for an intervention at `frame`."""
         if frame >= self.eligible:
             return "late"
-        return "true" if self.label[frame] else "false"
+        if self.label[frame]:
+            return "true"
+        return "justified" if self.justified[frame] else "unneeded"
+
+
+def _changed_command(states, start: int) -> bool:
+    """Whether the engagement starting at `start` applied, at some frame before control went
+    back to the ADS, another acceleration than the ADS commanded."""
+    for s in states[start:]:
+        if s.mode == "nominal":
+            return False
+        if s.accel_cmd_mps2 != s.ads_accel_mps2:
+            return True
+    return False
 
 
 def summarise(run: SupervisedRun, ref: Reference) -> dict:
@@ -147,6 +209,8 @@ def summarise(run: SupervisedRun, ref: Reference) -> dict:
     starts = [k for k, m in enumerate(modes) if m in FALLBACK_MODES
               and (k == 0 or modes[k - 1] not in FALLBACK_MODES)]
     verdicts = [ref.judge(k) for k in starts]
+    changed = [_changed_command(states[:end], k) for k in starts]
+    false = sum(v == "unneeded" and c for v, c in zip(verdicts, changed, strict=True))
     acting = np.array([m != "nominal" for m in modes], dtype=bool)  # (F,)
     accel = np.array([s.accel_cmd_mps2 for s in states[:end]])
     speed = np.array([f.scene.speed_mps[0] for f in ep.frames[:end]])
@@ -159,7 +223,10 @@ def summarise(run: SupervisedRun, ref: Reference) -> dict:
         "collided": o.collided, "collision_time_s": o.collision_time_s,
         "other_actor": o.other_actor, "struck_from_behind": struck_from_behind(ep),
         "duration_s": o.duration_s, "min_distance_m": o.min_distance_m,
-        "interventions": len(starts), "false_interventions": verdicts.count("false"),
+        "interventions": len(starts), "false_interventions": false,
+        "false_alarms": verdicts.count("justified") + verdicts.count("unneeded"),
+        "justified_interventions": verdicts.count("justified"),
+        "idle_interventions": verdicts.count("unneeded") - false,
         "true_interventions": verdicts.count("true"), "first_lead_s": first_lead,
         "fallback_s": float(acting.sum()) * dt_s,
         "peak_decel_mps2": float(max(0.0, -accel[acting].min())) if acting.any() else 0.0,
@@ -194,7 +261,7 @@ def sweep_trigger(job: RunJob, trigger: TriggerSpec, scores: list[float],
     while pending:
         group = pending.pop(0)
         lead = index[group[0]]
-        risk_scorer = scorer(DataRoot.resolve(job.root), s, trigger)
+        risk_scorer = scorer(DataRoot.resolve(job.root), s, trigger, job)
         run = run_supervised(job.spec, lambda m, sc=risk_scorer: sc.score(FrameInputs.of(m)),
                              Trigger(trigger.name, trigger.version, group, s.consecutive),
                              s.fallback)
@@ -246,7 +313,7 @@ def supervise_run(job: RunJob) -> dict:
     import orjson
 
     root, s = DataRoot.resolve(job.root), job.settings
-    scorers = [scorer(root, s, t) for t in s.triggers]
+    scorers = [scorer(root, s, t, job) for t in s.triggers]
     drivers: list[ObservedDriver] = []
     unsupervised = run_episode(job.spec, driver=observed(scorers, drivers))
     o = unsupervised.outcome
@@ -259,11 +326,12 @@ def supervise_run(job: RunJob) -> dict:
     record = {"scenario_id": job.spec.scenario_id, "seed": job.spec.seed,
               "status": o.status, "reason": o.reason}
     if o.status == STATUS_OK:
-        ref = Reference.of(unsupervised, s.horizon_s)
+        ref = Reference.of(unsupervised, s.horizon_s, s.criticality)
         record["unsupervised"] = {
             "collided": o.collided, "collision_time_s": o.collision_time_s,
             "other_actor": o.other_actor, "struck_from_behind": struck_from_behind(unsupervised),
-            "duration_s": o.duration_s, "safe_s": ref.safe_s, "eligible_frames": ref.eligible}
+            "duration_s": o.duration_s, "safe_s": ref.safe_s, "calm_s": ref.calm_s,
+            "safe_encounters": ref.safe_encounters, "eligible_frames": ref.eligible}
         record["triggers"] = {t.name: sweep_trigger(job, t, scores, ref)
                               for t, scores in zip(s.triggers, drivers[0].scores, strict=True)}
     path = Path(job.folder) / "runs" / f"{job.spec.scenario_id}.json"

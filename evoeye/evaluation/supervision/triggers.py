@@ -9,8 +9,14 @@ negative, where no FPR target reaches — the sweep goes on by the validation po
 threshold per target frame recall of `RECALLS` that still lies above the top negative, so a
 trigger whose strictest FPR threshold still alarms too often on new runs has stricter ones to
 offer. Targets that give the same threshold are one threshold. A worker loads the monitor again
-from its `TriggerSpec` (picklable; kept per process), so the sweep runs the same on local
+from its `TriggerSpec` (picklable; kept per thread), so the sweep runs the same on local
 processes or a task runner.
+
+The *oracle* (`oracle_trigger`) is the ceiling every report draws beside them: it knows when
+the unsupervised run collides and engages exactly τ s before, for each τ of `ORACLE_LEADS_S`,
+and never in a run without a collision. Its score at a frame is minus the time left to the
+collision, counted in whole frames (−inf in a safe run); its threshold for τ lies half a frame
+beyond −τ, so it alarms first at the frame τ s before contact.
 """
 
 from __future__ import annotations
@@ -26,6 +32,7 @@ from evoeye.monitor.calibration import calibrate
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES, load_version
 from evoeye.monitor.protocol import Monitor
 from evoeye.paths import DataRoot
+from evoeye.sim.runner import SimConfig
 from evoeye.store import SplitSpec
 from evoeye.store.windows import DEFAULT_HORIZON_S
 
@@ -35,6 +42,9 @@ SWEEP_FPRS = (0.05, 0.02, 0.01, 0.005, 0.002, 0.001, 5e-4, 2e-4, 1e-4, 5e-5, 2e-
 RECALLS = (0.2, 0.1, 0.05)  # target frame recalls on validation, above every negative
 RULES = ("ttc", "ttc-2d", "rss", "rss-2s")  # the rule-based triggers (no training)
 DEFAULT_BASELINES = ("ttc", "ttc-2d", "rss", "aem", "context-only")  # `evoeye supervise`'s
+ORACLE = "oracle"  # the oracle trigger's name and source
+ORACLE_LEADS_S = (0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0)  # τ: it engages τ s before contact
+FRAME_S = 1.0 / SimConfig().rate_hz  # the frames the oracle counts in (20 Hz)
 
 
 @dataclass(frozen=True)
@@ -59,6 +69,17 @@ class TriggerSpec:
     def rule_based(self) -> bool:
         return self.source == "baseline" and self.ref in RULES
 
+    @property
+    def oracle(self) -> bool:
+        return self.source == ORACLE
+
+    @property
+    def leads_s(self) -> tuple[float, ...]:
+        """The oracle's τ per threshold (its thresholds are −τ − half a frame)."""
+        if not self.oracle:
+            raise ValueError(f"{self.name} is no oracle: its thresholds are no leads")
+        return tuple(round(-t - FRAME_S / 2, 6) for t in self.thresholds)
+
     def to_dict(self) -> dict:
         return asdict(self)
 
@@ -66,6 +87,17 @@ class TriggerSpec:
     def of(cls, d: dict) -> TriggerSpec:
         return cls(**{**d, **{k: tuple(d[k]) for k in ("thresholds", "targets", "val_fprs",
                                                        "val_recalls")}})
+
+
+def oracle_trigger(leads_s: Sequence[float] = ORACLE_LEADS_S) -> TriggerSpec:
+    """The oracle (module doc), engaging τ s before each known collision for each τ."""
+    if not leads_s or min(leads_s) <= 0:
+        raise ValueError(f"the oracle's leads must be positive seconds, got {list(leads_s)}")
+    leads = sorted({round(float(t), 6) for t in leads_s}, reverse=True)  # thresholds ascend
+    n = len(leads)
+    return TriggerSpec(ORACLE, ORACLE, "", "oracle-1",
+                       tuple(-t - FRAME_S / 2 for t in leads), tuple(f"τ {t:g} s" for t in leads),
+                       (0.0,) * n, (0.0,) * n)
 
 
 def load_monitor(root: DataRoot, scenario: str, splits: SplitSpec, source: str,

@@ -28,8 +28,9 @@ def trigger(name: str, source: str = "baseline") -> TriggerSpec:
 
 def sim(collided: bool, false: int = 0, *, rear: bool = False, fallback_s: float = 2.0,
         lead_s: float | None = None) -> dict:
+    # the earlier measure counted twice as many here (half of them justified or idle)
     return {"collided": collided, "struck_from_behind": rear, "false_interventions": false,
-            "interventions": max(false, 1), "fallback_s": fallback_s, "duration_s": 20.0,
+            "false_alarms": 2 * false, "interventions": max(2 * false, 1), "fallback_s": fallback_s, "duration_s": 20.0,
             "peak_decel_mps2": 6.0, "peak_jerk_mps3": 10.0, "first_lead_s": lead_s}
 
 
@@ -43,7 +44,8 @@ def record(sid: str, collided0: bool, per_trigger: dict[str, list[dict | None]])
                           "first_alarm_frame": [None if o is None else 10 for o in outcomes]}
     return {"scenario_id": sid, "status": "ok", "unsupervised": {
         "collided": collided0, "struck_from_behind": False, "duration_s": 20.0,
-        "safe_s": SAFE_S}, "triggers": triggers}
+        "safe_s": SAFE_S + 2.0, "calm_s": SAFE_S, "safe_encounters": 0 if collided0 else 2},
+        "triggers": triggers}
 
 
 @pytest.fixture(scope="module")
@@ -78,10 +80,17 @@ def test_rows_hold_exactly_the_listed_fields_and_the_counts(data) -> None:
     assert s["safe_h"] == pytest.approx(safe_h)
     assert by["fusion", 0.2]["false_interventions_per_h"] == pytest.approx(4 / safe_h)
     assert by["fusion", 0.5]["false_interventions_per_h"] == pytest.approx(1 / safe_h)
+    label_safe_h = 40 * (SAFE_S + 2.0) / 3600  # the earlier measure, its own denominator
+    assert s["label_safe_h"] == pytest.approx(label_safe_h) and s["safe_encounters"] == 60
+    assert by["fusion", 0.2]["false_alarms_per_h"] == pytest.approx(8 / label_safe_h)
     point = next(p for p in s["points"] if p["trigger"] == "ttc" and p["threshold"] == 0.2)
     assert point["caused_rear_end"] == 1 and point["label"] == "ttc"
     fusion = next(p for p in s["points"] if p["trigger"] == "fusion")
     assert fusion["label"] == "FusionMonitor" and fusion["lead_s"] == 1.0
+    assert fusion["false_per_encounter"] == pytest.approx(4 / 60)
+    low, high = fusion["false_interventions_poisson_ci"]  # exact: 4 events in safe_h hours
+    assert low == pytest.approx(1.0899 / safe_h, rel=1e-3)
+    assert high == pytest.approx(10.2416 / safe_h, rel=1e-3)
     lo, hi = fusion["prevented_ci"]
     assert lo <= fusion["prevented_share"] == 0.8 <= hi and lo < hi
 
@@ -136,3 +145,56 @@ def test_the_report_leads_with_the_fusion_monitor_against_the_best_rule(data) ->
     md = markdown_report([s])
     assert md.index("FusionMonitor prevents") < md.index("| Trigger |")  # headline first
     assert "### ttc: operating curve" in md
+
+
+def _with_oracle(records: list[dict]) -> list[dict]:
+    """The records with an oracle at τ = 2, 1, 0.5 s (thresholds ascending): it prevents every
+    collision from 1 s ahead, none at 0.5 s."""
+    out = []
+    for r in records:
+        c0 = r["unsupervised"]["collided"]
+        sims = [sim(False, lead_s=t) for t in (2.0, 1.0)] + [sim(True, lead_s=0.5)]
+        oracle = {"version": "oracle-1", "sims": sims if c0 else [],
+                  "sim_of": [0, 1, 2] if c0 else [None] * 3,
+                  "first_alarm_frame": [10, 30, 40] if c0 else [None] * 3}
+        out.append({**r, "triggers": {**r["triggers"], "oracle": oracle}})
+    return out
+
+
+def test_the_oracle_is_the_ceiling_beside_every_trigger(data) -> None:
+    from evoeye.evaluation.supervision.triggers import oracle_trigger
+
+    settings, records = data
+    oracle = oracle_trigger((0.5, 1.0, 2.0))
+    assert oracle.leads_s == (2.0, 1.0, 0.5) and list(oracle.thresholds) == sorted(
+        oracle.thresholds)
+    with_oracle = Settings(settings.scenario, "b", (*settings.triggers, oracle))
+    s = summarise_supervision(with_oracle, _with_oracle(records), budgets=(5.0,), resamples=200)
+    assert [(o["lead_s"], o["prevented_share"]) for o in s["oracle"]] == [
+        (0.5, 0.0), (1.0, 1.0), (2.0, 1.0)]
+    assert "oracle" not in {r["trigger"] for r in s["rows"] + s["at_budget"]}
+    assert all(d["b"] != "oracle" for d in s["differences"])
+    fusion = next(r for r in s["at_budget"] if r["trigger"] == "fusion")
+    # the FusionMonitor leads by 1 s: the oracle prevents all there; at 0.75 s half
+    assert fusion["oracle_at_lead"] == 1.0 and fusion["share_of_oracle"] == pytest.approx(0.8)
+    from evoeye.evaluation.supervision.summary import oracle_share_at
+
+    assert oracle_share_at(s["oracle"], 0.75) == pytest.approx(0.5)
+    assert oracle_share_at(s["oracle"], 0.25) == 0.0 and oracle_share_at([], 1.0) is None
+
+
+def test_operating_points_are_chosen_on_the_selection_runs_and_reported_on_these(data) -> None:
+    settings, records = data
+    # on the selection runs the loosest threshold intervenes falsely nowhere: chosen at 5/h
+    select = [{**r, "triggers": {n: {**t, "sims": [{**x, "false_interventions": 0}
+                                                   for x in t["sims"]]}
+                                 for n, t in r["triggers"].items()}} for r in records]
+    s = summarise_supervision(settings, records, budgets=(5.0,), resamples=200, select=select)
+    assert s["operating_points"] == "validation" and s["selection_runs"] == 40
+    fusion = next(r for r in s["at_budget"] if r["trigger"] == "fusion")
+    assert fusion["threshold"] == 0.2 and fusion["val_false_interventions_per_h"] == 0.0
+    # reported as it is on these runs: over the budget it was chosen for
+    assert fusion["false_interventions_per_h"] == pytest.approx(4 / (40 * SAFE_S / 3600))
+    leaky = summarise_supervision(settings, records, budgets=(5.0,), resamples=200)
+    assert leaky["operating_points"] == "test"
+    assert next(r for r in leaky["at_budget"] if r["trigger"] == "fusion")["threshold"] == 0.9

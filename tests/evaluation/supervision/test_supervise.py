@@ -19,7 +19,7 @@ from evoeye.evaluation.supervision.sweep import (
     supervise_run,
     supervised_spec,
 )
-from evoeye.evaluation.supervision.triggers import realised, sweep_thresholds
+from evoeye.evaluation.supervision.triggers import ORACLE_LEADS_S, realised, sweep_thresholds
 from evoeye.log import read_run
 from evoeye.store import SplitSpec, Warehouse, ingest
 
@@ -37,8 +37,9 @@ def result(sup):
 
 
 def test_every_run_gets_a_record_paired_with_its_logged_outcome(sup, result) -> None:
-    (trigger,) = result.settings.triggers
+    trigger, oracle = result.settings.triggers  # the oracle comes with every supervision
     assert trigger.name == "ttc" and list(trigger.thresholds) == sorted(set(trigger.thresholds))
+    assert oracle.oracle and oracle.leads_s == tuple(sorted(ORACLE_LEADS_S, reverse=True))
     assert len(result.records) == 4 and not result.errors
     logged = {s.scenario_id: m for s, m in plan_supervision(sup.root, result.settings).runs}
     for r in result.records:
@@ -56,6 +57,33 @@ def test_every_run_gets_a_record_paired_with_its_logged_outcome(sup, result) -> 
         frames = [f if f is not None else 10**6 for f in t["first_alarm_frame"]]
         assert frames == sorted(frames)
     assert sum(r["unsupervised"]["collided"] for r in result.records) == 2
+
+
+def test_the_oracle_engages_tau_before_each_known_collision_and_nowhere_else(result) -> None:
+    leads = result.settings.trigger("oracle").leads_s
+    for r in result.records:
+        u, o = r["unsupervised"], r["triggers"]["oracle"]
+        if not u["collided"]:
+            assert o["first_alarm_frame"] == [None] * len(leads) and not o["sims"]
+            continue
+        contact = round(u["collision_time_s"] * 20)
+        assert o["first_alarm_frame"] == [contact - round(t * 20) for t in leads]
+        assert all(s["true_interventions"] == 1 and s["false_interventions"] == 0
+                   and s["first_lead_s"] == pytest.approx(t)
+                   for s, t in zip((o["sims"][i] for i in o["sim_of"]), leads, strict=True))
+        assert not o["sims"][o["sim_of"][0]]["collided"]  # 3 s ahead prevents it here
+
+
+def test_each_intervention_is_judged_and_the_earlier_measure_kept(result) -> None:
+    for r in result.records:
+        u = r["unsupervised"]
+        assert 0 <= u["calm_s"] <= u["safe_s"] + 1e-9 and u["safe_encounters"] >= 0
+        for s in r["triggers"]["ttc"]["sims"]:
+            judged = (s["true_interventions"] + s["justified_interventions"]
+                      + s["false_interventions"] + s["idle_interventions"])
+            assert judged <= s["interventions"]  # the rest came late
+            assert s["false_alarms"] == (s["justified_interventions"]
+                                         + s["false_interventions"] + s["idle_interventions"])
 
 
 def test_each_simulation_is_logged_with_the_supervisor_channels(sup, result) -> None:

@@ -1,0 +1,131 @@
+"""How close a run came to a collision, frame by frame, from its ground truth: the judge of
+whether an intervention was needed.
+
+An AEB engineer does not call a brake on a near miss a nuisance. So an intervention at frame k
+is *justified* when the unsupervised run, within H after k, collides (Definition 1's label) or
+comes *critically close*:
+
+* ground-truth TTC-2D < `critical_ttc_s` (1.5 s): the ego's box and another actor's, both
+  keeping their velocity and heading, would touch that soon (`boxes.first_contact_s`, the
+  exact sweep the TTC-2D baseline runs on perceived boxes, here on the true ones);
+* or a required deceleration > `critical_decel_mps2` (4 m/s², beyond the ADS's 3.5 m/s² comfort
+  limit): for the actors ahead in the ego's corridor, the larger of DRAC (closing speed² over
+  twice the bumper gap: the lead keeps its speed) and the deceleration that stops the ego
+  behind a lead braking to a stop at its present deceleration. Both are lower bounds of what
+  avoiding it really takes, so "critical" errs towards calling a brake a nuisance.
+
+A frame is *in conflict* — part of a hazardous encounter — at looser bounds (TTC-2D <
+`conflict_ttc_s`, 3 s, or required deceleration > `conflict_decel_mps2`, 2 m/s²). A *safe
+hazardous encounter* is a maximal stretch of conflict frames before any collision that never
+turns critical and has no collision within H: the situations (a braking lead, a cut-in) a
+trigger must ride through without braking. False interventions are reported per hour of safe
+driving and per safe hazardous encounter.
+"""
+
+from __future__ import annotations
+
+from dataclasses import asdict, dataclass
+
+import numpy as np
+
+from evoeye.boxes import box_corners, first_contact_s
+from evoeye.scene import SceneState
+
+CORRIDOR_MARGIN_M = 0.3  # as the TTC baseline's corridor
+
+
+@dataclass(frozen=True)
+class Criticality:
+    """The thresholds of the module doc (recorded with every supervision)."""
+
+    critical_ttc_s: float = 1.5
+    critical_decel_mps2: float = 4.0
+    conflict_ttc_s: float = 3.0
+    conflict_decel_mps2: float = 2.0
+
+    def __post_init__(self) -> None:
+        if not (0 < self.critical_ttc_s <= self.conflict_ttc_s
+                and 0 < self.conflict_decel_mps2 <= self.critical_decel_mps2):
+            raise ValueError(f"criticality bounds: 0 < critical TTC <= conflict TTC and "
+                             f"0 < conflict decel <= critical decel, got {self}")
+
+    def to_dict(self) -> dict:
+        return asdict(self)
+
+
+@dataclass(frozen=True)
+class FrameRisk:
+    """Per frame of a run: ground-truth TTC-2D (s, inf without conflict) and required
+    deceleration (m/s², 0 without a closing lead)."""
+
+    ttc_s: np.ndarray  # (F,)
+    decel_mps2: np.ndarray  # (F,)
+
+    def critical(self, c: Criticality) -> np.ndarray:  # (F,) bool
+        return (self.ttc_s < c.critical_ttc_s) | (self.decel_mps2 > c.critical_decel_mps2)
+
+    def conflict(self, c: Criticality) -> np.ndarray:  # (F,) bool
+        return (self.ttc_s < c.conflict_ttc_s) | (self.decel_mps2 > c.conflict_decel_mps2)
+
+
+def scene_risk(scene: SceneState) -> tuple[float, float]:
+    """(TTC-2D in s, required deceleration in m/s²) of the ego (row 0) against every other
+    actor of one ground-truth scene."""
+    if scene.n < 2:
+        return float("inf"), 0.0
+    h0 = float(scene.heading_rad[0])
+    c, s = np.cos(h0), np.sin(h0)
+    ddx, ddy = scene.x_m[1:] - scene.x_m[0], scene.y_m[1:] - scene.y_m[0]
+    dx, dy = c * ddx + s * ddy, -s * ddx + c * ddy  # (n,) ego frame: x forward, y left
+    dvx_w, dvy_w = scene.vx_mps[1:] - scene.vx_mps[0], scene.vy_mps[1:] - scene.vy_mps[0]
+    dvx, dvy = c * dvx_w + s * dvy_w, -s * dvx_w + c * dvy_w
+    dh = scene.heading_rad[1:] - h0
+    other = box_corners(dx, dy, dh, scene.length_m[1:], scene.width_m[1:])
+    zero = np.zeros(1)
+    ego = box_corners(zero, zero, zero, scene.length_m[:1], scene.width_m[:1])
+    ttc = first_contact_s(np.broadcast_to(ego, other.shape), other, np.stack([dvx, dvy], -1))
+    # the corridor ahead: longitudinal gap, closing speed, the lead's own deceleration
+    ahead = (dx > 0) & (np.abs(dy) < (scene.width_m[0] + scene.width_m[1:]) / 2
+                        + CORRIDOR_MARGIN_M)
+    gap = np.maximum(dx - (scene.length_m[0] + scene.length_m[1:]) / 2, 0.05)
+    closing = np.maximum(-dvx, 0.0)
+    drac = closing**2 / (2 * gap)
+    lead_speed = np.maximum(scene.speed_mps[1:] * np.cos(dh), 0.0)
+    lead_decel = np.maximum(-scene.accel_mps2[1:] * np.cos(dh), 0.0)
+    ego_speed = max(float(scene.speed_mps[0]), 0.0)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        stop_gap = gap + np.where(lead_decel > 0, lead_speed**2 / (2 * lead_decel), np.inf)
+        stop = np.where(lead_decel > 0, ego_speed**2 / (2 * stop_gap), 0.0)
+    need = np.where(ahead, np.maximum(drac, stop), 0.0)
+    return float(ttc.min(initial=np.inf)), float(need.max(initial=0.0))
+
+
+def frame_risk(scenes: list[SceneState]) -> FrameRisk:
+    """`scene_risk` of every frame of a run."""
+    pairs = np.array([scene_risk(s) for s in scenes], dtype=np.float64).reshape(-1, 2)
+    return FrameRisk(pairs[:, 0], pairs[:, 1])
+
+
+def justified_frames(label: np.ndarray, critical: np.ndarray, horizon_frames: int) -> np.ndarray:
+    """(E,) bool: an intervention at frame k is justified (module doc) — its label is 1, or a
+    critical frame lies in [k, k + horizon_frames]. `label` (E,) over the eligible frames,
+    `critical` (≥ E,) over the run's frames."""
+    e = len(label)
+    crit = np.asarray(critical[:e], dtype=np.int64)
+    # critical frames in the window [k, k + h]: a suffix-sum difference
+    tail = np.concatenate([np.cumsum(crit[::-1])[::-1], [0]])  # tail[k] = crit[k:].sum()
+    k = np.arange(e)
+    ahead = tail[k] - tail[np.minimum(k + horizon_frames + 1, e)]
+    return (np.asarray(label, bool)) | (ahead > 0)
+
+
+def safe_encounters(conflict: np.ndarray, justified: np.ndarray) -> int:
+    """Maximal stretches of conflict frames (over the eligible frames) with no justified
+    frame: the hazardous encounters that ended safely."""
+    e = len(justified)
+    c = np.asarray(conflict[:e], bool)
+    if not c.any():
+        return 0
+    edges = np.flatnonzero(np.diff(np.concatenate([[0], c.astype(np.int8), [0]])))
+    starts, stops = edges[::2], edges[1::2]
+    return int(sum(not justified[a:b].any() for a, b in zip(starts, stops, strict=True)))
