@@ -4,16 +4,21 @@
 bounds, help, and the registry's names as the JSON schema's enum) to a base model holding what
 the flow adds itself; `KnownNames` checks every field that names registered things. So an option
 is declared once, in `evoeye.evolve.campaign.config`, for the flows as for the command line.
+`flat_parameters` gives a flow such a model's fields as its own parameters (the nightly
+deployment's, which a flow run may then override one at a time).
 """
 
 from __future__ import annotations
 
-from collections.abc import Collection
-from typing import Any, ClassVar
+import inspect
+from collections.abc import Callable, Collection
+from typing import Annotated, Any, ClassVar, TypeVar
 
 from pydantic import BaseModel, Field, create_model, model_validator
 
 from evoeye.evolve.campaign.config import campaign_options, check_known, known
+
+F = TypeVar("F", bound=Callable[..., Any])
 
 
 class KnownNames(BaseModel):
@@ -48,3 +53,23 @@ def campaign_model(name: str, base: type[KnownNames], module: str,
     model = create_model(name, __base__=base, __module__=module, **campaign_fields(exclude))
     model.__doc__ = base.__doc__
     return model
+
+
+def flat_parameters(model: type[BaseModel]) -> Callable[[F], F]:
+    """Decorator: a `**fields` function takes the fields of `model` as keyword-only parameters
+    (type, bounds, names and default of each; its help in the docstring's Args section), so
+    that a flow made of it has them as its own parameters: Prefect's form and schema show
+    each, and a flow run may set one alone (`--param budget_s=800`)."""
+    def flat(fn: F) -> F:
+        params = [inspect.Parameter(
+            name, inspect.Parameter.KEYWORD_ONLY,
+            annotation=Annotated[field.annotation, *field.metadata,
+                                 Field(json_schema_extra=field.json_schema_extra)],
+            default=field.get_default(call_default_factory=True))
+            for name, field in model.model_fields.items()]
+        fn.__signature__ = inspect.Signature(params)  # type: ignore[attr-defined]
+        helps = [f"    {name}: {' '.join((field.description or name).split())}"
+                 for name, field in model.model_fields.items()]
+        fn.__doc__ = "\n".join([inspect.cleandoc(fn.__doc__ or ""), "", "Args:", *helps])
+        return fn
+    return flat

@@ -14,7 +14,7 @@ import os
 import sys
 import types
 import typing
-from collections.abc import Callable, Sequence
+from collections.abc import Callable, Mapping, Sequence
 from pathlib import Path
 from typing import Any
 
@@ -38,12 +38,23 @@ def _inner(annotation: Any) -> Any:
     return annotation
 
 
-def _help(field: Any) -> str:
+def _help(field: Any, about: str | None = None, default: Any = argparse.SUPPRESS) -> str:
     extra = field.json_schema_extra if isinstance(field.json_schema_extra, dict) else {}
     choices = f"one of {', '.join(map(str, extra['enum']))}; " if "enum" in extra else ""
-    default = field.get_default(call_default_factory=True)
-    about = f"{field.description} " if field.description else ""
-    return f"{about}({choices}default: {default})"
+    if default is argparse.SUPPRESS:
+        default = field.get_default(call_default_factory=True)
+    about = about or field.description
+    return f"{about + ' ' if about else ''}({choices}default: {default})"
+
+
+@dataclasses.dataclass(frozen=True)
+class Override:
+    """How one field shows on a command line other than the model says: its help, its
+    default (applied, and shown by --help) and other flags for it."""
+
+    help: str | None = None
+    default: Any = argparse.SUPPRESS
+    aliases: tuple[str, ...] = ()
 
 
 def say_what_we_wait_for() -> None:
@@ -59,23 +70,27 @@ def _plain(value: Any) -> Any:
     return dataclasses.asdict(value) if dataclasses.is_dataclass(value) else str(value)
 
 
-def parser_for(params: type[BaseModel], description: str | None) -> argparse.ArgumentParser:
-    """An argparse parser with one option per field of `params` (absent ones stay absent)."""
+def parser_for(params: type[BaseModel], description: str | None,
+               overrides: Mapping[str, Override] | None = None) -> argparse.ArgumentParser:
+    """An argparse parser with one option per field of `params` (absent ones stay absent,
+    unless `overrides` gives them a default)."""
     ap = argparse.ArgumentParser(prog=f"python -m flows.{Path(sys.argv[0]).stem}",
                                  description=description, epilog=API_NOTE,
                                  argument_default=argparse.SUPPRESS,
                                  formatter_class=argparse.RawDescriptionHelpFormatter)
     for name, field in params.model_fields.items():
-        flag = "--" + name.replace("_", "-")
+        how = (overrides or {}).get(name, Override())
+        flags = ["--" + name.replace("_", "-"), *how.aliases]
         kind = _inner(field.annotation)
+        common = {"dest": name, "help": _help(field, how.help, how.default),
+                  "default": how.default}
         if kind is bool:
-            ap.add_argument(flag, dest=name, action=argparse.BooleanOptionalAction,
-                            help=_help(field))
+            ap.add_argument(*flags, action=argparse.BooleanOptionalAction, **common)
         elif typing.get_origin(kind) is list:
-            ap.add_argument(flag, dest=name, nargs="+", metavar="VALUE", help=_help(field))
+            ap.add_argument(*flags, nargs="+", metavar="VALUE", **common)
         else:
-            ap.add_argument(flag, dest=name, metavar=getattr(kind, "__name__", "VALUE").upper(),
-                            help=_help(field))
+            ap.add_argument(*flags, metavar=getattr(kind, "__name__", "VALUE").upper(),
+                            **common)
     return ap
 
 

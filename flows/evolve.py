@@ -9,7 +9,8 @@ and `score` (feedback refresh and the round's commit). The tasks pass only the p
 run ids: each rebuilds the campaign's state from the data root (`Campaign.start`, with the
 round's new run ids), where `acquire` left the new logs and their feedback. Because the state
 lives in the warehouse, a round flow run that crashed is simply run again by the next flow run
-(e.g. tomorrow night's), with nothing lost or repeated.
+(e.g. tomorrow night's), with nothing lost or repeated. A flow run that adds no round, its
+budget spent, says so in its log and its result (`nothing_to_do`, `message`).
 """
 
 from __future__ import annotations
@@ -24,6 +25,7 @@ from pydantic import Field, model_validator
 from evoeye.evolve.campaign.config import CampaignConfig, config_from, option_values
 from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.campaign.report import rounds_markdown
+from evoeye.evolve.campaign.state import CampaignState
 from evoeye.paths import DataRoot
 from evoeye.store.feedback import read_rounds
 from flows.campaign_params import KnownNames, campaign_model
@@ -33,9 +35,12 @@ from flows.published import named, publish
 class CampaignRun(KnownNames):
     """One campaign (its id follows from the options, minus the budget and max_rounds)."""
 
-    root: str | None = None  # default: $EVOEYE_HOME or ./evoeye-data
-    max_rounds: int | None = Field(None, ge=1)  # rounds in this flow run (None: to the budget)
-    assess: bool = False  # also score every G_r on the Test Set and the Hard Set
+    root: str | None = Field(None, description="Data root; None: $EVOEYE_HOME, else "
+                             "./evoeye-data.")
+    max_rounds: int | None = Field(None, ge=1, description="Rounds in this flow run; None: "
+                                   "until the budget is spent.")
+    assess: bool = Field(False, description="Also score every G_r on the Test Set and the "
+                         "Hard Set.")
 
     def config(self) -> CampaignConfig:
         return config_from(self.model_dump())
@@ -126,11 +131,18 @@ def round_flow(params: EvolveParams) -> dict[str, Any] | None:
     return out
 
 
-@flow(name="evoeye-evolve", log_prints=True,
-      flow_run_name=named(lambda p: (p or EvolveParams()).run_name()))
-def evolution_flow(params: EvolveParams | None = None) -> dict[str, Any]:
-    """Run rounds (each a `round-<r>` flow run) until the budget is spent or max_rounds."""
-    params = params or EvolveParams()
+def nothing_to_do(campaign: Campaign, state: CampaignState) -> str:
+    """What a flow run that added no round says: the campaign has spent its budget."""
+    cfg = campaign.config
+    return (f"nothing to do: campaign {campaign.campaign_id} has spent its budget "
+            f"({state.spent_s:.0f} of {cfg.budget_s:.0f} simulated s; a run may last "
+            f"{cfg.max_run_s:.0f} s); a larger budget_s continues it")
+
+
+def run_campaign(params: CampaignRun) -> dict[str, Any]:
+    """The body of a campaign flow run: rounds (each a `round-<r>` flow run) until the budget
+    is spent or max_rounds; a run that adds none says so in its log and its result."""
+    logger = get_run_logger()
     campaign = make_campaign(params)
     state = campaign.start()
     rounds: list[dict[str, Any]] = []
@@ -142,10 +154,22 @@ def evolution_flow(params: EvolveParams | None = None) -> dict[str, Any]:
             break
         rounds.append(out)
         state = campaign.start()
+    idle = None if rounds else nothing_to_do(campaign, state)
+    if idle:
+        logger.warning(idle)
     publish_rounds(campaign, "evoeye-evolve")
     return {"campaign_id": campaign.campaign_id, "rounds": rounds, "round": state.round,
             "monitor": state.monitor, "simulated_s": state.spent_s,
-            "done": campaign.done(state), "root": str(campaign.root.path)}
+            "done": campaign.done(state), "root": str(campaign.root.path),
+            "nothing_to_do": idle is not None,
+            "message": idle or f"{len(rounds)} round(s) added, now at round {state.round}"}
+
+
+@flow(name="evoeye-evolve", log_prints=True,
+      flow_run_name=named(lambda p: (p or EvolveParams()).run_name()))
+def evolution_flow(params: EvolveParams | None = None) -> dict[str, Any]:
+    """Run rounds (each a `round-<r>` flow run) until the budget is spent or max_rounds."""
+    return run_campaign(params or EvolveParams())
 
 
 if __name__ == "__main__":

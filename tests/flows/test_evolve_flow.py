@@ -1,4 +1,5 @@
-"""The evolution flow through Prefect: a flow run per round (`round-<r>-…`); the deployment."""
+"""The evolution flow through Prefect: a flow run per round (`round-<r>-…`); the nightly
+deployment is in test_deploy.py."""
 
 from __future__ import annotations
 
@@ -6,7 +7,6 @@ import pytest
 from pydantic import ValidationError
 
 from evoeye.store.feedback import read_rounds
-from flows.deploy import NIGHTLY_CRON, nightly_deployment
 from flows.evolve import EvolveParams, evolution_flow
 
 SCENARIO = "unprotected-intersection"  # the scenario of the `seeded` fixture (conftest)
@@ -42,36 +42,19 @@ def test_params_are_the_campaign_options_and_give_back_the_config() -> None:
     assert params.config() == cfg and params.root == "/r" and params.max_rounds == 1
 
 
-def test_nightly_deployment_has_cron_and_parameter_schema() -> None:
-    d = nightly_deployment(EvolveParams(scenario=SCENARIO, strategy="uniform", budget_s=60))
-    assert d.name == "nightly-evolution"
-    assert d.schedules[0].schedule.cron == NIGHTLY_CRON == "0 2 * * *"
-    assert d.parameters["params"]["strategy"] == "uniform"
-    schema = d._parameter_openapi_schema.model_dump()
-    fields = schema["definitions"]["EvolveParams"]["properties"]
-    assert {"scenario", "strategy", "budget_s", "seed", "n_round", "max_rounds"} <= set(fields)
-    assert "avfuzzer" in fields["strategy"]["enum"]
-    assert d.concurrency_limit == 1
-
-
-def test_one_constant_is_the_default_strategy_of_evolve_its_flow_and_the_nightly_run(
-        monkeypatch) -> None:
-    """DEFAULT_STRATEGY is what `evoeye evolve`, EvolveParams and the deployment run."""
+def test_one_constant_is_the_default_strategy_of_evolve_and_its_flow() -> None:
+    """DEFAULT_STRATEGY is what `evoeye evolve` and EvolveParams run (and the nightly
+    deployment: test_deploy.py)."""
     import inspect
 
     from evoeye.cli.evolve import evolve_command
     from evoeye.evolve.campaign import config
-    from flows import deploy
 
     assert config.DEFAULT_STRATEGY == "evoeye"
     assert config.CampaignConfig().strategy == config.DEFAULT_STRATEGY
     assert EvolveParams().strategy == config.DEFAULT_STRATEGY
     assert inspect.signature(evolve_command).parameters["strategy"].default \
         == config.DEFAULT_STRATEGY
-    served = {}
-    monkeypatch.setattr("prefect.serve", lambda d: served.setdefault("d", d))
-    deploy.main(["--scenario", SCENARIO])
-    assert served["d"].parameters["params"]["strategy"] == config.DEFAULT_STRATEGY
 
 
 def test_evolution_flow_runs_each_round_as_a_flow_run(seeded, latest_artifact) -> None:
