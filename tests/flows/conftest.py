@@ -42,15 +42,26 @@ def prefect_server() -> Iterator[None]:
         yield
 
 
-@pytest.fixture(scope="session")
-def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[DataRoot, str]:
-    """A data root with 16 ingested intersection runs and a G_0 (campaign tests add to it)."""
+def tiny_root(path: Path) -> tuple[DataRoot, str]:
+    """A data root at `path` with 16 ingested intersection runs and a G_0 (≈ 10 s)."""
     from evoeye.monitor import train_monitor
 
-    root = DataRoot.resolve(tmp_path_factory.mktemp("evolve-flow") / "data")
+    root = DataRoot.resolve(path)
     run_batch(plan_uniform(SCENARIO, 16, 3), root)
     ingest(root)
     return root, train_monitor(root, SCENARIO, seed=0, splits=SPLITS, epochs=1)
+
+
+@pytest.fixture(scope="session")
+def seeded(tmp_path_factory: pytest.TempPathFactory) -> tuple[DataRoot, str]:
+    """A data root with 16 ingested intersection runs and a G_0 (campaign tests add to it)."""
+    return tiny_root(tmp_path_factory.mktemp("evolve-flow") / "data")
+
+
+@pytest.fixture
+def fresh_root(tmp_path: Path) -> tuple[DataRoot, str]:
+    """A data root of the test's own, as `seeded`'s, for tests that must not share one."""
+    return tiny_root(tmp_path / "data")
 
 
 def _latest_artifact(key: str) -> str:
