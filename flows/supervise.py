@@ -30,11 +30,9 @@ from evoeye.evaluation.supervision.triggers import (
 from evoeye.monitor.families import load_version
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import SCENARIOS
-from evoeye.sim.supervisor import FallbackConfig
+from evoeye.sim.supervisor import DEFAULT_FALLBACK, FALLBACKS, FallbackConfig, fallback_with
 from evoeye.store import SplitSpec
 from flows.runners import task_runner
-
-F = FallbackConfig()
 
 
 class SuperviseParams(BaseModel):
@@ -48,10 +46,13 @@ class SuperviseParams(BaseModel):
     fprs: list[float] = Field(default_factory=lambda: list(SWEEP_FPRS))
     recalls: list[float] = Field(default_factory=lambda: list(RECALLS))
     consecutive: int = Field(1, ge=1)
-    decel_mps2: float = Field(F.decel_mps2, gt=0.0)
-    jerk_mps3: float = Field(F.jerk_mps3, gt=0.0)
-    onset_s: float = Field(F.onset_s, ge=0.0)
-    hold_s: float = Field(F.hold_s, ge=0.0)
+    fallback_preset: str = Field(DEFAULT_FALLBACK, json_schema_extra={"enum": list(FALLBACKS)})
+    decel_mps2: float | None = Field(None, gt=0.0)  # None: the preset's; the same below
+    jerk_mps3: float | None = Field(None, gt=0.0)
+    onset_s: float | None = Field(None, ge=0.0)
+    hold_s: float | None = Field(None, ge=0.0)
+    stage_decel_mps2: float | None = Field(None, ge=0.0)  # staged braking (FallbackConfig)
+    stage_s: float | None = Field(None, ge=0.0)
     horizon_s: float = Field(3.0, ge=0.0)
     split_seed: int = Field(0, ge=0)
     train_frac: float = Field(0.8, ge=0.0, le=1.0)
@@ -73,11 +74,14 @@ class SuperviseParams(BaseModel):
 
     @property
     def fallback(self) -> FallbackConfig:
-        return FallbackConfig(self.decel_mps2, self.jerk_mps3, self.onset_s, self.hold_s)
+        return fallback_with(self.fallback_preset, decel_mps2=self.decel_mps2,
+                             jerk_mps3=self.jerk_mps3, onset_s=self.onset_s, hold_s=self.hold_s,
+                             stage_decel_mps2=self.stage_decel_mps2, stage_s=self.stage_s)
 
     def model_post_init(self, __context) -> None:
         check_batch_name(self.batch)
         self.splits  # noqa: B018  (validates the shares and the test batch's name)
+        self.fallback  # noqa: B018  (the preset's name and the values it is given)
         if unknown := [s for s in self.scenarios if s not in SCENARIOS]:
             raise ValueError(f"unknown logical scenario(s) {unknown}; known: {sorted(SCENARIOS)}")
         if unknown := [b for b in self.baselines if b not in BASELINES]:

@@ -23,5 +23,9 @@ SUPERVISE_BUDGETS = (0.5, 1.0, 2.0)  # evoeye.evaluation.supervision.summary.BUD
 ORACLE_LEADS_S = (0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5,
                   3.0)  # evoeye.evaluation.supervision.triggers.ORACLE_LEADS_S
 LOG_POLICIES = ("none", "collided", "all")  # evoeye.evaluation.supervision.settings.LOG_POLICIES
-FALLBACK = {"decel_mps2": 6.0, "jerk_mps3": 10.0, "onset_s": 0.1, "hold_s": 1.0,
-            "standstill_mps": 0.1}  # dataclasses.asdict(evoeye.sim.supervisor.FallbackConfig())
+FALLBACKS = {  # {name: FallbackConfig.to_dict()} of evoeye.sim.supervisor.FALLBACKS
+    "production": {"decel_mps2": 9.0, "jerk_mps3": 30.0, "onset_s": 0.1, "hold_s": 1.0,
+                   "standstill_mps": 0.1},
+    "comfort": {"decel_mps2": 6.0, "jerk_mps3": 10.0, "onset_s": 0.1, "hold_s": 1.0,
+                "standstill_mps": 0.1}}
+DEFAULT_FALLBACK = "production"  # evoeye.sim.supervisor.DEFAULT_FALLBACK

@@ -11,7 +11,8 @@ import typer
 
 from evoeye.cli.app import app, exit_with
 from evoeye.cli.defaults import (
-    FALLBACK,
+    DEFAULT_FALLBACK,
+    FALLBACKS,
     HORIZON_S,
     LOG_POLICIES,
     ORACLE_LEADS_S,
@@ -61,15 +62,25 @@ def supervise_command(
         "validation negative ('none' for none).")] = ",".join(f"{r:g}" for r in SWEEP_RECALLS),
     consecutive: Annotated[int, typer.Option(min=1, help="K: frames above the threshold "
                                              "that raise the alarm.")] = 1,
-    decel_mps2: Annotated[float, typer.Option(help="Fallback deceleration, m/s².")] =
-        FALLBACK["decel_mps2"],
-    jerk_mps3: Annotated[float, typer.Option(help="Fallback jerk limit, m/s³.")] =
-        FALLBACK["jerk_mps3"],
-    onset_s: Annotated[float, typer.Option(help="Brake dead time before the ramp, s.")] =
-        FALLBACK["onset_s"],
-    hold_s: Annotated[float, typer.Option(help="The fallback ends once the score stays at or "
-                                          "below the threshold this long, s.")] =
-        FALLBACK["hold_s"],
+    fallback: Annotated[str, typer.Option(
+        help="The fallback: " + "; ".join(f"{n}: {f['decel_mps2']:g} m/s² at {f['jerk_mps3']:g} "
+                                          "m/s³" for n, f in FALLBACKS.items())
+        + ". The options below change one of its values.")] = DEFAULT_FALLBACK,
+    decel_mps2: Annotated[float | None, typer.Option(
+        help="Fallback deceleration, m/s² (at most 9, the tyres').", show_default="--fallback's")
+        ] = None,
+    jerk_mps3: Annotated[float | None, typer.Option(
+        help="Fallback jerk limit, m/s³.", show_default="--fallback's")] = None,
+    onset_s: Annotated[float | None, typer.Option(
+        help="Brake dead time before the ramp, s.", show_default="--fallback's")] = None,
+    hold_s: Annotated[float | None, typer.Option(
+        help="The fallback ends once the score stays at or below the threshold this long, s.",
+        show_default="--fallback's")] = None,
+    stage_decel_mps2: Annotated[float | None, typer.Option(
+        help="Staged braking: the ramp stops at this deceleration first, m/s² …",
+        show_default="none")] = None,
+    stage_s: Annotated[float | None, typer.Option(
+        help="… for this long from its start, s.", show_default="none")] = None,
     horizon_s: Annotated[float, typer.Option(min=0.0, help="H: an intervention is true if the "
                                              "unsupervised run collides within it.")] = HORIZON_S,
     split_seed: Annotated[int, typer.Option(help="Split seed (calibration and the trained "
@@ -117,7 +128,7 @@ def supervise_command(
     from evoeye.evaluation.supervision import supervise
     from evoeye.evaluation.supervision.report import write_docs, write_report
     from evoeye.evaluation.supervision.summary import summarise_supervision
-    from evoeye.sim.supervisor import FallbackConfig
+    from evoeye.sim.supervisor import fallback_with
     from evoeye.store import SplitSpec
 
     if logs not in LOG_POLICIES:
@@ -128,7 +139,9 @@ def supervise_command(
         raise typer.BadParameter("no trigger: give --monitor or --baselines")
     try:
         splits = SplitSpec(split_seed, train_frac, val_frac, test_batch or batch)
-        fallback = FallbackConfig(decel_mps2, jerk_mps3, onset_s, hold_s)
+        fallback_config = fallback_with(fallback, decel_mps2=decel_mps2, jerk_mps3=jerk_mps3,
+                                        onset_s=onset_s, hold_s=hold_s,
+                                        stage_decel_mps2=stage_decel_mps2, stage_s=stage_s)
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from exc
     data = DataRoot.existing(root)
@@ -137,7 +150,7 @@ def supervise_command(
         result = supervise(data, scenario, batch, sources, splits=splits,
                            fprs=parse_floats(fprs, "--fprs"),
                            recalls=() if recalls == "none" else parse_floats(recalls, "--recalls"),
-                           fallback=fallback,
+                           fallback=fallback_config,
                            consecutive=consecutive, horizon_s=horizon_s, logs=logs,
                            logs_into_runs=logs_into_runs, workers=workers, limit=limit,
                            progress=bar, select_batch=select_batch,

@@ -23,6 +23,7 @@ from evoeye.sim.path import Path
 LANE_WIDTH_M = 4.0
 CRASH_DECEL_MPS2 = 8.0  # a vehicle in a contact brakes to a standstill at this rate
 # a cut-in goes only into a gap the ego could still keep by braking at CUT_IN_EGO_DECEL_MPS2
+MAX_DECEL_MPS2 = 9.0  # what the tyres give on a dry road: no car, NPC or ego, brakes harder
 # after CUT_IN_EGO_REACTION_S: gap ≥ closing·t + closing²/(2·b) (aggressive, not suicidal)
 CUT_IN_EGO_REACTION_S = 1.5
 CUT_IN_EGO_DECEL_MPS2 = 4.0
@@ -41,7 +42,7 @@ class DriverModel:
     min_gap_m: float = 2.0  # IDM s0
     delta: float = 4.0
     max_accel_mps2: float = 3.0
-    max_decel_mps2: float = 9.0
+    max_decel_mps2: float = MAX_DECEL_MPS2
     lat_accel_mps2: float = 3.0  # curve speed: v² · |κ| ≤ this
     crash_decel_mps2: float = CRASH_DECEL_MPS2
 
@@ -221,7 +222,8 @@ class EgoVehicle(Vehicle):
 
     def clip_actions(self) -> None:
         """After a contact the ego brakes to a standstill like a crashed NPC (highway-env's own
-        rule, accel = −speed, would let it roll on through what it hit for seconds)."""
+        rule, accel = −speed, would let it roll on through what it hit for seconds); it never
+        brakes harder than the tyres give (the ADS's controller saturates at 8 m/s² anyway)."""
         super().clip_actions()
         if self.crashed:
             self.action["acceleration"] = -CRASH_DECEL_MPS2 if self.speed > 0.0 else 0.0
@@ -230,3 +232,5 @@ class EgoVehicle(Vehicle):
         super().step(dt)
         if self.speed < 0.0:  # braking stops a vehicle; it never drives it backwards
             self.speed = 0.0
+        elif self.action["acceleration"] < -MAX_DECEL_MPS2:
+            self.action["acceleration"] = -MAX_DECEL_MPS2

@@ -9,7 +9,9 @@ that callable: this layer knows no monitor and no warehouse.
 
 Trigger: the alarm is K consecutive frames with score > threshold (`RuntimeMonitor`'s rule).
 Fallback, a minimal-risk manoeuvre (`FallbackConfig`): from the alarm, after the brakes' dead
-time, the deceleration ramps at a bounded jerk to a firm target and is held; the ego keeps to
+time, the deceleration ramps at a bounded jerk to its target and is held (optionally pausing at
+a partial stage first); the default, `production`, is in-lane emergency braking at 9 m/s²
+reached at 30 m/s³, `comfort` the firm 6 m/s² at 10 m/s³ of the first supervisions; the ego keeps to
 its lane (the ADS's steering along its planned path), never brakes less than the ADS itself asks
 (the ADS's AEB stays in force) and never reverses; at standstill it is held still. The fallback
 ends once the score has stayed at or below the threshold for `hold_s`; control then goes back
@@ -27,7 +29,7 @@ groups is simulated again from scratch, identical up to that frame (determinism)
 from __future__ import annotations
 
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import asdict, dataclass, field, replace
 
 import numpy as np
 
@@ -35,6 +37,7 @@ from evoeye.ads import ADS, ADSConfig
 from evoeye.ads.messages import ControlCommand, FrameMessages
 from evoeye.scene import RoadMap, SceneState
 from evoeye.sim.episode import Episode, RunSpec
+from evoeye.sim.npc import MAX_DECEL_MPS2
 from evoeye.sim.runner import DriverFactory, SimConfig, default_driver, run_episode
 
 Risk = Callable[[FrameMessages], float]  # one frame's ADS messages → risk score, in frame order
@@ -43,18 +46,57 @@ MODES = ("nominal", "braking", "holding", "handback")  # what drives the ego (Su
 
 @dataclass(frozen=True)
 class FallbackConfig:
-    """The minimal-risk manoeuvre and when it ends (module doc)."""
+    """The minimal-risk manoeuvre and when it ends (module doc). The defaults are `production`
+    (FALLBACKS): in-lane emergency braking at the tyres' limit, reached at the ADS's AEB jerk."""
 
-    decel_mps2: float = 6.0  # firm braking: beyond the ADS's comfort (3.5), short of its AEB (8.5)
-    jerk_mps3: float = 10.0  # the deceleration ramps (and the hand-back rises) at most this fast
+    decel_mps2: float = 9.0  # the tyres' limit (npc.MAX_DECEL_MPS2), beyond the ADS's AEB (8)
+    jerk_mps3: float = 30.0  # the deceleration ramps (and the hand-back rises) at most this fast
     onset_s: float = 0.1  # the brakes' dead time (ADSConfig.control.brake_dead_time_s)
     hold_s: float = 1.0  # it ends once the score stays at or below the threshold this long
     standstill_mps: float = 0.1  # at or below this speed the ego is held still
+    stage_decel_mps2: float = 0.0  # staged braking: the ramp first stops at this deceleration …
+    stage_s: float = 0.0  # … for this long from its start, then goes on to decel_mps2 (0: none)
 
     def __post_init__(self) -> None:
         if min(self.decel_mps2, self.jerk_mps3) <= 0 or min(self.onset_s, self.hold_s,
                                                              self.standstill_mps) < 0:
             raise ValueError(f"fallback decel and jerk must be > 0, times and speeds >= 0: {self}")
+        if self.decel_mps2 > MAX_DECEL_MPS2:
+            raise ValueError(f"fallback decel {self.decel_mps2} m/s² is beyond what the tyres "
+                             f"give ({MAX_DECEL_MPS2} m/s², the world's bound)")
+        if self.staged != (self.stage_decel_mps2 > 0) or self.stage_s < 0 or (
+                self.stage_decel_mps2 >= self.decel_mps2):
+            raise ValueError("a braking stage needs stage_s > 0 and 0 < stage_decel_mps2 < "
+                             f"decel_mps2 (or both 0 for none): {self}")
+
+    @property
+    def staged(self) -> bool:
+        return self.stage_s > 0
+
+    def to_dict(self) -> dict[str, float]:
+        """Its fields; the stage's only when it has one (a record written before stages
+        existed reads back as this fallback, and a supervision's key stays the same)."""
+        d = asdict(self)
+        if not self.staged:
+            del d["stage_decel_mps2"], d["stage_s"]
+        return d
+
+
+# Named fallbacks (`evoeye supervise --fallback`). `comfort` is the firm braking of the first
+# supervisions (docs/results/supervision-*), short of the ADS's AEB.
+FALLBACKS: dict[str, FallbackConfig] = {
+    "production": FallbackConfig(),
+    "comfort": FallbackConfig(decel_mps2=6.0, jerk_mps3=10.0),
+}
+DEFAULT_FALLBACK = "production"
+
+
+def fallback_with(name: str = DEFAULT_FALLBACK, **changes: float | None) -> FallbackConfig:
+    """The named fallback with the `changes` that are not None; ValueError naming the known
+    fallbacks, or what is wrong with the result."""
+    if name not in FALLBACKS:
+        raise ValueError(f"unknown fallback {name!r}; known: {', '.join(FALLBACKS)}")
+    return replace(FALLBACKS[name], **{k: v for k, v in changes.items() if v is not None})
 
 
 @dataclass(frozen=True)
@@ -145,6 +187,7 @@ class SupervisedDriver:
         self._applied_mps2 = 0.0  # the acceleration applied over the last step
         self._ramp_from_mps2 = 0.0  # where the braking ramp starts
         self._onset_frames = round(self.config.onset_s / self.dt_s)
+        self._stage_frames = round(self.config.stage_s / self.dt_s)
         self._k = 0
 
     @property
@@ -169,10 +212,12 @@ class SupervisedDriver:
         if accel != ads_mps2:
             cmd = msgs.control
             limit = self.ads.config.control
+            # brake 1 is the ADS's full brake (accel_min_mps2, 8 m/s²); the fallback may brake
+            # harder, up to the tyres' limit: accel_cmd_mps2 is what the world applies
+            brake = min(min(accel, 0.0) / limit.accel_min_mps2, 1.0)
             msgs.control = ControlCommand(
-                t_s=cmd.t_s, throttle=max(accel, 0.0) / limit.accel_max_mps2,
-                brake=min(accel, 0.0) / limit.accel_min_mps2, steering_rad=cmd.steering_rad,
-                accel_cmd_mps2=accel)
+                t_s=cmd.t_s, throttle=max(accel, 0.0) / limit.accel_max_mps2, brake=brake,
+                steering_rad=cmd.steering_rad, accel_cmd_mps2=accel)
         self._applied_mps2 = accel
         self.states.append(SupervisorState(
             scene.t_s, score, lead.threshold, score > lead.threshold,
@@ -197,8 +242,21 @@ class SupervisedDriver:
             self._ramp_from_mps2 = min(self._applied_mps2, 0.0)
         if speed_mps <= c.standstill_mps:
             return "holding", -max(speed_mps, 0.0) / dt
-        ramp = max(self._ramp_from_mps2 - c.jerk_mps3 * (ramp_frame + 1) * dt, -c.decel_mps2)
+        ramp = self._ramp(ramp_frame)
         return "braking", max(min(ramp, ads_mps2), -speed_mps / dt)
+
+    def _ramp(self, n: int) -> float:
+        """The fallback's own acceleration n frames into its ramp: down at the jerk limit from
+        where it started to decel_mps2, pausing at the stage's deceleration if it has one (or
+        where it started, if that was harder) until the stage is over."""
+        c, dt, a0 = self.config, self.dt_s, self._ramp_from_mps2
+        if c.staged:
+            stage = min(-c.stage_decel_mps2, a0)
+            if n < self._stage_frames:
+                return max(a0 - c.jerk_mps3 * (n + 1) * dt, stage)
+            a0 = max(a0 - c.jerk_mps3 * self._stage_frames * dt, stage)
+            n -= self._stage_frames
+        return max(a0 - c.jerk_mps3 * (n + 1) * dt, -c.decel_mps2)
 
 
 def supervised(risk: Risk, trigger: Trigger, config: FallbackConfig,

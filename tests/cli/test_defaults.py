@@ -31,8 +31,6 @@ def test_help_defaults_equal_their_sources() -> None:
 
 
 def test_supervise_help_defaults_equal_their_sources() -> None:
-    from dataclasses import asdict
-
     from evoeye.evaluation.supervision.settings import LOG_POLICIES
     from evoeye.evaluation.supervision.summary import BUDGETS_PER_H
     from evoeye.evaluation.supervision.triggers import (
@@ -41,14 +39,16 @@ def test_supervise_help_defaults_equal_their_sources() -> None:
         RECALLS,
         SWEEP_FPRS,
     )
-    from evoeye.sim.supervisor import FallbackConfig
+    from evoeye.sim.supervisor import DEFAULT_FALLBACK, FALLBACKS, FallbackConfig
 
     assert defaults.SWEEP_FPRS == SWEEP_FPRS and defaults.SWEEP_RECALLS == RECALLS
     assert defaults.SUPERVISE_BASELINES == DEFAULT_BASELINES
     assert defaults.SUPERVISE_BUDGETS == BUDGETS_PER_H
     assert defaults.ORACLE_LEADS_S == ORACLE_LEADS_S
     assert defaults.LOG_POLICIES == LOG_POLICIES
-    assert asdict(FallbackConfig()) == defaults.FALLBACK
+    assert {n: f.to_dict() for n, f in FALLBACKS.items()} == defaults.FALLBACKS
+    assert DEFAULT_FALLBACK == defaults.DEFAULT_FALLBACK
+    assert FallbackConfig() == FALLBACKS[DEFAULT_FALLBACK]
 
 
 def test_every_known_error_names_an_exception_class_that_exists() -> None:

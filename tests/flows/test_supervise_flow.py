@@ -54,3 +54,16 @@ def test_bad_parameters_are_refused_before_anything_runs() -> None:
         SuperviseParams(batch="../b")
     with pytest.raises(ValueError, match="logs"):
         SuperviseParams(batch="b", logs="some")
+    with pytest.raises(ValueError, match="unknown fallback"):
+        SuperviseParams(batch="b", fallback_preset="gentle")
+    with pytest.raises(ValueError, match="tyres"):
+        SuperviseParams(batch="b", decel_mps2=12.0)
+
+
+def test_the_flow_brakes_with_the_production_fallback_unless_told_otherwise() -> None:
+    from evoeye.sim.supervisor import FALLBACKS
+
+    assert SuperviseParams(batch="b").fallback == FALLBACKS["production"]
+    assert SuperviseParams(batch="b", fallback_preset="comfort").fallback == FALLBACKS["comfort"]
+    changed = SuperviseParams(batch="b", fallback_preset="comfort", hold_s=2.0).fallback
+    assert (changed.decel_mps2, changed.hold_s) == (6.0, 2.0)

@@ -3,6 +3,8 @@ thresholds share a simulation while they decide alike; same inputs, same run."""
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
@@ -12,6 +14,7 @@ from evoeye.batch import plan_uniform
 from evoeye.log.synthetic import synthetic_episode
 from evoeye.sim.runner import run_episode
 from evoeye.sim.supervisor import (
+    FALLBACKS,
     FallbackConfig,
     SupervisedDriver,
     Trigger,
@@ -71,12 +74,55 @@ def test_the_fallback_brakes_after_its_onset_at_a_bounded_jerk_to_its_decelerati
     assert [s.alarm for s in d.states] == [False] * 5 + [True] * 40
 
 
+def test_the_production_fallback_is_the_default_and_brakes_at_9_reached_at_30_per_s() -> None:
+    assert FallbackConfig() == FALLBACKS["production"]
+    d = drive([0.0] * 5 + [0.9] * 20, (0.5,), config=replace(FallbackConfig(), hold_s=10.0))
+    applied = np.array([s.accel_cmd_mps2 for s in d.states])
+    assert (applied[:7] == 1.0).all()  # the same dead time: 0.1 s
+    np.testing.assert_allclose(applied[7:14], [-1.5, -3.0, -4.5, -6.0, -7.5, -9.0, -9.0])
+    assert (applied[12:] == -9.0).all()  # 9 m/s² in 0.3 s, then held
+    comfort = drive([0.0] * 5 + [0.9] * 20, (0.5,), config=FALLBACKS["comfort"])
+    assert min(s.accel_cmd_mps2 for s in comfort.states) == -6.0  # one option away
+
+
+def test_a_staged_fallback_pauses_at_its_stage_then_brakes_fully_within_the_jerk_bound() -> None:
+    config = replace(FallbackConfig(onset_s=0.0, hold_s=10.0), stage_decel_mps2=4.0, stage_s=0.5)
+    d = drive([0.9] * 30, (0.5,), config=config)
+    applied = np.array([s.accel_cmd_mps2 for s in d.states])
+    # the stage: −1.5, −3, then −4 held until 0.5 s (10 frames) after the ramp's start …
+    np.testing.assert_allclose(applied[:10], [-1.5, -3.0] + [-4.0] * 8)
+    # … then on at 30 m/s³ to the full 9 m/s²
+    np.testing.assert_allclose(applied[10:15], [-5.5, -7.0, -8.5, -9.0, -9.0])
+    steps = np.diff(np.concatenate([[0.0], applied]))  # from the throttle cut (at once)
+    assert steps.min() >= -config.jerk_mps3 * DT - 1e-12  # no step harder than the jerk limit
+    unstaged = drive([0.9] * 30, (0.5,), config=replace(config, stage_decel_mps2=0.0,
+                                                         stage_s=0.0))
+    late = [s.accel_cmd_mps2 for s in unstaged.states].index(-9.0)
+    assert list(applied).index(-9.0) == late + 8  # the stage costs its time at 4 instead of 9
+
+
+def test_the_ads_stronger_aeb_wins_over_the_stage_and_the_ramp() -> None:
+    config = replace(FallbackConfig(onset_s=0.0, hold_s=10.0), stage_decel_mps2=4.0, stage_s=1.0)
+    ads = ScriptedADS([1.0] * 4 + [-8.0] * 26)  # the ADS's AEB fires during the stage
+    driver = SupervisedDriver(ads, lambda m: 0.9, Trigger("t", "v", (0.5,)), config, DT)
+    commands = []
+    for f in ads.frames:
+        f.scene.speed_mps[0] = 20.0
+        commands.append(driver.step(f.scene).control)
+    applied = [c.accel_cmd_mps2 for c in commands]
+    assert applied[:4] == [-1.5, -3.0, -4.0, -4.0]  # the stage, while the ADS asks for +1
+    assert applied[4:22] == [-8.0] * 18  # the AEB's 8 beats the stage's 4 and the ramp's 5.5, 7
+    assert applied[22:] == [-8.5] + [-9.0] * 7  # the ramp beyond it: the tyres' 9
+    assert all(0.0 <= c.brake <= 1.0 for c in commands)  # 1: the ADS's full brake or more
+    assert commands[-1].brake == 1.0 and commands[0].brake == pytest.approx(1.5 / 8.0)
+
+
 def test_the_fallback_never_brakes_less_than_the_ads_nor_reverses() -> None:
-    d = drive([0.9] * 30, (0.5,), ads_accel=-8.0, config=FallbackConfig(onset_s=0.0))
+    comfort = replace(FALLBACKS["comfort"], onset_s=0.0)
+    d = drive([0.9] * 30, (0.5,), ads_accel=-8.0, config=comfort)
     assert all(s.accel_cmd_mps2 == -8.0 for s in d.states)  # the ADS's AEB stays in force
     slowing = [2.0, 1.0, 0.2, 0.05, 0.0, 0.0]
-    d = drive([0.9] * 6, (0.5,), ads_accel=-8.0, speed_mps=slowing,
-              config=FallbackConfig(onset_s=0.0))
+    d = drive([0.9] * 6, (0.5,), ads_accel=-8.0, speed_mps=slowing, config=comfort)
     applied = [s.accel_cmd_mps2 for s in d.states]
     assert applied[:3] == [-8.0, -8.0, -0.2 / DT]  # never more than stops the ego this step
     assert [s.mode for s in d.states] == ["braking"] * 3 + ["holding"] * 3
@@ -159,3 +205,25 @@ def test_same_inputs_same_supervised_run(spec) -> None:
     assert a.states == b.states and a.episode.outcome == b.episode.outcome
     assert all(np.array_equal(x.scene.x_m, y.scene.x_m)
                for x, y in zip(a.episode.frames, b.episode.frames, strict=True))
+
+
+def test_fallbacks_by_name_with_changes_and_their_bounds() -> None:
+    from evoeye.sim.supervisor import fallback_with
+
+    assert fallback_with("comfort") == FallbackConfig(decel_mps2=6.0, jerk_mps3=10.0)
+    assert fallback_with("comfort", decel_mps2=7.0, jerk_mps3=None).jerk_mps3 == 10.0
+    assert fallback_with(stage_decel_mps2=4.0, stage_s=0.5).staged
+    with pytest.raises(ValueError, match="known: production, comfort"):
+        fallback_with("gentle")
+    with pytest.raises(ValueError, match="tyres"):
+        FallbackConfig(decel_mps2=9.5)  # no car brakes harder than the world lets it
+    for stage in ({"stage_s": 0.5}, {"stage_decel_mps2": 4.0}, {"stage_decel_mps2": 9.0,
+                                                                "stage_s": 0.5}):
+        with pytest.raises(ValueError, match="stage"):
+            FallbackConfig(**stage)
+    # a fallback without a stage records no stage: its record is the one written before stages
+    assert FALLBACKS["comfort"].to_dict() == {"decel_mps2": 6.0, "jerk_mps3": 10.0,
+                                              "onset_s": 0.1, "hold_s": 1.0,
+                                              "standstill_mps": 0.1}
+    staged = replace(FallbackConfig(), stage_decel_mps2=4.0, stage_s=0.5)
+    assert FallbackConfig(**staged.to_dict()) == staged

@@ -26,7 +26,7 @@ from evoeye import __version__
 from evoeye.evaluation.supervision.criticality import Criticality
 from evoeye.evaluation.supervision.triggers import TriggerSpec
 from evoeye.paths import DataRoot, check_batch_name
-from evoeye.sim.supervisor import FallbackConfig
+from evoeye.sim.supervisor import FALLBACKS, FallbackConfig
 from evoeye.store import SplitSpec
 from evoeye.store.windows import DEFAULT_HORIZON_S
 
@@ -66,7 +66,7 @@ class Settings:
     def to_dict(self) -> dict:
         return {"scenario": self.scenario, "batch": self.batch,
                 "triggers": [t.to_dict() for t in self.triggers],
-                "fallback": asdict(self.fallback), "consecutive": self.consecutive,
+                "fallback": self.fallback.to_dict(), "consecutive": self.consecutive,
                 "horizon_s": self.horizon_s, "splits": asdict(self.splits), "logs": self.logs,
                 "software_version": self.software_version,
                 "logs_into_runs": self.logs_into_runs, "criticality": self.criticality.to_dict()}
@@ -74,7 +74,7 @@ class Settings:
     @classmethod
     def of(cls, d: dict) -> Settings:
         return cls(d["scenario"], d["batch"], tuple(TriggerSpec.of(t) for t in d["triggers"]),
-                   FallbackConfig(**d["fallback"]), d["consecutive"], d["horizon_s"],
+                   recorded_fallback(d["fallback"]), d["consecutive"], d["horizon_s"],
                    SplitSpec(**d["splits"]), d["logs"], d["software_version"],
                    d.get("logs_into_runs", False), Criticality(**d.get("criticality", {})))
 
@@ -89,6 +89,12 @@ class Settings:
 
     def trigger(self, name: str) -> TriggerSpec:
         return next(t for t in self.triggers if t.name == name)
+
+
+def recorded_fallback(d: dict) -> FallbackConfig:
+    """A recorded fallback; a value it lacks is the `comfort` fallback's, which every
+    supervision used before fallbacks had names and stages (its dict lacks the stage)."""
+    return FallbackConfig(**{**FALLBACKS["comfort"].to_dict(), **d})
 
 
 def open_folder(root: DataRoot, settings: Settings) -> Path:
