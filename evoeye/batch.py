@@ -27,25 +27,28 @@ from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import get_scenario
 from evoeye.sim.episode import STATUS_OK, Episode, RunSpec
 from evoeye.sim.runner import run_episode, run_spec
+from evoeye.sim.worlds import DEFAULT_WORLD
 
 
 def plan_uniform(
     scenario: str, n: int, seed: int, *, batch: str | None = None, source: str = "uniform",
-    round: int = 0, ads: str = DEFAULT_PROFILE,
+    round: int = 0, ads: str = DEFAULT_PROFILE, world: str = DEFAULT_WORLD,
 ) -> list[RunSpec]:
     """n concrete scenarios drawn uniformly, each with its own run seed; all fixed by `seed`
-    (the same vectors and run seeds under every ADS profile `ads`)."""
+    (the same vectors and run seeds under every ADS profile `ads` and world variant `world`)."""
     if n < 1:
         raise ValueError(f"--n must be at least 1, got {n}")
     if seed < 0:
         raise ValueError(f"--seed must be non-negative, got {seed}")
     space = get_scenario(scenario)
-    profile = "" if ads == DEFAULT_PROFILE else f"{ads}-"
-    batch = check_batch_name(batch or f"{source}-{profile}seed{seed}")
+    variant = "".join(f"{v}-" for v, default in ((ads, DEFAULT_PROFILE), (world, DEFAULT_WORLD))
+                      if v != default)
+    batch = check_batch_name(batch or f"{source}-{variant}seed{seed}")
     xs = space.sample(np.random.default_rng(seed), n)
     run_seeds = np.random.SeedSequence(seed).generate_state(n)
     return [
-        run_spec(scenario, x, int(s), batch=batch, source=source, round=round, ads=ads)
+        run_spec(scenario, x, int(s), batch=batch, source=source, round=round, ads=ads,
+                 world=world)
         for x, s in zip(xs, run_seeds, strict=True)
     ]
 

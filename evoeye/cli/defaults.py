@@ -3,6 +3,7 @@ from; tests/cli/test_defaults.py checks each against its source."""
 
 SCENARIO_NAMES = ("highway-cut-in", "unprotected-intersection")  # evoeye.scenarios.SCENARIOS
 ADS_PROFILE_NAMES = ("default", "cautious", "firm-yield")  # evoeye.ads.profiles.ADS_PROFILES
+WORLD_NAMES = ("default", "follower")  # evoeye.sim.worlds.WORLD_NAMES
 SPLIT_SEED, TRAIN_FRAC, VAL_FRAC = 0, 0.5, 0.125  # evoeye.store.SplitSpec()
 RECIPE_NAMES, DEFAULT_RECIPE = ("v1", "v2", "v3"), "v3"  # evoeye.monitor.recipes
 CONTEXT_LEN = 5  # evoeye.store.windows.DEFAULT_CONTEXT_LEN

@@ -8,7 +8,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from evoeye.cli.app import app, exit_with
-from evoeye.cli.defaults import ADS_PROFILE_NAMES, SCENARIO_NAMES
+from evoeye.cli.defaults import ADS_PROFILE_NAMES, SCENARIO_NAMES, WORLD_NAMES
 from evoeye.cli.errors import ExitCode, UserError
 from evoeye.cli.output import err, out, table
 from evoeye.paths import BadNameError, DataRoot, check_batch_name
@@ -64,8 +64,22 @@ AdsOpt = Annotated[str, typer.Option(
     "a default batch name, of their own.")]
 
 
+def known_world(name: str) -> str:
+    """Typer callback: refuse an unknown --world before anything runs."""
+    if name not in WORLD_NAMES:
+        raise typer.BadParameter(f"unknown world {name!r}; known: {', '.join(WORLD_NAMES)}")
+    return name
+
+
+WorldOpt = Annotated[str, typer.Option(
+    "--world", callback=known_world, help=f"World variant: {', '.join(WORLD_NAMES)} "
+    "(docs/world.md; follower: a car behind the ego in its lane, highway-cut-in). A variant's "
+    "runs get ids, and a default batch name, of their own; `evoeye ingest` leaves them out.")]
+
+
 def simulate_batch(scenario: str, n: int, seed: int, data: DataRoot, workers: int,
-                   batch: str | None = None, ads: str = "default") -> BatchSummary:
+                   batch: str | None = None, ads: str = "default",
+                   world: str = "default") -> BatchSummary:
     """Plan, check the root can be written (PermissionError & co. if not), run with a progress
     bar, and report failures by scenario id."""
     from tqdm import tqdm
@@ -73,7 +87,7 @@ def simulate_batch(scenario: str, n: int, seed: int, data: DataRoot, workers: in
     from evoeye.batch import plan_uniform, run_batch
 
     try:
-        specs = plan_uniform(scenario, n, seed, batch=batch, ads=ads)
+        specs = plan_uniform(scenario, n, seed, batch=batch, ads=ads, world=world)
     except ValueError as exc:  # includes ScenarioError and BadNameError
         raise UserError(str(exc), "see `evoeye simulate --help`") from exc
     data.runs.mkdir(parents=True, exist_ok=True)
@@ -107,13 +121,14 @@ def simulate(
     workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 1,
     batch: BatchOpt = None,
     ads: AdsOpt = "default",
+    world: WorldOpt = "default",
 ) -> None:
     """Simulate N uniformly sampled concrete scenarios and write one MCAP log per run.
 
     Exits 3 if any run failed (the table and the lines above say which and why).
     """
     data = DataRoot.resolve(root)
-    summary = simulate_batch(scenario, n, seed, data, workers, batch, ads)
+    summary = simulate_batch(scenario, n, seed, data, workers, batch, ads, world)
     out().print(summary_table("simulate", [(scenario, summary)]))
     out().print(f"logs: {data.runs / scenario}")
     exit_with(failures_code([(scenario, summary)]))

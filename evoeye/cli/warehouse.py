@@ -46,6 +46,8 @@ def report_table(report: IngestReport) -> Table:
     t.add_row("already in the warehouse", str(report.skipped))
     t.add_row("duplicate scenario ids", str(len(report.duplicates)))
     t.add_row("quarantined", str(len(report.quarantined)))
+    if report.left_out:
+        t.add_row("left out (a world variant's runs)", str(len(report.left_out)))
     t.add_row("parts of a killed ingest removed", str(len(report.orphans_removed)))
     return t
 

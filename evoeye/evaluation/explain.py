@@ -20,6 +20,7 @@ from evoeye.batch import pool_context
 from evoeye.paths import DataRoot
 from evoeye.sim.counterfactual import VARIANTS, Explanation, explain_run
 from evoeye.sim.episode import RunSpec
+from evoeye.sim.worlds import DEFAULT_WORLD
 from evoeye.store import Warehouse
 from evoeye.store.attribution import AttributionRow, write_attribution
 
@@ -31,6 +32,7 @@ def spec_of(record: dict[str, Any]) -> RunSpec:
         seed=int(record["seed"]), scenario_id=record["scenario_id"], batch=record["batch"],
         source=record["source"], round=int(record["round"]),
         ads=record.get("ads_profile") or DEFAULT_PROFILE,
+        world=record.get("world") or DEFAULT_WORLD,  # a log's (the warehouse has no column)
     )
 
 

@@ -50,6 +50,7 @@ def run_values(episode: Episode) -> dict[str, Any]:
         "source": spec.source,
         "round": int(spec.round),
         "ads_profile": spec.ads,
+        "world": spec.world,
         "software_version": episode.software_version,
         "rate_hz": float(episode.rate_hz),
         "status": out.status,
@@ -65,11 +66,14 @@ def run_values(episode: Episode) -> dict[str, Any]:
 
 
 def encode_run(values: dict[str, Any]) -> dict[str, str]:
-    """Typed run metadata → the string → string MCAP metadata record."""
+    """Typed run metadata → the string → string MCAP metadata record. A field the schema marks
+    `omitted_at_default` is left out at its default (absent, it decodes as that default)."""
     props = load_schema(RUN_SCHEMA_FILE)["properties"]
     return {
         name: values[name] if _is_string(prop) else orjson.dumps(values[name]).decode()
         for name, prop in props.items()
+        if not (prop.get("omitted_at_default") and values.get(name, prop["default"])
+                == prop["default"])
     }
 
 

@@ -1,8 +1,10 @@
 """ONNX export of a monitor version: the network plus its sigmoid, batch axis dynamic.
 
 Inputs are named as in `evoeye.monitor.model.INPUTS`, shaped (B, L, …) like a WindowBatch
-(masks are bool), and the output `risk` is (B,) in [0, 1] — the same numbers as
-`FusionMonitor.score`; the exported file carries the version, its thresholds and the input
+(masks are bool), and the outputs are `risk`, (B,) in [0, 1] — the same numbers as
+`FusionMonitor.score` — and `logit`, (B,), the network's output before the sigmoid (as
+`FusionMonitor.logits`: thresholds compared on it do not saturate where float32 risks reach
+1.0); the exported file carries the version, its thresholds and the input
 spec as metadata_props (`metadata`). `onnx_session` runs it (`RuntimeMonitor` scores with it:
 at batch 1 ONNX Runtime takes half the time of the traced network). The TorchScript-based
 exporter is used (`dynamo=False`): the network is plain tensors and control-flow-free, and this
@@ -14,6 +16,7 @@ from __future__ import annotations
 import io
 import json
 import os
+import threading
 import warnings
 from pathlib import Path
 
@@ -28,36 +31,42 @@ from evoeye.monitor.model import INPUTS, FusionNet, example_inputs
 from evoeye.monitor.threads import MONITOR_THREADS
 
 OPSET = 17
+_EXPORTING = threading.Lock()
 OUTPUT = "risk"
+LOGIT = "logit"  # the second output
 
 
 class _Risk(nn.Module):
-    """FusionNet followed by the sigmoid, so the exported graph outputs risk scores."""
+    """FusionNet followed by the sigmoid, so the exported graph outputs risk scores (and the
+    logits they come from)."""
 
     def __init__(self, net: FusionNet):
         super().__init__()
         self.net = net
 
-    def forward(self, *inputs: torch.Tensor) -> torch.Tensor:
-        return torch.sigmoid(self.net(*inputs))
+    def forward(self, *inputs: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        logit = self.net(*inputs)
+        return torch.sigmoid(logit), logit
 
 
 def onnx_model(monitor: FusionMonitor) -> bytes:
-    """The monitor as a serialised ONNX model (weights embedded), the network as it is now."""
+    """The monitor as a serialised ONNX model (weights embedded), the network as it is now.
+    One export at a time per process: torch's exporter keeps global state, and two threads
+    exporting at once failed ('GLOBALS.in_onnx_export must be False')."""
     buffer = io.BytesIO()
-    with warnings.catch_warnings():  # the TorchScript exporter announces its deprecation
+    with _EXPORTING, warnings.catch_warnings():  # the exporter announces its deprecation
         warnings.simplefilter("ignore", DeprecationWarning)
         torch.onnx.export(
             _Risk(monitor.net).eval(), example_inputs(monitor.net), buffer, dynamo=False,
-            input_names=list(INPUTS), output_names=[OUTPUT], opset_version=OPSET,
-            dynamic_axes={name: {0: "batch"} for name in (*INPUTS, OUTPUT)},
+            input_names=list(INPUTS), output_names=[OUTPUT, LOGIT], opset_version=OPSET,
+            dynamic_axes={name: {0: "batch"} for name in (*INPUTS, OUTPUT, LOGIT)},
         )
     return buffer.getvalue()
 
 
 def onnx_session(monitor: FusionMonitor, threads: int = MONITOR_THREADS) -> ort.InferenceSession:
     """ONNX Runtime running the monitor (`onnx_model`) on the CPU with `threads` threads: feed
-    it arrays named as INPUTS, it returns [risk]."""
+    it arrays named as INPUTS, it returns [risk, logit]."""
     options = ort.SessionOptions()
     options.intra_op_num_threads = options.inter_op_num_threads = threads
     return ort.InferenceSession(onnx_model(monitor), options, providers=["CPUExecutionProvider"])
@@ -67,7 +76,8 @@ def input_spec(monitor: FusionMonitor) -> dict[str, dict]:
     """Each input's shape (the batch axis as "batch") and dtype, and the output's."""
     spec = {name: {"shape": ["batch", *t.shape[1:]], "dtype": str(t.dtype).removeprefix("torch.")}
             for name, t in zip(INPUTS, example_inputs(monitor.net), strict=True)}
-    return {**spec, OUTPUT: {"shape": ["batch"], "dtype": "float32", "range": [0.0, 1.0]}}
+    return {**spec, OUTPUT: {"shape": ["batch"], "dtype": "float32", "range": [0.0, 1.0]},
+            LOGIT: {"shape": ["batch"], "dtype": "float32"}}
 
 
 def metadata(monitor: FusionMonitor) -> dict[str, str]:

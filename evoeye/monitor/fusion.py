@@ -81,10 +81,19 @@ class FusionMonitor:
         with torch.inference_mode():
             return torch.sigmoid(self._forward(*net_inputs(batch))).numpy()
 
-    @intra_op_threads()
     def score(self, windows: Windows) -> np.ndarray:
         """(B,) float32 risk scores, one per window, in chunks of SCORE_BATCH windows, each
         distinct frame encoded once, on the monitor's device, on one intra-op thread."""
+        return self._outputs(windows, torch.sigmoid)
+
+    def logits(self, windows: Windows) -> np.ndarray:
+        """(B,) float32 logits of `score`'s risks (the same order; they do not saturate where
+        float32 risks reach 1.0, so thresholds there stay apart)."""
+        return self._outputs(windows, lambda logit: logit)
+
+    @intra_op_threads()
+    def _outputs(self, windows: Windows,
+                 head: Callable[[torch.Tensor], torch.Tensor]) -> np.ndarray:
         if windows.context_len != self.context_len:
             raise ValueError(f"monitor {self.version} takes contexts of L = {self.context_len} "
                              f"frames; these windows have L = {windows.context_len}")
@@ -101,7 +110,7 @@ class FusionMonitor:
                 logit = net.forward_frames(frames, torch.from_numpy(inverse).to(device),
                                            torch.from_numpy(windows.context_mask[index])
                                            .to(device))
-                out[index] = torch.sigmoid(logit).cpu().numpy()
+                out[index] = head(logit).cpu().numpy()
         return out
 
     def _scoring_net(self) -> FusionNet:

@@ -50,7 +50,9 @@ class OnlineScorer(Protocol):
 
 
 class FusionScorer:
-    """A FusionMonitor through its RuntimeMonitor (scores only: the supervisor thresholds)."""
+    """A FusionMonitor through its RuntimeMonitor (scores only: the supervisor thresholds).
+    Its score is the network's logit, not the risk: float32 risks saturate at 1.0 (a
+    threshold there is "off"), their logits stay apart; the order is the same."""
 
     def __init__(self, monitor: FusionMonitor) -> None:
         self.runtime = RuntimeMonitor(monitor, threshold=1.0)
@@ -59,7 +61,8 @@ class FusionScorer:
         self.runtime.reset()
 
     def score(self, frame: FrameInputs) -> float:
-        return self.runtime.step_features(frame.features, frame.t_s).score
+        self.runtime.step_features(frame.features, frame.t_s)
+        return self.runtime.last_logit
 
 
 class WindowScorer:

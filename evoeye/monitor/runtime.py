@@ -20,7 +20,7 @@ import numpy as np
 import onnxruntime as ort
 
 from evoeye.ads.messages import FrameMessages
-from evoeye.monitor.export import OUTPUT, onnx_session
+from evoeye.monitor.export import LOGIT, OUTPUT, onnx_session
 from evoeye.monitor.fusion import FusionMonitor
 from evoeye.store.features import FrameFeatures, frame_features
 from evoeye.store.records import MessageSignals
@@ -54,6 +54,7 @@ class RuntimeMonitor:
         self.consecutive = consecutive
         self._context: dict[str, np.ndarray] = {}  # (1, L, …) per input, oldest first
         self._risk = np.zeros(1, np.float32)  # the network's output, written in place
+        self._logit = np.zeros(1, np.float32)  # … and its logit (`last_logit`)
         self._session: ort.InferenceSession | None = None
         self._binding: ort.IOBinding | None = None  # the session reading the buffers above
         self._seen = 0  # frames of the current run
@@ -88,8 +89,15 @@ class RuntimeMonitor:
             for name, arr in self._context.items():
                 self._binding.bind_ortvalue_input(name, ort.OrtValue.ortvalue_from_numpy(arr))
             self._binding.bind_ortvalue_output(OUTPUT, ort.OrtValue.ortvalue_from_numpy(self._risk))
+            self._binding.bind_ortvalue_output(LOGIT,
+                                               ort.OrtValue.ortvalue_from_numpy(self._logit))
         self._session.run_with_iobinding(self._binding)
         return float(self._risk[0])
+
+    @property
+    def last_logit(self) -> float:
+        """The logit of the last frame's risk (a threshold on it does not saturate)."""
+        return float(self._logit[0])
 
     def _push(self, frame: dict[str, np.ndarray]) -> None:
         """Shift the context one slot left and put `frame` (arrays of 1 row) last; the first

@@ -23,6 +23,7 @@ class RunSpec:
     source: str = "initial"  # how it was acquired: initial / uniform / evoeye / avfuzzer / …
     round: int = 0
     ads: str = "default"  # the ADS profile that drives the ego (evoeye.ads.profiles)
+    world: str = "default"  # the world variant (evoeye.sim.worlds)
 
 
 @dataclass(frozen=True)

@@ -15,7 +15,7 @@ import numpy as np
 from highway_env.road.road import Road, RoadNetwork
 
 from evoeye.scene import RoadMap
-from evoeye.sim.npc import LANE_WIDTH_M, BrakeEvent, EgoVehicle, LaneChange, Npc
+from evoeye.sim.npc import LANE_WIDTH_M, BrakeEvent, DriverModel, EgoVehicle, LaneChange, Npc
 from evoeye.sim.path import Path
 from evoeye.sim.roadmap import road_map_from_network
 from evoeye.sim.world import World
@@ -98,3 +98,22 @@ def build_highway(p: dict[str, float], rng: np.random.Generator) -> tuple[World,
         for (lane, _, v_init, v_want, brake, change), x in zip(specs, xs, strict=True)
     ]
     return World(road, ego, npcs, road_map), ego_speed
+
+
+# The `follower` world variant (`worlds.py`): a car behind the ego in its lane, so that a
+# needless hard brake can get the ego struck from behind. A driver of highway traffic as every
+# NPC (IDM), at a common headway, who acts a human reaction time late.
+FOLLOWER_HEADWAY_S = 1.0  # its bumper gap to the ego at the start, and its IDM time headway
+FOLLOWER_REACTION_S = 1.0  # it acts on what it saw this long ago (NPC_REACTION_S: the same)
+FOLLOWER_SPEED_GAIN = 1.1  # it would drive this much faster than the ego: the ego holds it up
+
+
+def add_follower(world: World, p: dict[str, float], ego_speed: float) -> World:
+    """The highway world with a follower behind the ego in its lane (the last actor), at the
+    ego's speed, FOLLOWER_HEADWAY_S behind it."""
+    _, _, paths = _network()
+    x = EGO_START_X_M - world.ego.LENGTH - FOLLOWER_HEADWAY_S * ego_speed
+    driver = DriverModel(time_headway_s=FOLLOWER_HEADWAY_S, reaction_s=FOLLOWER_REACTION_S)
+    follower = Npc(world.road, paths[EGO_LANE], x, ego_speed,
+                   desired_speed_mps=FOLLOWER_SPEED_GAIN * ego_speed, driver=driver)
+    return World(world.road, world.ego, [*world.npcs, follower], world.road_map)

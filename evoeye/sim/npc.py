@@ -13,6 +13,7 @@ The ego is a highway-env kinematic bicycle driven by the ADS's command (`EgoVehi
 from __future__ import annotations
 
 import math
+from collections import deque
 from dataclasses import dataclass
 
 import numpy as np
@@ -22,8 +23,8 @@ from evoeye.sim.path import Path
 
 LANE_WIDTH_M = 4.0
 CRASH_DECEL_MPS2 = 8.0  # a vehicle in a contact brakes to a standstill at this rate
-# a cut-in goes only into a gap the ego could still keep by braking at CUT_IN_EGO_DECEL_MPS2
 MAX_DECEL_MPS2 = 9.0  # what the tyres give on a dry road: no car, NPC or ego, brakes harder
+# a cut-in goes only into a gap the ego could still keep by braking at CUT_IN_EGO_DECEL_MPS2
 # after CUT_IN_EGO_REACTION_S: gap ≥ closing·t + closing²/(2·b) (aggressive, not suicidal)
 CUT_IN_EGO_REACTION_S = 1.5
 CUT_IN_EGO_DECEL_MPS2 = 4.0
@@ -45,6 +46,7 @@ class DriverModel:
     max_decel_mps2: float = MAX_DECEL_MPS2
     lat_accel_mps2: float = 3.0  # curve speed: v² · |κ| ≤ this
     crash_decel_mps2: float = CRASH_DECEL_MPS2
+    reaction_s: float = 0.0  # it acts on what it saw this long ago (0: at once, as IDM does)
 
 
 @dataclass(frozen=True)
@@ -113,6 +115,7 @@ class Npc(Vehicle):
         self._armed = False  # the trigger gap was crossed; waiting for a clear target lane
         dm = self.driver
         self._curve_speed = curve_speed(path, dm)
+        self._reacting: deque[float] | None = None  # the decisions not acted on yet (reaction_s)
 
     # -- the script ------------------------------------------------------------------------------
     @property
@@ -149,7 +152,18 @@ class Npc(Vehicle):
         self._armed = False
 
     # -- longitudinal ----------------------------------------------------------------------------
-    def longitudinal(self, gap_m: float, leader_speed_mps: float) -> float:
+    def longitudinal(self, gap_m: float, leader_speed_mps: float, dt: float = 0.05) -> float:
+        """`decide`, acted on `driver.reaction_s` (whole steps of dt) later; until the first
+        decision comes due, the NPC keeps its speed."""
+        a = self.decide(gap_m, leader_speed_mps)
+        if self.driver.reaction_s <= 0.0 or self.crashed:
+            return a
+        if self._reacting is None:
+            self._reacting = deque([0.0] * round(self.driver.reaction_s / dt))
+        self._reacting.append(a)
+        return self._reacting.popleft()
+
+    def decide(self, gap_m: float, leader_speed_mps: float) -> float:
         """The bounded acceleration: IDM behind the leader (gap_m bumper to bumper, inf if
         none) towards the curve-limited desired speed, and the scripted brake."""
         dm = self.driver
@@ -227,10 +241,10 @@ class EgoVehicle(Vehicle):
         super().clip_actions()
         if self.crashed:
             self.action["acceleration"] = -CRASH_DECEL_MPS2 if self.speed > 0.0 else 0.0
+        elif self.action["acceleration"] < -MAX_DECEL_MPS2:
+            self.action["acceleration"] = -MAX_DECEL_MPS2
 
     def step(self, dt: float) -> None:
         super().step(dt)
         if self.speed < 0.0:  # braking stops a vehicle; it never drives it backwards
             self.speed = 0.0
-        elif self.action["acceleration"] < -MAX_DECEL_MPS2:
-            self.action["acceleration"] = -MAX_DECEL_MPS2

@@ -24,6 +24,7 @@ from evoeye.sim.footprint import min_ego_gap
 from evoeye.sim.highway import build_highway
 from evoeye.sim.intersection import build_intersection
 from evoeye.sim.world import World
+from evoeye.sim.worlds import DEFAULT_WORLD, check_world, run_variant, vary
 
 RATE_HZ = 20.0
 
@@ -48,16 +49,18 @@ class SimConfig:
 def run_spec(
     scenario: str, params, seed: int, *, batch: str = "default", source: str = "initial",
     round: int = 0,  # noqa: A002 - the paper's name for an acquisition round
-    ads: str = DEFAULT_PROFILE,
+    ads: str = DEFAULT_PROFILE, world: str = DEFAULT_WORLD,
 ) -> RunSpec:
-    """A validated RunSpec whose id is derived from (scenario, params, seed, ADS profile)."""
+    """A validated RunSpec whose id is derived from (scenario, params, seed, ADS profile,
+    world variant)."""
     space = get_scenario(scenario)
     x = space.validate(params)
     check_profile(ads)
+    check_world(world, scenario)
     return RunSpec(
         scenario=scenario, params=tuple(float(v) for v in x), seed=int(seed),
-        scenario_id=space.scenario_id(x, seed, "" if ads == DEFAULT_PROFILE else ads),
-        batch=batch, source=source, round=round, ads=ads,
+        scenario_id=space.scenario_id(x, seed, run_variant(ads, world)),
+        batch=batch, source=source, round=round, ads=ads, world=world,
     )
 
 
@@ -70,7 +73,8 @@ def _seeds(seed: int) -> tuple[np.random.Generator, np.random.Generator]:
 def build_world(spec: RunSpec, world_rng: np.random.Generator | None = None) -> tuple[World, float]:
     """The world of a run and the ego's cruise speed, exactly as `run_episode` sets it up."""
     params = get_scenario(spec.scenario).as_dict(spec.params)
-    return WORLD_BUILDERS[spec.scenario](params, world_rng or _seeds(spec.seed)[0])
+    world, cruise_mps = WORLD_BUILDERS[spec.scenario](params, world_rng or _seeds(spec.seed)[0])
+    return vary(spec.world, spec.scenario, world, params, cruise_mps), cruise_mps
 
 
 def scene_finite(scene: SceneState) -> bool:
@@ -106,6 +110,7 @@ def run_episode(
     config = config or SimConfig()
     get_scenario(spec.scenario).validate(spec.params)  # a bad vector is the caller's error: raise
     check_profile(spec.ads)
+    check_world(spec.world, spec.scenario)
     world_rng, ads_rng = _seeds(spec.seed)
     dt = 1.0 / config.rate_hz
     n_frames = int(round(config.duration_s * config.rate_hz))

@@ -107,7 +107,8 @@ class World:
                 rel, i, npc.lane_change.offset_m
             ):
                 npc.start_lane_change()
-        accels = [npc.longitudinal(gap[i], v_lead[i]) for i, npc in enumerate(self.npcs, start=1)]
+        accels = [npc.longitudinal(gap[i], v_lead[i], dt)
+                  for i, npc in enumerate(self.npcs, start=1)]
 
         ego = self.ego
         v_before = ego.speed

@@ -10,6 +10,9 @@
 * Bad logs: a log that `read_run` rejects, whose metadata does not fit its logical scenario
   (`metadata.py`), or that cannot be a record, is moved to
   `<root>/quarantine/` with a `.reason.txt` beside it, and the rest is ingested.
+* A run of a world variant (`evoeye.sim.worlds`, e.g. the follower) is left where it is and
+  out of the warehouse, which has no column for the world: re-simulated from a `scenarios` row
+  it would be another run. It is supervised from its log (`evoeye supervise` reads logs).
 * Writers (`lock.py`): a full ingest holds the writer lock exclusively. An ingest of one batch
   folder (`batch=`, a campaign's) locks only its partition and its new runs' ids (a run id
   committed by another batch meanwhile is a duplicate, never committed twice), so campaigns
@@ -30,6 +33,7 @@ import pyarrow as pa
 
 from evoeye.log import LogError, read_run
 from evoeye.paths import LOG_SUFFIX, DataRoot
+from evoeye.sim.worlds import DEFAULT_WORLD
 from evoeye.store.catalog import Warehouse, write_catalog
 from evoeye.store.features import FEATURES, FrameFeatures
 from evoeye.store.lock import WarehouseLockedError, WriterLock, key_lock
@@ -62,6 +66,7 @@ class IngestReport:
     skipped: int = 0  # logs already in the warehouse
     duplicates: list[str] = field(default_factory=list)  # logs of an already ingested scenario
     quarantined: list[tuple[str, str]] = field(default_factory=list)  # (log, reason)
+    left_out: list[str] = field(default_factory=list)  # logs of a world variant (module doc)
     orphans_removed: list[str] = field(default_factory=list)  # parts of a killed ingest
     catalog_error: str | None = None  # the DuckDB file could not be refreshed (data is in)
 
@@ -197,6 +202,9 @@ class Ingester:
                 source = None if converted else read_run(log, topics=self.topics)
                 meta = converted.metadata if converted else source.metadata
                 check_metadata(meta)
+                if meta.get("world", DEFAULT_WORLD) != DEFAULT_WORLD:
+                    report.left_out.append(rel)
+                    continue
                 scenario_id = str(meta["scenario_id"])
                 if scenario_id in done_ids:
                     report.duplicates.append(rel)

@@ -14,6 +14,7 @@ from typing import Any
 
 from evoeye.ads.profiles import DEFAULT_PROFILE
 from evoeye.scenarios import ScenarioError, get_scenario
+from evoeye.sim.worlds import DEFAULT_WORLD, run_variant
 from evoeye.store.records import RunRecordError
 
 # `LogicalScenario.scenario_id` gives `<logical scenario>-<12 hex>`. An id of that form (of any
@@ -56,7 +57,8 @@ def check_metadata(meta: dict[str, Any]) -> None:
         raise RunRecordError(f"run metadata does not fit its logical scenario: {e}") from None
     sid = str(meta.get("scenario_id"))
     profile = str(meta.get("ads_profile") or DEFAULT_PROFILE)
-    expected = space.scenario_id(x, seed, "" if profile == DEFAULT_PROFILE else profile)
+    world = str(meta.get("world") or DEFAULT_WORLD)
+    expected = space.scenario_id(x, seed, run_variant(profile, world))
     if CANONICAL_ID.fullmatch(sid) and sid != expected:
         raise RunRecordError(f"scenario_id {sid} does not match its parameters and seed "
                              f"(they give {expected})")

@@ -84,3 +84,18 @@ def test_ads_names_a_profile_and_its_runs_go_to_a_batch_of_their_own(tmp_path) -
     refused = runner.invoke(app, [*SIM, "--ads", "reckless", "--root", str(tmp_path / "x")])
     assert refused.exit_code == 2 and "known: default, cautious, firm-yield" in refused.output
     assert not (tmp_path / "x").exists()  # refused before anything ran
+
+
+def test_world_names_a_variant_and_its_runs_go_to_a_batch_of_their_own(tmp_path) -> None:
+    from evoeye.log import read_run
+
+    result = runner.invoke(app, [*SIM[:-1], "1", "--world", "follower", "--root", str(tmp_path)])
+    assert result.exit_code == ExitCode.OK, result.output
+    (log,) = (tmp_path / "runs" / "highway-cut-in").glob("*/*.mcap")
+    assert log.parent.name == "uniform-follower-seed0"
+    assert read_run(log, topics=()).metadata["world"] == "follower"
+    refused = runner.invoke(app, [*SIM, "--world", "fog", "--root", str(tmp_path / "x")])
+    assert refused.exit_code == 2 and "known: default, follower" in refused.output
+    other = runner.invoke(app, ["simulate", "--scenario", "unprotected-intersection", "--n", "1",
+                                "--world", "follower", "--root", str(tmp_path / "y")])
+    assert other.exit_code == 2 and "no variant of unprotected-intersection" in other.output

@@ -147,3 +147,16 @@ def test_a_log_written_before_profiles_existed_reads_as_the_default_profile(
     assert decode_run(older) == decode_run(record)
     with pytest.raises(ValueError, match="missing fields \\['seed'\\]"):  # others stay required
         decode_run({k: v for k, v in record.items() if k != "seed"})
+
+
+def test_the_world_is_recorded_only_when_it_is_not_the_default(episode: Episode) -> None:
+    from dataclasses import replace
+
+    from evoeye.log.records import decode_run, encode_run
+
+    record = encode_run(run_values(episode))
+    assert "world" not in record  # a default world's log is as before variants existed
+    assert decode_run(record)["world"] == "default"
+    varied = replace(episode, spec=replace(episode.spec, world="follower"))
+    record = encode_run(run_values(varied))
+    assert record["world"] == "follower" and decode_run(record)["world"] == "follower"

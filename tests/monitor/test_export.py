@@ -6,7 +6,7 @@ import numpy as np
 import onnx
 import onnxruntime as ort
 
-from evoeye.monitor.export import OUTPUT, export_onnx
+from evoeye.monitor.export import LOGIT, OUTPUT, export_onnx
 from evoeye.monitor.model import INPUTS
 from evoeye.monitor.registry import load_monitor
 from evoeye.store import load_windows
@@ -20,13 +20,17 @@ def test_onnx_runtime_and_torch_give_the_same_scores(tiny, trained, tmp_path) ->
     session = ort.InferenceSession(str(path), providers=["CPUExecutionProvider"])
     assert [i.name for i in session.get_inputs()] == list(INPUTS)
     windows = load_windows(tiny.root, context_len=5, horizon_s=tiny.horizon_s)
-    expected = monitor.score(windows)
+    expected, logits = monitor.score(windows), monitor.logits(windows)
     for index in (np.arange(len(windows)), np.array([7]), np.arange(3, 120, 2)):
         arrays = windows.arrays(index)
-        (risk,) = session.run([OUTPUT], {name: arrays[name] for name in INPUTS})
-        assert risk.shape == (len(index),)
+        risk, logit = session.run([OUTPUT, LOGIT], {name: arrays[name] for name in INPUTS})
+        assert risk.shape == logit.shape == (len(index),)
         np.testing.assert_allclose(risk, expected[index], rtol=0, atol=1e-5)
+        np.testing.assert_allclose(logit, logits[index], rtol=1e-4, atol=1e-4)
     assert expected.std() > 0.05  # real, varied scores, not a constant
+    # the logits are the risks before their sigmoid
+    np.testing.assert_allclose(1 / (1 + np.exp(-logits.astype(np.float64))), expected,
+                               rtol=0, atol=1e-6)
 
 
 def test_the_file_says_which_version_it_is_its_thresholds_and_its_inputs(tiny, trained,
@@ -48,3 +52,4 @@ def test_the_file_says_which_version_it_is_its_thresholds_and_its_inputs(tiny, t
         assert spec[given.name]["dtype"] == ("bool" if given.type == "tensor(bool)"
                                              else "float32")
     assert spec[OUTPUT]["range"] == [0.0, 1.0]
+    assert [o.name for o in session.get_outputs()] == [OUTPUT, LOGIT] and LOGIT in spec

@@ -47,7 +47,9 @@ def test_the_fusion_monitor_streams_through_its_runtime_monitor(tiny, monitor) -
     sid = tiny.ids["val"][0]
     windows = load_windows(tiny.root, [sid], context_len=5, horizon_s=tiny.horizon_s)
     streamed = _stream(scorer, tiny.episodes[sid])
-    np.testing.assert_allclose(streamed[: len(windows)], monitor.score(windows), atol=1e-5)
+    # the logits: thresholds on them do not saturate where float32 risks reach 1.0
+    np.testing.assert_allclose(streamed[: len(windows)], monitor.logits(windows), atol=1e-4)
+    assert np.ptp(streamed) > 1.0
     again = _stream(scorer, tiny.episodes[sid])  # reset starts a new run
     np.testing.assert_array_equal(again, streamed)
 

@@ -252,3 +252,23 @@ def test_the_ads_profile_is_a_column_and_explain_resimulates_under_it(
                     {"scenario_id": "p-firm", "ads_profile": "firm-yield"}]
     specs = {s.scenario_id: s.ads for s in pending_runs(root)}
     assert specs == {"p-default": "default", "p-firm": "firm-yield"}
+
+
+def test_a_world_variants_run_is_left_out_where_it_is(root: DataRoot, episode_factory,
+                                                       log_writer) -> None:
+    from dataclasses import replace
+
+    from evoeye.evaluation.explain import spec_of
+
+    plain = episode_factory("w-default", n_frames=6, seed=1)
+    follower = episode_factory("w-follower", n_frames=6, seed=2)
+    follower.spec = replace(follower.spec, world="follower")
+    logs = [log_writer(root, ep) for ep in (plain, follower)]
+    report = ingest(root)
+    assert report.ingested == ["w-default"] and not report.quarantined
+    assert report.left_out == ["runs/highway-cut-in/b000/w-follower.mcap"]
+    assert logs[1].exists()  # still there, for `evoeye supervise` to read
+    assert spec_of(read_run(logs[1], topics=()).metadata).world == "follower"
+    assert spec_of(read_run(logs[0], topics=()).metadata).world == "default"
+    again = ingest(root)
+    assert not again.ingested and again.left_out == report.left_out

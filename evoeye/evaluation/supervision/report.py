@@ -103,10 +103,16 @@ def budget_table(summary: dict, budget: float) -> Table:
              _opt(None if r.get("share_of_oracle") is None else 100 * r["share_of_oracle"],
                   ".0f"),
              str(r["collisions_caused"]),
-             "off" if r["threshold"] is None else f"{r['threshold']:.4g}"]
-            for r in _at(summary, budget)]
+             _threshold(r)] for r in _at(summary, budget)]
     return Table(["Trigger", f"Prevented % at ≤ {budget:g}/h", "False int./h [Poisson]",
                   "False alarms/h", "Lead s", "% of oracle", "Caused", "Threshold"], rows)
+
+
+def _threshold(r: dict) -> str:
+    """A threshold as the trigger compares it: its score, or its logit (the FusionMonitor)."""
+    if r["threshold"] is None:
+        return "off"
+    return f"{r['threshold']:.4g}" + (" (logit)" if r.get("scale") == "logit" else "")
 
 
 def oracle_table(summary: dict) -> Table:
@@ -139,7 +145,7 @@ def differences_table(summary: dict) -> Table:
 def curve_table(summary: dict, trigger: str) -> Table:
     rows = []
     for p in (p for p in summary["points"] if p["trigger"] == trigger):
-        rows.append([f"{p['threshold']:.4g} ({p['target']})",
+        rows.append([f"{_threshold(p)} ({p['target']})",
                      f"{_rate(p['false_interventions_per_h'])}"
                      f"{ci(p['false_interventions_ci'], scale=1.0)}",
                      f"{pct(p['prevented_share'])}{ci(p['prevented_ci'])}",

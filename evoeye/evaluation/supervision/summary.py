@@ -201,7 +201,7 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
     points = []
     for j, thr in enumerate(t.thresholds):
         points.append({
-            "trigger": t.name, "label": t.label, "threshold": thr,
+            "trigger": t.name, "label": t.label, "threshold": thr, "scale": t.scale,
             "target": t.targets[j], "val_fpr": t.val_fprs[j], "val_recall": t.val_recalls[j],
             "prevented_share": _finite(p_share[j]),
             "prevented_ci": p_ci[j], "false_interventions_per_h": _finite(fi[j]),
@@ -334,7 +334,7 @@ def summarise_supervision(settings: Settings, records: list[dict],
     }
 
 
-POINT_FIELDS = ("threshold", "prevented_share", "false_interventions_per_h",
+POINT_FIELDS = ("threshold", "scale", "prevented_share", "false_interventions_per_h",
                 "false_interventions_ci", "false_interventions_poisson_ci", "false_alarms_per_h",
                 "collisions_caused", "lead_s", "lead_ci")
 
@@ -353,7 +353,8 @@ def _operating_index(points: list[dict], budget: float) -> int | None:
 def _point_fields(p: dict | None) -> dict:
     """An operating point's figures; supervision off for None."""
     if p is None:
-        return {"threshold": None, "prevented_share": 0.0, "false_interventions_per_h": 0.0,
+        return {"threshold": None, "scale": None, "prevented_share": 0.0,
+                "false_interventions_per_h": 0.0,
                 "false_interventions_ci": [0.0, 0.0], "false_interventions_poisson_ci": [0.0, 0.0],
                 "false_alarms_per_h": 0.0, "collisions_caused": 0, "lead_s": None,
                 "lead_ci": [None, None]}

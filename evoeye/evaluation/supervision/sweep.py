@@ -319,6 +319,9 @@ def supervise_run(job: RunJob) -> dict:
     o = unsupervised.outcome
     logged = (job.logged.get("status"), job.logged.get("collided"),
               job.logged.get("collision_time_s"))
+    if o.status != STATUS_OK and logged[0] == STATUS_OK:
+        raise ReproductionError(f"{job.spec.scenario_id} failed when re-simulated under the "
+                                f"triggers, not when logged: {o.reason}")
     if (o.status, o.collided, o.collision_time_s) != logged:
         raise ReproductionError(
             f"{job.spec.scenario_id} re-simulates as {(o.status, o.collided, o.collision_time_s)}"

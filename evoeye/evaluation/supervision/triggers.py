@@ -59,6 +59,7 @@ class TriggerSpec:
     targets: tuple[str, ...]  # per threshold, the loosest target that gave it: "FPR 0.05", …
     val_fprs: tuple[float, ...]  # per threshold, the FPR it realises on validation
     val_recalls: tuple[float, ...]  # … and the frame recall
+    scale: str = "score"  # what the thresholds compare: "score", or "logit" (`trigger_scores`)
 
     @property
     def label(self) -> str:
@@ -98,6 +99,23 @@ def oracle_trigger(leads_s: Sequence[float] = ORACLE_LEADS_S) -> TriggerSpec:
     return TriggerSpec(ORACLE, ORACLE, "", "oracle-1",
                        tuple(-t - FRAME_S / 2 for t in leads), tuple(f"τ {t:g} s" for t in leads),
                        (0.0,) * n, (0.0,) * n)
+
+
+def trigger_scores(monitor: Monitor, windows) -> tuple[np.ndarray, str]:
+    """(scores, scale) a trigger thresholds: a monitor's logits where it has them (the
+    FusionMonitor: its float32 risks saturate at 1.0, and a threshold there is "off"; the
+    logits keep their order and stay apart), else its scores."""
+    logits = getattr(monitor, "logits", None)
+    if logits is not None:
+        return logits(windows), "logit"
+    return monitor.score(windows), "score"
+
+
+def _finite(monitor: Monitor, logits: np.ndarray) -> np.ndarray:
+    out = np.asarray(logits, dtype=np.float64).reshape(-1)
+    if not np.isfinite(out).all():
+        raise ValueError(f"{monitor.name} returned non-finite logits")
+    return out
 
 
 def load_monitor(root: DataRoot, scenario: str, splits: SplitSpec, source: str,
@@ -161,10 +179,11 @@ def calibrate_triggers(root: DataRoot, scenario: str,
         raise ValueError(f"{scenario}: the validation split has no frames to calibrate on")
     specs = []
     for (source, ref), m in zip(sources, monitors, strict=True):
-        scores = check_scores(m, m.score(narrow(val.windows, monitor_context_len(m))), len(val))
+        raw, scale = trigger_scores(m, narrow(val.windows, monitor_context_len(m)))
+        scores = check_scores(m, raw, len(val)) if scale == "score" else _finite(m, raw)
         labels = val.windows.label
         sweep = sweep_thresholds(scores, labels, fprs, recalls)
         fpr, recall = realised(scores, labels, list(sweep))
         specs.append(TriggerSpec(m.name, source, ref, m.version, tuple(sweep),
-                                 tuple(sweep.values()), fpr, recall))
+                                 tuple(sweep.values()), fpr, recall, scale))
     return specs

@@ -14,19 +14,27 @@ import pytest
 from evoeye.evaluation.supervision.batch import plan_supervision
 from evoeye.evaluation.supervision.settings import Settings
 from evoeye.evaluation.supervision.sweep import RunJob, supervise_run
-from evoeye.evaluation.supervision.triggers import calibrate_triggers
+from evoeye.evaluation.supervision.triggers import calibrate_triggers, oracle_trigger
 
 TRIGGERS = [("baseline", "ttc"), ("baseline", "rss")]
 
 
 @pytest.fixture(scope="module")
 def settings(sup) -> Settings:
-    triggers = calibrate_triggers(sup.root, sup.scenario, TRIGGERS, sup.splits, sup.fprs, 3.0)
-    return Settings(sup.scenario, sup.batch, tuple(triggers), splits=sup.splits, logs="none")
+    """A FusionMonitor (ONNX Runtime, thresholds on its logits), TTC, RSS and the oracle."""
+    from evoeye.monitor import train_monitor
+
+    version = train_monitor(sup.root, sup.scenario, seed=0, splits=sup.splits, epochs=1)
+    triggers = calibrate_triggers(sup.root, sup.scenario, [("version", version), *TRIGGERS],
+                                  sup.splits, sup.fprs, 3.0)
+    assert [t.scale for t in triggers] == ["logit", "score", "score"]
+    return Settings(sup.scenario, sup.batch, (*triggers, oracle_trigger()), splits=sup.splits,
+                    logs="none")
 
 
 def _jobs(sup, settings: Settings, folder: Path) -> list[RunJob]:
-    runs = plan_supervision(sup.root, replace(settings, batch=sup.batch)).runs
+    """The batch's two colliding runs (1 and 2) and a safe one (3)."""
+    runs = plan_supervision(sup.root, replace(settings, batch=sup.batch)).runs[1:]
     return [RunJob(str(sup.root.path), str(folder), settings, spec, meta) for spec, meta in runs]
 
 
@@ -47,7 +55,7 @@ def test_two_runs_supervised_at_once_in_threads_reproduce_their_twins(
             records = list(pool.map(supervise_run, jobs))  # a ReproductionError propagates
     finally:
         sys.setswitchinterval(was)
-    assert len(records) == 4 and any(r["triggers"]["ttc"]["sims"] for r in records)
+    assert len(records) == 3 and any(r["triggers"]["ttc"]["sims"] for r in records)
     assert {r["scenario_id"]: r for r in records} == alone
 
 
