@@ -8,6 +8,7 @@ budget tables are published as a Markdown artifact.
 
 from __future__ import annotations
 
+from dataclasses import replace
 from typing import Any
 
 from prefect import flow, get_run_logger, task
@@ -16,16 +17,23 @@ from pydantic import BaseModel, Field
 
 from evoeye.evaluation.monitors import BASELINES
 from evoeye.evaluation.rq1 import trained_on
-from evoeye.evaluation.supervision.batch import RunJob, collect, plan_supervision
+from evoeye.evaluation.supervision.batch import (
+    RunJob,
+    SupervisionResult,
+    collect,
+    plan_supervision,
+)
 from evoeye.evaluation.supervision.report import markdown_report, write_docs, write_report
 from evoeye.evaluation.supervision.settings import LOG_POLICIES, Settings
 from evoeye.evaluation.supervision.summary import BUDGETS_PER_H, summarise_supervision
 from evoeye.evaluation.supervision.sweep import supervise_run
 from evoeye.evaluation.supervision.triggers import (
     DEFAULT_BASELINES,
+    ORACLE_LEADS_S,
     RECALLS,
     SWEEP_FPRS,
     calibrate_triggers,
+    oracle_trigger,
 )
 from evoeye.monitor.families import load_version
 from evoeye.paths import DataRoot, check_batch_name
@@ -61,6 +69,8 @@ class SuperviseParams(BaseModel):
     logs: str = Field("collided", json_schema_extra={"enum": list(LOG_POLICIES)})
     logs_into_runs: bool = False  # True: the supervised logs are ingested as training data
     budgets: list[float] = Field(default_factory=lambda: list(BUDGETS_PER_H))
+    select_batch: str | None = None  # other held-out runs the operating points are chosen on
+    oracle_leads_s: list[float] = Field(default_factory=lambda: list(ORACLE_LEADS_S))
     limit: int | None = Field(None, ge=1)
     workers: int = Field(2, ge=1, le=64)
     dask_address: str | None = None
@@ -80,6 +90,13 @@ class SuperviseParams(BaseModel):
 
     def model_post_init(self, __context) -> None:
         check_batch_name(self.batch)
+        if self.select_batch is not None:
+            check_batch_name(self.select_batch)
+            if self.select_batch == self.batch:
+                raise ValueError("select_batch is the batch reported on: choose operating "
+                                 "points on other runs")
+        if self.oracle_leads_s and min(self.oracle_leads_s) <= 0:
+            raise ValueError(f"oracle_leads_s must be positive, got {self.oracle_leads_s}")
         self.splits  # noqa: B018  (validates the shares and the test batch's name)
         self.fallback  # noqa: B018  (the preset's name and the values it is given)
         if unknown := [s for s in self.scenarios if s not in SCENARIOS]:
@@ -98,6 +115,8 @@ def calibrate(root: DataRoot, scenario: str, params: SuperviseParams) -> Setting
     sources = [("version", v) for v in versions] + [("baseline", b) for b in params.baselines]
     triggers = calibrate_triggers(root, scenario, sources, params.splits, params.fprs,
                                   params.horizon_s, params.recalls)
+    if params.oracle_leads_s:
+        triggers.append(oracle_trigger(params.oracle_leads_s))
     return Settings(scenario, params.batch, tuple(triggers), params.fallback,
                     params.consecutive, params.horizon_s, params.splits, params.logs,
                     logs_into_runs=params.logs_into_runs)
@@ -109,10 +128,10 @@ def supervise_one(job: RunJob) -> str:
     return job.spec.scenario_id
 
 
-def supervise_scenario(root: DataRoot, scenario: str, params: SuperviseParams) -> dict:
-    """Calibrate, supervise every run not done yet (a task each), summarise."""
-    settings = calibrate(root, scenario, params)
-    plan = plan_supervision(root, settings, params.limit)
+def supervise_batch(root: DataRoot, settings: Settings, limit: int | None
+                    ) -> SupervisionResult:
+    """Every run of the settings' batch not done yet, a task each."""
+    plan = plan_supervision(root, settings, limit)
     futures = {supervise_one.submit(j): j for j in plan.jobs}
     errors = []
     for future, job in futures.items():
@@ -120,10 +139,21 @@ def supervise_scenario(root: DataRoot, scenario: str, params: SuperviseParams) -
             future.result()
         except Exception as exc:  # noqa: BLE001 - reported per run, the others go on
             errors.append((job.spec.scenario_id, f"{type(exc).__name__}: {exc}"))
-    result = collect(settings, plan, errors)
-    summary = summarise_supervision(settings, result.records, tuple(params.budgets))
+    return collect(settings, plan, errors)
+
+
+def supervise_scenario(root: DataRoot, scenario: str, params: SuperviseParams) -> dict:
+    """Calibrate, supervise every run not done yet (and the selection batch's, if given),
+    summarise."""
+    settings = calibrate(root, scenario, params)
+    select = (None if params.select_batch is None else
+              supervise_batch(root, replace(settings, batch=params.select_batch), params.limit))
+    result = supervise_batch(root, settings, params.limit)
+    summary = summarise_supervision(settings, result.records, tuple(params.budgets),
+                                    select=select.records if select else None)
     summary["folder"] = str(result.folder)
-    summary["errors"] = [{"scenario_id": s, "reason": r} for s, r in result.errors]
+    errors = result.errors + (select.errors if select else [])
+    summary["errors"] = [{"scenario_id": s, "reason": r} for s, r in errors]
     return summary
 
 

@@ -8,6 +8,7 @@ import pytest
 
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.evaluation.supervision.summary import ROW_FIELDS
+from evoeye.evaluation.supervision.triggers import ORACLE_LEADS_S
 from evoeye.paths import DataRoot
 from evoeye.store import ingest
 from flows.supervise import SuperviseParams, supervise_flow
@@ -17,11 +18,13 @@ SCENARIO = "unprotected-intersection"
 
 @pytest.fixture
 def root(tmp_path: Path) -> DataRoot:
-    """12 ingested runs to calibrate on, and a batch of 2 held-out runs to supervise."""
+    """12 ingested runs to calibrate on, a batch of 2 held-out runs to supervise and 2 more
+    to choose operating points on."""
     root = DataRoot.resolve(tmp_path / "data")
     run_batch(plan_uniform(SCENARIO, 12, 3), root)
     ingest(root)
     run_batch(plan_uniform(SCENARIO, 2, 9, batch="held"), root)
+    run_batch(plan_uniform(SCENARIO, 2, 11, batch="sel"), root)
     return root
 
 
@@ -31,11 +34,15 @@ def test_supervise_flow_writes_the_report_and_an_artifact(prefect_server: None,
 
     params = SuperviseParams(root=str(root.path), scenarios=[SCENARIO], batch="held",
                              baselines=["ttc"], fprs=[0.05, 0.01], workers=1,
-                             report_name="flow", docs=str(tmp_path / "docs"))
+                             report_name="flow", docs=str(tmp_path / "docs"),
+                             select_batch="sel")
     out = supervise_flow(params)
     (summary,) = out["summaries"]
     assert summary["runs"] == 2 and not summary["errors"]
     assert summary["rows"] and all(tuple(r) == ROW_FIELDS for r in summary["rows"])
+    assert {r["trigger"] for r in summary["rows"]} == {"ttc"}  # the oracle is no row …
+    assert [o["lead_s"] for o in summary["oracle"]] == sorted(ORACLE_LEADS_S)  # … but a curve
+    assert summary["operating_points"] == "validation" and summary["selection_runs"] == 2
     records = list(Path(summary["folder"]).glob("runs/*.json"))
     assert len(records) == 2
     folder = Path(out["report_dir"])
@@ -54,6 +61,8 @@ def test_bad_parameters_are_refused_before_anything_runs() -> None:
         SuperviseParams(batch="../b")
     with pytest.raises(ValueError, match="logs"):
         SuperviseParams(batch="b", logs="some")
+    with pytest.raises(ValueError, match="select_batch is the batch"):
+        SuperviseParams(batch="b", select_batch="b")
     with pytest.raises(ValueError, match="unknown fallback"):
         SuperviseParams(batch="b", fallback_preset="gentle")
     with pytest.raises(ValueError, match="tyres"):

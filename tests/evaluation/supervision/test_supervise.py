@@ -170,3 +170,12 @@ def test_a_supervised_run_keeps_the_ads_profile_of_its_run(new_eval_root, sup) -
     runs = batch_runs(root, sup.scenario, sup.batch)
     assert {spec for spec, _ in runs} == set(specs)  # the profile and the ids
     assert {supervised_spec(spec, "ttc", 0).ads for spec, _ in runs} == {"cautious"}
+
+
+def test_operating_points_are_never_chosen_on_the_batch_reported_on(sup) -> None:
+    with pytest.raises(ValueError, match="choose operating points on other runs"):
+        supervise(sup.root, sup.scenario, sup.batch, TRIGGERS, splits=sup.splits,
+                  fprs=sup.fprs, select_batch=sup.batch)
+    with pytest.raises(ValueError, match="not held out"):  # runs the monitors learned from
+        supervise(sup.root, sup.scenario, sup.batch, TRIGGERS, splits=sup.splits,
+                  fprs=sup.fprs, select_batch="b000")
