@@ -30,7 +30,8 @@ def sim(collided: bool, false: int = 0, *, rear: bool = False, fallback_s: float
         lead_s: float | None = None) -> dict:
     # the earlier measure counted twice as many here (half of them justified or idle)
     return {"collided": collided, "struck_from_behind": rear, "false_interventions": false,
-            "false_alarms": 2 * false, "interventions": max(2 * false, 1), "fallback_s": fallback_s, "duration_s": 20.0,
+            "false_alarms": 2 * false, "interventions": max(2 * false, 1),
+            "fallback_s": fallback_s, "duration_s": 20.0,
             "peak_decel_mps2": 6.0, "peak_jerk_mps3": 10.0, "first_lead_s": lead_s}
 
 
