@@ -115,6 +115,17 @@ def _threshold(r: dict) -> str:
     return f"{r['threshold']:.4g}" + (" (logit)" if r.get("scale") == "logit" else "")
 
 
+def mechanism_table(summary: dict, budget: float) -> Table:
+    """The unsupervised collisions by mechanism (`evaluation.mechanism`), and how many of each
+    every trigger prevents at the budget."""
+    rows_at = _at(summary, budget)
+    rows = [[kind, str(n)] + [str(r.get("prevented_by_mechanism", {}).get(kind, 0))
+                              for r in rows_at]
+            for kind, n in summary.get("mechanisms", {}).items()]
+    return Table(["Mechanism", "Collisions"] + [f"{r['label']} ≤ {budget:g}/h" for r in rows_at],
+                 rows)
+
+
 def oracle_table(summary: dict) -> Table:
     rows = [[f"{o['lead_s']:g}", f"{pct(o['prevented_share'])}{ci(o['prevented_ci'])}",
              str(o["collisions_caused"])] for o in summary.get("oracle", [])]
@@ -182,6 +193,10 @@ def markdown_report(summaries: list[dict], figures: dict[str, str] | None = None
         parts += [f"## {s['scenario']}", "", _setup(s), "", _chosen_on(s), ""]
         for b in s["budgets_per_h"]:
             parts += [budget_table(s, b).markdown(), ""]
+        if s.get("mechanisms"):
+            parts += ["What collides, by mechanism (`evaluation/mechanism.py`), and what each "
+                      f"trigger prevents of it at ≤ {headline_budget(s):g} per hour:", "",
+                      mechanism_table(s, headline_budget(s)).markdown(), ""]
         if s.get("oracle"):
             parts += ["The ceiling: the oracle engaging τ s before each known collision.", "",
                       oracle_table(s).markdown(), ""]
@@ -224,6 +239,8 @@ def html_report(summaries: list[dict], title: str = "evoeye supervision report")
                  f'<p class="note">{escape(_chosen_on(s))}</p>',
                  f'<div class="charts">{curve_svg(s)}{lead_svg(s)}</div>']
         body += [budget_table(s, b).html() for b in s["budgets_per_h"]]
+        if s.get("mechanisms"):
+            body.append(mechanism_table(s, headline_budget(s)).html())
         if s.get("oracle"):
             body.append(oracle_table(s).html())
         if s["differences"]:

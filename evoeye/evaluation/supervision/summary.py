@@ -46,6 +46,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from evoeye.evaluation.mechanism import MECHANISMS
 from evoeye.evaluation.stats import poisson_ci
 from evoeye.evaluation.supervision.settings import Settings
 from evoeye.evaluation.supervision.triggers import FRAME_S, ORACLE, TriggerSpec
@@ -67,6 +68,7 @@ class RunTable:
     safe_s: np.ndarray  # (R,) eligible seconds labelled 0 (false alarms' denominator)
     calm_s: np.ndarray  # (R,) eligible seconds where no intervention is justified
     encounters: np.ndarray  # (R,) safe hazardous encounters
+    mechanism: np.ndarray  # (R,) object: the unsupervised collision's mechanism, None if safe
     collided: np.ndarray  # (R, Θ) bool
     rear_end: np.ndarray  # (R, Θ) bool: collided, struck from behind
     false: np.ndarray  # (R, Θ) false interventions
@@ -111,8 +113,9 @@ class RunTable:
         a = {k: np.array(v, dtype=float).reshape(len(records), n) for k, v in cols.items()}
         def per_run(key: str) -> np.ndarray:
             return np.array([u[key] for u in unsup], float)
+        kinds = np.array([(u.get("mechanism") or {}).get("kind") for u in unsup], dtype=object)
         return cls(trigger, per_run("collided") > 0, per_run("safe_s"), per_run("calm_s"),
-                   per_run("safe_encounters"), a["collided"] > 0, a["rear_end"] > 0,
+                   per_run("safe_encounters"), kinds, a["collided"] > 0, a["rear_end"] > 0,
                    a["false"], a["alarms"], a["interventions"], a["fallback_s"],
                    a["duration_s"], a["decel"], a["jerk"], a["lead"])
 
@@ -194,6 +197,7 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
     bf = _ratio(weights @ table.false, (weights @ table.calm_s)[:, None] / 3600.0)
     p_ci, f_ci = _ci(bp), _ci(bf)
     acted = table.interventions > 0
+    kinds = sorted({k for k in table.mechanism if k is not None})
     once = np.ones((1, len(c0)))
     lead = [None if np.isnan(m := weighted_medians(col, once)[0]) else float(m)
             for col in table.lead_s.T]
@@ -212,6 +216,8 @@ def trigger_points(table: RunTable, weights: np.ndarray) -> tuple[list[dict], np
             "false_alarms_per_h": _finite(fa[j]),
             "collisions_prevented": int(prevented[:, j].sum()),
             "collisions_caused": int(caused[:, j].sum()),
+            "prevented_by_mechanism": {k: int((prevented[:, j] & (table.mechanism == k)).sum())
+                                       for k in kinds},
             "caused_rear_end": int((caused[:, j] & table.rear_end[:, j]).sum()),
             "rear_end": int(table.rear_end[:, j].sum()),  # every supervised one hit from behind
             "interventions": int(table.interventions[:, j].sum()),
@@ -319,6 +325,8 @@ def summarise_supervision(settings: Settings, records: list[dict],
         "safe_h": float(tables[0].calm_s.sum() / 3600.0),  # no intervention justified
         "label_safe_h": float(tables[0].safe_s.sum() / 3600.0),  # labelled 0 (false alarms')
         "safe_encounters": int(tables[0].encounters.sum()),
+        "mechanisms": {k: int((tables[0].mechanism == k).sum())
+                       for k in MECHANISMS if (tables[0].mechanism == k).any()},
         "rows": [dict(zip(ROW_FIELDS, (p["trigger"], p["threshold"], len(ok), int(c0.sum()),
                                        p["collisions_prevented"], p["collisions_caused"],
                                        p["false_interventions_per_h"], p["false_alarms_per_h"]),
@@ -336,7 +344,7 @@ def summarise_supervision(settings: Settings, records: list[dict],
 
 POINT_FIELDS = ("threshold", "scale", "prevented_share", "false_interventions_per_h",
                 "false_interventions_ci", "false_interventions_poisson_ci", "false_alarms_per_h",
-                "collisions_caused", "lead_s", "lead_ci")
+                "collisions_caused", "lead_s", "lead_ci", "prevented_by_mechanism")
 
 
 def _operating_index(points: list[dict], budget: float) -> int | None:
@@ -357,7 +365,7 @@ def _point_fields(p: dict | None) -> dict:
                 "false_interventions_per_h": 0.0,
                 "false_interventions_ci": [0.0, 0.0], "false_interventions_poisson_ci": [0.0, 0.0],
                 "false_alarms_per_h": 0.0, "collisions_caused": 0, "lead_s": None,
-                "lead_ci": [None, None]}
+                "lead_ci": [None, None], "prevented_by_mechanism": {}}
     return {k: p[k] for k in POINT_FIELDS}
 
 

@@ -34,6 +34,7 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.atomic import atomic_file
+from evoeye.evaluation.mechanism import mechanism
 from evoeye.evaluation.supervision.criticality import (
     Criticality,
     frame_risk,
@@ -334,7 +335,8 @@ def supervise_run(job: RunJob) -> dict:
             "collided": o.collided, "collision_time_s": o.collision_time_s,
             "other_actor": o.other_actor, "struck_from_behind": struck_from_behind(unsupervised),
             "duration_s": o.duration_s, "safe_s": ref.safe_s, "calm_s": ref.calm_s,
-            "safe_encounters": ref.safe_encounters, "eligible_frames": ref.eligible}
+            "safe_encounters": ref.safe_encounters, "eligible_frames": ref.eligible,
+            "mechanism": None if (m := mechanism(unsupervised)) is None else m.to_dict()}
         record["triggers"] = {t.name: sweep_trigger(job, t, scores, ref)
                               for t, scores in zip(s.triggers, drivers[0].scores, strict=True)}
     path = Path(job.folder) / "runs" / f"{job.spec.scenario_id}.json"

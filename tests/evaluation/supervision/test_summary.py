@@ -199,3 +199,17 @@ def test_operating_points_are_chosen_on_the_selection_runs_and_reported_on_these
     leaky = summarise_supervision(settings, records, budgets=(5.0,), resamples=200)
     assert leaky["operating_points"] == "test"
     assert next(r for r in leaky["at_budget"] if r["trigger"] == "fusion")["threshold"] == 0.9
+
+
+def test_collisions_are_counted_and_prevented_by_mechanism(data) -> None:
+    from evoeye.evaluation.supervision.report import markdown_report
+
+    settings, records = data
+    kinds = ["braking-lead"] * 5 + ["cut-in"] * 5  # the ten colliding runs, in order
+    with_kinds = [{**r, "unsupervised": {**r["unsupervised"], "mechanism": {
+        "kind": kinds[i]} if i < 10 else None}} for i, r in enumerate(records)]
+    s = summarise_supervision(settings, with_kinds, budgets=(5.0,), resamples=200)
+    assert s["mechanisms"] == {"braking-lead": 5, "cut-in": 5}
+    fusion = next(r for r in s["at_budget"] if r["trigger"] == "fusion")
+    assert fusion["prevented_by_mechanism"] == {"braking-lead": 5, "cut-in": 3}  # runs 0–7
+    assert "| braking-lead | 5 | 5 |" in markdown_report([s])

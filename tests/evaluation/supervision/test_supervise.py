@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from evoeye.batch import plan_uniform, run_batch
+from evoeye.evaluation.mechanism import MECHANISMS
 from evoeye.evaluation.supervision import check_held_out, supervise
 from evoeye.evaluation.supervision.batch import batch_runs, plan_supervision, record_path
 from evoeye.evaluation.supervision.sweep import (
@@ -78,6 +79,8 @@ def test_each_intervention_is_judged_and_the_earlier_measure_kept(result) -> Non
     for r in result.records:
         u = r["unsupervised"]
         assert 0 <= u["calm_s"] <= u["safe_s"] + 1e-9 and u["safe_encounters"] >= 0
+        assert (u["mechanism"] is None) == (not u["collided"])
+        assert u["mechanism"] is None or u["mechanism"]["kind"] in MECHANISMS
         for s in r["triggers"]["ttc"]["sims"]:
             judged = (s["true_interventions"] + s["justified_interventions"]
                       + s["false_interventions"] + s["idle_interventions"])
