@@ -86,7 +86,7 @@ class FallbackConfig:
 
 
 # Named fallbacks (`evoeye supervise --fallback`). `comfort` is the firm braking of the first
-# supervisions (docs/results/supervision-*), short of the ADS's AEB.
+# supervisions (docs/results/supervision-comfort-*), short of the ADS's AEB.
 FALLBACKS: dict[str, FallbackConfig] = {
     "production": FallbackConfig(),
     "comfort": FallbackConfig(decel_mps2=6.0, jerk_mps3=10.0),

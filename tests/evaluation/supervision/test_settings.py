@@ -16,7 +16,8 @@ RESULTS = Path(__file__).parents[3] / "docs" / "results"
 
 @pytest.mark.parametrize("scenario", ["highway-cut-in", "unprotected-intersection"])
 def test_a_recorded_supervision_reads_back_with_the_fallback_it_used(scenario: str) -> None:
-    recorded = json.loads((RESULTS / f"supervision-{scenario}.json").read_text())["settings"]
+    recorded = json.loads((RESULTS / f"supervision-comfort-{scenario}.json").read_text())[
+        "settings"]
     settings = Settings.of(recorded)
     assert settings.fallback == FALLBACKS["comfort"] != FallbackConfig()
     assert settings.to_dict()["fallback"] == recorded["fallback"]  # its part of the key
