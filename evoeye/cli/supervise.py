@@ -179,7 +179,7 @@ def supervise_command(
 
 
 def _print_summary(summary: dict, done_before: int) -> None:
-    from evoeye.evaluation.supervision.report import ci, headline, headline_budget
+    from evoeye.evaluation.supervision.report import chosen_on, ci, headline, headline_budget
 
     budget = headline_budget(summary)
     t = table(f"supervise {summary['scenario']}: at ≤ {budget:g} false intervention/h",
@@ -194,6 +194,7 @@ def _print_summary(summary: dict, done_before: int) -> None:
                   "off" if r["threshold"] is None else f"{r['threshold']:.4g}")
     out().print(t)
     out().print(headline(summary, budget).replace("**", ""))
+    out().print(chosen_on(summary))
     sims = summary["simulations"]
     out().print(f"{summary['runs']} runs ({done_before} done before), {sims['shared']} "
                 f"simulations (every threshold alone: {sims['naive']}); results in "

@@ -132,7 +132,7 @@ def oracle_table(summary: dict) -> Table:
     return Table(["Oracle lead τ s", "Prevented % [CI]", "Caused"], rows)
 
 
-def _chosen_on(summary: dict) -> str:
+def chosen_on(summary: dict) -> str:
     if summary.get("operating_points") == "validation":
         return (f"Each trigger's operating point at a budget was chosen on "
                 f"{summary['selection_runs']} other supervised runs (validation) and is reported "
@@ -190,7 +190,7 @@ def markdown_report(summaries: list[dict], figures: dict[str, str] | None = None
     parts = ["# Monitor in the loop: the supervisor's operating curves", ""]
     parts += [line for s in summaries for line in (headline(s), "")] + [TERMS, ""]
     for s in summaries:
-        parts += [f"## {s['scenario']}", "", _setup(s), "", _chosen_on(s), ""]
+        parts += [f"## {s['scenario']}", "", _setup(s), "", chosen_on(s), ""]
         for b in s["budgets_per_h"]:
             parts += [budget_table(s, b).markdown(), ""]
         if s.get("mechanisms"):
@@ -236,7 +236,7 @@ def html_report(summaries: list[dict], title: str = "evoeye supervision report")
     body.append(f'<p class="note">{escape(TERMS)}</p>')
     for s in summaries:
         body += [f"<h2>{escape(s['scenario'])}</h2>", f'<p class="note">{escape(_setup(s))}</p>',
-                 f'<p class="note">{escape(_chosen_on(s))}</p>',
+                 f'<p class="note">{escape(chosen_on(s))}</p>',
                  f'<div class="charts">{curve_svg(s)}{lead_svg(s)}</div>']
         body += [budget_table(s, b).html() for b in s["budgets_per_h"]]
         if s.get("mechanisms"):

@@ -198,6 +198,10 @@ def test_operating_points_are_chosen_on_the_selection_runs_and_reported_on_these
     assert fusion["false_interventions_per_h"] == pytest.approx(4 / (40 * SAFE_S / 3600))
     leaky = summarise_supervision(settings, records, budgets=(5.0,), resamples=200)
     assert leaky["operating_points"] == "test"
+    from evoeye.evaluation.supervision.report import markdown_report
+
+    assert "chosen on 40 other supervised runs" in markdown_report([s])
+    assert "chosen on these very runs" in markdown_report([leaky])  # and says so
     assert next(r for r in leaky["at_budget"] if r["trigger"] == "fusion")["threshold"] == 0.9
 
 
