@@ -9,7 +9,9 @@ scores upwards, which does not matter for alarms: thresholds are calibrated on v
 target FPR. Optimiser Adam (`evoeye.monitor.adam`: torch's, without its compiler import), its
 learning rate per step from the recipe's schedule; batches as the recipe's batching makes them
 (`evoeye.monitor.batching`); early stopping on validation AUPRC after every epoch (the best
-epoch's weights are kept). Seeded: the same seed, data and thread count give the same weights.
+epoch's weights are kept; a recipe may select on the partial AUROC of the strict-threshold end
+instead, and leave the last moments before contact out of training: `evoeye.monitor.lookahead`).
+Seeded: the same seed, data and thread count give the same weights.
 """
 
 from __future__ import annotations
@@ -29,6 +31,7 @@ from evoeye.monitor.adam import Adam
 from evoeye.monitor.batching import BATCHINGS, lr_schedule
 from evoeye.monitor.card import ranking_metrics
 from evoeye.monitor.fusion import FusionMonitor
+from evoeye.monitor.lookahead import selection_metric, training_windows
 from evoeye.monitor.model import FusionNet
 from evoeye.monitor.recipes import TrainParams
 from evoeye.monitor.threads import intra_op_threads
@@ -118,6 +121,7 @@ def fit(net: FusionNet, train: Windows, val: Windows,
     Call under `reproducible` (train_monitor does) for seeded, repeatable weights; without
     dropout the loop draws no number from the global RNG, so `kernels` is enough.
     """
+    train = training_windows(train, params.min_lead_s, params.near_misses)
     n_pos = check_windows(train, val)
     device = next(net.parameters()).device
     pos_weight = params.pos_weight or (len(train) - n_pos) / n_pos
@@ -126,8 +130,9 @@ def fit(net: FusionNet, train: Windows, val: Windows,
     gen = torch.Generator().manual_seed(params.seed)
     batches = BATCHINGS[params.batching](train, params, device)
     lr_at = lr_schedule(params, batches.steps())
-    # AUPRC needs both classes in validation; without, early stopping falls back to val loss
+    # AUPRC (pAUC) needs both classes in validation; without, early stopping uses the val loss
     use_auprc = ranking_metrics(np.zeros(len(val)), val.label)["auprc"] is not None
+    select = params.select_on
     best, best_state, best_epoch, history = -np.inf, copy.deepcopy(net.state_dict()), 0, []
     clock = PhaseClock(FIT_PHASES, time.thread_time)
     t0, c0 = time.perf_counter(), time.thread_time()
@@ -135,7 +140,9 @@ def fit(net: FusionNet, train: Windows, val: Windows,
     def validate() -> tuple[dict[str, Any], float, float]:  # metrics, loss, stopping criterion
         scores, val_loss = _val_score(net, val)
         metrics = ranking_metrics(scores, val.label)
-        return metrics, val_loss, metrics["auprc"] if use_auprc else -val_loss
+        if select != "auprc" and use_auprc:  # another criterion: recorded beside AUROC, AUPRC
+            metrics[select] = selection_metric(select, scores, val.label)
+        return metrics, val_loss, metrics[select] if use_auprc else -val_loss
 
     if params.keep_parent:  # the starting weights are epoch 0
         with clock("validation"):

@@ -34,6 +34,8 @@ from evoeye.monitor.threads import MONITOR_THREADS
 
 BATCHINGS = ("windows", "chunks")
 SCHEDULES = ("constant", "cosine", "hold-decay")
+SELECTIONS = ("auprc", "pauc")  # the early-stopping criterion (evoeye.monitor.lookahead)
+NEAR_MISSES = ("safe", "ignored", "unsafe")  # how near misses train (evoeye.monitor.lookahead)
 
 
 @dataclass(frozen=True)
@@ -56,12 +58,22 @@ class TrainParams:
     schedule: str = "constant"  # SCHEDULES: the learning rate over the steps of `epochs`
     warmup_epochs: float = 0.0  # linear warm-up from 0 to `lr`, in epochs
     keep_parent: bool = False  # the starting weights are epoch 0 of early stopping (doc)
+    select_on: str = "auprc"  # SELECTIONS: the validation criterion of early stopping
+    min_lead_s: float = 0.0  # unsafe windows closer to their collision do not train
+    near_misses: str = "safe"  # NEAR_MISSES: the windows of an emergency without a collision
 
     def __post_init__(self) -> None:
         if self.batching not in BATCHINGS:
             raise ValueError(f"unknown batching {self.batching!r}; known: {list(BATCHINGS)}")
         if self.schedule not in SCHEDULES:
             raise ValueError(f"unknown schedule {self.schedule!r}; known: {list(SCHEDULES)}")
+        if self.select_on not in SELECTIONS:
+            raise ValueError(f"unknown selection {self.select_on!r}; known: {list(SELECTIONS)}")
+        if self.near_misses not in NEAR_MISSES:
+            raise ValueError(f"unknown near_misses {self.near_misses!r}; known: "
+                             f"{list(NEAR_MISSES)}")
+        if self.min_lead_s < 0:
+            raise ValueError(f"min_lead_s must be >= 0, got {self.min_lead_s}")
         for name, least in (("epochs", 1), ("patience", 1), ("batch_size", 1),
                             ("chunk_windows", 1), ("threads", 1)):
             if getattr(self, name) < least:
@@ -73,7 +85,7 @@ class TrainParams:
 
 V1 = TrainParams()
 ADDED_FIELDS = ("recipe", "batching", "chunk_windows", "schedule", "warmup_epochs",
-                "keep_parent")
+                "keep_parent", "select_on", "min_lead_s", "near_misses")
 RECIPES: dict[str, TrainParams] = {
     "v1": V1,
     "v2": replace(V1, recipe="v2", batching="chunks", chunk_windows=32, batch_size=1024,
@@ -94,6 +106,18 @@ def recipe_params(recipe: str | None = None, **overrides: Any) -> TrainParams:
     if unknown := sorted(set(overrides) - known):
         raise ValueError(f"unknown training parameter(s) {unknown}; known: {sorted(known)}")
     return replace(RECIPES[name], **overrides)
+
+
+# added for issue 37 (evoeye.monitor.lookahead), after ledger keys recorded every field
+LOOKAHEAD_FIELDS = ("select_on", "min_lead_s", "near_misses")
+
+
+def recipe_key(params: TrainParams) -> dict[str, Any]:
+    """Every field but the seed, as a ledger key records a training's recipe — the
+    LOOKAHEAD_FIELDS only where they differ from their defaults, so keys made before them
+    still find their units."""
+    return {k: v for k, v in asdict(params).items()
+            if k != "seed" and (k not in LOOKAHEAD_FIELDS or v != getattr(V1, k))}
 
 
 def card_hyperparameters(params: TrainParams) -> dict[str, Any]:

@@ -42,6 +42,7 @@ from evoeye.monitor.card import (
 from evoeye.monitor.device import pick_device
 from evoeye.monitor.fit import FitResult, Progress, fit, kernels, reproducible
 from evoeye.monitor.fusion import FusionMonitor
+from evoeye.monitor.lookahead import PAUC_MAX_FPR
 from evoeye.monitor.model import MODULES, FusionConfig, FusionNet
 from evoeye.monitor.protocol import Thresholds
 from evoeye.monitor.recipes import TrainParams, card_hyperparameters, recipe_params
@@ -53,6 +54,8 @@ from evoeye.store.features import FrameFeatures
 from evoeye.store.selection import RunFilter, Runs, SplitSpec
 from evoeye.store.windows import DEFAULT_CONTEXT_LEN, DEFAULT_HORIZON_S, Windows, load_windows
 
+# the card's record of the early-stopping criterion (TrainParams.select_on)
+EARLY_STOPPING = {"auprc": "val AUPRC", "pauc": f"val pAUC (FPR <= {PAUC_MAX_FPR:g})"}
 _reproducible = reproducible  # the name tests and older callers import
 __all__ = ["FitResult", "TrainParams", "Trained", "fit", "fit_windows", "train_monitor",
            "train_monitors"]
@@ -238,7 +241,7 @@ def _card(t: Trained, scenario: str | None, horizon_s: float, init_from: str | N
         "config": result.net.config.to_dict(),
         "hyperparameters": {**card_hyperparameters(t.params), "pos_weight": result.pos_weight,
                             "loss": "BCEWithLogitsLoss(pos_weight)", "optimizer": "Adam",
-                            "early_stopping": "val AUPRC"},
+                            "early_stopping": EARLY_STOPPING[t.params.select_on]},
         "training": {"best_epoch": result.best_epoch, "epochs_run": len(result.history),
                      "time_s": round(result.time_s, 2), "cpu_s": round(result.cpu_s, 2),
                      "device": str(device), "phases": result.phases,

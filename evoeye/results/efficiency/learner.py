@@ -9,7 +9,7 @@ monitor.
 
 from __future__ import annotations
 
-from dataclasses import asdict, dataclass, field, replace
+from dataclasses import dataclass, field, replace
 
 import numpy as np
 
@@ -17,7 +17,7 @@ from evoeye.evolve.campaign.assess import metrics_dict
 from evoeye.evolve.campaign.config import REPLAY_EPOCHS, REPLAY_PATIENCE, REPLAY_RATIO
 from evoeye.evolve.search.feedback import scenario_disagreement, scenario_feedback
 from evoeye.monitor.fusion import FusionMonitor
-from evoeye.monitor.recipes import TrainParams, recipe_params
+from evoeye.monitor.recipes import TrainParams, recipe_key, recipe_params
 from evoeye.monitor.train import fit_windows
 from evoeye.store.windows import Windows
 
@@ -33,7 +33,7 @@ class Learner:
     @property
     def recipe(self) -> dict:
         """The training recipe (every hyper-parameter but the seed), for ledger keys."""
-        return {k: v for k, v in asdict(self.params).items() if k != "seed"}
+        return recipe_key(self.params)
 
     def scratch(self, train: Windows, seed: int) -> FusionMonitor:
         """A FusionMonitor trained from scratch on `train` with `seed`."""
