@@ -31,8 +31,9 @@ TERMS = ("Collisions prevented (scenario-level recall of the paper's RQ1, here c
          "earlier measure — every engagement while the unsupervised run had no collision "
          "within H. Lead: median time from the first true intervention to the unsupervised "
          "collision. Oracle: a trigger that engages τ s before each known collision and never "
-         "otherwise; 'of oracle' is the trigger's prevented share over the oracle's at the "
-         "trigger's own lead. Intervals: 95 % paired percentile bootstrap over runs.")
+         "otherwise; '% of oracle' is the trigger's prevented share over the oracle's at the "
+         "trigger's own median lead (above 100 % where its preventions come with leads longer "
+         "than its median). Intervals: 95 % paired percentile bootstrap over runs.")
 
 
 def ci(pair: list | None, scale: float = 100.0, signed: bool = False) -> str:
