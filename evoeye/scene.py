@@ -46,6 +46,28 @@ class SceneState:
     def vy_mps(self) -> np.ndarray:
         return self.speed_mps * np.sin(self.heading_rad)
 
+    def relative_to_ego(self) -> EgoRelative:
+        """Every other actor (rows 1…) in the ego's frame: x forward, y left."""
+        h0 = float(self.heading_rad[0])
+        c, s = np.cos(h0), np.sin(h0)
+        ddx, ddy = self.x_m[1:] - self.x_m[0], self.y_m[1:] - self.y_m[0]
+        dvx, dvy = self.vx_mps[1:] - self.vx_mps[0], self.vy_mps[1:] - self.vy_mps[0]
+        return EgoRelative(c * ddx + s * ddy, -s * ddx + c * ddy, c * dvx + s * dvy,
+                           -s * dvx + c * dvy,
+                           (self.heading_rad[1:] - h0 + np.pi) % (2 * np.pi) - np.pi)
+
+
+@dataclass(frozen=True)
+class EgoRelative:
+    """The other actors of a scene relative to the ego, in its frame (x forward, y left);
+    (n − 1,) each, in the scene's row order."""
+
+    dx_m: np.ndarray
+    dy_m: np.ndarray
+    dvx_mps: np.ndarray
+    dvy_mps: np.ndarray
+    dheading_rad: np.ndarray  # in [−π, π)
+
 
 @dataclass(frozen=True)
 class Lane:

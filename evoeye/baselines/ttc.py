@@ -34,6 +34,7 @@ COS_DH, SIN_DH = (PERCEPTION_FEATURES.index(k) for k in ("cos_dheading", "sin_dh
 LENGTH, WIDTH = (PERCEPTION_FEATURES.index(k) for k in ("length_m", "width_m"))
 EGO_LENGTH_M = PlanningConfig().ego_length_m  # the ego's footprint, as the ADS knows it
 EGO_WIDTH_M = PlanningConfig().ego_width_m
+CORRIDOR_MARGIN_M = 0.3  # beyond the two half widths: the corridor an obstacle is "in"
 
 
 def min_ttc_s(
@@ -42,7 +43,7 @@ def min_ttc_s(
     *,
     ego_length_m: float = EGO_LENGTH_M,
     ego_width_m: float = EGO_WIDTH_M,
-    corridor_margin_m: float = 0.3,
+    corridor_margin_m: float = CORRIDOR_MARGIN_M,
 ) -> np.ndarray:
     """(B,) smallest TTC in s over the obstacles (B, n, 9) with `mask` (B, n); +inf if none."""
     dx, dy, dvx = perception[..., DX], perception[..., DY], perception[..., DVX]
@@ -120,7 +121,7 @@ class NewestFrameTTC:
 class TTCMonitor(NewestFrameTTC):
     """Rule-based monitor: TTC of the obstacles in the ego's corridor."""
 
-    corridor_margin_m: float = 0.3
+    corridor_margin_m: float = CORRIDOR_MARGIN_M
     name: str = "ttc"
 
     def min_ttc_s(self, perception: np.ndarray, mask: np.ndarray) -> np.ndarray:

@@ -179,19 +179,19 @@ def supervise_command(
 
 
 def _print_summary(summary: dict, done_before: int) -> None:
-    from evoeye.evaluation.supervision.report import chosen_on, ci, headline, headline_budget
+    from evoeye.evaluation.supervision.report import (
+        budget_table,
+        chosen_on,
+        headline,
+        headline_budget,
+    )
 
     budget = headline_budget(summary)
+    rows = budget_table(summary, budget)  # the report's own table at the headline budget
     t = table(f"supervise {summary['scenario']}: at ≤ {budget:g} false intervention/h",
-              ["trigger", "prevented % [CI]", "false int./h", "false alarms/h", "lead s",
-               "of oracle", "caused", "threshold"], left=("trigger",))
-    for r in (r for r in summary["at_budget"] if r["budget_per_h"] == budget):
-        t.add_row(r["label"], f"{100 * r['prevented_share']:.1f}{ci(r['prevented_ci'])}",
-                  f"{r['false_interventions_per_h']:.2f}", f"{r['false_alarms_per_h']:.2f}",
-                  "–" if r["lead_s"] is None else f"{r['lead_s']:.2f}",
-                  "–" if r["share_of_oracle"] is None else f"{100 * r['share_of_oracle']:.0f} %",
-                  str(r["collisions_caused"]),
-                  "off" if r["threshold"] is None else f"{r['threshold']:.4g}")
+              rows.header, left=(rows.header[0],))
+    for row in rows.rows:
+        t.add_row(*row)
     out().print(t)
     out().print(headline(summary, budget).replace("**", ""))
     out().print(chosen_on(summary))

@@ -26,6 +26,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from evoeye.baselines.ttc import CORRIDOR_MARGIN_M
 from evoeye.sim.counterfactual import struck_from_behind
 from evoeye.sim.episode import Episode
 
@@ -34,7 +35,6 @@ LOOKBACK_S = 6.0
 CUT_IN_S = 3.0
 BRAKING_MPS2 = 2.0  # a deceleration beyond the ADS's gentle speed keeping
 CROSSING_RAD = math.radians(30)
-CORRIDOR_MARGIN_M = 0.3
 
 
 @dataclass(frozen=True)
@@ -65,11 +65,10 @@ def mechanism(episode: Episode) -> Mechanism | None:
         hit = np.flatnonzero(sc.actor_id == o.other_actor)
         if not hit.size:
             continue
-        i, h = int(hit[0]), float(sc.heading_rad[0])
-        ddx, ddy = float(sc.x_m[i] - sc.x_m[0]), float(sc.y_m[i] - sc.y_m[0])
-        dh = (float(sc.heading_rad[i]) - h + math.pi) % (2 * math.pi) - math.pi
-        rows.append(((contact - k) * dt, math.cos(h) * ddx + math.sin(h) * ddy,
-                     -math.sin(h) * ddx + math.cos(h) * ddy, dh, float(sc.accel_mps2[i]),
+        i = int(hit[0])
+        rel = sc.relative_to_ego()  # rows 1…: the partner is row i − 1
+        rows.append(((contact - k) * dt, rel.dx_m[i - 1], rel.dy_m[i - 1],
+                     rel.dheading_rad[i - 1], float(sc.accel_mps2[i]),
                      (float(sc.width_m[0]) + float(sc.width_m[i])) / 2 + CORRIDOR_MARGIN_M))
     if not rows:
         return Mechanism("other", None, None)

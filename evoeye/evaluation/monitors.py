@@ -66,11 +66,15 @@ def monitor_context_len(monitor: Monitor, default: int = 5) -> int:
     return int(getattr(monitor, "context_len", default) or default)
 
 
-def check_scores(monitor: Monitor, scores: np.ndarray, n: int) -> np.ndarray:
-    """The monitor's scores as (n,) float64 in [0, 1], or a clear error."""
+def check_scores(monitor: Monitor, scores: np.ndarray, n: int, *,
+                 unit_interval: bool = True) -> np.ndarray:
+    """The monitor's scores as (n,) float64, finite and (with `unit_interval`: risks, not
+    logits) in [0, 1], or a clear error."""
     s = np.asarray(scores, dtype=np.float64).reshape(-1)
     if s.shape != (n,):
         raise ValueError(f"{monitor.name} returned {s.shape} scores for {n} windows")
-    if not np.isfinite(s).all() or s.min(initial=0.0) < 0.0 or s.max(initial=0.0) > 1.0:
+    if not np.isfinite(s).all():
+        raise ValueError(f"{monitor.name} returned non-finite scores")
+    if unit_interval and (s.min(initial=0.0) < 0.0 or s.max(initial=0.0) > 1.0):
         raise ValueError(f"{monitor.name} returned scores outside [0, 1]")
     return s

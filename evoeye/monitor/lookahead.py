@@ -46,9 +46,8 @@ def collision_lead_s(windows: Windows) -> np.ndarray:
     n = len(windows)
     if n == 0:
         return np.zeros(0)
-    sid = windows.scenario_id
-    start = np.flatnonzero(np.r_[True, sid[1:] != sid[:-1]])
-    end = np.append(start[1:], n) - 1  # last row of each run
+    start, stop = windows.run_bounds()
+    end = stop - 1  # last row of each run
     t = windows.t_s
     period = np.where(end > start, t[end] - t[np.maximum(end - 1, 0)], 0.05)
     collided = np.maximum.reduceat(windows.label.astype(np.int8), start) > 0
@@ -74,9 +73,7 @@ def near_miss_windows(windows: Windows, decel_mps2: float = NEAR_MISS_DECEL_MPS2
     if n == 0:
         return out
     accel = windows.features.control[windows.context[:, -1], EGO_ACCEL]  # (B,) at each frame
-    sid = windows.scenario_id
-    start = np.flatnonzero(np.r_[True, sid[1:] != sid[:-1]])
-    for lo, hi in zip(start, np.append(start[1:], n), strict=True):
+    for lo, hi in zip(*windows.run_bounds(), strict=True):
         t = windows.t_s[lo:hi]
         hard = np.flatnonzero(accel[lo:hi] < -decel_mps2)  # frames braking that hard
         if len(hard) == 0:

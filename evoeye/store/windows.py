@@ -119,6 +119,13 @@ class Windows:
 
         return WindowBatch(**{k: torch.from_numpy(v) for k, v in self.arrays(index).items()})
 
+    def run_bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(R,) each run's first window and (R,) one past its last (a run's windows are
+        consecutive); both empty without windows."""
+        sid = self.scenario_id
+        starts = np.flatnonzero(np.r_[True, sid[1:] != sid[:-1]])[: len(sid)]
+        return starts, np.r_[starts[1:], len(sid)][: len(starts)]
+
     def subset(self, index: np.ndarray | slice) -> Windows:
         """Some of the windows, sharing the frame features (e.g. one scenario, a stride)."""
         return Windows(

@@ -28,10 +28,9 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from evoeye.baselines.ttc import CORRIDOR_MARGIN_M
 from evoeye.boxes import box_corners, first_contact_s
 from evoeye.scene import SceneState
-
-CORRIDOR_MARGIN_M = 0.3  # as the TTC baseline's corridor
 
 
 @dataclass(frozen=True)
@@ -73,13 +72,8 @@ def scene_risk(scene: SceneState) -> tuple[float, float]:
     actor of one ground-truth scene."""
     if scene.n < 2:
         return float("inf"), 0.0
-    h0 = float(scene.heading_rad[0])
-    c, s = np.cos(h0), np.sin(h0)
-    ddx, ddy = scene.x_m[1:] - scene.x_m[0], scene.y_m[1:] - scene.y_m[0]
-    dx, dy = c * ddx + s * ddy, -s * ddx + c * ddy  # (n,) ego frame: x forward, y left
-    dvx_w, dvy_w = scene.vx_mps[1:] - scene.vx_mps[0], scene.vy_mps[1:] - scene.vy_mps[0]
-    dvx, dvy = c * dvx_w + s * dvy_w, -s * dvx_w + c * dvy_w
-    dh = scene.heading_rad[1:] - h0
+    rel = scene.relative_to_ego()
+    dx, dy, dvx, dvy, dh = rel.dx_m, rel.dy_m, rel.dvx_mps, rel.dvy_mps, rel.dheading_rad
     other = box_corners(dx, dy, dh, scene.length_m[1:], scene.width_m[1:])
     zero = np.zeros(1)
     ego = box_corners(zero, zero, zero, scene.length_m[:1], scene.width_m[:1])

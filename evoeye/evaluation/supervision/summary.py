@@ -49,7 +49,7 @@ import numpy as np
 from evoeye.evaluation.mechanism import MECHANISMS
 from evoeye.evaluation.stats import poisson_ci
 from evoeye.evaluation.supervision.settings import Settings
-from evoeye.evaluation.supervision.triggers import FRAME_S, ORACLE, TriggerSpec
+from evoeye.evaluation.supervision.triggers import ORACLE, TriggerSpec
 from evoeye.monitor.families import DEFAULT_FAMILY
 
 BUDGETS_PER_H = (0.5, 1.0, 2.0)
@@ -238,12 +238,15 @@ def _simulated(records: list[dict]) -> list[dict]:
     return ok
 
 
-def oracle_curve(points: list[dict]) -> list[dict]:
+def oracle_curve(settings: Settings, points: list[dict]) -> list[dict]:
     """The oracle's prevented share (and CI) per lead τ, ascending; [] without an oracle."""
-    out = [{"lead_s": round(-p["threshold"] - FRAME_S / 2, 6),
-            "prevented_share": p["prevented_share"], "prevented_ci": p["prevented_ci"],
-            "collisions_caused": p["collisions_caused"]}
-           for p in points if p["trigger"] == ORACLE]
+    oracle = next((t for t in settings.triggers if t.oracle), None)
+    if oracle is None:
+        return []
+    mine = [p for p in points if p["trigger"] == oracle.name]  # in threshold order
+    out = [{"lead_s": lead, "prevented_share": p["prevented_share"],
+            "prevented_ci": p["prevented_ci"], "collisions_caused": p["collisions_caused"]}
+           for lead, p in zip(oracle.leads_s, mine, strict=True)]
     return sorted(out, key=lambda o: o["lead_s"])
 
 
@@ -285,7 +288,7 @@ def summarise_supervision(settings: Settings, records: list[dict],
     picked = None if sel is None else {
         t.name: trigger_points(RunTable.of(t, sel), np.ones((1, len(sel))))[0]
         for t in settings.triggers if not t.oracle}
-    ceiling = oracle_curve(points)
+    ceiling = oracle_curve(settings, points)
     c0 = tables[0].collided0
     budget_rows, differences = [], []
     for b in budgets:

@@ -161,7 +161,7 @@ class Reference:
         hit = np.array([f.scene.ego_collision for f in episode.frames], dtype=bool)
         keep = eligible_frames(t, hit)
         label = frame_labels(t, hit, horizon_s)[keep]
-        risk = frame_risk([f.scene for f in episode.frames])
+        risk = frame_risk([f.scene for f in episode.frames[: int(keep.sum())]])  # eligible
         dt_s = 1.0 / episode.rate_hz
         justified = justified_frames(label, risk.critical(criticality),
                                      int(round(horizon_s / dt_s)))

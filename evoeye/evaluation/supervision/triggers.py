@@ -111,13 +111,6 @@ def trigger_scores(monitor: Monitor, windows) -> tuple[np.ndarray, str]:
     return monitor.score(windows), "score"
 
 
-def _finite(monitor: Monitor, logits: np.ndarray) -> np.ndarray:
-    out = np.asarray(logits, dtype=np.float64).reshape(-1)
-    if not np.isfinite(out).all():
-        raise ValueError(f"{monitor.name} returned non-finite logits")
-    return out
-
-
 def load_monitor(root: DataRoot, scenario: str, splits: SplitSpec, source: str,
                  ref: str) -> Monitor:
     """The monitor of a trigger: a saved version by id, or the named baseline (trained ones are
@@ -180,7 +173,7 @@ def calibrate_triggers(root: DataRoot, scenario: str,
     specs = []
     for (source, ref), m in zip(sources, monitors, strict=True):
         raw, scale = trigger_scores(m, narrow(val.windows, monitor_context_len(m)))
-        scores = check_scores(m, raw, len(val)) if scale == "score" else _finite(m, raw)
+        scores = check_scores(m, raw, len(val), unit_interval=scale == "score")
         labels = val.windows.label
         sweep = sweep_thresholds(scores, labels, fprs, recalls)
         fpr, recall = realised(scores, labels, list(sweep))

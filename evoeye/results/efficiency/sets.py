@@ -56,11 +56,7 @@ def _run_table(data: DataRoot, batch: str) -> RunTable:
 def run_ranges(windows: Windows) -> dict[str, tuple[int, int]]:
     """scenario id → (first, last + 1) of its windows (a run's windows are consecutive)."""
     ids = windows.scenario_id
-    if len(ids) == 0:
-        return {}
-    starts = np.flatnonzero(np.r_[True, ids[1:] != ids[:-1]])
-    stops = np.r_[starts[1:], len(ids)]
-    return {str(ids[a]): (int(a), int(b)) for a, b in zip(starts, stops, strict=True)}
+    return {str(ids[a]): (int(a), int(b)) for a, b in zip(*windows.run_bounds(), strict=True)}
 
 
 @dataclass
