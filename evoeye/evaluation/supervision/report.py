@@ -81,6 +81,7 @@ def headline(summary: dict, budget: float | None = None) -> str:
     r = rows[rival["b"]]
     verdict = ("more than" if (rival["ci"][0] or 0) > 0 else
                "fewer than" if (rival["ci"][1] or 0) < 0 else "no surely different share from")
+    mcnemar = "" if rival.get("p") is None else f" (McNemar p = {rival['p']:.2g})"
     oracle = ("" if fusion.get("oracle_at_lead") is None else
               f" (at its median lead of {fusion['lead_s']:.2f} s the oracle prevents "
               f"{pct(fusion['oracle_at_lead'])} %)")
@@ -89,7 +90,7 @@ def headline(summary: dict, budget: float | None = None) -> str:
         f"{ci(fusion['prevented_ci'])} of them{oracle} and causes {fusion['collisions_caused']} "
         f"new ones; the best rule-based trigger, {r['label']}, prevents "
         f"{pct(r['prevented_share'])} %{ci(r['prevented_ci'])}. Paired difference "
-        f"{100 * rival['difference']:+.1f} points{ci(rival['ci'], signed=True)}: "
+        f"{100 * rival['difference']:+.1f} points{ci(rival['ci'], signed=True)}{mcnemar}: "
         f"{verdict} every rule-based trigger"
         + ("." if verdict != "more than" or all((d["ci"][0] or 0) > 0 for d in diffs)
            else " but not all of them (table below)."))
@@ -143,6 +144,12 @@ def chosen_on(summary: dict) -> str:
             "reported on.")
 
 
+def _p(difference: dict) -> str:
+    """' p 0.012': the exact McNemar p of a paired difference, if recorded."""
+    p = difference.get("p")
+    return "" if p is None else f" p {p:.2g}"
+
+
 def differences_table(summary: dict) -> Table:
     budgets = summary["budgets_per_h"]
     by = {(d["b"], d["budget_per_h"]): d for d in summary["differences"]}
@@ -150,7 +157,7 @@ def differences_table(summary: dict) -> Table:
     labels = {p["trigger"]: p["label"] for p in summary["points"]}
     rows = [[labels[n] + ("" if by[n, budgets[0]]["rule_based"] else " (trained)")]
             + [f"{100 * by[n, b]['difference']:+.1f}{ci(by[n, b]['ci'], signed=True)}"
-               for b in budgets] for n in names]
+               f"{_p(by[n, b])}" for b in budgets] for n in names]
     return Table(["FusionMonitor − trigger"] + [f"≤ {b:g}/h, points" for b in budgets], rows)
 
 

@@ -35,7 +35,9 @@ figures come from the same resamples — the comparison is paired run by run —
 as products of the resampling counts with the per-run values; the operating point at a budget
 is chosen again in every resample, so its CI includes the choice (the CIs of the false
 interventions and the lead time at a budget are those of the threshold chosen on all runs).
-Medians in a resample are weighted by the resampling counts. Percentile rather than BCa:
+Medians in a resample are weighted by the resampling counts. Each paired difference also
+carries the exact McNemar p (`stats.paired_warnings_p`) of the two triggers' operating points:
+which unsupervised collisions one prevents and the other does not. Percentile rather than BCa:
 a choice among thresholds is no smooth statistic, and BCa's correction assumes one.
 """
 
@@ -47,7 +49,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from evoeye.evaluation.mechanism import MECHANISMS
-from evoeye.evaluation.stats import poisson_ci
+from evoeye.evaluation.stats import paired_warnings_p, poisson_ci
 from evoeye.evaluation.supervision.settings import Settings
 from evoeye.evaluation.supervision.triggers import ORACLE, TriggerSpec
 from evoeye.monitor.families import DEFAULT_FAMILY
@@ -291,12 +293,14 @@ def summarise_supervision(settings: Settings, records: list[dict],
     ceiling = oracle_curve(settings, points)
     c0 = tables[0].collided0
     budget_rows, differences = [], []
+    tables_by = {t.trigger.name: t for t in tables}
     for b in budgets:
-        chosen, share = {}, {}
+        chosen, share, saved = {}, {}, {}
         for name, (pts, bp, bf) in curves.items():
             if picked is None:
                 chosen[name] = at_budget(bp, bf, b)  # (B,)
-                best = _operating_point(pts, b)
+                j = _operating_index(pts, b)
+                best = _point_fields(None if j is None else pts[j])
             else:
                 j = _operating_index(picked[name], b)
                 chosen[name] = (np.zeros(len(bp)) if j is None
@@ -305,6 +309,9 @@ def summarise_supervision(settings: Settings, records: list[dict],
                 best["val_false_interventions_per_h"] = (
                     0.0 if j is None else picked[name][j]["false_interventions_per_h"])
             share[name] = best["prevented_share"] or 0.0
+            # (C,) which unsupervised collisions it prevents there: the paired test's data
+            saved[name] = (np.zeros(int(c0.sum()), bool) if j is None
+                           else tables_by[name].prevented[c0, j])
             budget_rows.append({"budget_per_h": b, "trigger": name,
                                 "label": settings.trigger(name).label,
                                 "prevented_ci": _ci(chosen[name]), **best,
@@ -317,7 +324,8 @@ def summarise_supervision(settings: Settings, records: list[dict],
                 point = share[DEFAULT_FAMILY] - share[name]
                 differences.append({"budget_per_h": b, "a": DEFAULT_FAMILY, "b": name,
                                     "rule_based": settings.trigger(name).rule_based,
-                                    "difference": point, "ci": _ci(d)})
+                                    "difference": point, "ci": _ci(d),
+                                    "p": paired_warnings_p(saved[DEFAULT_FAMILY], saved[name])})
     sims = sum(len(r["triggers"][t.name]["sims"]) for r in ok for t in settings.triggers)
     alarmed = sum(f is not None for r in ok for t in settings.triggers
                   for f in r["triggers"][t.name]["first_alarm_frame"])
@@ -370,8 +378,3 @@ def _point_fields(p: dict | None) -> dict:
                 "false_alarms_per_h": 0.0, "collisions_caused": 0, "lead_s": None,
                 "lead_ci": [None, None], "prevented_by_mechanism": {}}
     return {k: p[k] for k in POINT_FIELDS}
-
-
-def _operating_point(points: list[dict], budget: float) -> dict:
-    j = _operating_index(points, budget)
-    return _point_fields(None if j is None else points[j])

@@ -108,7 +108,8 @@ def test_at_a_budget_each_trigger_runs_at_its_best_threshold_within_it(data) -> 
     assert at[60.0, "ttc"]["threshold"] == 0.2 and at[60.0, "ttc"]["collisions_caused"] == 1
     (d5, d60) = [d for d in s["differences"] if d["b"] == "ttc"]
     assert d5["difference"] == pytest.approx(0.6) and d5["ci"][0] > 0  # paired: it excludes 0
-    assert d60["difference"] == pytest.approx(0.0)
+    assert d5["p"] == pytest.approx(2 * 0.5**6)  # McNemar: 6 runs only fusion prevents, 0 ttc
+    assert d60["difference"] == pytest.approx(0.0) and d60["p"] == 1.0  # the same 8 runs
     assert s["simulations"]["naive"] == 40 * (1 + 6)
 
 
@@ -143,6 +144,7 @@ def test_the_report_leads_with_the_fusion_monitor_against_the_best_rule(data) ->
     assert "the FusionMonitor prevents 80.0 %" in text and "causes 0 new ones" in text
     assert "best rule-based trigger, ttc, prevents 20.0 %" in text
     assert "Paired difference +60.0 points" in text and "more than every rule-based" in text
+    assert "(McNemar p = 0.031)" in text
     md = markdown_report([s])
     assert md.index("FusionMonitor prevents") < md.index("| Trigger |")  # headline first
     assert "### ttc: operating curve" in md
