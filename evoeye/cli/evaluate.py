@@ -10,6 +10,7 @@ from typing import Annotated
 import typer
 
 from evoeye.cli.app import app
+from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.defaults import BASELINE_NAMES, SPLIT_SEED, TRAIN_FRAC, VAL_FRAC
 from evoeye.cli.errors import UserError
 from evoeye.cli.output import StepBar
@@ -30,8 +31,9 @@ def evaluate_command(
     root: Annotated[Path | None, typer.Option(
         "--root", help="Data root (default: $EVOEYE_HOME or ./evoeye-data).")] = None,
     scenario: Annotated[list[str] | None, typer.Option(
-        "--scenario", help="Logical scenario (repeat for several; default: all in the "
-                           "warehouse).")] = None,
+        "--scenario", callback=scenario_check(recorded=True), help=scenario_help(
+            "Logical scenario (repeat for several; default: all in the warehouse).",
+            recorded=True))] = None,
     monitor: Annotated[list[str] | None, typer.Option(
         "--monitor", help="Trained monitor version to evaluate (repeatable).")] = None,
     baselines: Annotated[str, typer.Option(

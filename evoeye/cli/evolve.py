@@ -16,6 +16,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from evoeye.cli.app import app
+from evoeye.cli.choices import scenario_check, scenario_help, scenario_names
 from evoeye.cli.output import StepBar
 from evoeye.evolve.campaign.config import campaign_options
 from evoeye.paths import DataRoot
@@ -122,8 +123,9 @@ def experiment_command(
     options: dict[str, Any],
     root: Root = None,
     scenario: Annotated[list[str] | None, typer.Option(
-        "--scenario", help="Logical scenarios (repeatable; default: both). The first one's G_0 "
-        "is --monitor.")] = None,
+        "--scenario", callback=scenario_check(), help=scenario_help(
+            "Logical scenarios (repeatable; default: every one). The first one's G_0 is "
+            "--monitor."))] = None,
     budget_s: Annotated[float | None, typer.Option(
         "--budget-s", min=0.0, help="Simulated seconds per campaign (default: the simulated "
         "time of the scenario's initial training data, as in the paper).")] = None,
@@ -150,7 +152,7 @@ def experiment_command(
     from evoeye.evolve.campaign.report import write_experiment_report
 
     data = DataRoot.existing(root)
-    scenarios = scenario or ["highway-cut-in", "unprotected-intersection"]
+    scenarios = scenario or list(scenario_names())
     try:
         check_known("method", strategy or MAIN)
     except ValueError as e:

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from evoeye.cli.app import app
+from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.defaults import ABLATION_NAMES as ABLATIONS
 from evoeye.cli.defaults import CONTEXT_LEN as DEFAULT_CONTEXT_LEN
 from evoeye.cli.defaults import DEFAULT_RECIPE, RECIPE_NAMES, SPLIT_SEED, TARGET_FPRS
@@ -48,7 +49,9 @@ def metrics_table(card: dict[str, Any]) -> Table:
 
 @app.command("train")
 def train_command(
-    scenario: Annotated[str, typer.Option("--scenario", help="Logical scenario to train on.")],
+    scenario: Annotated[str, typer.Option(
+        "--scenario", callback=scenario_check(),
+        help=scenario_help("Logical scenario to train on."))],
     root: RootOpt = None,
     context_len: Annotated[int | None, typer.Option(
         "--context-len", min=1, help=f"L, frames per context (default {DEFAULT_CONTEXT_LEN}, "

@@ -11,7 +11,6 @@ def test_help_defaults_equal_their_sources() -> None:
     from evoeye.monitor.inputs import ABLATIONS, MODULES
     from evoeye.monitor.protocol import TARGET_FPRS
     from evoeye.monitor.recipes import DEFAULT_RECIPE, RECIPES
-    from evoeye.scenarios import SCENARIOS
     from evoeye.sim.worlds import WORLD_NAMES
     from evoeye.store import SplitSpec
     from evoeye.store.ingest import DEFAULT_RUNS_PER_PART
@@ -19,7 +18,7 @@ def test_help_defaults_equal_their_sources() -> None:
 
     split = SplitSpec()
     pairs = {
-        "SCENARIO_NAMES": tuple(SCENARIOS), "ADS_PROFILE_NAMES": tuple(ADS_PROFILES),
+        "ADS_PROFILE_NAMES": tuple(ADS_PROFILES),
         "WORLD_NAMES": WORLD_NAMES,
         "SPLIT_SEED": split.seed, "TRAIN_FRAC": split.train_frac, "VAL_FRAC": split.val_frac,
         "CONTEXT_LEN": DEFAULT_CONTEXT_LEN, "HORIZON_S": DEFAULT_HORIZON_S,

@@ -20,7 +20,7 @@ def test_the_demo_flow_ends_with_its_summary_and_where_the_results_are(
     out = demo_flow(DemoParams(root=str(root.path), n=12, evolve_runs=2, workers=2))
     text = out["summary"]
     assert text.startswith("evoeye demo: what the runtime monitor achieves")
-    for scenario in steps.RUNS:
+    for scenario in steps.plan()[0]:
         block = text.split(f"{scenario} — ")[1].split("\n\n")[0]
         assert "FusionMonitor warned of " in block and " of safe driving (" in block
         assert "Best rule-based baseline, " in block
@@ -33,5 +33,5 @@ def test_the_demo_flow_ends_with_its_summary_and_where_the_results_are(
     assert len(list(root.runs.rglob("*.mcap"))) == 2 * 12 + 2 * 2  # demo runs + the rounds'
     assert text in latest_artifact("evoeye-demo")
     assert flow_run_names(f"demo-{root.path.name}")
-    assert flow_run_names(*(f"simulate-{s}-demo-n12" for s in steps.RUNS)) == sorted(
-        f"simulate-{s}-demo-n12" for s in steps.RUNS)
+    assert flow_run_names(*(f"simulate-{s}-demo-n12" for s in steps.plan()[0])) == sorted(
+        f"simulate-{s}-demo-n12" for s in steps.plan()[0])

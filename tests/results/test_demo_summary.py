@@ -65,10 +65,11 @@ def test_too_few_collisions_are_said_so_in_the_summary(tmp_path) -> None:
 def test_a_monitor_is_shipped_per_scenario_and_installs_into_a_root(tmp_path) -> None:
     from evoeye.monitor.families import load_version
     from evoeye.results import demo_monitors
-    from evoeye.scenarios import SCENARIOS
+    from evoeye.scenarios import SCENARIO_SPECS
 
     versions = packaged_versions()
-    assert set(versions) == set(SCENARIOS)
+    assert set(versions) == {n for n, s in SCENARIO_SPECS.items() if s.demo_monitor}
+    assert versions == {n: demo.shipped_version(n) for n in versions}
     cards = packaged_cards()
     root = DataRoot.resolve(tmp_path)
     for scenario, version in versions.items():
@@ -86,17 +87,27 @@ def test_a_monitor_is_shipped_per_scenario_and_installs_into_a_root(tmp_path) ->
         assert monitor.card["logical_scenario"] == scenario
 
 
-def test_a_scenario_without_a_shipped_monitor_is_one_clear_error(tmp_path, monkeypatch) -> None:
-    monkeypatch.setattr(demo, "packaged_versions", lambda: {})
+def test_a_scenario_without_a_shipped_monitor_is_skipped_or_one_clear_error(
+        tmp_path, monkeypatch) -> None:
+    from evoeye.scenarios import SCENARIO_SPECS, ScenarioError
+
+    monkeypatch.setitem(SCENARIO_SPECS, SCENARIO,
+                        replace(SCENARIO_SPECS[SCENARIO], demo_monitor=None))
     with pytest.raises(LookupError, match="make demo-monitors"):
         demo.shipped_monitor(DataRoot.resolve(tmp_path), SCENARIO)
+    run, skipped = demo.plan()
+    assert skipped == [SCENARIO] and SCENARIO not in run and run
+    assert SCENARIO in demo.skipped_line(skipped)
+    assert demo.plan([SCENARIO]) == ([], [SCENARIO])
+    with pytest.raises(ScenarioError, match="unknown logical scenario 'roundabout'; simulated ones: "):
+        demo.plan(["roundabout"])
 
 
 def test_the_demo_runs_are_never_the_shipped_monitors_training_runs() -> None:
     from evoeye.batch import plan_uniform
     from evoeye.results import demo_monitors
 
-    for scenario in demo.RUNS:
+    for scenario in demo.plan()[0]:
         shipped = {s.params for s in plan_uniform(scenario, 500, demo_monitors.SEED,
                                                   batch=demo_monitors.BATCH)}
         fresh = {s.params for s in plan_uniform(scenario, 120, 0, batch=demo.BATCH)}
