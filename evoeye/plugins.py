@@ -10,8 +10,9 @@ costs no entry point scan, and a built-in module is imported only when the regis
 
 from __future__ import annotations
 
+import functools
 import pkgutil
-from collections.abc import Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping
 from importlib import import_module
 from typing import Any, Generic, Protocol, TypeVar
 
@@ -35,12 +36,24 @@ class UnknownNameError(RegistryError, KeyError):
         return str(self.args[0])
 
 
-class Registry(Mapping[str, T], Generic[T]):
-    """Name → declaration, in registration order: the built-ins (modules in name order), then
-    the entry points (in name order), then whatever `register` added."""
+@functools.cache
+def _entry_points() -> Any:
+    """Every installed package's entry points, read once per process (one scan of sys.path
+    for all registries)."""
+    from importlib.metadata import entry_points
 
-    def __init__(self, kind: str, *, package: str, attr: str, group: str, cls: type) -> None:
+    return entry_points()
+
+
+class Registry(Mapping[str, T], Generic[T]):
+    """Name → declaration, in registration order: the built-ins (modules in name order, or by
+    `order` of the declaration when given), then the entry points (in name order), then whatever
+    `register` added."""
+
+    def __init__(self, kind: str, *, package: str, attr: str, group: str, cls: type,
+                 order: Callable[[T], int] | None = None) -> None:
         self.kind, self.package, self.attr, self.group, self.cls = kind, package, attr, group, cls
+        self.order = order
         self._items: dict[str, T] = {}
         self._loaded = False
 
@@ -68,21 +81,22 @@ class Registry(Mapping[str, T], Generic[T]):
         if self._loaded:
             return
         self._loaded = True  # first, so that a plugin reading the registry while it loads works
-        from importlib.metadata import entry_points
-
         package = import_module(self.package)
+        builtin: list[T] = []
         for info in sorted(pkgutil.iter_modules(package.__path__), key=lambda m: m.name):
             module = import_module(f"{self.package}.{info.name}")
             if hasattr(module, self.attr):
-                for item in self._declared(module, module.__name__):
-                    self.register(item)
-        for ep in sorted(entry_points(group=self.group), key=lambda e: e.name):
+                builtin += self._declared(module, module.__name__)
+        for item in sorted(builtin, key=self.order) if self.order else builtin:
+            self.register(item)
+        for ep in sorted(_entry_points().select(group=self.group), key=lambda e: e.name):
             for item in self._declared(ep.load(), f"entry point {ep.name} = {ep.value}"):
                 self.register(item)
 
     def reload(self) -> None:
         """Forget everything and read the built-ins and entry points again (after a package
         was installed in this process)."""
+        _entry_points.cache_clear()
         self._items.clear()
         self._loaded = False
         self._load()

@@ -9,8 +9,6 @@ CONTEXT_LEN = 5  # evoeye.store.windows.DEFAULT_CONTEXT_LEN
 HORIZON_S = 3.0  # evoeye.store.windows.DEFAULT_HORIZON_S
 TARGET_FPRS = (0.05, 0.01)  # evoeye.monitor.protocol.TARGET_FPRS
 RUNS_PER_PART = 32  # evoeye.store.ingest.DEFAULT_RUNS_PER_PART
-BASELINE_NAMES = ("ttc", "ttc-2d", "rss", "rss-2s", "aem",
-                  "context-only", "where-when")  # evoeye.evaluation.monitors.BASELINES
 MODULE_NAMES = ("perception", "prediction", "planning", "control")  # evoeye.monitor.inputs.MODULES
 ABLATION_NAMES = ("perception", "perception+prediction", "perception+prediction+planning",
                   "all")  # evoeye.monitor.inputs.ABLATIONS

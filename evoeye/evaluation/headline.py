@@ -14,19 +14,21 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from evoeye.evaluation.monitors import BASELINES, RULES
+from evoeye.evaluation.baselines import BASELINE_SPECS, rule_names
+from evoeye.evaluation.monitors import BASELINES
 from evoeye.evaluation.stats import paired_warnings_p
 from evoeye.evaluation.table import DASH, UNREACHABLE, Table, with_ci
+from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 
 MIN_COLLISIONS = 10  # fewer test collisions: figures with intervals, but no "better than"
 ALPHA = 0.05  # the paired test's level for "warns of more collisions than"
-LABELS = {"fusion": "FusionMonitor", "ttc": "TTC", "ttc-2d": "TTC-2D", "rss": "RSS",
-          "rss-2s": "RSS-2s", "aem": "AEM", "context-only": "context-only"}
-
-
 def label(name: str) -> str:
-    """How reports name a monitor ("fusion" → "FusionMonitor")."""
-    return LABELS.get(name, name)
+    """How reports name a monitor ("fusion" → "FusionMonitor", a baseline by its spec's label,
+    else its name)."""
+    if name == DEFAULT_FAMILY:
+        return FAMILIES[DEFAULT_FAMILY].label
+    spec = BASELINE_SPECS.get(name)
+    return name if spec is None else spec.label
 
 
 @dataclass(frozen=True)
@@ -82,7 +84,7 @@ def ranked(f: Figures) -> tuple:
 
 def best_rule(report: dict, point: Point) -> Figures | None:
     """The best rule-based baseline evaluated (`ranked`), if any was."""
-    rules = [figures(m, point) for m in report["monitors"] if m["name"] in RULES]
+    rules = [figures(m, point) for m in report["monitors"] if m["name"] in rule_names()]
     return min(rules, key=ranked) if rules else None
 
 

@@ -1,7 +1,8 @@
 """What `evoeye results` runs: its sizes and choices, declared once and validated.
 
 Plain data that imports nothing heavy (the command line reads it at start-up); the defaults that
-come from elsewhere are literals checked against their sources by tests/results/test_config.py.
+come from elsewhere are literals checked against their sources by tests/results/test_config.py;
+the scenarios and baselines are read from their registries.
 
 Sizes, and why:
 
@@ -31,11 +32,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
+from evoeye.evaluation.baselines import BASELINE_SPECS
 from evoeye.results.efficiency.config import EfficiencyConfig
 from evoeye.scenarios import SCENARIO_SPECS, SCENARIOS
 
-BASELINES = ("ttc", "ttc-2d", "rss", "rss-2s", "aem",
-             "context-only", "where-when")  # evoeye.evaluation.monitors.BASELINES
+BASELINES = BASELINE_SPECS  # the registered baselines' names (evoeye.evaluation.baselines)
 CONTEXT_LENS = (1, 3, 5, 7)  # evoeye.evaluation.ablation.CONTEXT_LENS
 INPUTS = ("perception", "perception+prediction", "perception+prediction+planning",
           "all")  # evoeye.monitor.inputs.ABLATIONS
@@ -111,7 +112,7 @@ class ResultsConfig:
     val_frac: float | None = None  # None: 0.2 with a test batch, else SplitSpec's 0.125
     horizon_s: float = 3.0
     # RQ1 and the monitor ablation
-    baselines: tuple[str, ...] = BASELINES
+    baselines: tuple[str, ...] = field(default_factory=lambda: tuple(BASELINES))  # registered
     context_lens: tuple[int, ...] = CONTEXT_LENS
     inputs: tuple[str, ...] = INPUTS
     epochs: int | None = None  # every training (None: each trainer's default)

@@ -23,8 +23,8 @@ from dataclasses import dataclass, field
 from importlib.resources import files
 from pathlib import Path
 
+from evoeye.evaluation.baselines import rule_names
 from evoeye.evaluation.headline import MIN_COLLISIONS, point_note, summary
-from evoeye.evaluation.monitors import RULES
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.report import change_words
 from evoeye.monitor.pretrained import install, packaged_cards, packaged_versions
@@ -107,7 +107,7 @@ def evaluate_shipped(root: DataRoot, scenario: str) -> dict:
     dict, `EvaluationReport.to_dict()`); the scores go to monitor_scores."""
     from evoeye.evaluation.rq1 import rq1
 
-    (report,) = rq1(root, [scenario], baselines=RULES,
+    (report,) = rq1(root, [scenario], baselines=rule_names(),
                     monitor_versions=[shipped_monitor(root, scenario)], splits=SPLITS,
                     latency=False)
     return report.to_dict()

@@ -7,7 +7,6 @@ from evoeye.cli import defaults
 
 def test_help_defaults_equal_their_sources() -> None:
     from evoeye.ads.profiles import ADS_PROFILES
-    from evoeye.evaluation.monitors import BASELINES
     from evoeye.monitor.inputs import ABLATIONS, MODULES
     from evoeye.monitor.protocol import TARGET_FPRS
     from evoeye.monitor.recipes import DEFAULT_RECIPE, RECIPES
@@ -23,7 +22,6 @@ def test_help_defaults_equal_their_sources() -> None:
         "SPLIT_SEED": split.seed, "TRAIN_FRAC": split.train_frac, "VAL_FRAC": split.val_frac,
         "CONTEXT_LEN": DEFAULT_CONTEXT_LEN, "HORIZON_S": DEFAULT_HORIZON_S,
         "TARGET_FPRS": TARGET_FPRS, "RUNS_PER_PART": DEFAULT_RUNS_PER_PART,
-        "BASELINE_NAMES": tuple(BASELINES),
         "MODULE_NAMES": MODULES, "ABLATION_NAMES": tuple(ABLATIONS),
         "RECIPE_NAMES": tuple(RECIPES), "DEFAULT_RECIPE": DEFAULT_RECIPE,
     }

@@ -99,7 +99,7 @@ def test_a_scenario_without_a_shipped_monitor_is_skipped_or_one_clear_error(
     assert skipped == [SCENARIO] and SCENARIO not in run and run
     assert SCENARIO in demo.skipped_line(skipped)
     assert demo.plan([SCENARIO]) == ([], [SCENARIO])
-    with pytest.raises(ScenarioError, match="unknown logical scenario 'roundabout'; simulated ones: "):
+    with pytest.raises(ScenarioError, match="unknown logical scenario 'roundabout'; simulated "):
         demo.plan(["roundabout"])
 
 

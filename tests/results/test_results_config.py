@@ -22,13 +22,11 @@ def every(runs: int = 0, **per: int) -> dict[str, int]:
 
 def test_the_literal_defaults_are_their_sources() -> None:
     from evoeye.evaluation.ablation import CONTEXT_LENS
-    from evoeye.evaluation.monitors import BASELINES
     from evoeye.evolve.campaign.experiment import ABLATION, MAIN
     from evoeye.monitor.inputs import ABLATIONS
     from evoeye.monitor.recipes import DEFAULT_RECIPE, LEGACY_RECIPE, RECIPES
     from evoeye.splits import SplitSpec
 
-    assert tuple(BASELINES) == config.BASELINES
     assert config.CONTEXT_LENS == CONTEXT_LENS
     assert tuple(ABLATIONS) == config.INPUTS
     assert config.METHODS == MAIN + ABLATION
