@@ -23,6 +23,7 @@ class Named(Protocol):
 
 
 T = TypeVar("T", bound=Named)
+V = TypeVar("V")
 
 
 class RegistryError(ValueError):
@@ -133,3 +134,23 @@ class Registry(Mapping[str, T], Generic[T]):
     def unknown(self, name: str) -> str:
         """The one-line error for a name not registered, naming the known ones."""
         return f"unknown {self.kind} {name!r}; known: {', '.join(self) or 'none'}"
+
+
+class View(Mapping[str, V], Generic[V]):
+    """A registry's names → one part of each declaration (e.g. a scenario's space), read
+    through to the registry (so a declaration added later is in it)."""
+
+    def __init__(self, registry: Registry[Any], part: Callable[[Any], V]) -> None:
+        self.registry, self.part = registry, part
+
+    def __getitem__(self, name: str) -> V:
+        return self.part(self.registry[name])
+
+    def __iter__(self) -> Iterator[str]:
+        return iter(self.registry)
+
+    def __len__(self) -> int:
+        return len(self.registry)
+
+    def __contains__(self, name: object) -> bool:
+        return name in self.registry

@@ -10,7 +10,7 @@ through the family registry (`evoeye.monitor.families`), whatever its family.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterable, Iterator, Mapping
+from collections.abc import Callable, Iterable
 
 import numpy as np
 
@@ -18,28 +18,14 @@ from evoeye.evaluation.baselines import BASELINE_SPECS
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES, load_version
 from evoeye.monitor.protocol import Monitor
 from evoeye.paths import DataRoot
+from evoeye.plugins import View
 from evoeye.store import SplitSpec
 
 BaselineBuilder = Callable[[DataRoot, str, SplitSpec], Monitor]
 
 
-class Builders(Mapping[str, BaselineBuilder]):
-    """Baseline name → `(root, scenario, splits) -> Monitor`: a view of the registry."""
-
-    def __getitem__(self, name: str) -> BaselineBuilder:
-        return BASELINE_SPECS[name].build
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(BASELINE_SPECS)
-
-    def __len__(self) -> int:
-        return len(BASELINE_SPECS)
-
-    def __contains__(self, name: object) -> bool:
-        return name in BASELINE_SPECS
-
-
-BASELINES = Builders()
+# baseline name → `(root, scenario, splits) -> Monitor`, read from the registry
+BASELINES: View[BaselineBuilder] = View(BASELINE_SPECS, lambda spec: spec.build)
 
 
 def baseline_monitors(root: DataRoot, scenario: str,

@@ -1,10 +1,11 @@
 """Logical scenario spaces, looked up by name in the registry (`registry.SCENARIO_SPECS`)."""
 
-from evoeye.scenarios.registry import SCENARIO_SPECS, AuditBands, ScenarioSpec, Spaces
+from evoeye.plugins import View
+from evoeye.scenarios.registry import SCENARIO_SPECS, AuditBands, ScenarioSpec
 from evoeye.scenarios.space import DEFAULT_DELTA, LogicalScenario, Parameter, ScenarioError
 
 # the simulated scenarios' spaces: built-in and third-party, read from the registry
-SCENARIOS: Spaces = Spaces()
+SCENARIOS: View[LogicalScenario] = View(SCENARIO_SPECS, lambda spec: spec.space)
 # Runs that were recorded, not simulated here (`evoeye import`): a space with no parameter, so a
 # recording's run metadata fits it. Never simulated, sampled or searched (not in SCENARIOS).
 EXTERNAL = LogicalScenario("external", "a run recorded by another stack and imported", ())

@@ -9,7 +9,7 @@ list of scenarios in evoeye is read from `SCENARIO_SPECS`.
 
 from __future__ import annotations
 
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable
 from dataclasses import dataclass
 from importlib import import_module
 from typing import Any
@@ -71,19 +71,3 @@ class ScenarioSpec:
 SCENARIO_SPECS: Registry[ScenarioSpec] = Registry(
     "logical scenario", package="evoeye.scenarios.builtin", attr="SCENARIO",
     group=ENTRY_POINT_GROUP, cls=ScenarioSpec)
-
-
-class Spaces(Mapping[str, LogicalScenario]):
-    """The registered scenarios' parameter spaces by name (a view of SCENARIO_SPECS)."""
-
-    def __getitem__(self, name: str) -> LogicalScenario:
-        return SCENARIO_SPECS[name].space
-
-    def __iter__(self) -> Iterator[str]:
-        return iter(SCENARIO_SPECS)
-
-    def __len__(self) -> int:
-        return len(SCENARIO_SPECS)
-
-    def __contains__(self, name: object) -> bool:
-        return name in SCENARIO_SPECS
