@@ -29,7 +29,7 @@ def frames_equal(a, b):
                 np.testing.assert_array_equal(np.asarray(v), np.asarray(mb.to_dict()[k]))
 
 
-@pytest.mark.parametrize("scenario", ["highway-cut-in", "unprotected-intersection"])
+@pytest.mark.parametrize("scenario", sorted(SCENARIOS))
 def test_same_spec_gives_the_same_run(scenario):
     spec = spec_for(scenario, seed=11, draw=3)
     a, b = run_episode(spec), run_episode(spec)
@@ -45,7 +45,7 @@ def test_a_different_seed_changes_the_ads_noise_but_not_the_scenario():
     assert a.frames[0].messages.localization.x_m != b.frames[0].messages.localization.x_m
 
 
-@pytest.mark.parametrize("scenario", ["highway-cut-in", "unprotected-intersection"])
+@pytest.mark.parametrize("scenario", sorted(SCENARIOS))
 def test_runs_last_20_s_or_end_2_s_after_the_first_collision(scenario):
     for draw in range(6):
         ep = run_episode(spec_for(scenario, draw=draw))
