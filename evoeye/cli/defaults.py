@@ -8,6 +8,7 @@ RECIPE_NAMES, DEFAULT_RECIPE = ("v1", "v2", "v3"), "v3"  # evoeye.monitor.recipe
 CONTEXT_LEN = 5  # evoeye.store.windows.DEFAULT_CONTEXT_LEN
 HORIZON_S = 3.0  # evoeye.store.windows.DEFAULT_HORIZON_S
 TARGET_FPRS = (0.05, 0.01)  # evoeye.monitor.protocol.TARGET_FPRS
+WARNING_K = 3  # evoeye.monitor.protocol.WARNING_K
 RUNS_PER_PART = 32  # evoeye.store.ingest.DEFAULT_RUNS_PER_PART
 MODULE_NAMES = ("perception", "prediction", "planning", "control")  # evoeye.monitor.inputs.MODULES
 ABLATION_NAMES = ("perception", "perception+prediction", "perception+prediction+planning",

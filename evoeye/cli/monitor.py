@@ -11,7 +11,7 @@ from evoeye.cli.app import app
 from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.defaults import ABLATION_NAMES as ABLATIONS
 from evoeye.cli.defaults import CONTEXT_LEN as DEFAULT_CONTEXT_LEN
-from evoeye.cli.defaults import DEFAULT_RECIPE, RECIPE_NAMES, SPLIT_SEED, TARGET_FPRS
+from evoeye.cli.defaults import DEFAULT_RECIPE, RECIPE_NAMES, SPLIT_SEED, TARGET_FPRS, WARNING_K
 from evoeye.cli.defaults import HORIZON_S as DEFAULT_HORIZON_S
 from evoeye.cli.defaults import MODULE_NAMES as MODULES
 from evoeye.cli.errors import UserError
@@ -145,7 +145,8 @@ def replay_command(
     fpr: Annotated[float, typer.Option(help=f"Alarm threshold's target FPR, one of "
                                        f"{TARGET_FPRS}.")] = TARGET_FPRS[0],
     consecutive: Annotated[int, typer.Option(
-        "--consecutive", min=1, help="Frames above the threshold before the alarm (K).")] = 1,
+        "--consecutive", min=1, help="Frames above the threshold before the alarm (K; the "
+        "reports' headline and the demo count a warning at the same K).")] = WARNING_K,
 ) -> None:
     """Copy a run log with the monitor's risk channel and alarm markers (Foxglove/Lichtblick).
 
