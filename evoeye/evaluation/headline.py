@@ -82,6 +82,9 @@ def ranked(f: Figures) -> tuple:
             -(lead or 0.0))
 
 
+BEST_RULE = "the rule that warned of the most collisions; ties: fewer false alarms, longer lead"
+
+
 def best_rule(report: dict, point: Point) -> Figures | None:
     """The best rule-based baseline evaluated (`ranked`), if any was."""
     rules = [figures(m, point) for m in report["monitors"] if m["name"] in rule_names()]
@@ -116,12 +119,18 @@ def _few(n: int) -> bool:
 
 
 def dataset_words(report: dict, point: Point) -> str:
-    """"40 test runs: 8 with a collision, 32 collision-free (0.15 h of driving)"."""
-    test = report["dataset"]["test"]
+    """"40 test runs (…): 8 with a collision, 32 collision-free (0.15 h of driving); …": the
+    runs measured, and the validation runs the thresholds were set on (a report counts the
+    runs of each split apart: the test runs are never the validation ones)."""
+    test, val = report["dataset"]["test"], report["dataset"].get("val")
     fa = figures(report["monitors"][0], point).false_alarms if report["monitors"] else None
     hours = f" ({fa['safe_h']:.2f} h of driving)" if fa else ""
-    return (f"{test['scenarios']} test runs: {test['violations']} with a collision, "
+    text = (f"{test['scenarios']} test runs, which no monitor trained or was calibrated on: "
+            f"{test['violations']} with a collision, "
             f"{test['scenarios'] - test['violations']} collision-free{hours}")
+    if val is not None:
+        text += f"; the thresholds were set on {val['scenarios']} other, validation runs"
+    return text
 
 
 def describe(f: Figures) -> str:
@@ -198,7 +207,7 @@ def summary(report: dict) -> list[str]:
     ours, rule = trained(report, point), best_rule(report, point)
     lines += [f"  {describe(f)}." for f in ours]
     if rule is not None:
-        lines.append(f"  Best rule-based baseline, {describe(rule)}.")
+        lines.append(f"  Best rule-based baseline ({BEST_RULE}), {describe(rule)}.")
     if ours and rule is not None and ours[0].reachable and rule.reachable:
         lines.append(f"  Verdict: {verdict(ours[0], rule)}.")
     elif not ours and _few(report["dataset"]["test"]["violations"]):

@@ -14,6 +14,7 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
+import evoeye.baselines  # noqa: F401  (registers the trained baselines' monitor families)
 from evoeye.evaluation.baselines import BASELINE_SPECS
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES, load_version
 from evoeye.monitor.protocol import Monitor

@@ -137,14 +137,17 @@ def write_summary(result: DemoResult) -> None:
 
 WHICH = ("Which figure is which: 'FusionMonitor' is the monitor shipped with evoeye (trained by "
          "`make demo-monitors` on {runs}; see its card), measured here on this demo's test "
-         "runs, which it never saw. The evolution round ran here, on this demo's runs.")
+         "runs, which it never saw; its thresholds were set again on this demo's validation "
+         "runs, as every monitor's. The evolution round ran here, on this demo's runs.")
 
 
 def _trained_on(scenarios: Iterable[str]) -> str:
-    """"400 highway-cut-in runs, …": what the shipped monitors were trained on."""
+    """"401 training runs (and calibrated on 99 validation runs) of highway-cut-in, …": what
+    the shipped monitors were trained on."""
     cards = {s: packaged_cards(folder)[s] for s in scenarios
              if (folder := shipped_folder(s)) is not None}
-    return ", ".join(f"{card['data']['train']['runs']} {scenario} runs"
+    return ", ".join(f"{card['data']['train']['runs']} training runs (and calibrated on "
+                     f"{card['data']['val']['runs']} validation runs) of {scenario}"
                      for scenario, card in cards.items())
 
 

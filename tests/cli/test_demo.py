@@ -22,7 +22,7 @@ def test_demo_prints_the_summary_per_scenario_and_where_the_results_are(tmp_path
     shipped = plan()[0]  # every scenario that ships a demo monitor
     for scenario in shipped:
         assert f"{scenario} — " in text
-    assert text.count("Best rule-based baseline, ") == text.count("Evolution: ") == len(shipped)
+    assert text.count("Best rule-based baseline (") == text.count("Evolution: ") == len(shipped)
     where = text.split("Where the results are:")[1]
     assert str(root.runs) in where and str(root.path / "reports" / "demo") in where
     summary = (root.path / "reports" / "demo" / "summary.md").read_text()

@@ -23,7 +23,7 @@ def test_the_demo_flow_ends_with_its_summary_and_where_the_results_are(
     for scenario in steps.plan()[0]:
         block = text.split(f"{scenario} — ")[1].split("\n\n")[0]
         assert "FusionMonitor warned of " in block and " of safe driving (" in block
-        assert "Best rule-based baseline, " in block
+        assert "Best rule-based baseline (" in block
         assert "Evolution: 1 round(s) added 2 runs" in block
         assert "too few to compare" in block  # 12 runs: a handful of test collisions
     paths = dict(out["paths"])
