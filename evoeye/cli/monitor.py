@@ -118,7 +118,7 @@ def train_command(
             recipe=recipe, device=device, keep_parent=keep_parent,
             **{k: v for k, v in given.items() if v is not None})
     except ValueError as exc:
-        raise UserError(str(exc), "check --scenario, and that `evoeye ingest` has run") from exc
+        raise UserError(str(exc), ingested_words(data, scenario)) from exc
     if init_from is not None and version == init_from:
         console.print(f"no epoch of the fine-tune beat {init_from} on the validation split: "
                       "the parent is kept (its card below)")
@@ -131,6 +131,28 @@ def train_command(
                   f"L = {card['context_len']}")
     console.print(f"card: {version_dir(data, version) / CARD_FILE}")
     console.print(f"version: [bold]{version}[/]")
+
+
+RUN_COUNTS = ("SELECT logical_scenario, count(*) AS runs, count(*) FILTER (WHERE collided) AS "
+              "collided FROM scenarios GROUP BY logical_scenario")
+
+
+def ingested_words(data: DataRoot, scenario: str) -> str:
+    """What the warehouse holds of `scenario`, as a hint under a failed training."""
+    import duckdb
+
+    from evoeye.store import Warehouse
+
+    more = f"`evoeye simulate --scenario {scenario} --n N`, then `evoeye ingest`"
+    try:
+        rows = Warehouse(data).read_only_sql(RUN_COUNTS).to_pylist()
+    except duckdb.Error:
+        return f"the warehouse at {data.warehouse} cannot be read: {more}"
+    row = next((r for r in rows if r["logical_scenario"] == scenario), None)
+    if row is None:
+        return f"no run of {scenario} is ingested: {more}"
+    return (f"the warehouse holds {row['runs']} runs of {scenario}, {row['collided']} with a "
+            f"collision; more runs: {more}")
 
 
 @app.command("replay")

@@ -6,7 +6,11 @@ from evoeye.cli import defaults
 
 
 def test_help_defaults_equal_their_sources() -> None:
+    import evoeye.baselines  # noqa: F401  (registers the baselines' monitor families)
     from evoeye.ads.profiles import ADS_PROFILES
+    from evoeye.evolve.campaign.experiment import methods
+    from evoeye.evolve.search import STRATEGIES
+    from evoeye.monitor.families import evolvable_families
     from evoeye.monitor.inputs import ABLATIONS, MODULES
     from evoeye.monitor.protocol import TARGET_FPRS, WARNING_K
     from evoeye.monitor.recipes import DEFAULT_RECIPE, RECIPES
@@ -25,6 +29,8 @@ def test_help_defaults_equal_their_sources() -> None:
         "RUNS_PER_PART": DEFAULT_RUNS_PER_PART,
         "MODULE_NAMES": MODULES, "ABLATION_NAMES": tuple(ABLATIONS),
         "RECIPE_NAMES": tuple(RECIPES), "DEFAULT_RECIPE": DEFAULT_RECIPE,
+        "STRATEGY_NAMES": tuple(STRATEGIES), "FAMILY_NAMES": tuple(evolvable_families()),
+        "METHOD_NAMES": tuple(methods()),
     }
     shown = {name: getattr(defaults, name) for name in pairs}
     assert shown == pairs
