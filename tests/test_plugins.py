@@ -57,7 +57,7 @@ def test_every_list_of_scenarios_and_baselines_takes_the_plugins(installed: Path
     import numpy as np
 
     from evoeye.evaluation.audit import bands_of
-    from evoeye.evaluation.headline import label
+    from evoeye.evaluation.headline import label, scenario_words
     from evoeye.evaluation.monitors import BASELINES
     from evoeye.results import demo
     from evoeye.results.config import ResultsConfig
@@ -67,6 +67,7 @@ def test_every_list_of_scenarios_and_baselines_takes_the_plugins(installed: Path
     assert list(SCENARIOS)[-1] == SCENARIO and SCENARIOS[SCENARIO].dim == 2
     assert SCENARIO in ResultsConfig().scenarios and SCENARIO in EfficiencyConfig().regimes
     assert bands_of(SCENARIO).collision_rate == (0.0, 1.0)
+    assert scenario_words(SCENARIO) == f"{SCENARIO} (toy braking lead)"
     space = SCENARIOS[SCENARIO]
     world, cruise_mps = world_builder(SCENARIO)(space.as_dict(space.low), np.random.default_rng(0))
     assert cruise_mps > 0 and world.scene().n >= 2

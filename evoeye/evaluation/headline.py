@@ -19,6 +19,7 @@ from evoeye.evaluation.monitors import BASELINES
 from evoeye.evaluation.stats import paired_warnings_p
 from evoeye.evaluation.table import DASH, UNREACHABLE, Table, with_ci
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
+from evoeye.scenarios import SCENARIO_SPECS
 
 MIN_COLLISIONS = 10  # fewer test collisions: figures with intervals, but no "better than"
 ALPHA = 0.05  # the paired test's level for "warns of more collisions than"
@@ -200,10 +201,16 @@ def _interval(est: dict) -> tuple[float, float] | None:
     return est["low"], est["high"]
 
 
+def scenario_words(name: str) -> str:
+    """"highway-cut-in (S1: a highway, …)": a scenario's name and its label, if registered."""
+    spec = SCENARIO_SPECS.get(name)
+    return name if spec is None else f"{name} ({spec.label})"
+
+
 def summary(report: dict) -> list[str]:
     """The plain-words headline of one logical scenario: a line per sentence."""
     point = operating_point(report)
-    lines = [f"{report['logical_scenario']} — {dataset_words(report, point)}."]
+    lines = [f"{scenario_words(report['logical_scenario'])} — {dataset_words(report, point)}."]
     ours, rule = trained(report, point), best_rule(report, point)
     lines += [f"  {describe(f)}." for f in ours]
     if rule is not None:

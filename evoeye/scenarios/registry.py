@@ -47,7 +47,7 @@ class ScenarioSpec:
 
     space: LogicalScenario
     world: str | Callable[..., Any]
-    label: str  # how reports name it, e.g. "S1 highway cut-in"
+    label: str  # what it is, in a few words, beside its name in summaries
     bands: AuditBands
     ads_profiles: tuple[str, ...] = ("default",)  # the stacks it is studied with, default first
     # the package whose version folders hold its shipped demo monitor (the one whose card names

@@ -6,6 +6,7 @@ import pytest
 from typer.testing import CliRunner
 
 from evoeye.cli import app
+from evoeye.evaluation.headline import scenario_words
 from evoeye.paths import DataRoot
 from evoeye.results.demo import plan
 
@@ -21,7 +22,7 @@ def test_demo_prints_the_summary_per_scenario_and_where_the_results_are(tmp_path
     assert "Operating point: each monitor's alarm threshold is set on validation runs" in text
     shipped = plan()[0]  # every scenario that ships a demo monitor
     for scenario in shipped:
-        assert f"{scenario} — " in text
+        assert f"{scenario_words(scenario)} — " in text
     assert text.count("Best rule-based baseline (") == text.count("Evolution: ") == len(shipped)
     where = text.split("Where the results are:")[1]
     assert str(root.runs) in where and str(root.path / "reports" / "demo") in where

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from evoeye.evaluation.headline import scenario_words
 from evoeye.paths import DataRoot
 from evoeye.results import demo as steps
 from flows.demo import DemoParams, demo_flow
@@ -21,7 +22,7 @@ def test_the_demo_flow_ends_with_its_summary_and_where_the_results_are(
     text = out["summary"]
     assert text.startswith("evoeye demo: what the runtime monitor achieves")
     for scenario in steps.plan()[0]:
-        block = text.split(f"{scenario} — ")[1].split("\n\n")[0]
+        block = text.split(f"{scenario_words(scenario)} — ")[1].split("\n\n")[0]
         assert "FusionMonitor warned of " in block and " of safe driving (" in block
         assert "Best rule-based baseline (" in block
         assert "Evolution: 1 round(s) added 2 runs" in block

@@ -53,6 +53,8 @@ def test_the_summary_answers_how_many_how_early_and_how_many_false_alarms(tmp_pa
     assert ("34 test runs, which no monitor trained or was calibrated on: 14 with a collision, "
             "20 collision-free") in text
     assert "; the thresholds were set on 24 other, validation runs." in text
+    assert text.splitlines()[4].startswith(
+        "highway-cut-in (S1: a highway, a braking lead and cut-ins) — 34 test runs")
     shipped = demo.packaged_cards()["highway-cut-in"]["data"]
     assert (f"trained by `make demo-monitors` on {shipped['train']['runs']} training runs "
             f"(and calibrated on {shipped['val']['runs']} validation runs) of highway-cut-in"

@@ -169,7 +169,7 @@ SPACE = LogicalScenario(
 SCENARIO = ScenarioSpec(
     SPACE,
     world="evoeye.sim.highway:build_highway",
-    label="S1 highway cut-in",
+    label="S1: a highway, a braking lead and cut-ins",
     # the paper's rate is 34 %; the band is wide enough for the ADS's failure mix to move
     bands=AuditBands(collision_rate=(0.20, 0.50)),
     demo_monitor=SHIPPED,

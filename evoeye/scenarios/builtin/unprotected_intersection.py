@@ -98,7 +98,7 @@ SPACE = LogicalScenario(
 SCENARIO = ScenarioSpec(
     SPACE,
     world="evoeye.sim.intersection:build_intersection",
-    label="S2 unprotected intersection",
+    label="S2: a four-way intersection without signals",
     bands=AuditBands(collision_rate=(0.50, 0.85)),  # the paper's rate is 77 %
     # the cautious stack collides in 4.5 % of its runs here: the rare-failure regime of the
     # sample-efficiency study (evoeye.results.efficiency.config)
