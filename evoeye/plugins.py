@@ -82,6 +82,14 @@ class Registry(Mapping[str, T], Generic[T]):
         if self._loaded:
             return
         self._loaded = True  # first, so that a plugin reading the registry while it loads works
+        try:
+            self._load_all()
+        except BaseException:
+            self._items.clear()  # no half-filled registry: the next read raises again
+            self._loaded = False
+            raise
+
+    def _load_all(self) -> None:
         package = import_module(self.package)
         builtin: list[T] = []
         for info in sorted(pkgutil.iter_modules(package.__path__), key=lambda m: m.name):
