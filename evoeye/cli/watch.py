@@ -10,7 +10,7 @@ import typer
 
 from evoeye.cli.app import app
 from evoeye.cli.autoware import MappingOpt, load_mapping_option
-from evoeye.cli.defaults import TARGET_FPRS
+from evoeye.cli.defaults import TARGET_FPRS, WARNING_K
 from evoeye.cli.errors import UserError
 from evoeye.cli.monitor import MonitorOpt, RootOpt
 from evoeye.cli.output import err
@@ -30,7 +30,8 @@ def watch_command(
     fpr: Annotated[float, typer.Option(help=f"Alarm threshold's target FPR, one of "
                                        f"{TARGET_FPRS}.")] = TARGET_FPRS[0],
     consecutive: Annotated[int, typer.Option(
-        "--consecutive", min=1, help="Frames above the threshold before the alarm (K).")] = 1,
+        "--consecutive", min=1, help="Frames above the threshold before the alarm (K; as "
+        "`evoeye replay` and the reports count a warning).")] = WARNING_K,
     idle_s: Annotated[float, typer.Option(
         "--idle-s", min=0.0, help="Stop after this long without a new message.")] = 5.0,
 ) -> None:

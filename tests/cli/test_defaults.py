@@ -36,7 +36,7 @@ def test_help_defaults_equal_their_sources() -> None:
     assert shown == pairs
 
 
-def test_replay_and_the_reports_count_a_warning_at_one_k() -> None:
+def test_replay_watch_and_the_reports_count_a_warning_at_one_k() -> None:
     import inspect
 
     import typer
@@ -46,10 +46,12 @@ def test_replay_and_the_reports_count_a_warning_at_one_k() -> None:
     from evoeye.evaluation.headline import operating_point
     from evoeye.monitor.replay import replay
 
-    command = typer.main.get_command(app).commands["replay"]
-    cli_k = next(p.default for p in command.params if p.name == "consecutive")
+    commands = typer.main.get_command(app).commands
+    cli_ks = {name: next(p.default for p in commands[name].params if p.name == "consecutive")
+              for name in ("replay", "watch")}
     report = {"fprs": [0.05, 0.01], "ks": list(SCENARIO_KS)}
-    assert cli_k == inspect.signature(replay).parameters["consecutive"].default == \
+    assert cli_ks == {"replay": defaults.WARNING_K, "watch": defaults.WARNING_K}
+    assert inspect.signature(replay).parameters["consecutive"].default == \
         int(operating_point(report).k) == defaults.WARNING_K
 
 

@@ -8,6 +8,7 @@ import evoeye.cli.monitor  # noqa: F401  (registers the commands)
 from evoeye.cli.app import app
 from evoeye.cli.errors import ExitCode
 from evoeye.monitor.registry import read_card
+from evoeye.scenarios import SCENARIOS
 
 
 def test_train_command_prints_version_metrics_and_card(tiny) -> None:
@@ -28,8 +29,13 @@ def test_train_command_prints_version_metrics_and_card(tiny) -> None:
 def test_train_command_reports_bad_input_without_a_traceback(tiny) -> None:
     result = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path), "--scenario",
                                       "nowhere"])
+    assert result.exit_code == 2 and "unknown logical scenario 'nowhere'" in result.output
+    other = next(s for s in SCENARIOS if s != tiny.scenario)  # known, with no run here
+    result = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path), "--scenario",
+                                      other], env={"COLUMNS": "200"})
     assert result.exit_code == ExitCode.USER_ERROR
     assert "training and validation windows" in result.output
+    assert f"no run of {other} is ingested" in " ".join(result.output.split())
     result = CliRunner().invoke(app, ["train", "--root", str(tiny.root.path), "--scenario",
                                       tiny.scenario, "--init-from", "fusion-000000000000"])
     assert result.exit_code == ExitCode.USER_ERROR and "no monitor version" in result.output

@@ -35,7 +35,7 @@ def records(path: Path) -> tuple[list[tuple[str, int, bytes]], dict, list]:
 def replayed(tiny, trained, tmp_path_factory):
     sid = tiny.ids["val"][0]  # a colliding run
     out = tmp_path_factory.mktemp("replay") / "run.risk.mcap"
-    report = replay(tiny.logs[sid], load_monitor(tiny.root, trained), out)
+    report = replay(tiny.logs[sid], load_monitor(tiny.root, trained), out, consecutive=1)
     return sid, report
 
 

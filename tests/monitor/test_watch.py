@@ -16,6 +16,7 @@ from typer.testing import CliRunner
 
 from evoeye.cli import app
 from evoeye.log.records import UNLABELLED
+from evoeye.monitor.protocol import WARNING_K
 from evoeye.monitor.registry import load_monitor
 from evoeye.monitor.replay import RISK_TOPIC, replay
 from evoeye.monitor.runtime import RuntimeMonitor
@@ -36,7 +37,7 @@ def bag(tiny, tmp_path_factory) -> Path:
 
 
 def _watch(tiny, trained, bag: Path, out: Path, lines: list[bytes]) -> list:
-    runtime = RuntimeMonitor(load_monitor(tiny.root, trained))
+    runtime = RuntimeMonitor(load_monitor(tiny.root, trained), consecutive=WARNING_K)
     assembler = FrameAssembler(Mapping(), UNLABELLED)
     watch = Watch(runtime, out, lines.append)
     for topic, msgtype, msg, log_ns in follow(next(bag.glob("*.mcap")), idle_s=0.0):
