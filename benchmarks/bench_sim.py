@@ -28,7 +28,8 @@ from benchmarks.machine import describe
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.log import write_episode
 from evoeye.paths import DataRoot
-from evoeye.sim.runner import WORLD_BUILDERS, build_world, run_episode
+from evoeye.scenarios import SCENARIOS
+from evoeye.sim.runner import build_world, run_episode
 
 DT_S = 0.05
 
@@ -103,7 +104,7 @@ def main() -> None:
           "| full / world cost | full ms/frame | of which log | 1 worker s | 2 workers s "
           "| speedup |")
     print("|---|---|---|---|---|---|---|---|---|---|---|---|---|")
-    for name in WORLD_BUILDERS:
+    for name in SCENARIOS:
         specs = plan_uniform(name, args.runs, seed=7)
         run_episode(specs[0])  # warm the per-process caches (road networks, imports)
         with tempfile.TemporaryDirectory() as d:

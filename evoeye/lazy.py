@@ -15,3 +15,15 @@ def lazy_attributes(package: str, where: Mapping[str, str]) -> Callable[[str], A
             return getattr(import_module(where[name]), name)
         raise AttributeError(f"module {package!r} has no attribute {name!r}")
     return __getattr__
+
+
+class LazyModule:
+    """A stand-in for module `name` that imports it on first attribute access, for a module
+    that must import cheaply (e.g. the scenario registry, read by `--help`) but uses a heavy
+    one in its functions."""
+
+    def __init__(self, name: str) -> None:
+        self._name = name
+
+    def __getattr__(self, attr: str) -> Any:
+        return getattr(import_module(self._name), attr)

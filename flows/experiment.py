@@ -47,7 +47,7 @@ PER_CAMPAIGN = ("scenario", "strategy", "seed", "budget_s", "family", "reference
 
 
 class ExperimentRun(KnownNames):
-    """The experiment (defaults: the paper's — both scenarios, 3 seeds, budget = initial data)."""
+    """The experiment (defaults: every registered scenario, 3 seeds, budget = initial data)."""
 
     names = {"scenarios": "scenario", "strategies": "method"}
 

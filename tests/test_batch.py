@@ -1,5 +1,7 @@
 """Batches: planned, simulated and logged; safe to kill and re-run; failures isolated."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 from typer.testing import CliRunner
@@ -8,6 +10,7 @@ from evoeye.batch import plan_uniform, run_batch
 from evoeye.cli import app
 from evoeye.log import read_run
 from evoeye.paths import DataRoot
+from evoeye.scenarios import SCENARIO_SPECS
 from evoeye.sim import runner
 from evoeye.sim.runner import SimConfig
 
@@ -76,14 +79,15 @@ def test_the_same_seed_gives_byte_identical_logs(tmp_path):
 def test_one_broken_run_does_not_stop_the_batch(tmp_path, monkeypatch):
     specs = plan_uniform("highway-cut-in", 3, seed=6)
     bad = specs[1].scenario_id
-    real = runner.WORLD_BUILDERS["highway-cut-in"]
+    real = runner.world_builder("highway-cut-in")
 
     def sometimes_broken(params, rng):
         if np.isclose(params["ego_speed_mps"], specs[1].params[0]):
             raise RuntimeError("boom")
         return real(params, rng)
 
-    monkeypatch.setitem(runner.WORLD_BUILDERS, "highway-cut-in", sometimes_broken)
+    monkeypatch.setitem(SCENARIO_SPECS, "highway-cut-in",
+                        replace(SCENARIO_SPECS["highway-cut-in"], world=sometimes_broken))
     summary = run_batch(specs, DataRoot.resolve(tmp_path))
     by_id = {r.scenario_id: r for r in summary.results}
     assert by_id[bad].status == "failed" and "boom" in by_id[bad].reason

@@ -8,6 +8,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from evoeye.cli.app import app, exit_with
+from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.errors import ExitCode
 from evoeye.cli.output import out, table
 from evoeye.cli.simulate import RootOpt, plain_batch
@@ -35,7 +36,9 @@ def summary_table(audits: list[ScenarioAudit]) -> Table:
 @app.command("audit")
 def audit_command(
     root: RootOpt = None,
-    scenario: Annotated[str | None, typer.Option(help="Only this logical scenario.")] = None,
+    scenario: Annotated[str | None, typer.Option(
+        callback=scenario_check(recorded=True),
+        help=scenario_help("Only this logical scenario.", recorded=True))] = None,
     batch: Annotated[str | None, typer.Option(
         callback=plain_batch, help="Only this batch (e.g. demo, uniform-seed0).")] = None,
     workers: Annotated[int, typer.Option(min=1, help="Processes reading logs.")] = 1,

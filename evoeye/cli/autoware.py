@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from evoeye.cli.app import app, exit_with
+from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.errors import ExitCode, UserError
 from evoeye.cli.monitor import RootOpt, export_app
 from evoeye.cli.output import err, out
@@ -76,7 +77,8 @@ def export_autoware(
         exists=True, dir_okay=False)] = None,
     root: RootOpt = None,
     scenario: Annotated[str | None, typer.Option(
-        "--scenario", help="Only this logical scenario's runs.")] = None,
+        "--scenario", callback=scenario_check(recorded=True), help=scenario_help(
+            "Only this logical scenario's runs.", recorded=True))] = None,
     rates: Annotated[str, typer.Option(
         "--rates", help="realistic: Autoware's rates (odometry 50 Hz, objects and planning "
         "10 Hz, control 33 Hz); lossless: every topic at 20 Hz.")] = "realistic",

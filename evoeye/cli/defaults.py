@@ -1,17 +1,20 @@
 """Defaults shown in `--help`, kept here so that help never imports the heavy modules they come
 from; tests/cli/test_defaults.py checks each against its source."""
 
-SCENARIO_NAMES = ("highway-cut-in", "unprotected-intersection")  # evoeye.scenarios.SCENARIOS
 ADS_PROFILE_NAMES = ("default", "cautious", "firm-yield")  # evoeye.ads.profiles.ADS_PROFILES
 WORLD_NAMES = ("default", "follower")  # evoeye.sim.worlds.WORLD_NAMES
 SPLIT_SEED, TRAIN_FRAC, VAL_FRAC = 0, 0.5, 0.125  # evoeye.store.SplitSpec()
 RECIPE_NAMES, DEFAULT_RECIPE = ("v1", "v2", "v3"), "v3"  # evoeye.monitor.recipes
+STRATEGY_NAMES = ("evoeye", "no-feedback", "no-density", "uniform", "avfuzzer", "sobol",
+                  "boundary", "disagreement", "evoeye-knn",
+                  "evoeye-forest")  # evoeye.evolve.search.STRATEGIES
+FAMILY_NAMES = ("fusion", "aem")  # evoeye.monitor.families.evolvable_families()
+METHOD_NAMES = (*STRATEGY_NAMES, "aem-evo")  # evoeye.evolve.campaign.experiment.methods()
 CONTEXT_LEN = 5  # evoeye.store.windows.DEFAULT_CONTEXT_LEN
 HORIZON_S = 3.0  # evoeye.store.windows.DEFAULT_HORIZON_S
 TARGET_FPRS = (0.05, 0.01)  # evoeye.monitor.protocol.TARGET_FPRS
+WARNING_K = 3  # evoeye.monitor.protocol.WARNING_K
 RUNS_PER_PART = 32  # evoeye.store.ingest.DEFAULT_RUNS_PER_PART
-BASELINE_NAMES = ("ttc", "ttc-2d", "rss", "rss-2s", "aem",
-                  "context-only", "where-when")  # evoeye.evaluation.monitors.BASELINES
 MODULE_NAMES = ("perception", "prediction", "planning", "control")  # evoeye.monitor.inputs.MODULES
 ABLATION_NAMES = ("perception", "perception+prediction", "perception+prediction+planning",
                   "all")  # evoeye.monitor.inputs.ABLATIONS

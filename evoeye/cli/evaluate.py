@@ -10,18 +10,21 @@ from typing import Annotated
 import typer
 
 from evoeye.cli.app import app
-from evoeye.cli.defaults import BASELINE_NAMES, SPLIT_SEED, TRAIN_FRAC, VAL_FRAC
+from evoeye.cli.choices import scenario_check, scenario_help
+from evoeye.cli.defaults import SPLIT_SEED, TRAIN_FRAC, VAL_FRAC
 from evoeye.cli.errors import UserError
 from evoeye.cli.output import StepBar
+from evoeye.evaluation.baselines import BASELINE_SPECS
 from evoeye.paths import DataRoot
 
 
 def parse_baselines(text: str) -> list[str]:
     """'ttc,rss,aem' → names; '' or 'none' → none."""
     names = [n.strip() for n in text.split(",") if n.strip() and n.strip() != "none"]
-    unknown = [n for n in names if n not in BASELINE_NAMES]
+    unknown = [n for n in names if n not in BASELINE_SPECS]
     if unknown:
-        raise typer.BadParameter(f"unknown baseline(s) {unknown}; known: {list(BASELINE_NAMES)}")
+        raise typer.BadParameter(f"unknown baseline(s) {', '.join(unknown)}; known: "
+                                 f"{', '.join(BASELINE_SPECS)}")
     return names
 
 
@@ -30,13 +33,14 @@ def evaluate_command(
     root: Annotated[Path | None, typer.Option(
         "--root", help="Data root (default: $EVOEYE_HOME or ./evoeye-data).")] = None,
     scenario: Annotated[list[str] | None, typer.Option(
-        "--scenario", help="Logical scenario (repeat for several; default: all in the "
-                           "warehouse).")] = None,
+        "--scenario", callback=scenario_check(recorded=True), help=scenario_help(
+            "Logical scenario (repeat for several; default: all in the warehouse).",
+            recorded=True))] = None,
     monitor: Annotated[list[str] | None, typer.Option(
         "--monitor", help="Trained monitor version to evaluate (repeatable).")] = None,
     baselines: Annotated[str, typer.Option(
-        help=f"Comma-separated baselines: {', '.join(BASELINE_NAMES)} ('none' for none).")
-    ] = ",".join(BASELINE_NAMES),
+        help=f"Comma-separated baselines: {', '.join(BASELINE_SPECS)} ('none' for none).")
+    ] = ",".join(BASELINE_SPECS),
     fusion: Annotated[bool, typer.Option(
         "--train-fusion/--no-train-fusion",
         help="Also train a FusionMonitor per scenario (seed 0, L = 5) and evaluate it.")] = False,

@@ -16,8 +16,10 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from evoeye.cli.app import app
+from evoeye.cli.choices import scenario_check, scenario_help, scenario_names
+from evoeye.cli.defaults import FAMILY_NAMES, METHOD_NAMES, RECIPE_NAMES, STRATEGY_NAMES
 from evoeye.cli.output import StepBar
-from evoeye.evolve.campaign.config import campaign_options
+from evoeye.evolve.campaign.config import FEEDBACK_MODES, UPDATE_MODES, campaign_options
 from evoeye.paths import DataRoot
 
 if TYPE_CHECKING:
@@ -25,6 +27,21 @@ if TYPE_CHECKING:
 
 Root = Annotated[Path | None, typer.Option(
     "--root", help="Data root (default: $EVOEYE_HOME or ./evoeye-data).")]
+
+
+def choices(kind: str | None) -> tuple[str, ...]:
+    """The values a campaign option naming a `kind` of thing takes (a KNOWN key of
+    `evoeye.evolve.campaign.config`), as `--help` lists them; () for a free one."""
+    listed = {"strategy": STRATEGY_NAMES, "update": UPDATE_MODES, "feedback": FEEDBACK_MODES,
+              "family": FAMILY_NAMES, "recipe": RECIPE_NAMES}
+    if kind == "scenario":
+        return scenario_names()
+    return tuple(listed.get(kind or "", ()))
+
+
+def _help(text: str, kind: str | None) -> str:
+    names = choices(kind)
+    return f"{text} One of: {', '.join(names)}." if names else text
 
 
 def with_campaign_options(exclude: Collection[str] = ()) -> Callable[[Callable], Callable]:
@@ -38,7 +55,8 @@ def with_campaign_options(exclude: Collection[str] = ()) -> Callable[[Callable],
                                    annotation=Annotated[o.type | None if o.optional else o.type,
                                                         typer.Option(
                                                             "--" + o.name.replace("_", "-"),
-                                                            help=o.help, min=o.ge, max=o.le)])
+                                                            help=_help(o.help, o.names),
+                                                            min=o.ge, max=o.le)])
                  for o in mine]
 
         @wraps(command)
@@ -122,8 +140,9 @@ def experiment_command(
     options: dict[str, Any],
     root: Root = None,
     scenario: Annotated[list[str] | None, typer.Option(
-        "--scenario", help="Logical scenarios (repeatable; default: both). The first one's G_0 "
-        "is --monitor.")] = None,
+        "--scenario", callback=scenario_check(), help=scenario_help(
+            "Logical scenarios (repeatable; default: every one). The first one's G_0 is "
+            "--monitor."))] = None,
     budget_s: Annotated[float | None, typer.Option(
         "--budget-s", min=0.0, help="Simulated seconds per campaign (default: the simulated "
         "time of the scenario's initial training data, as in the paper).")] = None,
@@ -134,8 +153,9 @@ def experiment_command(
     ablation: Annotated[bool, typer.Option("--ablation/--no-ablation")] = True,
     strategy: Annotated[list[str] | None, typer.Option(
         "--strategy", help="Run only these methods (repeatable): a strategy, or <family>-evo "
-        "(evoeye evolving another monitor family, e.g. aem-evo); default: the RQ2 ones, plus "
-        "the ablations (no-feedback, no-density, aem-evo) unless --no-ablation.")] = None,
+        "(evoeye evolving another monitor family); default: the RQ2 ones, plus the ablations "
+        "(no-feedback, no-density, aem-evo) unless --no-ablation. One of: "
+        f"{', '.join(METHOD_NAMES)}.")] = None,
     name: Annotated[str | None, typer.Option("--name", help="Report folder name.")] = None,
     workers: Annotated[int | None, typer.Option(
         "--workers", min=1, help="Campaigns run side by side in this many local processes "
@@ -150,7 +170,7 @@ def experiment_command(
     from evoeye.evolve.campaign.report import write_experiment_report
 
     data = DataRoot.existing(root)
-    scenarios = scenario or ["highway-cut-in", "unprotected-intersection"]
+    scenarios = scenario or list(scenario_names())
     try:
         check_known("method", strategy or MAIN)
     except ValueError as e:

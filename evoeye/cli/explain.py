@@ -10,6 +10,7 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from evoeye.cli.app import app
+from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.errors import UserError
 from evoeye.cli.output import out, table
 from evoeye.cli.warehouse import RootOpt, attribution_table
@@ -58,7 +59,9 @@ def explain(
         help="Explain this one run log (its spec is read from the log's metadata; nothing is "
              "stored). Without it: every ingested collision run not yet explained.")] = None,
     root: RootOpt = None,
-    scenario: Annotated[str | None, typer.Option(help="Only this logical scenario.")] = None,
+    scenario: Annotated[str | None, typer.Option(
+        callback=scenario_check(recorded=True),
+        help=scenario_help("Only this logical scenario.", recorded=True))] = None,
     batch: Annotated[str | None, typer.Option(help="Only this batch.")] = None,
     limit: Annotated[int | None, typer.Option(min=1, help="At most this many runs.")] = None,
     workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 2,

@@ -8,9 +8,10 @@ from typing import TYPE_CHECKING, Annotated, Any
 import typer
 
 from evoeye.cli.app import app
+from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.defaults import ABLATION_NAMES as ABLATIONS
 from evoeye.cli.defaults import CONTEXT_LEN as DEFAULT_CONTEXT_LEN
-from evoeye.cli.defaults import DEFAULT_RECIPE, RECIPE_NAMES, SPLIT_SEED, TARGET_FPRS
+from evoeye.cli.defaults import DEFAULT_RECIPE, RECIPE_NAMES, SPLIT_SEED, TARGET_FPRS, WARNING_K
 from evoeye.cli.defaults import HORIZON_S as DEFAULT_HORIZON_S
 from evoeye.cli.defaults import MODULE_NAMES as MODULES
 from evoeye.cli.errors import UserError
@@ -48,7 +49,9 @@ def metrics_table(card: dict[str, Any]) -> Table:
 
 @app.command("train")
 def train_command(
-    scenario: Annotated[str, typer.Option("--scenario", help="Logical scenario to train on.")],
+    scenario: Annotated[str, typer.Option(
+        "--scenario", callback=scenario_check(),
+        help=scenario_help("Logical scenario to train on."))],
     root: RootOpt = None,
     context_len: Annotated[int | None, typer.Option(
         "--context-len", min=1, help=f"L, frames per context (default {DEFAULT_CONTEXT_LEN}, "
@@ -115,7 +118,7 @@ def train_command(
             recipe=recipe, device=device, keep_parent=keep_parent,
             **{k: v for k, v in given.items() if v is not None})
     except ValueError as exc:
-        raise UserError(str(exc), "check --scenario, and that `evoeye ingest` has run") from exc
+        raise UserError(str(exc), ingested_words(data, scenario)) from exc
     if init_from is not None and version == init_from:
         console.print(f"no epoch of the fine-tune beat {init_from} on the validation split: "
                       "the parent is kept (its card below)")
@@ -130,6 +133,28 @@ def train_command(
     console.print(f"version: [bold]{version}[/]")
 
 
+RUN_COUNTS = ("SELECT logical_scenario, count(*) AS runs, count(*) FILTER (WHERE collided) AS "
+              "collided FROM scenarios GROUP BY logical_scenario")
+
+
+def ingested_words(data: DataRoot, scenario: str) -> str:
+    """What the warehouse holds of `scenario`, as a hint under a failed training."""
+    import duckdb
+
+    from evoeye.store import Warehouse
+
+    more = f"`evoeye simulate --scenario {scenario} --n N`, then `evoeye ingest`"
+    try:
+        rows = Warehouse(data).read_only_sql(RUN_COUNTS).to_pylist()
+    except duckdb.Error:
+        return f"the warehouse at {data.warehouse} cannot be read: {more}"
+    row = next((r for r in rows if r["logical_scenario"] == scenario), None)
+    if row is None:
+        return f"no run of {scenario} is ingested: {more}"
+    return (f"the warehouse holds {row['runs']} runs of {scenario}, {row['collided']} with a "
+            f"collision; more runs: {more}")
+
+
 @app.command("replay")
 def replay_command(
     log: Annotated[Path, typer.Argument(help="Run log (.mcap) to replay.", exists=True,
@@ -142,7 +167,8 @@ def replay_command(
     fpr: Annotated[float, typer.Option(help=f"Alarm threshold's target FPR, one of "
                                        f"{TARGET_FPRS}.")] = TARGET_FPRS[0],
     consecutive: Annotated[int, typer.Option(
-        "--consecutive", min=1, help="Frames above the threshold before the alarm (K).")] = 1,
+        "--consecutive", min=1, help="Frames above the threshold before the alarm (K; the "
+        "reports' headline and the demo count a warning at the same K).")] = WARNING_K,
 ) -> None:
     """Copy a run log with the monitor's risk channel and alarm markers (Foxglove/Lichtblick).
 

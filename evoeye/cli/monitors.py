@@ -9,6 +9,7 @@ from typing import Annotated
 import typer
 
 from evoeye.cli.app import app
+from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.output import out, table
 from evoeye.cli.simulate import RootOpt
 from evoeye.paths import DataRoot
@@ -26,7 +27,8 @@ def _count(x: int | None) -> str:
 def monitors_command(
     root: RootOpt = None,
     scenario: Annotated[str | None, typer.Option(
-        "--scenario", help="Only the versions trained on this logical scenario.")] = None,
+        "--scenario", callback=scenario_check(recorded=True), help=scenario_help(
+            "Only the versions trained on this logical scenario.", recorded=True))] = None,
     as_json: Annotated[bool, typer.Option("--json", help="Print the rows as JSON.")] = False,
 ) -> None:
     """List the trained monitors: version, scenario, family, parent, training data, validation

@@ -14,6 +14,7 @@ from typing import Annotated
 import typer
 
 from evoeye.cli.app import app
+from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.defaults import ADS_PROFILE_NAMES
 from evoeye.cli.output import out
 from evoeye.cli.simulate import RootOpt, known_profile, plain_batch
@@ -28,7 +29,9 @@ def _profile(name: str | None) -> str | None:
 def predictability_command(
     root: RootOpt = None,
     scenario: Annotated[list[str] | None, typer.Option(
-        "--scenario", help="Logical scenario (repeatable; default: every one with runs).")
+        "--scenario", callback=scenario_check(recorded=True),
+        help=scenario_help("Logical scenario (repeatable; default: every one with runs).",
+                           recorded=True))
     ] = None,
     batch: Annotated[str | None, typer.Option(
         callback=plain_batch, help="Only the runs of this batch (default: all).")] = None,

@@ -8,6 +8,7 @@ from typing import Annotated
 import typer
 
 from evoeye.cli.app import app
+from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.output import StepBar
 from evoeye.paths import DataRoot
 from evoeye.results.config import (
@@ -32,7 +33,8 @@ def results_command(
     root: Annotated[Path | None, typer.Option(
         "--root", help="Data root (default: $EVOEYE_HOME or ./evoeye-data).")] = None,
     scenario: Annotated[list[str] | None, typer.Option(
-        "--scenario", help="Logical scenario (repeatable; default: both).")] = None,
+        "--scenario", callback=scenario_check(),
+        help=scenario_help("Logical scenario (repeatable; default: every one)."))] = None,
     part: Annotated[list[str] | None, typer.Option(
         "--part", help=f"Run only these parts (repeatable): {', '.join(PARTS)}.")] = None,
     training_seeds: Annotated[int, typer.Option(

@@ -8,7 +8,8 @@ from typing import TYPE_CHECKING, Annotated
 import typer
 
 from evoeye.cli.app import app, exit_with
-from evoeye.cli.defaults import ADS_PROFILE_NAMES, SCENARIO_NAMES, WORLD_NAMES
+from evoeye.cli.choices import scenario_check, scenario_help
+from evoeye.cli.defaults import ADS_PROFILE_NAMES, WORLD_NAMES
 from evoeye.cli.errors import ExitCode, UserError
 from evoeye.cli.output import err, out, table
 from evoeye.paths import BadNameError, DataRoot, check_batch_name
@@ -77,6 +78,10 @@ WorldOpt = Annotated[str, typer.Option(
     "runs get ids, and a default batch name, of their own; `evoeye ingest` leaves them out.")]
 
 
+SimulatedOpt = Annotated[str, typer.Option(
+    "--scenario", callback=scenario_check(), help=scenario_help("Logical scenario."))]
+
+
 def simulate_batch(scenario: str, n: int, seed: int, data: DataRoot, workers: int,
                    batch: str | None = None, ads: str = "default",
                    world: str = "default") -> BatchSummary:
@@ -114,7 +119,7 @@ def failures_code(rows: list[tuple[str, BatchSummary]]) -> ExitCode:
 
 @app.command()
 def simulate(
-    scenario: Annotated[str, typer.Option(help=f"Logical scenario: {', '.join(SCENARIO_NAMES)}.")],
+    scenario: SimulatedOpt,
     n: Annotated[int, typer.Option("--n", min=1, help="Number of runs.")] = 10,
     seed: Annotated[int, typer.Option(min=0, help="Batch seed: fixes vectors and run seeds.")] = 0,
     root: RootOpt = None,

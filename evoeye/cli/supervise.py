@@ -10,13 +10,13 @@ from typing import Annotated
 import typer
 
 from evoeye.cli.app import app, exit_with
+from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.defaults import (
     DEFAULT_FALLBACK,
     FALLBACKS,
     HORIZON_S,
     LOG_POLICIES,
     ORACLE_LEADS_S,
-    SCENARIO_NAMES,
     SPLIT_SEED,
     SUPERVISE_BASELINES,
     SUPERVISE_BUDGETS,
@@ -61,7 +61,8 @@ def default_monitors(root: DataRoot, scenario: str, given: list[str] | None) -> 
 
 @app.command("supervise")
 def supervise_command(
-    scenario: Annotated[str, typer.Option(help=f"Logical scenario: {', '.join(SCENARIO_NAMES)}.")],
+    scenario: Annotated[str, typer.Option(
+        callback=scenario_check(), help=scenario_help("Logical scenario."))],
     batch: Annotated[str, typer.Option(
         callback=plain_batch, help="The batch of logged runs to supervise (e.g. the Test Set's "
         "test-seed<S>): the same scenarios and seeds, paired.")],

@@ -71,8 +71,14 @@ def ingest_into(data: DataRoot, runs_per_part: int = RUNS_PER_PART) -> None:
     from tqdm import tqdm
 
     from evoeye.store import ingest
+    from evoeye.store.ingest import discover_logs
 
-    if not data.warehouse.is_dir():
+    if not discover_logs(data.runs):
+        err().print(f"[yellow]warning:[/] no run logs under {data.runs}: nothing to ingest "
+                    "(`evoeye simulate --scenario NAME` writes some there)")
+        if not data.warehouse.is_dir():
+            return  # nothing to create a warehouse for
+    elif not data.warehouse.is_dir():
         where = "" if data.path.is_dir() else " (the data root does not exist yet)"
         err().print(f"creating a new warehouse at {data.warehouse}{where}")
     bars: list[tqdm] = []  # made once ingest knows how many logs it will read
@@ -140,6 +146,14 @@ def write_json(result: pa.Table) -> None:
                                   option=orjson.OPT_SERIALIZE_NUMPY).decode() + "\n")
 
 
+def _holds_runs(data: DataRoot) -> bool:
+    """Whether the warehouse holds any ingested run."""
+    from evoeye.store import Warehouse
+
+    query = "SELECT count(*) AS n FROM scenarios"
+    return bool(Warehouse(data).read_only_sql(query).column("n")[0].as_py())
+
+
 @app.command("sql")
 def sql_command(
     query: Annotated[str, typer.Argument(help="SQL over the warehouse views, e.g. "
@@ -167,6 +181,9 @@ def sql_command(
         raise UserError(str(exc), "--allow-files lets a query read other files") from exc
     except duckdb.Error as exc:
         raise UserError(str(exc), "the views are listed in docs/warehouse.md") from exc
+    if result.num_rows == 0 and not _holds_runs(data):
+        err().print(f"[yellow]warning:[/] the warehouse at {data.warehouse} holds no run yet: "
+                    "`evoeye simulate`, then `evoeye ingest`, fill it")
     if fmt is Format.csv:
         write_csv(result)
     elif fmt is Format.json:

@@ -22,13 +22,13 @@ from evoeye.evaluation.metrics import Curves, FrameMetrics, frame_metrics
 from evoeye.evaluation.monitors import check_scores, monitor_context_len
 from evoeye.evaluation.scenario import Runs, ScenarioMetrics, scenario_metrics
 from evoeye.monitor.calibration import calibrate_on_validation
-from evoeye.monitor.protocol import TARGET_FPRS, Monitor, Thresholds
+from evoeye.monitor.protocol import TARGET_FPRS, WARNING_K, Monitor, Thresholds
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 from evoeye.store.scores import ScoreRows, write_scores
 from evoeye.store.windows import DEFAULT_HORIZON_S
 
-SCENARIO_KS = (1, 3)
+SCENARIO_KS = (1, WARNING_K)  # the headline reads the largest: a warning
 
 
 @dataclass

@@ -14,19 +14,22 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from evoeye.evaluation.monitors import BASELINES, RULES
+from evoeye.evaluation.baselines import BASELINE_SPECS, rule_names
+from evoeye.evaluation.monitors import BASELINES
 from evoeye.evaluation.stats import paired_warnings_p
 from evoeye.evaluation.table import DASH, UNREACHABLE, Table, with_ci
+from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
+from evoeye.scenarios import SCENARIO_SPECS
 
 MIN_COLLISIONS = 10  # fewer test collisions: figures with intervals, but no "better than"
 ALPHA = 0.05  # the paired test's level for "warns of more collisions than"
-LABELS = {"fusion": "FusionMonitor", "ttc": "TTC", "ttc-2d": "TTC-2D", "rss": "RSS",
-          "rss-2s": "RSS-2s", "aem": "AEM", "context-only": "context-only"}
-
-
 def label(name: str) -> str:
-    """How reports name a monitor ("fusion" → "FusionMonitor")."""
-    return LABELS.get(name, name)
+    """How reports name a monitor ("fusion" → "FusionMonitor", a baseline by its spec's label,
+    else its name)."""
+    if name == DEFAULT_FAMILY:
+        return FAMILIES[DEFAULT_FAMILY].label
+    spec = BASELINE_SPECS.get(name)
+    return name if spec is None else spec.label
 
 
 @dataclass(frozen=True)
@@ -80,9 +83,12 @@ def ranked(f: Figures) -> tuple:
             -(lead or 0.0))
 
 
+BEST_RULE = "the rule that warned of the most collisions; ties: fewer false alarms, longer lead"
+
+
 def best_rule(report: dict, point: Point) -> Figures | None:
     """The best rule-based baseline evaluated (`ranked`), if any was."""
-    rules = [figures(m, point) for m in report["monitors"] if m["name"] in RULES]
+    rules = [figures(m, point) for m in report["monitors"] if m["name"] in rule_names()]
     return min(rules, key=ranked) if rules else None
 
 
@@ -114,12 +120,18 @@ def _few(n: int) -> bool:
 
 
 def dataset_words(report: dict, point: Point) -> str:
-    """"40 test runs: 8 with a collision, 32 collision-free (0.15 h of driving)"."""
-    test = report["dataset"]["test"]
+    """"40 test runs (…): 8 with a collision, 32 collision-free (0.15 h of driving); …": the
+    runs measured, and the validation runs the thresholds were set on (a report counts the
+    runs of each split apart: the test runs are never the validation ones)."""
+    test, val = report["dataset"]["test"], report["dataset"].get("val")
     fa = figures(report["monitors"][0], point).false_alarms if report["monitors"] else None
     hours = f" ({fa['safe_h']:.2f} h of driving)" if fa else ""
-    return (f"{test['scenarios']} test runs: {test['violations']} with a collision, "
+    text = (f"{test['scenarios']} test runs, which no monitor trained or was calibrated on: "
+            f"{test['violations']} with a collision, "
             f"{test['scenarios'] - test['violations']} collision-free{hours}")
+    if val is not None:
+        text += f"; the thresholds were set on {val['scenarios']} other, validation runs"
+    return text
 
 
 def describe(f: Figures) -> str:
@@ -189,14 +201,20 @@ def _interval(est: dict) -> tuple[float, float] | None:
     return est["low"], est["high"]
 
 
+def scenario_words(name: str) -> str:
+    """"highway-cut-in (S1: a highway, …)": a scenario's name and its label, if registered."""
+    spec = SCENARIO_SPECS.get(name)
+    return name if spec is None else f"{name} ({spec.label})"
+
+
 def summary(report: dict) -> list[str]:
     """The plain-words headline of one logical scenario: a line per sentence."""
     point = operating_point(report)
-    lines = [f"{report['logical_scenario']} — {dataset_words(report, point)}."]
+    lines = [f"{scenario_words(report['logical_scenario'])} — {dataset_words(report, point)}."]
     ours, rule = trained(report, point), best_rule(report, point)
     lines += [f"  {describe(f)}." for f in ours]
     if rule is not None:
-        lines.append(f"  Best rule-based baseline, {describe(rule)}.")
+        lines.append(f"  Best rule-based baseline ({BEST_RULE}), {describe(rule)}.")
     if ours and rule is not None and ours[0].reachable and rule.reachable:
         lines.append(f"  Verdict: {verdict(ours[0], rule)}.")
     elif not ours and _few(report["dataset"]["test"]["violations"]):

@@ -1,10 +1,11 @@
 """Which monitors to evaluate: the baselines by name, trained monitors by version.
 
-TTC, TTC-2D and RSS (also `rss-2s`: CARLA's 2 s response time for the other vehicles) are rules
-and need no data. The trained baselines (AEM, the context-only control) are monitor families
-with an RQ1 `fit` on the scenario's train split (`evoeye.baselines.families`, trained once and
-found again). A version of any family loads through the family registry
-(`evoeye.monitor.families`), whatever its family.
+The baselines are the registered ones (`evoeye.evaluation.baselines`, one module each, and
+third-party ones through an entry point): TTC, TTC-2D and RSS (also `rss-2s`: CARLA's 2 s
+response time for the other vehicles) are rules and need no data; the trained ones (AEM, the
+context-only control) are monitor families with an RQ1 `fit` on the scenario's train split
+(`evoeye.baselines.families`, trained once and found again). A version of any family loads
+through the family registry (`evoeye.monitor.families`), whatever its family.
 """
 
 from __future__ import annotations
@@ -13,22 +14,19 @@ from collections.abc import Callable, Iterable
 
 import numpy as np
 
-from evoeye.baselines import CARLA_OTHER_VEHICLES, RSSMonitor, TTC2DMonitor, TTCMonitor
+import evoeye.baselines  # noqa: F401  (registers the trained baselines' monitor families)
+from evoeye.evaluation.baselines import BASELINE_SPECS
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES, load_version
 from evoeye.monitor.protocol import Monitor
 from evoeye.paths import DataRoot
+from evoeye.plugins import View
 from evoeye.store import SplitSpec
 
 BaselineBuilder = Callable[[DataRoot, str, SplitSpec], Monitor]
-BASELINES: dict[str, BaselineBuilder] = {
-    "ttc": lambda root, scenario, splits: TTCMonitor(),
-    "ttc-2d": lambda root, scenario, splits: TTC2DMonitor(),
-    "rss": lambda root, scenario, splits: RSSMonitor(),
-    "rss-2s": lambda root, scenario, splits: RSSMonitor(other=CARLA_OTHER_VEHICLES, name="rss-2s"),
-    # the trained baselines: every registered family with an RQ1 fit (aem, context-only)
-    **{name: family.fit for name, family in FAMILIES.items() if family.fit is not None},
-}
-RULES = tuple(name for name in BASELINES if name not in FAMILIES)  # no data, no training
+
+
+# baseline name → `(root, scenario, splits) -> Monitor`, read from the registry
+BASELINES: View[BaselineBuilder] = View(BASELINE_SPECS, lambda spec: spec.build)
 
 
 def baseline_monitors(root: DataRoot, scenario: str,

@@ -10,6 +10,9 @@ import numpy as np
 from evoeye.store.windows import Windows
 
 TARGET_FPRS = (0.05, 0.01)  # the paper's two operating points, calibrated on validation
+# a warning: this many consecutive alarm frames (0.15 s at 20 Hz), wherever a run's alarms are
+# read — `evoeye replay`, the reports' headline and the demo's summary
+WARNING_K = 3
 
 
 @dataclass(frozen=True)

@@ -38,6 +38,7 @@ from evoeye.log.mcap_writer import McapWriter
 from evoeye.log.viz import ego_label
 from evoeye.log.writer import CHUNK_SIZE_BYTES, COMPRESSION, LIBRARY, ZSTD_LEVEL, dumps
 from evoeye.monitor.fusion import FusionMonitor
+from evoeye.monitor.protocol import WARNING_K
 from evoeye.monitor.runtime import RiskState, RuntimeMonitor
 
 RISK_TOPIC = "/monitor/risk"
@@ -167,7 +168,7 @@ def _write_copy(source: bytes, stream: io.BufferedWriter,
 
 
 def replay(log: str | os.PathLike, monitor: FusionMonitor, out: str | os.PathLike | None = None,
-           *, fpr: float = 0.05, consecutive: int = 1) -> ReplayReport:
+           *, fpr: float = 0.05, consecutive: int = WARNING_K) -> ReplayReport:
     """Write a copy of `log` with the monitor's risk and alarm channels (default
     `<log>.risk.mcap` beside it); what the monitor said."""
     log = Path(log)

@@ -1,7 +1,8 @@
 """What `evoeye results` runs: its sizes and choices, declared once and validated.
 
 Plain data that imports nothing heavy (the command line reads it at start-up); the defaults that
-come from elsewhere are literals checked against their sources by tests/results/test_config.py.
+come from elsewhere are literals checked against their sources by tests/results/test_config.py;
+the scenarios and baselines are read from their registries.
 
 Sizes, and why:
 
@@ -31,11 +32,11 @@ from collections.abc import Mapping
 from dataclasses import dataclass, field, fields, replace
 from typing import Any
 
+from evoeye.evaluation.baselines import BASELINE_SPECS
 from evoeye.results.efficiency.config import EfficiencyConfig
+from evoeye.scenarios import SCENARIO_SPECS, SCENARIOS
 
-SCENARIOS = ("highway-cut-in", "unprotected-intersection")  # evoeye.scenarios.SCENARIOS
-BASELINES = ("ttc", "ttc-2d", "rss", "rss-2s", "aem",
-             "context-only", "where-when")  # evoeye.evaluation.monitors.BASELINES
+BASELINES = BASELINE_SPECS  # the registered baselines' names (evoeye.evaluation.baselines)
 CONTEXT_LENS = (1, 3, 5, 7)  # evoeye.evaluation.ablation.CONTEXT_LENS
 INPUTS = ("perception", "perception+prediction", "perception+prediction+planning",
           "all")  # evoeye.monitor.inputs.ABLATIONS
@@ -48,9 +49,10 @@ PARTS = (*PAPER_PARTS, "efficiency")  # + the sample-efficiency study (evoeye.re
 # with the k seeds of "G_0 (k seeds)" (what the data it acquired is worth, whatever the update)
 FINALS = ("update", "retrain")
 MONITOR_PARTS = ("rq1", "ablation")  # the parts that train on RQ1's data
-PAPER_TEST_RUNS = {"highway-cut-in": 75, "unprotected-intersection": 132}
-# the paper's initial data: its train + validation runs per scenario (split 0.8 : 0.2)
-PAPER_INITIAL_RUNS = {"highway-cut-in": 107 + 25, "unprotected-intersection": 177 + 45}
+# the paper's test runs, and its initial data (train + validation runs, split 0.8 : 0.2), of
+# the scenarios it studied (`ScenarioSpec.paper_runs`)
+PAPER_TEST_RUNS = {n: s.paper_runs[0] for n, s in SCENARIO_SPECS.items() if s.paper_runs}
+PAPER_INITIAL_RUNS = {n: s.paper_runs[1] for n, s in SCENARIO_SPECS.items() if s.paper_runs}
 # training recipes (evoeye.monitor.recipes RECIPES, DEFAULT_RECIPE, LEGACY_RECIPE): a config
 # recorded before the recipe was one of its fields was trained with the legacy one
 RECIPES = ("v1", "v2", "v3")
@@ -79,7 +81,7 @@ def parse_initial_runs(values: list[str]) -> int | dict[str, int]:
                              "(N a whole number >= 0)")
         if sep and scenario not in SCENARIOS:
             raise ValueError(f"--initial-runs {value!r}: unknown scenario {scenario!r}; known: "
-                             f"{list(SCENARIOS)}")
+                             f"{', '.join(SCENARIOS)}")
         if sep:
             per[scenario] = n
         else:
@@ -91,7 +93,7 @@ def parse_initial_runs(values: list[str]) -> int | dict[str, int]:
 class ResultsConfig:
     """Everything `evoeye results` regenerates, and at what size (module doc)."""
 
-    scenarios: tuple[str, ...] = SCENARIOS
+    scenarios: tuple[str, ...] = field(default_factory=lambda: tuple(SCENARIOS))  # registered
     training_seeds: tuple[int, ...] = (0, 1, 2, 3, 4, 5)
     campaign_seeds: tuple[int, ...] = tuple(range(20))
     final_seeds: int = 3  # k: a final monitor is judged by the mean over k training seeds
@@ -110,7 +112,7 @@ class ResultsConfig:
     val_frac: float | None = None  # None: 0.2 with a test batch, else SplitSpec's 0.125
     horizon_s: float = 3.0
     # RQ1 and the monitor ablation
-    baselines: tuple[str, ...] = BASELINES
+    baselines: tuple[str, ...] = field(default_factory=lambda: tuple(BASELINES))  # registered
     context_lens: tuple[int, ...] = CONTEXT_LENS
     inputs: tuple[str, ...] = INPUTS
     epochs: int | None = None  # every training (None: each trainer's default)
@@ -138,7 +140,7 @@ class ResultsConfig:
             runs = dict(self.initial_runs)
             if unknown_runs := sorted(set(runs) - set(SCENARIOS)):
                 raise ValueError(f"initial runs given for unknown scenario(s) {unknown_runs}; "
-                                 f"known: {list(SCENARIOS)}")
+                                 f"known: {', '.join(SCENARIOS)}")
             object.__setattr__(self, "initial_runs",
                                {s: int(runs.get(s, 0)) for s in self.scenarios})
         for name in ("training_seeds", "campaign_seeds"):  # pairs need two seeds at least

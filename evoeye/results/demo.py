@@ -1,8 +1,9 @@
 """The demo: what the monitor achieves, on fresh runs, in minutes (`evoeye demo`, `make demo`).
 
-1. Simulate `n` runs of each logical scenario (batch `demo`) and ingest them. The shipped
-   monitors (`evoeye.monitor.pretrained`) were trained on other runs (another seed), so these
-   are fresh to them.
+1. Simulate `n` runs of each logical scenario that ships a demo monitor (its
+   `ScenarioSpec.demo_monitor`; the others are skipped, and said so) in batch `demo`, and ingest
+   them. The shipped monitors (`evoeye.monitor.pretrained`) were trained on other runs (another
+   seed), so these are fresh to them.
 2. Per scenario, evaluate the shipped FusionMonitor against the rule-based baselines on the test
    runs, every threshold calibrated on the validation runs (`SPLITS`).
 3. Per scenario, one round of BlindSpotEvolver from the shipped monitor (G_0): propose
@@ -17,15 +18,18 @@ share: the settings, the evaluation, the campaign of each round and the summary.
 
 from __future__ import annotations
 
+from collections.abc import Iterable
 from dataclasses import dataclass, field
+from importlib.resources import files
 from pathlib import Path
 
+from evoeye.evaluation.baselines import rule_names
 from evoeye.evaluation.headline import MIN_COLLISIONS, point_note, summary
-from evoeye.evaluation.monitors import RULES
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.report import change_words
 from evoeye.monitor.pretrained import install, packaged_cards, packaged_versions
 from evoeye.paths import DataRoot
+from evoeye.scenarios import SCENARIO_SPECS, simulable
 from evoeye.store import SplitSpec
 from evoeye.store.feedback import RoundRow
 
@@ -33,7 +37,6 @@ BATCH = "demo"
 REPORT = "demo"
 SUMMARY_FILE = "summary.md"
 SPLITS = SplitSpec(seed=0, train_frac=0.3, val_frac=0.2)  # half of the runs are test runs
-RUNS = {"highway-cut-in": 120, "unprotected-intersection": 60}  # ≥ MIN_COLLISIONS test ones
 EVOLVE_RUNS = 4  # runs of the one evolution round, per scenario
 EVOLVE_SEED = 0
 
@@ -57,13 +60,46 @@ class DemoResult:
         return out
 
 
+def runs_of(scenario: str) -> int:
+    """The demo's runs of `scenario` by default (its `ScenarioSpec.demo_runs`: enough for
+    >= MIN_COLLISIONS test collisions)."""
+    return SCENARIO_SPECS[scenario].demo_runs
+
+
+def shipped_folder(scenario: str) -> Path | None:
+    """The folder of the versions shipped with `scenario`'s package, if it ships a monitor."""
+    package = simulable(scenario).demo_monitor
+    return None if package is None else Path(str(files(package)))
+
+
+def shipped_version(scenario: str) -> str | None:
+    """The version shipped for `scenario`, if any."""
+    folder = shipped_folder(scenario)
+    return None if folder is None else packaged_versions(folder).get(scenario)
+
+
+def plan(names: Iterable[str] | None = None) -> tuple[list[str], list[str]]:
+    """The demo's scenarios (`names`, default every registered one) split into those that
+    ship a monitor and those skipped for shipping none; ScenarioError for an unknown name."""
+    run, skipped = [], []
+    for name in names or SCENARIO_SPECS:
+        (run if shipped_version(name) else skipped).append(name)
+    return run, skipped
+
+
+def skipped_line(skipped: list[str]) -> str:
+    """What the demo says of the scenarios it skips."""
+    return (f"skipped (no demo monitor shipped; `make demo-monitors` trains one): "
+            f"{', '.join(skipped)}")
+
+
 def shipped_monitor(root: DataRoot, scenario: str) -> str:
     """The version shipped for `scenario`, installed into `root`."""
-    versions = packaged_versions()
-    if scenario not in versions:
+    version = shipped_version(scenario)
+    if version is None:
         raise LookupError(f"no monitor is shipped for {scenario!r}: build them with "
                           "`make demo-monitors`")
-    return install(root, versions[scenario])
+    return install(root, version, shipped_folder(scenario))
 
 
 def evaluate_shipped(root: DataRoot, scenario: str) -> dict:
@@ -71,7 +107,7 @@ def evaluate_shipped(root: DataRoot, scenario: str) -> dict:
     dict, `EvaluationReport.to_dict()`); the scores go to monitor_scores."""
     from evoeye.evaluation.rq1 import rq1
 
-    (report,) = rq1(root, [scenario], baselines=RULES,
+    (report,) = rq1(root, [scenario], baselines=rule_names(),
                     monitor_versions=[shipped_monitor(root, scenario)], splits=SPLITS,
                     latency=False)
     return report.to_dict()
@@ -101,13 +137,18 @@ def write_summary(result: DemoResult) -> None:
 
 WHICH = ("Which figure is which: 'FusionMonitor' is the monitor shipped with evoeye (trained by "
          "`make demo-monitors` on {runs}; see its card), measured here on this demo's test "
-         "runs, which it never saw. The evolution round ran here, on this demo's runs.")
+         "runs, which it never saw; its thresholds were set again on this demo's validation "
+         "runs, as every monitor's. The evolution round ran here, on this demo's runs.")
 
 
-def _trained_on() -> str:
-    """"400 highway-cut-in runs, …": what the shipped monitors were trained on."""
-    return ", ".join(f"{card['data']['train']['runs']} {scenario} runs"
-                     for scenario, card in packaged_cards().items())
+def _trained_on(scenarios: Iterable[str]) -> str:
+    """"401 training runs (and calibrated on 99 validation runs) of highway-cut-in, …": what
+    the shipped monitors were trained on."""
+    cards = {s: packaged_cards(folder)[s] for s in scenarios
+             if (folder := shipped_folder(s)) is not None}
+    return ", ".join(f"{card['data']['train']['runs']} training runs (and calibrated on "
+                     f"{card['data']['val']['runs']} validation runs) of {scenario}"
+                     for scenario, card in cards.items())
 
 
 def run_round(root: DataRoot, scenario: str, runs: int = EVOLVE_RUNS) -> list[RoundRow]:
@@ -134,7 +175,7 @@ def summary_text(result: DemoResult) -> str:
         if rows is not None:
             lines.append(f"  Evolution: {change_words(rows)}")
         lines.append("")
-    lines.append(WHICH.format(runs=_trained_on()))
+    lines.append(WHICH.format(runs=_trained_on(r["logical_scenario"] for r in result.reports)))
     if any(r["dataset"]["test"]["violations"] < MIN_COLLISIONS for r in result.reports):
         lines.append(f"Fewer than {MIN_COLLISIONS} test collisions in a scenario: its figures "
                      "carry wide intervals and no monitor is called better there.")

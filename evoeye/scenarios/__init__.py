@@ -1,9 +1,11 @@
-"""Logical scenario spaces, looked up by name."""
+"""Logical scenario spaces, looked up by name in the registry (`registry.SCENARIO_SPECS`)."""
 
-from evoeye.scenarios.catalog import HIGHWAY_CUT_IN, INTERSECTION
+from evoeye.plugins import View
+from evoeye.scenarios.registry import SCENARIO_SPECS, AuditBands, ScenarioSpec
 from evoeye.scenarios.space import DEFAULT_DELTA, LogicalScenario, Parameter, ScenarioError
 
-SCENARIOS: dict[str, LogicalScenario] = {s.name: s for s in (HIGHWAY_CUT_IN, INTERSECTION)}
+# the simulated scenarios' spaces: built-in and third-party, read from the registry
+SCENARIOS: View[LogicalScenario] = View(SCENARIO_SPECS, lambda spec: spec.space)
 # Runs that were recorded, not simulated here (`evoeye import`): a space with no parameter, so a
 # recording's run metadata fits it. Never simulated, sampled or searched (not in SCENARIOS).
 EXTERNAL = LogicalScenario("external", "a run recorded by another stack and imported", ())
@@ -15,9 +17,20 @@ def get_scenario(name: str) -> LogicalScenario:
     the known ones."""
     known = SCENARIOS.get(name) or RECORDED.get(name)
     if known is None:
-        names = sorted(SCENARIOS) + sorted(RECORDED)
-        raise ScenarioError(f"unknown logical scenario {name!r}; known: {names}")
+        raise ScenarioError(f"unknown logical scenario {name!r}; known: "
+                            f"{', '.join([*SCENARIOS, *RECORDED])}")
     return known
+
+
+def simulable(name: str) -> ScenarioSpec:
+    """The registered scenario `name`, or a ScenarioError naming the ones that can be
+    simulated (a recorded one, such as `external`, cannot)."""
+    spec = SCENARIO_SPECS.get(name)
+    if spec is None:
+        what = (f"logical scenario {name!r} is recorded, not simulated" if name in RECORDED
+                else f"unknown logical scenario {name!r}")
+        raise ScenarioError(f"{what}; simulated ones: {', '.join(SCENARIOS)}")
+    return spec
 
 
 __all__ = [
@@ -25,8 +38,12 @@ __all__ = [
     "EXTERNAL",
     "RECORDED",
     "SCENARIOS",
+    "SCENARIO_SPECS",
+    "AuditBands",
     "LogicalScenario",
     "Parameter",
     "ScenarioError",
+    "ScenarioSpec",
     "get_scenario",
+    "simulable",
 ]

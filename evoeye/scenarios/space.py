@@ -11,8 +11,14 @@ import hashlib
 import math
 from collections.abc import Sequence
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
-import numpy as np
+from evoeye.lazy import LazyModule
+
+if TYPE_CHECKING:
+    import numpy as np
+else:  # numpy on first use: the registry of scenarios is read by `evoeye --help`
+    np = LazyModule("numpy")
 
 DEFAULT_DELTA = 0.2  # neighbourhood radius, as a share of each parameter's range
 

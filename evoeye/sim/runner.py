@@ -17,22 +17,21 @@ import numpy as np
 from evoeye import __version__
 from evoeye.ads import ADS, DEFAULT_PROFILE, ADSConfig, ads_profile, check_profile
 from evoeye.ads.messages import FrameMessages
-from evoeye.scenarios import get_scenario
+from evoeye.scenarios import SCENARIO_SPECS, simulable
 from evoeye.scene import RoadMap, SceneState
 from evoeye.sim.episode import STATUS_FAILED, STATUS_OK, Episode, Frame, Outcome, RunSpec
 from evoeye.sim.footprint import min_ego_gap
-from evoeye.sim.highway import build_highway
-from evoeye.sim.intersection import build_intersection
 from evoeye.sim.world import World
 from evoeye.sim.worlds import DEFAULT_WORLD, check_world, run_variant, vary
 
 RATE_HZ = 20.0
 
 WorldBuilder = Callable[[dict[str, float], np.random.Generator], tuple[World, float]]
-WORLD_BUILDERS: dict[str, WorldBuilder] = {
-    "highway-cut-in": build_highway,
-    "unprotected-intersection": build_intersection,
-}
+
+
+def world_builder(scenario: str) -> WorldBuilder:
+    """The registered scenario's world builder (`ScenarioSpec.world`)."""
+    return simulable(scenario).world_builder()
 
 
 class SimulationError(RuntimeError):
@@ -53,7 +52,7 @@ def run_spec(
 ) -> RunSpec:
     """A validated RunSpec whose id is derived from (scenario, params, seed, ADS profile,
     world variant)."""
-    space = get_scenario(scenario)
+    space = simulable(scenario).space
     x = space.validate(params)
     check_profile(ads)
     check_world(world, scenario)
@@ -72,8 +71,8 @@ def _seeds(seed: int) -> tuple[np.random.Generator, np.random.Generator]:
 
 def build_world(spec: RunSpec, world_rng: np.random.Generator | None = None) -> tuple[World, float]:
     """The world of a run and the ego's cruise speed, exactly as `run_episode` sets it up."""
-    params = get_scenario(spec.scenario).as_dict(spec.params)
-    world, cruise_mps = WORLD_BUILDERS[spec.scenario](params, world_rng or _seeds(spec.seed)[0])
+    params = SCENARIO_SPECS[spec.scenario].space.as_dict(spec.params)
+    world, cruise_mps = world_builder(spec.scenario)(params, world_rng or _seeds(spec.seed)[0])
     return vary(spec.world, spec.scenario, world, params, cruise_mps), cruise_mps
 
 
@@ -108,7 +107,8 @@ def run_episode(
     another factory and get the same world, the same random streams and the same frame loop.
     """
     config = config or SimConfig()
-    get_scenario(spec.scenario).validate(spec.params)  # a bad vector is the caller's error: raise
+    # a bad vector is the caller's error: raise
+    simulable(spec.scenario).space.validate(spec.params)
     check_profile(spec.ads)
     check_world(spec.world, spec.scenario)
     world_rng, ads_rng = _seeds(spec.seed)

@@ -6,12 +6,14 @@ from evoeye.cli import defaults
 
 
 def test_help_defaults_equal_their_sources() -> None:
+    import evoeye.baselines  # noqa: F401  (registers the baselines' monitor families)
     from evoeye.ads.profiles import ADS_PROFILES
-    from evoeye.evaluation.monitors import BASELINES
+    from evoeye.evolve.campaign.experiment import methods
+    from evoeye.evolve.search import STRATEGIES
+    from evoeye.monitor.families import evolvable_families
     from evoeye.monitor.inputs import ABLATIONS, MODULES
-    from evoeye.monitor.protocol import TARGET_FPRS
+    from evoeye.monitor.protocol import TARGET_FPRS, WARNING_K
     from evoeye.monitor.recipes import DEFAULT_RECIPE, RECIPES
-    from evoeye.scenarios import SCENARIOS
     from evoeye.sim.worlds import WORLD_NAMES
     from evoeye.store import SplitSpec
     from evoeye.store.ingest import DEFAULT_RUNS_PER_PART
@@ -19,17 +21,36 @@ def test_help_defaults_equal_their_sources() -> None:
 
     split = SplitSpec()
     pairs = {
-        "SCENARIO_NAMES": tuple(SCENARIOS), "ADS_PROFILE_NAMES": tuple(ADS_PROFILES),
+        "ADS_PROFILE_NAMES": tuple(ADS_PROFILES),
         "WORLD_NAMES": WORLD_NAMES,
         "SPLIT_SEED": split.seed, "TRAIN_FRAC": split.train_frac, "VAL_FRAC": split.val_frac,
         "CONTEXT_LEN": DEFAULT_CONTEXT_LEN, "HORIZON_S": DEFAULT_HORIZON_S,
-        "TARGET_FPRS": TARGET_FPRS, "RUNS_PER_PART": DEFAULT_RUNS_PER_PART,
-        "BASELINE_NAMES": tuple(BASELINES),
+        "TARGET_FPRS": TARGET_FPRS, "WARNING_K": WARNING_K,
+        "RUNS_PER_PART": DEFAULT_RUNS_PER_PART,
         "MODULE_NAMES": MODULES, "ABLATION_NAMES": tuple(ABLATIONS),
         "RECIPE_NAMES": tuple(RECIPES), "DEFAULT_RECIPE": DEFAULT_RECIPE,
+        "STRATEGY_NAMES": tuple(STRATEGIES), "FAMILY_NAMES": tuple(evolvable_families()),
+        "METHOD_NAMES": tuple(methods()),
     }
     shown = {name: getattr(defaults, name) for name in pairs}
     assert shown == pairs
+
+
+def test_replay_and_the_reports_count_a_warning_at_one_k() -> None:
+    import inspect
+
+    import typer
+
+    from evoeye.cli import app
+    from evoeye.evaluation.harness import SCENARIO_KS
+    from evoeye.evaluation.headline import operating_point
+    from evoeye.monitor.replay import replay
+
+    command = typer.main.get_command(app).commands["replay"]
+    cli_k = next(p.default for p in command.params if p.name == "consecutive")
+    report = {"fprs": [0.05, 0.01], "ks": list(SCENARIO_KS)}
+    assert cli_k == inspect.signature(replay).parameters["consecutive"].default == \
+        int(operating_point(report).k) == defaults.WARNING_K
 
 
 def test_supervise_help_defaults_equal_their_sources() -> None:

@@ -5,6 +5,7 @@ from __future__ import annotations
 import pytest
 
 from evoeye.evaluation.headline import (
+    BEST_RULE,
     MIN_COLLISIONS,
     best_rule,
     headline_table,
@@ -60,7 +61,7 @@ def test_a_clear_difference_on_the_same_runs_is_called_one() -> None:
                monitor("rss", 5, n, [0] * 30), monitor("aem", 20, n, [9] * 30),
                collisions=n, safe=30)
     text = "\n".join(summary(r))
-    assert "Best rule-based baseline, TTC warned of 8 of 20" in text  # AEM is no rule
+    assert f"Best rule-based baseline ({BEST_RULE}), TTC warned of 8 of 20" in text  # AEM: no rule
     assert "FusionMonitor warns of more collisions than TTC" in text
     assert "0 (≤ 20.0) false alarms per hour" in text  # 0 in 0.15 h: at most 3.0 / 0.15 h
     assert "200.0 (200.0–200.0) false alarms per hour" in text  # one per 18 s run

@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from evoeye.evaluation.headline import scenario_words
 from evoeye.paths import DataRoot
 from evoeye.results import demo as steps
 from flows.demo import DemoParams, demo_flow
@@ -20,18 +21,19 @@ def test_the_demo_flow_ends_with_its_summary_and_where_the_results_are(
     out = demo_flow(DemoParams(root=str(root.path), n=12, evolve_runs=2, workers=2))
     text = out["summary"]
     assert text.startswith("evoeye demo: what the runtime monitor achieves")
-    for scenario in steps.RUNS:
-        block = text.split(f"{scenario} — ")[1].split("\n\n")[0]
+    for scenario in steps.plan()[0]:
+        block = text.split(f"{scenario_words(scenario)} — ")[1].split("\n\n")[0]
         assert "FusionMonitor warned of " in block and " of safe driving (" in block
-        assert "Best rule-based baseline, " in block
+        assert "Best rule-based baseline (" in block
         assert "Evolution: 1 round(s) added 2 runs" in block
         assert "too few to compare" in block  # 12 runs: a handful of test collisions
     paths = dict(out["paths"])
     summary = Path(paths["this summary"])
     assert summary.read_text().strip() == text.strip()
     assert Path(paths["report (Markdown, HTML, JSON)"]).is_file()
-    assert len(list(root.runs.rglob("*.mcap"))) == 2 * 12 + 2 * 2  # demo runs + the rounds'
+    shipped = len(steps.plan()[0])
+    assert len(list(root.runs.rglob("*.mcap"))) == shipped * (12 + 2)  # demo runs + the rounds'
     assert text in latest_artifact("evoeye-demo")
     assert flow_run_names(f"demo-{root.path.name}")
-    assert flow_run_names(*(f"simulate-{s}-demo-n12" for s in steps.RUNS)) == sorted(
-        f"simulate-{s}-demo-n12" for s in steps.RUNS)
+    assert flow_run_names(*(f"simulate-{s}-demo-n12" for s in steps.plan()[0])) == sorted(
+        f"simulate-{s}-demo-n12" for s in steps.plan()[0])

@@ -24,7 +24,8 @@ def _report(warned: int, collisions: int) -> dict:
             "false_alarms": {"0.05": fa.to_dict()}}}}
 
     return {"logical_scenario": SCENARIO, "fprs": [0.05], "ks": [3], "frame_period_s": 0.05,
-            "dataset": {"test": {"scenarios": collisions + 20, "violations": collisions}},
+            "dataset": {"test": {"scenarios": collisions + 20, "violations": collisions},
+                        "val": {"scenarios": 24, "violations": 5}},
             "monitors": [monitor("fusion", warned), monitor("ttc", warned // 2)]}
 
 
@@ -47,10 +48,21 @@ def test_the_summary_answers_how_many_how_early_and_how_many_false_alarms(tmp_pa
     assert "FusionMonitor warned of 12 of 14 collisions" in text
     assert "a median 2.0 (2.0–2.0) s before the collision" in text
     assert "false alarms per hour of safe driving (1 of 20 safe runs alarmed)" in text
-    assert "Best rule-based baseline, TTC warned of 6 of 14" in text
+    assert ("Best rule-based baseline (the rule that warned of the most collisions; ties: "
+            "fewer false alarms, longer lead), TTC warned of 6 of 14") in text
+    assert ("34 test runs, which no monitor trained or was calibrated on: 14 with a collision, "
+            "20 collision-free") in text
+    assert "; the thresholds were set on 24 other, validation runs." in text
+    assert text.splitlines()[4].startswith(
+        "highway-cut-in (S1: a highway, a braking lead and cut-ins) — 34 test runs")
+    shipped = demo.packaged_cards()["highway-cut-in"]["data"]
+    assert (f"trained by `make demo-monitors` on {shipped['train']['runs']} training runs "
+            f"(and calibrated on {shipped['val']['runs']} validation runs) of highway-cut-in"
+            ) in text
     assert "Verdict: FusionMonitor warns of more collisions than TTC" in text
-    assert ("Evolution: 1 round(s) added 4 runs (62 s simulated) and replaced G_0 fusion-a by "
-            "fusion-b: Test-Set F1@0.05 60.0 → 62.0 %, Hard-Set F1@0.05 0.0 → 25.0 %") in text
+    assert ("Evolution: 1 round(s) added 4 runs (62 s simulated) and replaced G_0 fusion-a (the "
+            "monitor the campaign started from) by fusion-b: Test-Set F1@0.05 60.0 → 62.0 %, "
+            "Hard-Set F1@0.05 0.0 → 25.0 %") in text
     assert "Which figure is which" in text and "Fewer than" not in text  # 14 collisions
     assert [w for w, _ in result.paths()][-1] == "this summary"
 
@@ -65,10 +77,11 @@ def test_too_few_collisions_are_said_so_in_the_summary(tmp_path) -> None:
 def test_a_monitor_is_shipped_per_scenario_and_installs_into_a_root(tmp_path) -> None:
     from evoeye.monitor.families import load_version
     from evoeye.results import demo_monitors
-    from evoeye.scenarios import SCENARIOS
+    from evoeye.scenarios import SCENARIO_SPECS
 
     versions = packaged_versions()
-    assert set(versions) == set(SCENARIOS)
+    assert set(versions) == {n for n, s in SCENARIO_SPECS.items() if s.demo_monitor}
+    assert versions == {n: demo.shipped_version(n) for n in versions}
     cards = packaged_cards()
     root = DataRoot.resolve(tmp_path)
     for scenario, version in versions.items():
@@ -86,17 +99,27 @@ def test_a_monitor_is_shipped_per_scenario_and_installs_into_a_root(tmp_path) ->
         assert monitor.card["logical_scenario"] == scenario
 
 
-def test_a_scenario_without_a_shipped_monitor_is_one_clear_error(tmp_path, monkeypatch) -> None:
-    monkeypatch.setattr(demo, "packaged_versions", lambda: {})
+def test_a_scenario_without_a_shipped_monitor_is_skipped_or_one_clear_error(
+        tmp_path, monkeypatch) -> None:
+    from evoeye.scenarios import SCENARIO_SPECS, ScenarioError
+
+    monkeypatch.setitem(SCENARIO_SPECS, SCENARIO,
+                        replace(SCENARIO_SPECS[SCENARIO], demo_monitor=None))
     with pytest.raises(LookupError, match="make demo-monitors"):
         demo.shipped_monitor(DataRoot.resolve(tmp_path), SCENARIO)
+    run, skipped = demo.plan()
+    assert skipped == [SCENARIO] and SCENARIO not in run and run
+    assert SCENARIO in demo.skipped_line(skipped)
+    assert demo.plan([SCENARIO]) == ([], [SCENARIO])
+    with pytest.raises(ScenarioError, match="unknown logical scenario 'roundabout'; simulated "):
+        demo.plan(["roundabout"])
 
 
 def test_the_demo_runs_are_never_the_shipped_monitors_training_runs() -> None:
     from evoeye.batch import plan_uniform
     from evoeye.results import demo_monitors
 
-    for scenario in demo.RUNS:
+    for scenario in demo.plan()[0]:
         shipped = {s.params for s in plan_uniform(scenario, 500, demo_monitors.SEED,
                                                   batch=demo_monitors.BATCH)}
         fresh = {s.params for s in plan_uniform(scenario, 120, 0, batch=demo.BATCH)}
@@ -108,7 +131,11 @@ def test_a_round_that_kept_g0_says_so_not_that_it_replaced_it() -> None:
 
     g0, round1 = _rounds()
     kept = change_words([g0, replace(round1, monitor_version=g0.monitor_version)])
-    assert "and kept G_0 fusion-a (no update beat it on the validation split" in kept
-    assert kept.endswith("to learn from).") and "replaced" not in kept and "→" not in kept
-    assert "replaced G_0 fusion-a by fusion-b: Test-Set F1@0.05 60.0 → 62.0 %" in change_words(
-        [g0, round1])
+    assert ("and kept G_0 fusion-a (the monitor the campaign started from; kept: no update beat "
+            "it on the validation split).") in kept
+    assert "replaced" not in kept and "→" not in kept
+    assert ("replaced G_0 fusion-a (the monitor the campaign started from) by fusion-b: "
+            "Test-Set F1@0.05 60.0 → 62.0 %") in change_words([g0, round1])
+    empty = change_words([g0, replace(round1, monitor_version=g0.monitor_version,
+                                      scenario_ids=[])])
+    assert "added 0 runs" in empty and "kept: no round acquired a run to learn from)." in empty

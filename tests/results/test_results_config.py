@@ -11,20 +11,22 @@ import pytest
 from evoeye.results import config
 from evoeye.results.config import PAPER_INITIAL_RUNS, ResultsConfig, parse_initial_runs
 
-S1, S2 = config.SCENARIOS
+PAPER = tuple(PAPER_INITIAL_RUNS)  # the paper's scenarios, whatever else is registered
+S1, S2 = PAPER
+
+
+def every(runs: int = 0, **per: int) -> dict[str, int]:
+    """`runs` for every registered scenario, except those given per name."""
+    return {**dict.fromkeys(config.SCENARIOS, runs), **per}
 
 
 def test_the_literal_defaults_are_their_sources() -> None:
     from evoeye.evaluation.ablation import CONTEXT_LENS
-    from evoeye.evaluation.monitors import BASELINES
     from evoeye.evolve.campaign.experiment import ABLATION, MAIN
     from evoeye.monitor.inputs import ABLATIONS
     from evoeye.monitor.recipes import DEFAULT_RECIPE, LEGACY_RECIPE, RECIPES
-    from evoeye.scenarios import SCENARIOS
     from evoeye.splits import SplitSpec
 
-    assert tuple(SCENARIOS) == config.SCENARIOS
-    assert tuple(BASELINES) == config.BASELINES
     assert config.CONTEXT_LENS == CONTEXT_LENS
     assert tuple(ABLATIONS) == config.INPUTS
     assert config.METHODS == MAIN + ABLATION
@@ -63,7 +65,7 @@ def test_the_defaults_are_the_issues_sizes() -> None:
     ({"initial_runs": 260, "test_runs": 0}, "need the Test Set simulated beside them"),
     ({"initial_runs": {S1: -1}}, r"initial runs must be >= 0, got \{'highway-cut-in': -1\}"),
     ({"initial_runs": {"roundabout": 5}}, r"unknown scenario\(s\) \['roundabout'\]"),
-    ({"initial_runs": {S1: 132}}, "give every scenario initial runs, or none"),
+    ({"initial_runs": {S1: 132}, "scenarios": PAPER}, "give every scenario initial runs, or none"),
 ])
 def test_bad_sizes_are_refused(kwargs: dict, message: str) -> None:
     with pytest.raises(ValueError, match=message):
@@ -88,10 +90,10 @@ def test_rq1_gets_initial_runs_of_its_own_only_when_the_study_simulates_fewer() 
 @pytest.mark.parametrize(("values", "runs"), [
     ([], 0),
     (["260"], 260),
-    (["paper"], PAPER_INITIAL_RUNS),
-    ([f"{S2}=222"], {S1: 0, S2: 222}),
-    (["100", f"{S2}=222"], {S1: 100, S2: 222}),
-    (["paper", f"{S1}=7"], {S1: 7, S2: PAPER_INITIAL_RUNS[S2]}),
+    (["paper"], every(**PAPER_INITIAL_RUNS)),
+    ([f"{S2}=222"], every(**{S2: 222})),
+    (["100", f"{S2}=222"], every(100, **{S2: 222})),
+    (["paper", f"{S1}=7"], every(**{**PAPER_INITIAL_RUNS, S1: 7})),
     ([f"{S1}=7", "50"], 50),  # a count for every scenario after a per-scenario one: it wins
 ])
 def test_initial_runs_are_one_count_or_per_scenario(values: list[str], runs) -> None:
@@ -117,14 +119,14 @@ def test_the_command_names_a_bad_initial_runs_value_before_it_runs(tmp_path) -> 
 
 
 def test_per_scenario_initial_runs_reach_each_scenario_and_rq1s_own_data() -> None:
-    cfg = ResultsConfig(initial_runs=PAPER_INITIAL_RUNS)
-    assert [cfg.runs_of(s) for s in config.SCENARIOS] == [132, 222] and cfg.rq1_own_data
+    cfg = ResultsConfig(scenarios=PAPER, initial_runs=PAPER_INITIAL_RUNS)
+    assert [cfg.runs_of(s) for s in PAPER] == [132, 222] and cfg.rq1_own_data
     assert cfg.rq1_config().initial_runs == {S1: config.RQ1_RUNS, S2: config.RQ1_RUNS}
-    mixed = ResultsConfig(initial_runs={S1: 132, S2: 2000})  # S2 has enough: it keeps its own
+    mixed = ResultsConfig(scenarios=PAPER, initial_runs={S1: 132, S2: 2000})  # S2 has enough
     assert mixed.rq1_config().initial_runs == {S1: config.RQ1_RUNS, S2: 2000}
     one = ResultsConfig(scenarios=(S2,), initial_runs=PAPER_INITIAL_RUNS)  # S1's is dropped
     assert one.initial_runs == {S2: 222} and one.runs_of(S1) == 0
-    assert not ResultsConfig(initial_runs={S1: 2000, S2: 1300}).rq1_own_data
+    assert not ResultsConfig(scenarios=PAPER, initial_runs={S1: 2000, S2: 1300}).rq1_own_data
 
 
 @pytest.mark.parametrize(("kwargs", "message"), [

@@ -1,9 +1,11 @@
 """One run: (scenario vector, seed) → Episode; reproducible, bounded, failures captured."""
 
+from dataclasses import replace
+
 import numpy as np
 import pytest
 
-from evoeye.scenarios import SCENARIOS, get_scenario
+from evoeye.scenarios import SCENARIO_SPECS, SCENARIOS, get_scenario
 from evoeye.sim import runner
 from evoeye.sim.runner import SimConfig, run_episode, run_spec
 
@@ -27,7 +29,7 @@ def frames_equal(a, b):
                 np.testing.assert_array_equal(np.asarray(v), np.asarray(mb.to_dict()[k]))
 
 
-@pytest.mark.parametrize("scenario", ["highway-cut-in", "unprotected-intersection"])
+@pytest.mark.parametrize("scenario", sorted(SCENARIOS))
 def test_same_spec_gives_the_same_run(scenario):
     spec = spec_for(scenario, seed=11, draw=3)
     a, b = run_episode(spec), run_episode(spec)
@@ -43,7 +45,7 @@ def test_a_different_seed_changes_the_ads_noise_but_not_the_scenario():
     assert a.frames[0].messages.localization.x_m != b.frames[0].messages.localization.x_m
 
 
-@pytest.mark.parametrize("scenario", ["highway-cut-in", "unprotected-intersection"])
+@pytest.mark.parametrize("scenario", sorted(SCENARIOS))
 def test_runs_last_20_s_or_end_2_s_after_the_first_collision(scenario):
     for draw in range(6):
         ep = run_episode(spec_for(scenario, draw=draw))
@@ -65,7 +67,8 @@ def test_a_run_that_raises_is_a_failed_episode_not_a_crash(monkeypatch):
     def broken(params, rng):
         raise RuntimeError("road network unavailable")
 
-    monkeypatch.setitem(runner.WORLD_BUILDERS, "highway-cut-in", broken)
+    monkeypatch.setitem(SCENARIO_SPECS, "highway-cut-in",
+                        replace(SCENARIO_SPECS["highway-cut-in"], world=broken))
     ep = run_episode(spec_for("highway-cut-in"))
     assert ep.outcome.status == "failed"
     assert "road network unavailable" in ep.outcome.reason
@@ -73,14 +76,15 @@ def test_a_run_that_raises_is_a_failed_episode_not_a_crash(monkeypatch):
 
 
 def test_a_nan_in_the_world_is_a_failed_episode(monkeypatch):
-    real = runner.WORLD_BUILDERS["highway-cut-in"]
+    real = runner.world_builder("highway-cut-in")
 
     def poisoned(params, rng):
         world, cruise = real(params, rng)
         world.npcs[0].speed = float("nan")
         return world, cruise
 
-    monkeypatch.setitem(runner.WORLD_BUILDERS, "highway-cut-in", poisoned)
+    monkeypatch.setitem(SCENARIO_SPECS, "highway-cut-in",
+                        replace(SCENARIO_SPECS["highway-cut-in"], world=poisoned))
     ep = run_episode(spec_for("highway-cut-in"))
     assert ep.outcome.status == "failed"
     assert "non-finite" in ep.outcome.reason
@@ -95,11 +99,10 @@ def test_run_spec_rejects_an_out_of_range_vector():
 
 @pytest.mark.parametrize("scenario", sorted(SCENARIOS))
 def test_every_logical_scenario_has_a_world_whose_actors_all_exist_from_the_start(scenario):
-    assert scenario in runner.WORLD_BUILDERS, f"{scenario} has no world builder"
     space = get_scenario(scenario)
     for draw in range(3):
         params = space.as_dict(space.sample(np.random.default_rng(draw)))
-        world, cruise = runner.WORLD_BUILDERS[scenario](params, np.random.default_rng(draw))
+        world, cruise = runner.world_builder(scenario)(params, np.random.default_rng(draw))
         first = world.scene()
         assert cruise > 0.0 and first.n >= 2
         for _ in range(20):  # 1 s with the ego holding its speed

@@ -8,16 +8,16 @@ per family; `summary.audit_root` ties them to the logs and the warehouse; `repor
 from evoeye.evaluation.audit.report import markdown_report, report_dir, write_report
 from evoeye.evaluation.audit.runs import AuditBounds, NoLogsError, RunAudit, audit_run, find_logs
 from evoeye.evaluation.audit.summary import ScenarioAudit, audit_root
-from evoeye.evaluation.audit.verdicts import COLLISION_BANDS, Thresholds, Verdict
+from evoeye.evaluation.audit.verdicts import Thresholds, Verdict, bands_of
 
 __all__ = [
-    "COLLISION_BANDS",
     "AuditBounds",
     "NoLogsError",
     "RunAudit",
     "ScenarioAudit",
     "Thresholds",
     "Verdict",
+    "bands_of",
     "audit_root",
     "audit_run",
     "find_logs",

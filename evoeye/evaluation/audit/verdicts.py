@@ -11,15 +11,17 @@ from dataclasses import asdict, dataclass
 from typing import TYPE_CHECKING, Any
 
 from evoeye.evaluation.audit.attribution import MODULES
+from evoeye.scenarios import SCENARIO_SPECS, AuditBands
 
 if TYPE_CHECKING:
     from evoeye.evaluation.audit.summary import ScenarioAudit
 
-# Collision-rate bands per logical scenario (issue "Done when"; the paper: 34 % and 77 %).
-COLLISION_BANDS: dict[str, tuple[float, float]] = {
-    "highway-cut-in": (0.20, 0.50),
-    "unprotected-intersection": (0.50, 0.85),
-}
+
+
+def bands_of(scenario: str) -> AuditBands | None:
+    """The scenario's audit bands (its `ScenarioSpec.bands`); None for one not registered."""
+    spec = SCENARIO_SPECS.get(scenario)
+    return None if spec is None else spec.bands
 
 
 @dataclass(frozen=True)
@@ -28,10 +30,10 @@ class Thresholds:
 
     careful_avoidable_min: float = 0.80
     careful_unavoidable_max: float = 0.20
-    clock_auroc_max: float = 0.70
-    # a monitor must beat the context-only control by 5 AUROC points (RQ1), so the control
-    # must leave that much room
-    context_auroc_max: float = 0.95
+    # the clock-only and context-only controls' limits for a scenario not registered (a
+    # registered one brings its own, `AuditBands`)
+    clock_auroc_max: float = AuditBands.clock_auroc_max
+    context_auroc_max: float = AuditBands.context_auroc_max
     diverse_modules_min: int = 3  # modules with at least module_share_min of the credit
     module_share_min: float = 0.10
     module_share_max: float = 0.60
@@ -63,7 +65,8 @@ NOT_INGESTED = "not ingested yet — run `evoeye ingest`"
 
 
 def _collision_rate(s: ScenarioAudit, t: Thresholds) -> Verdict:
-    band = COLLISION_BANDS.get(s.logical_scenario)
+    bands = bands_of(s.logical_scenario)
+    band = None if bands is None else bands.collision_rate
     value = f"{s.collided_runs}/{s.ok_runs} = {_pct(s.collision_rate)}" if s.ok_runs else "no runs"
     if band is None or not s.ok_runs:
         return Verdict("collision rate", value, "no band for this scenario", None)
@@ -100,25 +103,35 @@ def _careful(s: ScenarioAudit, t: Thresholds) -> Verdict:
                    and a.careful_unavoidable <= t.careful_unavoidable_max)
 
 
+def _controls(s: ScenarioAudit, t: Thresholds) -> tuple[float, float]:
+    """The clock-only and context-only AUROC limits for the scenario."""
+    bands = bands_of(s.logical_scenario)
+    if bands is None:
+        return t.clock_auroc_max, t.context_auroc_max
+    return bands.clock_auroc_max, bands.context_auroc_max
+
+
 def _clock(s: ScenarioAudit, t: Thresholds) -> Verdict:
-    bound = f"≤ {t.clock_auroc_max:.2f}"
+    limit = _controls(s, t)[0]
+    bound = f"≤ {limit:.2f}"
     if s.clock is None:
         return Verdict("clock-only AUROC", NOT_INGESTED, bound, None)
     h = s.clock.headline
     if h is None:
         return Verdict("clock-only AUROC", "undefined (one label class only)", bound, None)
-    return Verdict("clock-only AUROC", f"{h:.3f}", bound, h <= t.clock_auroc_max)
+    return Verdict("clock-only AUROC", f"{h:.3f}", bound, h <= limit)
 
 
 def _context(s: ScenarioAudit, t: Thresholds) -> Verdict:
-    name, bound = "context-only AUROC", f"≤ {t.context_auroc_max:.2f} (room for RQ1's +5)"
+    limit = _controls(s, t)[1]
+    name, bound = "context-only AUROC", f"≤ {limit:.2f} (room for RQ1's +5)"
     if s.context is None:
         return Verdict(name, NOT_INGESTED, bound, None)
     c = s.context
     if c.auroc is None:
         return Verdict(name, "undefined (one label class only)", bound, None)
     return Verdict(name, f"{c.auroc:.3f} (AUPRC {c.auprc:.3f})", bound,
-                   c.auroc <= t.context_auroc_max)
+                   c.auroc <= limit)
 
 
 def _diverse(s: ScenarioAudit, t: Thresholds) -> Verdict:

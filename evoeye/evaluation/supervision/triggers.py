@@ -26,6 +26,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
+from evoeye.evaluation.baselines import rule_names
 from evoeye.evaluation.dataset import load_split, narrow
 from evoeye.evaluation.monitors import BASELINES, check_scores, monitor_context_len
 from evoeye.monitor.calibration import calibrate
@@ -40,7 +41,6 @@ from evoeye.store.windows import DEFAULT_HORIZON_S
 # false frame in the ≈ 80–150 k validation frames of a 1 000-run root)
 SWEEP_FPRS = (0.05, 0.02, 0.01, 0.005, 0.002, 0.001, 5e-4, 2e-4, 1e-4, 5e-5, 2e-5, 1e-5)
 RECALLS = (0.2, 0.1, 0.05)  # target frame recalls on validation, above every negative
-RULES = ("ttc", "ttc-2d", "rss", "rss-2s")  # the rule-based triggers (no training)
 DEFAULT_BASELINES = ("ttc", "ttc-2d", "rss", "aem", "context-only")  # `evoeye supervise`'s
 ORACLE = "oracle"  # the oracle trigger's name and source
 ORACLE_LEADS_S = (0.5, 0.75, 1.0, 1.25, 1.5, 2.0, 2.5, 3.0)  # τ: it engages τ s before contact
@@ -73,7 +73,7 @@ class TriggerSpec:
 
     @property
     def rule_based(self) -> bool:
-        return self.source == "baseline" and self.ref in RULES
+        return self.source == "baseline" and self.ref in rule_names()
 
     @property
     def oracle(self) -> bool:

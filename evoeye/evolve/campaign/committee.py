@@ -13,7 +13,7 @@ G_r's committee is stored as feedback rows of mode `disagreement-k<K>[-prior-cor
 G_r, so a resumed campaign reads them instead of scoring again.
 
 Cost, per round: K monitor updates instead of one, and the new runs and the refresh scored K
-times (BENCHMARKS.md, "Strategies beyond the paper").
+times (BENCHMARKS.md, "The committee's cost in a campaign").
 """
 
 from __future__ import annotations

@@ -280,6 +280,9 @@ def rounds_markdown(rows: Sequence[RoundRow]) -> str:
     return "\n\n".join([head, rounds_table(rows).markdown(), change_words(rows)])
 
 
+G0_WORDS = "the monitor the campaign started from"
+
+
 def change_words(rows: Sequence[RoundRow]) -> str:
     """What evolution changed, G_0 to the last round's monitor, in words (with the sizes the
     figures rest on)."""
@@ -287,13 +290,13 @@ def change_words(rows: Sequence[RoundRow]) -> str:
         return "No acquisition round yet: the monitor is still G_0."
     g0, last = rows[0], rows[-1]
     new = sum(len(r.scenario_ids) for r in rows[1:])
-    kept = last.monitor_version == g0.monitor_version  # no update beat it on validation
+    kept = last.monitor_version == g0.monitor_version
+    why = ("no round acquired a run to learn from" if not new else
+           "no update beat it on the validation split")
+    g0_is = f"G_0 {g0.monitor_version} ({G0_WORDS}"
     text = (f"{len(rows) - 1} round(s) added {new} runs ({last.simulated_s - g0.simulated_s:.0f}"
-            f" s simulated) and " + (f"kept G_0 {g0.monitor_version} (no update beat it on the "
-                                     "validation split, or none had a run to learn from)"
-                                     if kept else
-                                     f"replaced G_0 {g0.monitor_version} by "
-                                     f"{last.monitor_version}"))
+            f" s simulated) and " + (f"kept {g0_is}; kept: {why})" if kept else
+                                     f"replaced {g0_is}) by {last.monitor_version}"))
     a, b = g0.metrics, last.metrics
     if kept:  # the same monitor: its figures are G_0's
         return text + "."

@@ -3,7 +3,8 @@
 Plain data (the command line reads it at start-up). Sizes, and why:
 
 * Regimes: a logical scenario and the ADS profile that drives it (`scenario` or
-  `scenario:profile`). Collisions are common under the default stack (≈ 25 % / 55 % of uniform
+  `scenario:profile`), by default each registered scenario under each of its `ads_profiles`.
+  Collisions are common under the default stack (≈ 25 % / 55 % of uniform
   runs); where they are rare (2–10 %), Uniform spends most of its budget on runs with nothing
   to learn. The cautious stack at the intersection is that regime (9 of 200 uniform runs
   collided, 4.5 %, on the seed the profiles were chosen on; the cautious stack on the highway
@@ -32,7 +33,9 @@ Plain data (the command line reads it at start-up). Sizes, and why:
 from __future__ import annotations
 
 from collections.abc import Mapping
-from dataclasses import dataclass, fields
+from dataclasses import dataclass, field, fields
+
+from evoeye.scenarios import SCENARIO_SPECS
 
 MODES = ("pool", "generative")
 UPDATES = ("replay", "retrain")  # the per-round monitor's update rule
@@ -63,8 +66,11 @@ def regime_name(scenario: str, profile: str) -> str:
 class EfficiencyConfig:
     """Everything the study regenerates, and at what size (module doc)."""
 
-    regimes: tuple[str, ...] = ("highway-cut-in", "unprotected-intersection",
-                                "unprotected-intersection:cautious")
+    # every registered scenario under each ADS profile it is studied with (its
+    # `ScenarioSpec.ads_profiles`): the intersection's cautious stack is the rare-failure one
+    regimes: tuple[str, ...] = field(default_factory=lambda: tuple(
+        regime_name(name, profile) for name, spec in SCENARIO_SPECS.items()
+        for profile in spec.ads_profiles))
     mode: str = "pool"  # pool: pick from the pre-simulated pool; generative: simulate
     update: str = "replay"  # the per-round monitor: fine-tuned (replay) or trained again
     strategies: tuple[str, ...] = STRATEGIES

@@ -14,7 +14,7 @@ from evoeye.evolve.search.avfuzzer import (
     roulette_select,
     roulette_weights,
 )
-from evoeye.scenarios import get_scenario
+from evoeye.scenarios import SCENARIOS, get_scenario
 
 HIGHWAY = get_scenario("highway-cut-in")  # 7 gene groups incl. the ego's single gene
 CROSSING = get_scenario("unprotected-intersection")  # 5 NPCs × 2 genes
@@ -254,7 +254,7 @@ def test_ask_tell_misuse_is_refused():
 @given(
     seed=st.integers(0, 2**32 - 1),
     told=st.lists(st.floats(0.0, 1.0), min_size=1, max_size=120),
-    scenario=st.sampled_from(["highway-cut-in", "unprotected-intersection"]),
+    scenario=st.sampled_from(sorted(SCENARIOS)),
 )
 def test_ga_proposals_always_lie_inside_the_space(seed, told, scenario):
     space = get_scenario(scenario)

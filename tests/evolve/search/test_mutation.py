@@ -7,7 +7,7 @@ from hypothesis import strategies as st
 
 from evoeye.evolve.search import DensityIndex, Records, make_strategy, regional_potential
 from evoeye.evolve.search.mutation import EPSILON, density_aware_mutation, exploit_probability
-from evoeye.scenarios import DEFAULT_DELTA, get_scenario
+from evoeye.scenarios import DEFAULT_DELTA, SCENARIOS, get_scenario
 
 CROSSING = get_scenario("unprotected-intersection")  # 10 parameters
 HIGHWAY = get_scenario("highway-cut-in")  # 20 parameters
@@ -127,7 +127,7 @@ def test_exploit_probability_is_one_at_the_max_and_defined_when_all_zero():
 @settings(max_examples=60, deadline=None)
 @given(
     name=st.sampled_from(["evoeye", "no-feedback", "no-density", "uniform"]),
-    scenario=st.sampled_from(["highway-cut-in", "unprotected-intersection"]),
+    scenario=st.sampled_from(sorted(SCENARIOS)),
     n=st.integers(1, 25),
     seed=st.integers(0, 2**32 - 1),
     edge=st.booleans(),
