@@ -202,12 +202,13 @@ class Exporter:
     def control(self, t_ns: int, c: dict, speed: float) -> Any:
         b = self.b
         lat = b.t["autoware_control_msgs/msg/Lateral"](
-            stamp=b.time(t_ns), steering_tire_angle=float(c["steering_rad"]),
+            stamp=b.time(t_ns), control_time=b.time(t_ns), steering_tire_angle=float(c["steering_rad"]),
             steering_tire_rotation_rate=0.0, is_defined_steering_tire_rotation_rate=False)
         lon = b.t["autoware_control_msgs/msg/Longitudinal"](
-            stamp=b.time(t_ns), velocity=float(speed), acceleration=float(c["accel_cmd_mps2"]),
+            stamp=b.time(t_ns), control_time=b.time(t_ns), velocity=float(speed), acceleration=float(c["accel_cmd_mps2"]),
             jerk=0.0, is_defined_acceleration=True, is_defined_jerk=False)
-        return b.t["autoware_control_msgs/msg/Control"](stamp=b.time(t_ns), lateral=lat,
+        return b.t["autoware_control_msgs/msg/Control"](stamp=b.time(t_ns),
+                                                        control_time=b.time(t_ns), lateral=lat,
                                                         longitudinal=lon)
 
     def factors(self, t_ns: int, topic: str, meant: str, plan: dict) -> Any:
