@@ -71,6 +71,7 @@ def ingest_into(data: DataRoot, runs_per_part: int = RUNS_PER_PART) -> None:
     from tqdm import tqdm
 
     from evoeye.store import ingest
+    from evoeye.store.schema import LAYOUT_VERSION
 
     if not data.warehouse.is_dir():
         where = "" if data.path.is_dir() else " (the data root does not exist yet)"
@@ -84,6 +85,9 @@ def ingest_into(data: DataRoot, runs_per_part: int = RUNS_PER_PART) -> None:
         for bar in bars:
             bar.close()
     console = out()
+    if report.migrated:
+        console.print(f"migrated {len(report.migrated)} warehouse parts to layout "
+                      f"{LAYOUT_VERSION} in place")
     console.print(report_table(report))
     for log, reason in report.quarantined:
         console.print(f"[yellow]quarantined[/] {log}: {reason}")

@@ -28,7 +28,14 @@ from evoeye.log import TOPICS
 from evoeye.log.channels import AGES_TOPIC
 from evoeye.sources.autoware import grids
 from evoeye.sources.autoware.config import REQUIRED_ROLES, Mapping
-from evoeye.sources.autoware.convert import ConversionError, Ego, converter, stamp_ns
+from evoeye.sources.autoware.convert import (
+    ConversionError,
+    Context,
+    Ego,
+    TrackIds,
+    converter,
+    stamp_ns,
+)
 from evoeye.sources.autoware.labels import GroundTruth
 
 ORIGIN_M = 1000.0
@@ -77,6 +84,7 @@ class FrameAssembler:
         v = self.mapping.vehicle
         self.truth = GroundTruth(self.label_source, v.length_m, v.width_m)
         self.period_ns = round(1e9 / self.mapping.rate_hz)
+        self.context = Context(v, TrackIds())  # one run's track ids, shared by every topic
 
     def push(self, topic: str, msgtype: str, msg: Any, log_ns: int) -> Iterator[Frame]:
         """Take one message; yield the frames it closes (an odometry message stamped later)."""
@@ -84,7 +92,7 @@ class FrameAssembler:
         if role is None:
             return
         try:
-            value = converter(role.partition(":")[0], msgtype)(msg, self.mapping.vehicle)
+            value = converter(role.partition(":")[0], msgtype)(msg, self.context)
         except ConversionError as e:
             raise SourceError(topic, str(e)) from None
         stamp = stamp_ns(msg)
