@@ -10,8 +10,8 @@ import pytest
 
 from evoeye.sources.autoware.config import Mapping, Vehicle
 from evoeye.sources.autoware.convert import (
-    ConversionError,
     Context,
+    ConversionError,
     Ego,
     TrackIds,
     objects,
@@ -36,7 +36,8 @@ def test_base_link_is_the_rear_axle_centre_behind_the_body_centre(ex) -> None:
     ego = odometry(msg, Context())
     assert (ego.x_m, ego.y_m, ego.heading_rad, ego.speed_mps) == pytest.approx(
         (10.0, 20.0, math.pi / 2, 7.0))
-    assert odometry(msg, Context(Vehicle(length_m=4.0, rear_overhang_m=1.0))).y_m == pytest.approx(19.5)
+    short = Context(Vehicle(length_m=4.0, rear_overhang_m=1.0))
+    assert odometry(msg, short).y_m == pytest.approx(19.5)
 
 
 def test_an_object_twist_is_in_the_object_frame(ex) -> None:

@@ -200,16 +200,16 @@ class Exporter:
         return b.t["autoware_planning_msgs/msg/Trajectory"](header=b.header(t_ns), points=pts)
 
     def control(self, t_ns: int, c: dict, speed: float) -> Any:
-        b = self.b
+        b, now = self.b, self.b.time(t_ns)  # control_time: the command is meant at once
         lat = b.t["autoware_control_msgs/msg/Lateral"](
-            stamp=b.time(t_ns), control_time=b.time(t_ns), steering_tire_angle=float(c["steering_rad"]),
+            stamp=now, control_time=now, steering_tire_angle=float(c["steering_rad"]),
             steering_tire_rotation_rate=0.0, is_defined_steering_tire_rotation_rate=False)
         lon = b.t["autoware_control_msgs/msg/Longitudinal"](
-            stamp=b.time(t_ns), control_time=b.time(t_ns), velocity=float(speed), acceleration=float(c["accel_cmd_mps2"]),
-            jerk=0.0, is_defined_acceleration=True, is_defined_jerk=False)
-        return b.t["autoware_control_msgs/msg/Control"](stamp=b.time(t_ns),
-                                                        control_time=b.time(t_ns), lateral=lat,
-                                                        longitudinal=lon)
+            stamp=now, control_time=now, velocity=float(speed),
+            acceleration=float(c["accel_cmd_mps2"]), jerk=0.0, is_defined_acceleration=True,
+            is_defined_jerk=False)
+        return b.t["autoware_control_msgs/msg/Control"](stamp=now, control_time=now,
+                                                        lateral=lat, longitudinal=lon)
 
     def factors(self, t_ns: int, topic: str, meant: str, plan: dict) -> Any:
         b, t = self.b, self.b.t

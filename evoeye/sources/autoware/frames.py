@@ -29,8 +29,8 @@ from evoeye.log.channels import AGES_TOPIC
 from evoeye.sources.autoware import grids
 from evoeye.sources.autoware.config import REQUIRED_ROLES, Mapping
 from evoeye.sources.autoware.convert import (
-    ConversionError,
     Context,
+    ConversionError,
     Ego,
     TrackIds,
     converter,
