@@ -45,26 +45,26 @@ def import_autoware(
 
     Exits 3 if any bag was refused (one line each: bag, topic, problem); the others go in.
     """
+    from rich.markup import escape
+
     from evoeye.sources.autoware.importer import import_bags
 
     data = DataRoot.resolve(root)
     report = import_bags(data, paths, mapping=load_mapping_option(mapping), batch=batch,
-                         on_bag=lambda p: err().print(f"reading {p}"))
+                         on_bag=lambda p: err().print(f"reading {escape(str(p))}"))
     console = out()
+    console.soft_wrap = True
     for note in report.notes:
-        console.print(f"[yellow]note[/] {note}")
+        console.print(f"[yellow]note[/] {escape(note)}")
     ingested = sum(len(r.ingested) for r in report.ingest)
     skipped = sum(r.skipped for r in report.ingest)
-    for r in report.ingest:
-        for log, reason in r.quarantined:
-            report.failed.append(f"{log}: {reason}")
     for sid, source in sorted(report.labels.items()):
-        console.print(f"{sid}: labels from {source}")
+        console.print(f"{sid}: labels from {escape(source)}")
     console.print(f"{len(report.labels)} bags converted, {ingested} runs ingested, {skipped} "
                   f"already in the warehouse (batch {batch})")
     if report.failed:
         for line in report.failed:
-            err().print(f"[red]refused[/] {line}")
+            err().print(f"[red]refused[/] {escape(line)}")
         exit_with(ExitCode.PARTIAL)
 
 

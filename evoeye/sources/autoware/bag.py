@@ -5,8 +5,9 @@ decode it when it embeds them (MCAP); otherwise ROS 2 Humble's types and the ven
 ones do (`typestore`). A bag that evoeye exported carries its run's identity (rosbag2
 custom data `evoeye.run`: scenario id, logical scenario, parameters, seed, round, ADS profile):
 it comes back under that id. Any other bag is a run of logical scenario `external`, its id
-from its bytes, so the same bag imported twice is the same run. Labels come from the bag's
-ground truth alone (`labels.py`), never from that record.
+from its content (every message's topic, type, receive time and bytes, `content_digest`), not
+from its storage: the same recording as MCAP and as `.db3`, or imported twice, is one run.
+Labels come from the bag's ground truth alone (`labels.py`), never from that record.
 """
 
 from __future__ import annotations
@@ -53,16 +54,36 @@ class ImportedRun:
         return [f.messages for f in self.frames]
 
 
-def bag_digest(path: Path) -> str:
-    """sha1 of the bag's bytes (every file of a bag folder, by name): the bag's identity."""
-    files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
+@dataclass(frozen=True)
+class Content:
+    """What a bag holds, whatever its storage: a digest of its messages and their count per
+    topic."""
+
+    digest: str  # sha1 over (receive ns, topic, type, sha1 of the CDR bytes), sorted
+    counts: dict[str, int]  # messages per topic
+
+
+def content_digest(reader: Any) -> Content:
+    """The bag's content (module doc), read without decoding a message."""
+    rows, counts = [], dict.fromkeys((c.topic for c in reader.connections), 0)
+    for conn, log_ns, raw in reader.messages():
+        rows.append((log_ns, conn.topic, conn.msgtype, hashlib.sha1(raw).digest()))
+        counts[conn.topic] += 1
     h = hashlib.sha1()
-    for p in files:
-        h.update(p.name.encode())
-        with open(p, "rb") as f:
-            while chunk := f.read(1 << 20):
-                h.update(chunk)
-    return h.hexdigest()
+    for log_ns, topic, msgtype, digest in sorted(rows):
+        h.update(b"%d\0%s\0%s\0" % (log_ns, topic.encode(), msgtype.encode()) + digest)
+    return Content(h.hexdigest(), counts)
+
+
+def _check_counts(path: Path, content: Content, mapping: Mapping) -> None:
+    """BagError for a bag without a message, or a required topic without one."""
+    if not any(content.counts.values()):
+        raise BagError(f"{path}: (bag): no message in the bag (its {len(content.counts)} "
+                       "topics are empty)")
+    for role in REQUIRED_ROLES:
+        topic = getattr(mapping.topics, role)
+        if not content.counts.get(topic):
+            raise BagError(f"{path}: {topic}: no message on a required topic ({role})")
 
 
 def _custom_data(reader: Any) -> dict[str, str]:
@@ -106,6 +127,10 @@ def _identity(path: Path, custom: dict[str, str]) -> dict[str, Any]:
         raise BagError(f"{path}: custom data {RUN_KEY}: malformed ({e})") from None
 
 
+def _scenario_id(identity: dict[str, Any], content: Content) -> str:
+    return identity.get("scenario_id", f"autoware_{content.digest[:16]}")
+
+
 def bag_run_id(path: str | Path) -> tuple[str, str]:
     """(logical scenario, scenario id) the bag imports as, without decoding a message."""
     from rosbags.highlevel import AnyReader
@@ -114,22 +139,23 @@ def bag_run_id(path: str | Path) -> tuple[str, str]:
     try:
         with AnyReader([path], default_typestore=typestore()) as reader:
             identity = _identity(path, _custom_data(reader))
+            sid = identity["scenario_id"] if identity else _scenario_id({},
+                                                                         content_digest(reader))
     except BagError:
         raise
     except Exception as e:  # as read_bag: a bag rosbags cannot open
         raise BagError(f"{path}: (bag): unreadable bag ({type(e).__name__}: {e})") from None
-    return (identity.get("logical_scenario", EXTERNAL_SCENARIO),
-            identity.get("scenario_id", f"autoware_{bag_digest(path)[:16]}"))
+    return identity.get("logical_scenario", EXTERNAL_SCENARIO), sid
 
 
-def _metadata(path: Path, custom: dict[str, str], assembler: FrameAssembler,
+def _metadata(path: Path, custom: dict[str, str], content: Content, assembler: FrameAssembler,
               frames: list[Frame], source: str) -> dict[str, Any]:
     identity = _identity(path, custom)
     truth = assembler.truth
     first = next((f for f in frames if f.messages["/sim/ground_truth"]["ego_collision"]), None)
     dt_s = 1.0 / assembler.mapping.rate_hz
     return {
-        "scenario_id": identity.get("scenario_id", f"autoware_{bag_digest(path)[:16]}"),
+        "scenario_id": _scenario_id(identity, content),
         "logical_scenario": identity.get("logical_scenario", EXTERNAL_SCENARIO),
         "param_names": identity.get("param_names", []),
         "params": identity.get("params", []),
@@ -160,6 +186,8 @@ def read_bag(path: str | Path, mapping: Mapping | None = None) -> ImportedRun:
     try:
         with AnyReader([path], default_typestore=typestore()) as reader:
             wanted = _check_topics(reader, mapping, path)
+            content = content_digest(reader)
+            _check_counts(path, content, mapping)
             source = label_source(mapping, {c.topic for c in wanted})
             assembler = FrameAssembler(mapping, source)
             frames: list[Frame] = []
@@ -188,4 +216,5 @@ def read_bag(path: str | Path, mapping: Mapping | None = None) -> ImportedRun:
     if source == UNLABELLED:
         notes.append(f"{path}: (bag): no ground truth ({mapping.topics.collision or '-'}, "
                      f"{mapping.topics.ground_truth_objects or '-'}): imported unlabelled")
-    return ImportedRun(path, _metadata(path, custom, assembler, frames, source), frames, notes)
+    return ImportedRun(path, _metadata(path, custom, content, assembler, frames, source), frames,
+                       notes)

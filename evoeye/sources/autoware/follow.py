@@ -5,8 +5,10 @@ for the next poll), chunks are opened as they land, and messages come out in fil
 the receive order `FrameAssembler` wants. Record with `--storage-config-file` holding
 `noChunking: true` (docs/autoware.md) and each message is on disk at once; with chunking a
 message waits for its chunk (about 1 MB). CDR is decoded with rosbags, by the definitions the
-file embeds (falling back to the vendored Autoware and ROS 2 Humble types). In a folder of split
-bags (`<name>_0.mcap`, `<name>_1.mcap`, …) a file is finished when the next one appears.
+file embeds, as `evoeye import` decodes it (`typestore.bag_typestore`: the vendored Autoware and
+ROS 2 Humble types only for a file that embeds none). A message that does not decode, or a file
+that is not MCAP, is a `SourceError` naming the topic. In a folder of split bags
+(`<name>_0.mcap`, `<name>_1.mcap`, …) a file is finished when the next one appears.
 """
 
 from __future__ import annotations
@@ -24,7 +26,8 @@ from mcap.records import Channel, Footer, Message, Schema
 from mcap.stream_reader import StreamReader
 from mcap.writer import MCAP0_MAGIC
 
-from evoeye.sources.autoware.typestore import typestore
+from evoeye.sources.autoware.frames import SourceError
+from evoeye.sources.autoware.typestore import bag_typestore
 
 _HEAD = struct.Struct("<BQ")  # opcode, record length
 SPLIT_INDEX = re.compile(r"_(\d+)\.mcap$")
@@ -45,12 +48,8 @@ class McapFollower:
 
     def _typestore(self) -> Any:
         if self._store is None:
-            from rosbags.typesys import get_types_from_msg
-
-            self._store = typestore()
-            for s in self._schemas.values():
-                if s.encoding == "ros2msg" and s.name not in self._store.fielddefs:
-                    self._store.register(get_types_from_msg(s.data.decode(), s.name))
+            self._store = bag_typestore((s.name, s.encoding, s.data.decode())
+                                        for s in self._schemas.values())
         return self._store
 
     def _complete(self, data: bytes) -> int:
@@ -73,7 +72,7 @@ class McapFollower:
             if len(data) < len(MCAP0_MAGIC):
                 return []
             if data[: len(MCAP0_MAGIC)] != MCAP0_MAGIC:
-                raise ValueError(f"{self.path}: not an MCAP file (bad leading magic)")
+                raise SourceError("(bag)", "not an MCAP file (bad leading magic)")
             data = data[len(MCAP0_MAGIC):]
             self.offset = len(MCAP0_MAGIC)
         end = self._complete(data)
@@ -99,7 +98,11 @@ class McapFollower:
         elif isinstance(record, Message):
             topic, msgtype = self._channels.get(record.channel_id, ("", ""))
             if self.topics is None or topic in self.topics:
-                msg = self._typestore().deserialize_cdr(record.data, msgtype)
+                try:
+                    msg = self._typestore().deserialize_cdr(record.data, msgtype)
+                except Exception as e:  # rosbags raises several kinds on bytes it cannot read
+                    raise SourceError(topic, f"cannot decode {msgtype} "
+                                             f"({type(e).__name__}: {e})") from None
                 out.append((topic, msgtype, msg, record.log_time))
         elif isinstance(record, Footer):
             self.finished = True

@@ -55,6 +55,7 @@ def import_bags(root: DataRoot, paths: Sequence[Path], *, mapping: Mapping | Non
     check_batch_name(batch)
     report = ImportReport()
     partitions: set[tuple[str, str]] = set()
+    bag_of: dict[str, Path] = {}  # run log (relative to the root) → its bag
     for bag in find_bags(paths):
         if on_bag is not None:
             on_bag(bag)
@@ -71,9 +72,13 @@ def import_bags(root: DataRoot, paths: Sequence[Path], *, mapping: Mapping | Non
             report.failed.append(str(e))
             continue
         report.logs.append(log)
+        bag_of[root.relative(log)] = bag
         partitions.add((scenario, batch))
     for partition in sorted(partitions):
-        report.ingest.append(ingest_batch(root, partition))
+        ingested = ingest_batch(root, partition)
+        report.ingest.append(ingested)
+        for log, reason in ingested.quarantined:  # the log is moved aside: nothing went in
+            report.failed.append(f"{bag_of.get(log, log)}: (bag): not ingested ({reason})")
     if partitions:
         refresh_catalog(root)  # a batch ingest leaves the DuckDB file's views alone
     return report
