@@ -4,7 +4,8 @@ rosbags writes the messages, typed by ROS 2 Humble's definitions and the upstrea
 autoware_msgs files (schemas/external/autoware, checked byte for byte against upstream by
 tests/sources/test_autoware_upstream.py), registered here directly. The drive: the ego
 (evoeye's default vehicle, base_link at the rear axle) follows a lane at 10 m/s towards a
-stopped car, brakes late at 6 m/s² and hits it; a second car drives alongside in the next lane.
+stopped car 45 m ahead, brakes late (at 3.5 s, 6 m/s²) and hits it at 5 m/s (at 4.3 s); a
+second car drives 40 m ahead in the next lane at the ego's speed.
 Every object has a random 16-byte UUID. Topics at Autoware's rates (odometry 50 Hz, tracked and
 predicted objects and trajectory 10 Hz, control 30 Hz, ground truth 10 Hz), each with its own
 phase; header stamps run ahead of the receive (bag) time by a clock offset less each topic's
@@ -69,11 +70,11 @@ class Drive:
     """The drive's kinematics (module doc); times in s from T0_NS."""
 
     seed: int = 0
-    duration_s: float = 4.0
+    duration_s: float = 5.0
     speed_mps: float = 10.0
-    brake_at_s: float = 2.0
+    brake_at_s: float = 3.5
     decel_mps2: float = 6.0
-    lead_ahead_m: float = 30.75  # the stopped car's centre ahead of the ego's body centre
+    lead_ahead_m: float = 45.75  # the stopped car's centre ahead of the ego's body centre
     lead_size: tuple[float, float] = (4.5, 1.8)
     uuids: list[bytes] = field(init=False)
 
@@ -104,7 +105,7 @@ class Drive:
         lane from the ego's rear axle at t = 0; centres."""
         centre0 = EGO[0] / 2 - EGO[2]
         return [(self.uuids[0], centre0 + self.lead_ahead_m, 0.0, 0.0, *self.lead_size),
-                (self.uuids[1], centre0 + 8.0 + 10.0 * t, 3.5, 10.0, 4.6, 1.9)]
+                (self.uuids[1], centre0 + 40.0 + 10.0 * t, 3.5, 10.0, 4.6, 1.9)]
 
     # -- messages --------------------------------------------------------------------------
 
