@@ -31,6 +31,16 @@ def load_mapping_option(path: Path | None):  # noqa: ANN202 - the type lives in 
         raise UserError(str(exc), "see docs/autoware.md, \"Mapping file\"") from exc
 
 
+LogsArg = Annotated[list[Path] | None, typer.Argument(
+    help="Run logs to export (default: every run under <root>/runs, or --scenario's).",
+    exists=True, dir_okay=False)]
+ScenarioOpt = Annotated[str | None, typer.Option("--scenario",
+                                                 help="Only this logical scenario's runs.")]
+RatesOpt = Annotated[str, typer.Option(
+    "--rates", help="realistic: the stack's rates (odometry 50 Hz, objects and planning 10 Hz, "
+    "control 33 Hz); lossless: every topic at 20 Hz.")]
+
+
 @import_app.command("autoware")
 def import_autoware(
     paths: Annotated[list[Path], typer.Argument(
@@ -45,13 +55,25 @@ def import_autoware(
 
     Exits 3 if any bag was refused (one line each: bag, topic, problem); the others go in.
     """
-    from rich.markup import escape
-
     from evoeye.sources.autoware.importer import import_bags
 
     data = DataRoot.resolve(root)
     report = import_bags(data, paths, mapping=load_mapping_option(mapping), batch=batch,
-                         on_bag=lambda p: err().print(f"reading {escape(str(p))}"))
+                         on_bag=reading)
+    print_import(report, batch)
+
+
+def reading(path: Path) -> None:
+    """One line on stderr as each recording is read."""
+    from rich.markup import escape
+
+    err().print(f"reading {escape(str(path))}")
+
+
+def print_import(report, batch: str) -> None:  # noqa: ANN001 - ImportReport, a heavy module
+    """What an import did, one line each; exit 3 if any recording was refused."""
+    from rich.markup import escape
+
     console = out()
     console.soft_wrap = True
     for note in report.notes:
@@ -60,8 +82,8 @@ def import_autoware(
     skipped = sum(r.skipped for r in report.ingest)
     for sid, source in sorted(report.labels.items()):
         console.print(f"{sid}: labels from {escape(source)}")
-    console.print(f"{len(report.labels)} bags converted, {ingested} runs ingested, {skipped} "
-                  f"already in the warehouse (batch {batch})")
+    console.print(f"{len(report.labels)} recordings converted, {ingested} runs ingested, "
+                  f"{skipped} already in the warehouse (batch {batch})")
     if report.failed:
         for line in report.failed:
             err().print(f"[red]refused[/] {escape(line)}")
@@ -71,19 +93,28 @@ def import_autoware(
 @export_app.command("autoware")
 def export_autoware(
     output: Annotated[Path, typer.Option("--out", help="Folder for the bags (one per run).")],
-    logs: Annotated[list[Path] | None, typer.Argument(
-        help="Run logs to export (default: every run under <root>/runs, or --scenario's).",
-        exists=True, dir_okay=False)] = None,
+    logs: LogsArg = None,
     root: RootOpt = None,
-    scenario: Annotated[str | None, typer.Option(
-        "--scenario", help="Only this logical scenario's runs.")] = None,
-    rates: Annotated[str, typer.Option(
-        "--rates", help="realistic: Autoware's rates (odometry 50 Hz, objects and planning "
-        "10 Hz, control 33 Hz); lossless: every topic at 20 Hz.")] = "realistic",
+    scenario: ScenarioOpt = None,
+    rates: RatesOpt = "realistic",
     mapping: MappingOpt = None,
 ) -> None:
     """Write simulated runs as Autoware-typed rosbag2 MCAP bags (with their ground truth)."""
-    from evoeye.sources.autoware.export import RATES, export_run
+    from evoeye.sources.autoware.export import export_run
+
+    logs = logs_to_export(logs, root, scenario, rates)
+    output.mkdir(parents=True, exist_ok=True)
+    chosen = load_mapping_option(mapping)
+    for log in logs:
+        bag = export_run(log, output, mapping=chosen, rates=rates)
+        out().print(f"wrote {bag}")
+
+
+def logs_to_export(logs: list[Path] | None, root: Path | None, scenario: str | None,
+                   rates: str) -> list[Path]:
+    """The run logs an export names (default: every run of the root, or the scenario's);
+    UserError for unknown rates or no log."""
+    from evoeye.sources.autoware.export import RATES
     from evoeye.store.ingest import discover_logs
 
     if rates not in RATES:
@@ -93,8 +124,4 @@ def export_autoware(
         logs = discover_logs(data.runs / scenario if scenario else data.runs)
     if not logs:
         raise UserError("no run log to export", "simulate some first: `evoeye simulate …`")
-    output.mkdir(parents=True, exist_ok=True)
-    chosen = load_mapping_option(mapping)
-    for log in logs:
-        bag = export_run(log, output, mapping=chosen, rates=rates)
-        out().print(f"wrote {bag}")
+    return logs

@@ -117,18 +117,23 @@ def _check_topics(reader: Any, mapping: Mapping, path: Path) -> list[Any]:
 
 def _identity(path: Path, custom: dict[str, str]) -> dict[str, Any]:
     """The run identity an exported bag carries; {} for any other bag."""
-    if RUN_KEY not in custom:
+    return run_identity(path, custom.get(RUN_KEY))
+
+
+def run_identity(path: Path, text: str | bytes | None) -> dict[str, Any]:
+    """The run identity of an exported recording (the JSON it carries), {} if none."""
+    if text is None:
         return {}
     try:
-        record = orjson.loads(custom[RUN_KEY])
+        record = orjson.loads(text)
         return {**{k: record[k] for k in IDENTITY},
                 **{k: record.get(k, default) for k, default in OPTIONAL_IDENTITY.items()}}
     except (orjson.JSONDecodeError, KeyError, TypeError) as e:
         raise BagError(f"{path}: custom data {RUN_KEY}: malformed ({e})") from None
 
 
-def _scenario_id(identity: dict[str, Any], content: Content) -> str:
-    return identity.get("scenario_id", f"autoware_{content.digest[:16]}")
+def _scenario_id(identity: dict[str, Any], content: Content, software: str = SOFTWARE) -> str:
+    return identity.get("scenario_id", f"{software}_{content.digest[:16]}")
 
 
 def bag_run_id(path: str | Path) -> tuple[str, str]:
@@ -148,23 +153,24 @@ def bag_run_id(path: str | Path) -> tuple[str, str]:
     return identity.get("logical_scenario", EXTERNAL_SCENARIO), sid
 
 
-def _metadata(path: Path, custom: dict[str, str], content: Content, assembler: FrameAssembler,
-              frames: list[Frame], source: str) -> dict[str, Any]:
-    identity = _identity(path, custom)
+def run_metadata(identity: dict[str, Any], content: Content, assembler: FrameAssembler,
+                 frames: list[Frame], source: str, software: str = SOFTWARE) -> dict[str, Any]:
+    """The run record (schemas/mcap/run.v1.json) of a recording's frames: its identity if it
+    carries one (an exported recording), else a run of logical scenario `external`."""
     truth = assembler.truth
     first = next((f for f in frames if f.messages["/sim/ground_truth"]["ego_collision"]), None)
     dt_s = 1.0 / assembler.mapping.rate_hz
     return {
-        "scenario_id": _scenario_id(identity, content),
+        "scenario_id": _scenario_id(identity, content, software),
         "logical_scenario": identity.get("logical_scenario", EXTERNAL_SCENARIO),
         "param_names": identity.get("param_names", []),
         "params": identity.get("params", []),
         "seed": identity.get("seed", 0),
         "batch": "",  # the importer's batch
-        "source": identity.get("source", SOFTWARE),
+        "source": identity.get("source", software),
         "round": identity.get("round", 0),
         "ads_profile": identity.get("ads_profile", DEFAULT_PROFILE),
-        "software_version": SOFTWARE,
+        "software_version": software,
         "rate_hz": assembler.mapping.rate_hz,
         "status": "ok",
         "reason": "",
@@ -203,6 +209,13 @@ def read_bag(path: str | Path, mapping: Mapping | None = None) -> ImportedRun:
     except Exception as e:  # rosbags raises many kinds on a truncated or corrupt bag
         kind = "unreadable" if not isinstance(e, AnyReaderError | FileNotFoundError) else "bad"
         raise BagError(f"{path}: (bag): {kind} bag ({type(e).__name__}: {e})") from None
+    return imported_run(path, mapping, assembler, frames, _identity(path, custom), content)
+
+
+def imported_run(path: Path, mapping: Mapping, assembler: FrameAssembler, frames: list[Frame],
+                 identity: dict[str, Any], content: Content,
+                 software: str = SOFTWARE) -> ImportedRun:
+    """A recording's converted frames as a run, with its notes; BagError if it has none."""
     if not frames:
         raise BagError(f"{path}: (bag): no frame: the required topics never overlap in time")
     notes = []
@@ -213,8 +226,9 @@ def read_bag(path: str | Path, mapping: Mapping | None = None) -> ImportedRun:
         notes.append(f"{path}: {mapping.topics.trajectory}: all-zero time_from_start in "
                      f"{assembler.recovered_plan_times} trajectories, times rebuilt from arc "
                      "length over speed")
+    source = assembler.label_source
     if source == UNLABELLED:
         notes.append(f"{path}: (bag): no ground truth ({mapping.topics.collision or '-'}, "
                      f"{mapping.topics.ground_truth_objects or '-'}): imported unlabelled")
-    return ImportedRun(path, _metadata(path, custom, content, assembler, frames, source), frames,
-                       notes)
+    metadata = run_metadata(identity, content, assembler, frames, source, software)
+    return ImportedRun(path, metadata, frames, notes)

@@ -104,6 +104,7 @@ class Ego:
     y_m: float
     heading_rad: float
     speed_mps: float
+    accel_mps2: float | None = None  # a pose that carries it (Apollo's); else another topic's
 
 
 def odometry(msg: Any, ctx: Context) -> Ego:
@@ -184,6 +185,9 @@ class Trajectory:
     speed_mps: np.ndarray
     accel_mps2: np.ndarray
     times_recovered: bool  # the times were all zero and come from arc length over speed
+    # a stack whose trajectory message carries the decision (Apollo's DecisionResult):
+    # (decision, target speed m/s or None, leader track id); None: from the factor topics
+    decision: tuple[str, float | None, int] | None = None
 
 
 def _times_from_arc_length(x: np.ndarray, y: np.ndarray, v: np.ndarray) -> np.ndarray:
