@@ -5,6 +5,7 @@ ones alike; evoeye's writer gives a record its reader reads back; bad files are 
 from __future__ import annotations
 
 import lzma
+import math
 from collections import Counter
 from pathlib import Path
 
@@ -103,3 +104,43 @@ def test_a_bad_record_is_one_line_naming_the_problem(foreign, tmp_path, spoil, p
     with pytest.raises(RecordError) as refused:
         read_record(bad)
     assert problem in str(refused.value) and "\n" not in str(refused.value)
+
+
+def test_a_record_cyber_record_wrote_imports_as_an_unlabelled_external_run(foreign) -> None:
+    import math
+
+    from evoeye.log import TOPICS
+    from evoeye.sources.apollo.run import read_record_run
+
+    run = read_record_run(foreign)
+    assert run.metadata["logical_scenario"] == "external"
+    assert run.metadata["scenario_id"].startswith("apollo_")
+    assert run.metadata["label_source"] == "none" and "imported unlabelled" in run.notes[0]
+    assert len(run.frames) == 10  # 20 Hz over the half second, from the first pose
+    for f in run.frames:
+        t = f.t_ns - foreign_spec.T0_NS
+        want = foreign_spec.expected(t / 1e9)
+        loc, obs = f.messages[TOPICS.localization], f.messages[TOPICS.obstacles]
+        # the body centre 1.5 m ahead of the rear axle, re-origined by whole kilometres
+        ahead = 1.5 * math.cos(foreign_spec.HEADING), 1.5 * math.sin(foreign_spec.HEADING)
+        assert loc["x_m"] == pytest.approx(want["x"] + ahead[0] - 587_000.0)
+        assert loc["y_m"] == pytest.approx(want["y"] + ahead[1] - 4_141_000.0)
+        assert loc["speed_mps"] == pytest.approx(foreign_spec.SPEED)
+        assert obs["track_id"] == [foreign_spec.OBSTACLE_ID] and obs["obj_class"] == ["car"]
+        assert obs["x_m"][0] == pytest.approx(want["obs_x"] - 587_000.0)
+        assert f.messages[TOPICS.control]["accel_cmd_mps2"] == pytest.approx(0.2)
+
+
+def test_an_obstacle_given_as_a_polygon_gets_the_box_around_it() -> None:
+    from evoeye.sources.apollo.convert import obstacles
+    from evoeye.sources.autoware.convert import Context
+
+    msg = vendored()["apollo.perception.PerceptionObstacles"]()
+    o = msg.perception_obstacle.add(id=0, theta=math.pi / 2, type=3)  # no length, width
+    for x, y in ((9.0, 18.0), (11.0, 18.0), (11.0, 22.0), (9.0, 22.0)):
+        o.polygon_point.add(x=x, y=y)
+    got = obstacles(msg, Context())
+    assert got["track_id"] == [2**31]  # Apollo's id 0 is not evoeye's ego
+    assert (got["x_m"][0], got["y_m"][0]) == pytest.approx((10.0, 20.0))
+    assert (got["length_m"][0], got["width_m"][0]) == pytest.approx((4.0, 2.0))
+    assert (got["vx_mps"], got["obj_class"]) == ([0.0], ["pedestrian"])  # no velocity: at rest

@@ -77,13 +77,25 @@ def _box(o: Any) -> tuple[float, float, float, float]:
             float(np.ptp(across)))
 
 
+def _xy(msg: Any, name: str) -> tuple[float, float] | None:
+    """(x, y) of a Point3D field, None if unset (Apollo's Point3D defaults to NaN)."""
+    if not msg.HasField(name):
+        return None
+    p = getattr(msg, name)
+    return (p.x, p.y) if math.isfinite(p.x) and math.isfinite(p.y) else None
+
+
 def localization(msg: Any, ctx: Context) -> Ego:
     pose = msg.pose
+    position, v = _xy(pose, "position"), _xy(pose, "linear_velocity")
+    if position is None or v is None or not pose.HasField("heading"):
+        raise ConversionError("a pose without position, heading or linear_velocity")
     h = pose.heading
-    v, a = pose.linear_velocity, pose.linear_acceleration
+    a = _xy(pose, "linear_acceleration")  # without it: the speed's finite difference
     ahead = ctx.vehicle.centre_ahead_m
-    return Ego(pose.position.x + ahead * math.cos(h), pose.position.y + ahead * math.sin(h), h,
-               v.x * math.cos(h) + v.y * math.sin(h), a.x * math.cos(h) + a.y * math.sin(h))
+    return Ego(position[0] + ahead * math.cos(h), position[1] + ahead * math.sin(h), h,
+               v[0] * math.cos(h) + v[1] * math.sin(h),
+               None if a is None else a[0] * math.cos(h) + a[1] * math.sin(h))
 
 
 def obstacles(msg: Any, ctx: Context) -> dict[str, Any]:
@@ -91,8 +103,9 @@ def obstacles(msg: Any, ctx: Context) -> dict[str, Any]:
     rows = []
     for o in msg.perception_obstacle:
         x, y, length, width = _box(o)
-        rows.append((track_id(o.id), _class(o), x, y, o.theta, o.velocity.x, o.velocity.y,
-                     length, width, o.confidence))
+        vx, vy = _xy(o, "velocity") or (0.0, 0.0)  # an obstacle without one: at rest
+        rows.append((track_id(o.id), _class(o), x, y, o.theta, vx, vy, length, width,
+                     o.confidence))
     names = ("track_id", "obj_class", "x_m", "y_m", "heading_rad", "vx_mps", "vy_mps",
              "length_m", "width_m", "confidence")
     cols = list(zip(*rows, strict=True)) if rows else [()] * len(names)
