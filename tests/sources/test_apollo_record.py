@@ -107,8 +107,6 @@ def test_a_bad_record_is_one_line_naming_the_problem(foreign, tmp_path, spoil, p
 
 
 def test_a_record_cyber_record_wrote_imports_as_an_unlabelled_external_run(foreign) -> None:
-    import math
-
     from evoeye.log import TOPICS
     from evoeye.sources.apollo.run import read_record_run
 
