@@ -88,7 +88,7 @@ def read_record(path: str | Path) -> Record:
                 c = channel_cls.FromString(body)
                 record.channels[c.name] = Channel(c.name, c.message_type, c.proto_desc)
             elif kind == CHUNK_BODY:
-                raw = _decompress(body, header.compress)
+                raw = decompress(body, header.compress)
                 record.messages += [(m.channel_name, m.time, m.content)
                                     for m in body_cls.FromString(raw).messages]
             elif kind not in (CHUNK_HEADER, INDEX):
@@ -100,7 +100,7 @@ def read_record(path: str | Path) -> Record:
     return record
 
 
-def _decompress(body: bytes, compress: int) -> bytes:
+def decompress(body: bytes, compress: int) -> bytes:
     if compress == COMPRESS_NONE:
         return body
     if compress == COMPRESS_BZ2:

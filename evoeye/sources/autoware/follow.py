@@ -115,18 +115,20 @@ def _split_files(folder: Path) -> list[Path]:
 
 
 def follow(path: Path, *, topics: set[str] | None = None, poll_s: float = 0.005,
-           idle_s: float = 5.0, sleep: Callable[[float], None] = time.sleep
-           ) -> Iterator[Decoded]:
+           idle_s: float = 5.0, sleep: Callable[[float], None] = time.sleep,
+           follower: Callable[[Path, set[str] | None], Any] = McapFollower,
+           split_files: Callable[[Path], list[Path]] = _split_files) -> Iterator[Decoded]:
     """The messages of a growing MCAP file (or folder of split bags), in file order; ends when
-    the (last) file is finished and nothing new appears for `idle_s`, or stays idle that long."""
+    the (last) file is finished and nothing new appears for `idle_s`, or stays idle that long.
+    Another format: its `follower` (with `poll()`, `path`, `finished`) and `split_files`."""
     done: list[Path] = []
-    current: McapFollower | None = None
+    current: Any = None
     idle_since = time.monotonic()
     while True:
-        files = _split_files(path) if path.is_dir() else ([path] if path.exists() else [])
+        files = split_files(path) if path.is_dir() else ([path] if path.exists() else [])
         pending = [f for f in files if f not in done]
         if current is None and pending:
-            current = McapFollower(pending[0], topics)
+            current = follower(pending[0], topics)
         got = current.poll() if current is not None else []
         yield from got
         if current is not None and not got:
