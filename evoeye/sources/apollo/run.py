@@ -11,7 +11,6 @@ message's channel, type, time and bytes).
 
 from __future__ import annotations
 
-import hashlib
 from collections.abc import Sequence
 from pathlib import Path
 from typing import Any
@@ -24,6 +23,7 @@ from evoeye.sources.autoware.bag import (
     BagError,
     Content,
     ImportedRun,
+    content_of,
     imported_run,
     run_identity,
 )
@@ -68,15 +68,9 @@ def _read(path: Path) -> Record:
 
 
 def _content(record: Record) -> Content:
-    rows, counts = [], dict.fromkeys(record.channels, 0)
-    for name, t_ns, raw in record.messages:
-        kind = record.channels[name].message_type if name in record.channels else ""
-        rows.append((t_ns, name, kind, hashlib.sha1(raw).digest()))
-        counts[name] = counts.get(name, 0) + 1
-    h = hashlib.sha1()
-    for t_ns, name, kind, digest in sorted(rows):
-        h.update(b"%d\0%s\0%s\0" % (t_ns, name.encode(), kind.encode()) + digest)
-    return Content(h.hexdigest(), counts)
+    kinds = {c.name: c.message_type for c in record.channels.values()}
+    return content_of(record.channels, ((t_ns, name, kinds.get(name, ""), raw)
+                                        for name, t_ns, raw in record.messages))
 
 
 def _identity(path: Path, record: Record) -> dict[str, Any]:
@@ -84,7 +78,7 @@ def _identity(path: Path, record: Record) -> dict[str, Any]:
     if not raws:
         return {}
     header = vendored()["apollo.common.Header"].FromString(raws[0])
-    return run_identity(path, header.module_name)
+    return run_identity(path, header.module_name, RUN_CHANNEL)
 
 
 def record_run_id(path: Path) -> tuple[str, str]:

@@ -13,6 +13,7 @@ Labels come from the bag's ground truth alone (`labels.py`), never from that rec
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -63,16 +64,24 @@ class Content:
     counts: dict[str, int]  # messages per topic
 
 
-def content_digest(reader: Any) -> Content:
-    """The bag's content (module doc), read without decoding a message."""
-    rows, counts = [], dict.fromkeys((c.topic for c in reader.connections), 0)
-    for conn, log_ns, raw in reader.messages():
-        rows.append((log_ns, conn.topic, conn.msgtype, hashlib.sha1(raw).digest()))
-        counts[conn.topic] += 1
+def content_of(topics: Iterable[str], messages: Iterable[tuple[int, str, str, bytes]]
+               ) -> Content:
+    """The content of a recording of `topics` with `messages` (receive ns, topic, type,
+    serialized bytes), in any order."""
+    rows, counts = [], dict.fromkeys(topics, 0)
+    for log_ns, topic, msgtype, raw in messages:
+        rows.append((log_ns, topic, msgtype, hashlib.sha1(raw).digest()))
+        counts[topic] = counts.get(topic, 0) + 1
     h = hashlib.sha1()
     for log_ns, topic, msgtype, digest in sorted(rows):
         h.update(b"%d\0%s\0%s\0" % (log_ns, topic.encode(), msgtype.encode()) + digest)
     return Content(h.hexdigest(), counts)
+
+
+def content_digest(reader: Any) -> Content:
+    """The bag's content (module doc), read without decoding a message."""
+    return content_of((c.topic for c in reader.connections),
+                      ((log_ns, c.topic, c.msgtype, raw) for c, log_ns, raw in reader.messages()))
 
 
 def _check_counts(path: Path, content: Content, mapping: Mapping) -> None:
@@ -117,11 +126,12 @@ def _check_topics(reader: Any, mapping: Mapping, path: Path) -> list[Any]:
 
 def _identity(path: Path, custom: dict[str, str]) -> dict[str, Any]:
     """The run identity an exported bag carries; {} for any other bag."""
-    return run_identity(path, custom.get(RUN_KEY))
+    return run_identity(path, custom.get(RUN_KEY), f"custom data {RUN_KEY}")
 
 
-def run_identity(path: Path, text: str | bytes | None) -> dict[str, Any]:
-    """The run identity of an exported recording (the JSON it carries), {} if none."""
+def run_identity(path: Path, text: str | bytes | None, where: str) -> dict[str, Any]:
+    """The run identity of an exported recording (the JSON it carries at `where`), {} if
+    none."""
     if text is None:
         return {}
     try:
@@ -129,7 +139,7 @@ def run_identity(path: Path, text: str | bytes | None) -> dict[str, Any]:
         return {**{k: record[k] for k in IDENTITY},
                 **{k: record.get(k, default) for k, default in OPTIONAL_IDENTITY.items()}}
     except (orjson.JSONDecodeError, KeyError, TypeError) as e:
-        raise BagError(f"{path}: custom data {RUN_KEY}: malformed ({e})") from None
+        raise BagError(f"{path}: {where}: malformed ({e})") from None
 
 
 def _scenario_id(identity: dict[str, Any], content: Content, software: str = SOFTWARE) -> str:
