@@ -9,9 +9,11 @@ import typer
 
 from evoeye.cli.autoware import (
     LogsArg,
+    MappingOpt,
     RatesOpt,
     ScenarioOpt,
     import_app,
+    load_mapping_option,
     logs_to_export,
     print_import,
     reading,
@@ -27,6 +29,7 @@ def import_apollo(
         help="cyber records: .record files (split ones too), or folders of them.",
         exists=True)],
     root: RootOpt = None,
+    mapping: MappingOpt = None,
     batch: Annotated[str, typer.Option("--batch", help="Batch the runs go in.")] = "apollo",
 ) -> None:
     """Import Apollo cyber records as runs: scored, replayed and queried like simulated ones;
@@ -35,11 +38,12 @@ def import_apollo(
     Exits 3 if any record was refused (one line each: record, channel, problem); the others
     go in.
     """
-    from evoeye.sources.apollo.run import RECORDS
+    from evoeye.sources.apollo.run import RECORDS, apollo_mapping
     from evoeye.sources.autoware.importer import import_bags
 
-    report = import_bags(DataRoot.resolve(root), paths, batch=batch, on_bag=reading,
-                         recordings=RECORDS)
+    chosen = load_mapping_option(mapping, apollo_mapping())
+    report = import_bags(DataRoot.resolve(root), paths, mapping=chosen, batch=batch,
+                         on_bag=reading, recordings=RECORDS)
     print_import(report, batch)
 
 

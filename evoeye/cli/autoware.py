@@ -22,11 +22,13 @@ MappingOpt = Annotated[Path | None, typer.Option(
     help="TOML file overriding the default topics, vehicle and clock (docs/autoware.md).")]
 
 
-def load_mapping_option(path: Path | None):  # noqa: ANN202 - the type lives in a heavy module
+def load_mapping_option(path: Path | None, base=None):  # noqa: ANN001, ANN202 - heavy types
+    """The mapping a --mapping file gives over `base` (default: Autoware's); a bad file is a
+    UserError."""
     from evoeye.sources.autoware.config import MappingError, load_mapping
 
     try:
-        return load_mapping(path)
+        return load_mapping(path, base)
     except MappingError as exc:
         raise UserError(str(exc), "see docs/autoware.md, \"Mapping file\"") from exc
 

@@ -44,8 +44,7 @@ def watch_command(
     from evoeye.sources.autoware.frames import SourceError
 
     data = DataRoot.existing(root)
-    chosen = load_mapping_option(mapping)
-    assembler, messages = (_apollo if is_record(path) else _autoware)(path, chosen, idle_s)
+    assembler, messages = (_apollo if is_record(path) else _autoware)(path, mapping, idle_s)
     fusion = load_monitor(data, monitor)
     if output is None:
         data.replays.mkdir(parents=True, exist_ok=True)
@@ -74,18 +73,18 @@ def watch_command(
     err().print(f"{len(watch.states)} frames, {alarms} alarm frames; wrote {output}")
 
 
-def _autoware(path: Path, mapping, idle_s: float):  # noqa: ANN001, ANN202 - heavy types
+def _autoware(path: Path, mapping: Path | None, idle_s: float):  # noqa: ANN202 - heavy types
     """The frame assembler and the followed messages of a rosbag2 MCAP recording."""
     from evoeye.log.records import UNLABELLED
     from evoeye.sources.autoware.follow import follow
     from evoeye.sources.autoware.frames import FrameAssembler
 
-    assembler = FrameAssembler(mapping, UNLABELLED)  # a monitor needs no label
+    assembler = FrameAssembler(load_mapping_option(mapping), UNLABELLED)  # needs no label
     return assembler, follow(path, topics=set(assembler.roles), idle_s=idle_s)
 
 
-def _apollo(path: Path, mapping, idle_s: float):  # noqa: ANN001, ANN202 - heavy types
-    """… of an Apollo cyber record (its channels are fixed: `--mapping` is Autoware's)."""
+def _apollo(path: Path, mapping: Path | None, idle_s: float):  # noqa: ANN202 - heavy types
+    """… of an Apollo cyber record (a --mapping file overrides Apollo's defaults)."""
     from evoeye.log.records import UNLABELLED
     from evoeye.sources.apollo import convert
     from evoeye.sources.apollo.follow import RecordFollower, record_splits
@@ -93,7 +92,7 @@ def _apollo(path: Path, mapping, idle_s: float):  # noqa: ANN001, ANN202 - heavy
     from evoeye.sources.autoware.follow import follow
     from evoeye.sources.autoware.frames import FrameAssembler
 
-    assembler = FrameAssembler(apollo_mapping(), UNLABELLED, lookup=convert.converter,
-                               stamp=convert.stamp_ns)
+    assembler = FrameAssembler(load_mapping_option(mapping, apollo_mapping()), UNLABELLED,
+                               lookup=convert.converter, stamp=convert.stamp_ns)
     return assembler, follow(path, topics=set(assembler.roles), idle_s=idle_s,
                              follower=RecordFollower, split_files=record_splits)

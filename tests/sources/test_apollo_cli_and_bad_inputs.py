@@ -105,3 +105,28 @@ def test_export_then_import_from_the_shell(sim_runs, short, tmp_path: Path) -> N
         result.stdout
     n = Warehouse(root).sql("SELECT count(*) AS n FROM scenarios").column("n")[0].as_py()
     assert n == 2
+
+
+def test_a_mapping_file_renames_channels_and_sets_the_vehicle(short, tmp_path) -> None:
+    from evoeye.sources.apollo.run import apollo_mapping
+    from evoeye.sources.autoware.config import MappingError, load_mapping
+
+    toml = tmp_path / "apollo.toml"
+    toml.write_text('[topics]\ncontrol = "/apollo/control_v2"\n[vehicle]\nmax_steer_rad = 0.25\n')
+    mapping = load_mapping(toml, apollo_mapping())
+    assert mapping.topics.control == "/apollo/control_v2"
+    assert mapping.topics.odometry == T.odometry and mapping.vehicle.max_steer_rad == 0.25
+    renamed = [("/apollo/control_v2" if n == T.control else n, t, m) for n, t, m in short]
+    record = write_record(tmp_path / "renamed.record", renamed)
+    default, mapped = read_record_run(write_record(tmp_path / "plain.record", short)), \
+        read_record_run(record, mapping)
+    steer = [f.messages["/ads/control/command"]["steering_rad"] for f in mapped.frames]
+    assert steer == pytest.approx([0.5 * f.messages["/ads/control/command"]["steering_rad"]
+                                   for f in default.frames])  # half the range, half the angle
+    assert max(abs(s) for s in steer) > 1e-4
+    toml.write_text('[planning_factors]\n"/x" = "yield"\n')
+    with pytest.raises(MappingError, match="not on factor topics"):
+        load_mapping(toml, apollo_mapping())
+    result = CliRunner().invoke(app, ["import", "apollo", str(record), "--root",
+                                      str(tmp_path / "data"), "--mapping", str(toml)])
+    assert result.exit_code == ExitCode.USER_ERROR and "not on factor topics" in result.output
