@@ -3,14 +3,13 @@ included; realistic rates lose what the Autoware round trip loses (docs/apollo.m
 
 from __future__ import annotations
 
-import numpy as np
 import pytest
 
 from evoeye.paths import DataRoot
 from evoeye.sources.apollo.export import export_record
 from evoeye.sources.apollo.run import RECORDS
 from evoeye.sources.autoware.importer import import_bags
-from evoeye.store import Warehouse, load_windows
+from evoeye.store import Warehouse
 
 TOLERANCE = 1e-5
 
@@ -34,16 +33,9 @@ def imported(sim_runs, tmp_path_factory) -> dict[str, DataRoot]:
     return out
 
 
-def test_lossless_records_give_the_native_features_and_labels(sim_runs, imported) -> None:
-    ids = sorted(sim_runs.logs)
-    native = load_windows(sim_runs.root, ids)
-    back = load_windows(imported["lossless"], ids)
-    assert len(native) == len(back) > 0
-    assert np.array_equal(native.frame, back.frame)
-    assert np.array_equal(native.label, back.label) and native.label.sum() > 0
-    a, b = native.arrays(), back.arrays()
-    for name in a:
-        assert np.abs(a[name].astype(np.float64) - b[name]).max() <= TOLERANCE, name
+def test_lossless_records_give_the_native_features_and_labels(sim_runs, imported,
+                                                             same_windows) -> None:
+    same_windows(sim_runs.root, imported["lossless"], sorted(sim_runs.logs), TOLERANCE)
 
 
 def test_lossless_records_keep_the_outcome_and_name_the_label_source(sim_runs,

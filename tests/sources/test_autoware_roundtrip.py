@@ -17,7 +17,7 @@ from evoeye.paths import DataRoot
 from evoeye.sources.autoware.compare import feature_gaps, matched_windows
 from evoeye.sources.autoware.export import export_run
 from evoeye.sources.autoware.importer import import_bags
-from evoeye.store import Warehouse, load_windows
+from evoeye.store import Warehouse
 
 TOLERANCE = 1e-5
 # realistic rates: the 95th percentile of |imported − native| per feature, over the slots both
@@ -52,18 +52,9 @@ def imported(sim_runs, tmp_path_factory) -> dict[str, DataRoot]:
     return out
 
 
-def test_lossless_import_gives_the_native_features_and_labels(sim_runs, imported) -> None:
-    ids = sorted(sim_runs.logs)
-    native = load_windows(sim_runs.root, ids)
-    back = load_windows(imported["lossless"], ids)
-    assert len(native) == len(back) > 0
-    assert np.array_equal(native.scenario_id, back.scenario_id)
-    assert np.array_equal(native.frame, back.frame)
-    assert np.array_equal(native.label, back.label) and native.label.sum() > 0
-    a, b = native.arrays(), back.arrays()
-    for name in a:
-        assert a[name].shape == b[name].shape, name
-        assert np.abs(a[name].astype(np.float64) - b[name]).max() <= TOLERANCE, name
+def test_lossless_import_gives_the_native_features_and_labels(sim_runs, imported,
+                                                            same_windows) -> None:
+    same_windows(sim_runs.root, imported["lossless"], sorted(sim_runs.logs), TOLERANCE)
 
 
 def test_lossless_import_keeps_the_outcome_and_names_the_label_source(sim_runs,
