@@ -80,9 +80,11 @@ KNOWN_ERRORS: dict[str, str] = {
                                                              "software version",
     "evoeye.store.lock.WarehouseLockedError": "wait for the other writer to finish, then run "
                                               "again",
-    "evoeye.store.schema.WarehouseLayoutError": "re-ingest: move warehouse/scenarios, "
-                                                "warehouse/frames and warehouse/frame_features "
-                                                "aside, then run `evoeye ingest` again",
+    "evoeye.store.schema.WarehouseLayoutError": "`evoeye ingest` migrates the previous layout "
+                                                "in place; an older one is re-ingested: move "
+                                                "warehouse/scenarios, warehouse/frames and "
+                                                "warehouse/frame_features aside, then run "
+                                                "`evoeye ingest` again",
     "builtins.PermissionError": ROOT_HINT,
     "builtins.NotADirectoryError": ROOT_HINT,
     "builtins.FileExistsError": ROOT_HINT,
