@@ -27,6 +27,7 @@ from evoeye.batch import pool_context
 from evoeye.evolve.campaign.assess import Assessor
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.loop import Campaign
+from evoeye.evolve.campaign.state import redrawn_note
 from evoeye.lifeline import die_with_parent
 from evoeye.paths import DataRoot
 from evoeye.store.feedback import RoundMetrics
@@ -99,7 +100,9 @@ def run_campaign(job: CampaignJob, brief: Brief = no_metrics,
     lines: list[str] = []
 
     def on_round(row, state) -> None:
-        lines.append(f"{job.label} round {row.round}: {brief(row.metrics)}")
+        note = redrawn_note(state)
+        lines.append(f"{job.label} round {row.round}: {brief(row.metrics)}"
+                     + (f" | {note}" if note else ""))
         if say is not None:
             say(lines[-1])
 
