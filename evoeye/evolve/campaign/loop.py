@@ -53,6 +53,7 @@ from evoeye.atomic import remove_stale_temps
 from evoeye.batch import simulate_and_keep
 from evoeye.evolve.campaign.committee import Committee
 from evoeye.evolve.campaign.config import CampaignConfig, campaign_id
+from evoeye.evolve.campaign.guard import CampaignCancelled, campaign_lease
 from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
 from evoeye.evolve.campaign.state import (
@@ -119,6 +120,7 @@ class Campaign:
         self._recipe = {"recipe": config.recipe} if self.family.recipes else {}  # its trainings'
         self.assess = assess  # may be set after construction (e.g. from the campaign's ids)
         self._monitors: dict[str, object] = {}
+        self.should_stop: Callable[[], bool] | None = None  # asked before each run and update
         self.clock = PhaseClock()  # wall seconds per phase of this object's calls
 
     # -- identity and initial data -------------------------------------------------------------
@@ -248,6 +250,7 @@ class Campaign:
         held = held_runs(self.root, cfg.scenario, self.campaign_id, state.records)
         state.redrawn = []
         while len(new) < cfg.n_round and not self.done(state):
+            self.check_stop()
             with self.clock("simulate"):
                 prop = state.strategy.propose(state.records)
                 spec = fresh_spec(cfg, self.campaign_id, prop.x, state, held,
@@ -347,16 +350,19 @@ class Campaign:
         new_ids = self.acquire(state)
         if not new_ids:
             return None
+        self.check_stop()
         version, train_s = self.update_monitor(state)
         return self.finish_round(state, new_ids, version, train_s)
 
     def run(self, max_rounds: int | None = None,
             on_round: Callable[[RoundRow, CampaignState], None] | None = None) -> CampaignState:
-        """Resume, then run rounds until the budget is spent (or `max_rounds` more are done).
+        """Resume, then run rounds until the budget is spent (or `max_rounds` more are done),
+        holding the campaign's lease (`guard.py`: CampaignBusyError if another process runs it).
         Each warehouse part is decoded once for all rounds (`cached_parts`), the warehouse's
         DuckDB views are installed once per state of it (`shared_connections`), and the rounds'
         garbage collections skip what was loaded before them (`frozen_heap`)."""
-        with cached_parts(), shared_connections():
+        with campaign_lease(self.root.batch_dir(self.config.scenario, self.campaign_id),
+                            self.campaign_id), cached_parts(), shared_connections():
             state = self.start()
             done_rounds = 0
             with frozen_heap():
@@ -372,6 +378,10 @@ class Campaign:
         return state
 
     # -- helpers ---------------------------------------------------------------------------------
+    def check_stop(self) -> None:
+        if self.should_stop is not None and self.should_stop():
+            raise CampaignCancelled(f"campaign {self.campaign_id} stopped on request")
+
     def _store_feedback(self, version: str, scenario_ids) -> None:
         """Score ingested runs with `version` and store f (runs already stored are skipped)."""
         have = self.stored_feedback(version)

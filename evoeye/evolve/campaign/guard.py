@@ -1,0 +1,48 @@
+"""One writer per campaign, and a way to stop one between its steps.
+
+A campaign that runs holds an exclusive `flock` on `.campaign.lock` in its folder
+(`runs/<scenario>/<campaign id>/`), with the holder's host, PID and start time in it. A second
+process that would run the same campaign — a re-run while the first is still going, on any host
+of a cluster whose shared filesystem honours `flock` (docs/distributed.md) — is refused with
+that line. The kernel drops the lock when its holder exits, however it exits.
+
+`Campaign.should_stop` is asked before every run and every monitor update; when it answers yes,
+the campaign raises `CampaignCancelled` and stops there. What it stored is whole (a campaign
+is resumable at any point), so a re-run picks up from its last stored round.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Iterator
+from contextlib import contextmanager
+from pathlib import Path
+
+from evoeye.store.lock import WarehouseLockedError, WriterLock
+
+LEASE_FILE = ".campaign.lock"
+
+
+class CampaignBusyError(RuntimeError):
+    """Another process is running this campaign."""
+
+
+class CampaignCancelled(RuntimeError):
+    """The campaign was asked to stop (the experiment that started it failed elsewhere)."""
+
+
+@contextmanager
+def campaign_lease(folder: Path, campaign_id: str) -> Iterator[None]:
+    """Hold the campaign's lock for the block; CampaignBusyError, naming the holder, if another
+    process holds it."""
+    path = folder / LEASE_FILE
+    try:
+        lock = WriterLock(path).__enter__()
+    except WarehouseLockedError:
+        holder = path.read_text(encoding="utf-8").strip() or "another process"
+        raise CampaignBusyError(
+            f"campaign {campaign_id} is already running ({holder}): one writer per campaign; "
+            "wait for it to finish, or stop that process, and run again") from None
+    try:
+        yield
+    finally:
+        lock.__exit__(None, None, None)

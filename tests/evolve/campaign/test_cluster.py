@@ -1,0 +1,109 @@
+"""Campaigns on a real Dask cluster: the preflight, a failure that stops the others, one writer
+per campaign, and a cluster without workers."""
+
+from __future__ import annotations
+
+import os
+import time
+
+import pytest
+from campaign_helpers import SCENARIO, SPLITS
+from distributed import Client, LocalCluster
+
+from evoeye.evolve.campaign import cluster as cluster_mod
+from evoeye.evolve.campaign.cluster import ClusterError
+from evoeye.evolve.campaign.config import CampaignConfig
+from evoeye.evolve.campaign.experiment import campaign_jobs, plan_experiment
+from evoeye.evolve.campaign.guard import CampaignBusyError, campaign_lease
+from evoeye.evolve.campaign.loop import Campaign
+from evoeye.evolve.campaign.workers import run_campaigns
+from evoeye.paths import DataRoot
+from evoeye.store.feedback import read_rounds
+
+BASE = CampaignConfig(SCENARIO, n_round=1, epochs=1, splits=SPLITS)
+
+
+def _jobs(root: DataRoot, budget_s: float = 600.0):
+    plan = plan_experiment(root, [SCENARIO], BASE, strategies=["uniform", "evoeye"], seeds=[0],
+                           budget_s=budget_s)
+    return campaign_jobs(root, plan)
+
+
+def _cluster(n: int = 2) -> LocalCluster:
+    return LocalCluster(n_workers=n, threads_per_worker=1, processes=True,
+                        dashboard_address=None)
+
+
+def _evolved(root: DataRoot) -> list:
+    return [r for r in read_rounds(root) if r.round > 0]
+
+
+def test_a_worker_that_cannot_see_the_root_is_named_before_any_campaign_starts(
+        root_copy, tmp_path, monkeypatch) -> None:
+    real = root_copy("real")
+    view, elsewhere = tmp_path / "view", tmp_path / "elsewhere"
+    view.mkdir()
+    elsewhere.mkdir()
+    (view / "data").symlink_to(real.path)
+    monkeypatch.chdir(view)  # the client and the workers start here, where ./data is the root
+    root = DataRoot.resolve("/proc/self/cwd/data")  # one path, each process's own view of it
+    lines: list[str] = []
+    with _cluster() as cluster, Client(cluster.scheduler_address) as client:
+        blind = sorted(client.scheduler_info()["workers"])[0]
+        client.run(os.chdir, str(elsewhere), workers=[blind])  # its ./data is no root
+        t0 = time.monotonic()
+        with pytest.raises(ClusterError) as err:
+            run_campaigns(_jobs(root), dask_address=cluster.scheduler_address,
+                          progress=lines.append)
+        elapsed = time.monotonic() - t0
+        assert not any(client.processing().values())  # no campaign runs anywhere
+    message = str(err.value)
+    assert f"Dask worker {blind} on " in message
+    assert "cannot see /proc/self/cwd/data" in message and "\n" not in message
+    assert elapsed < 30
+    assert read_rounds(real) == []  # not even round 0: the preflight comes first
+
+
+def test_a_failed_campaign_stops_the_others_and_a_running_one_is_never_run_twice(
+        root_copy) -> None:
+    root = root_copy("stop")
+    jobs = _jobs(root)
+    busy, other = (Campaign(root, j.config) for j in (jobs[1], jobs[0]))
+    lines: list[str] = []
+    with _cluster() as cluster:
+        folder = root.batch_dir(SCENARIO, busy.campaign_id)
+        # as if a first run of it still held it
+        with campaign_lease(folder, busy.campaign_id), pytest.raises(ClusterError,
+                                                                     match="already running"):
+            run_campaigns(jobs, dask_address=cluster.scheduler_address, progress=lines.append)
+        stopped = len(read_rounds(root, other.campaign_id))
+        with campaign_lease(root.batch_dir(SCENARIO, other.campaign_id), other.campaign_id):
+            pass  # free: the other campaign stopped, its worker holds nothing
+        time.sleep(2)
+        assert len(read_rounds(root, other.campaign_id)) == stopped
+    assert not other.finished()  # stopped long before its 600 s budget
+    assert "stopping 1 unfinished campaign(s) on the cluster" in lines, lines
+    with campaign_lease(folder, busy.campaign_id), pytest.raises(CampaignBusyError,
+                                                                 match="pid"):
+        busy.run(max_rounds=1)  # the same process again: refused too, naming the holder
+
+
+def test_a_cluster_without_workers_fails_after_the_timeout(root_copy, monkeypatch) -> None:
+    monkeypatch.setattr(cluster_mod, "NO_WORKERS_TIMEOUT_S", 2.0)
+    root = root_copy("empty")
+    with _cluster(0) as cluster, pytest.raises(ClusterError, match="no Dask worker joined"):
+        run_campaigns(_jobs(root), dask_address=cluster.scheduler_address,
+                      progress=lambda line: None)
+    assert _evolved(root) == []
+
+
+def test_a_failed_campaign_stops_the_local_workers_too(root_copy) -> None:
+    root = root_copy("local")
+    jobs = _jobs(root)
+    busy, other = (Campaign(root, j.config) for j in (jobs[1], jobs[0]))
+    with campaign_lease(root.batch_dir(SCENARIO, busy.campaign_id), busy.campaign_id), \
+            pytest.raises(CampaignBusyError, match="already running"):
+        run_campaigns(jobs, workers=2, progress=lambda line: None)
+    with campaign_lease(root.batch_dir(SCENARIO, other.campaign_id), other.campaign_id):
+        pass  # its worker process was stopped with the failure
+    assert not other.finished()
