@@ -48,12 +48,13 @@ def campaign_ids(scenario: str, strategy: str, seed: int, initial: np.ndarray,
     records = Records(params=initial, feedback=np.array([f for _, f in outcomes]),
                       fitness=np.array([c for c, _ in outcomes]),
                       disagreement=np.array([f for _, f in outcomes]))
-    strat = make_strategy(strategy, space, seed if old else search_seed(seed, strategy),
+    campaign = f"evo-{strategy}-s{seed}"  # stands for its id (a hash of its whole config)
+    strat = make_strategy(strategy, space, seed if old else search_seed(seed, campaign),
                           **strategy_options(strategy, delta=0.2, batch=20))
     ids = []
     for k in range(proposals):
         x = strat.propose(records).x
-        run = run_seed(seed, k) if old else campaign_run_seed(seed, strategy, k)
+        run = run_seed(seed, k) if old else campaign_run_seed(seed, campaign, k)
         ids.append(run_spec(scenario, x, run).scenario_id)
         fitness, feedback = _outcome(space.normalise(x))
         strat.tell(x, fitness)

@@ -16,6 +16,7 @@ from prefect import flow, get_run_logger, task
 from prefect.cache_policies import NONE
 from pydantic import Field
 
+from evoeye.evolve.campaign.cluster import check_cluster, loopback_api_note
 from evoeye.evolve.campaign.config import CampaignConfig, config_from
 from evoeye.evolve.campaign.experiment import (
     ABLATION,
@@ -27,6 +28,7 @@ from evoeye.evolve.campaign.experiment import (
     method_of,
     plan_experiment,
 )
+from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.campaign.report import markdown, write_experiment_report
 from evoeye.evolve.campaign.workers import (
     CampaignDone,
@@ -97,9 +99,14 @@ def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
     plan = plan_experiment(root, params.scenarios, params.base(), strategies=params.strategies,
                            seeds=range(params.repetitions), budget_s=params.budget_s)
     jobs = campaign_jobs(root, plan)
+    if params.dask_address:  # every worker sees the root and runs this evoeye (cluster.py)
+        check_cluster(params.dask_address, str(root.path),
+                      sorted({Campaign(root, c).reference for c in plan}))
     prepare_campaigns(jobs)
     runner = task_runner(params.workers, params.dask_address)
-    with shared_with_workers():
+    with shared_with_workers() as api_url:
+        if params.dask_address and (note := loopback_api_note(api_url)):
+            get_run_logger().warning(note)
         campaigns_flow.with_options(task_runner=runner)(
             jobs, [f"{c.scenario}-{method_of(c)}-s{c.seed}" for c in plan])
     refresh_catalog(root)

@@ -87,6 +87,28 @@ def preflight(client: Client, address: str, root: str, monitors: Sequence[str]) 
     return sorted(views)
 
 
+def check_cluster(address: str, root: str, monitors: Sequence[str]) -> list[str]:
+    """`preflight` with a client of its own (for a caller whose task runner connects later);
+    the workers' addresses."""
+    from distributed import Client
+
+    with Client(address) as client:
+        return preflight(client, address, root, monitors)
+
+
+def loopback_api_note(api_url: str | None) -> str | None:
+    """A note if the Prefect API the workers are handed is this host's loopback address, which
+    workers on other hosts cannot reach; None otherwise."""
+    from urllib.parse import urlparse
+
+    host = urlparse(api_url or "").hostname or ""
+    if host not in ("127.0.0.1", "localhost", "::1"):
+        return None
+    return (f"note: the Prefect API at {api_url} is this host's loopback address: Dask workers "
+            "on other hosts cannot reach it; start `prefect server start --host 0.0.0.0` and "
+            "set PREFECT_API_URL on every host (docs/distributed.md)")
+
+
 def dask_say(topic: str) -> Callable[[str], None]:
     """A worker's `say`: publish the line on the experiment's topic (the client prints it)."""
     from distributed import get_worker

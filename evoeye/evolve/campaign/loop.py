@@ -214,7 +214,7 @@ class Campaign:
         n_init = len(self.initial["scenario_id"])
         records = self.with_stored(records, last.monitor_version)
         cfg = self.config
-        strategy = make_strategy(cfg.strategy, self.space, search_seed(cfg.seed, cfg.strategy),
+        strategy = make_strategy(cfg.strategy, self.space, search_seed(cfg.seed, self.campaign_id),
                                  **strategy_options(cfg.strategy, delta=cfg.delta,
                                                     batch=cfg.n_round))
         mine = records.tail(n_init)

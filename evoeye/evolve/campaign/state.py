@@ -114,7 +114,7 @@ def held_runs(root: DataRoot, scenario: str, campaign_id: str,
     """scenario_id → batch of the campaign's records (D_init, its earlier rounds' runs) and of
     every round-0 run of `scenario` the root holds (batches, Test Sets). Other campaigns' runs
     are left out: they may be written while this one runs, and what it draws must not depend
-    on that (their streams are their own: `evoeye.seeds`)."""
+    on that (each campaign's streams are its own: `evoeye.seeds`)."""
     rows = Warehouse(root).sql(
         "SELECT scenario_id, batch FROM scenarios WHERE logical_scenario = ? AND round = 0",
         [scenario]).to_pydict()
@@ -128,7 +128,7 @@ def fresh_spec(cfg: CampaignConfig, campaign_id: str, x: np.ndarray, state: Camp
     while `held` has the run it gives; each such run is added to `state.redrawn`. Deterministic
     for the same root, so a resumed round redraws alike."""
     for attempt in range(MAX_REDRAWS + 1):
-        seed = campaign_run_seed(cfg.seed, cfg.strategy, state.acquired, attempt)
+        seed = campaign_run_seed(cfg.seed, campaign_id, state.acquired, attempt)
         spec = run_spec(cfg.scenario, x, seed, batch=campaign_id, source=cfg.strategy,
                         round=state.round + 1, ads=ads)
         if spec.scenario_id not in held:

@@ -107,3 +107,13 @@ def test_a_failed_campaign_stops_the_local_workers_too(root_copy) -> None:
     with campaign_lease(root.batch_dir(SCENARIO, other.campaign_id), other.campaign_id):
         pass  # its worker process was stopped with the failure
     assert not other.finished()
+
+
+def test_a_loopback_prefect_api_is_noted_for_a_cluster() -> None:
+    from evoeye.evolve.campaign.cluster import loopback_api_note
+
+    note = loopback_api_note("http://127.0.0.1:4200/api")
+    assert note is not None and "prefect server start --host 0.0.0.0" in note
+    assert loopback_api_note("http://localhost:4200/api") is not None
+    assert loopback_api_note("http://192.0.2.2:4200/api") is None
+    assert loopback_api_note(None) is None

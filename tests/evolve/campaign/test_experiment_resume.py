@@ -141,7 +141,7 @@ def test_a_lost_dask_worker_is_reported_and_changes_no_record(root_copy, uninter
             assert run.is_alive() and time.monotonic() < deadline
             time.sleep(0.05)
         victim = next(w for w, keys in client.processing().items() if keys)
-        client.run(os._exit, 1, workers=[victim], on_error="ignore", wait=False)
+        os.kill(client.run(os.getpid, workers=[victim])[victim], signal.SIGKILL)
         run.join(600)
     moved = [line for line in lines if line.startswith(f"Dask worker {victim} left")]
     assert len(moved) == 1 and "move to another worker" in moved[0], lines

@@ -27,14 +27,15 @@ def test_the_old_stream_met_the_batch_and_the_new_one_does_not() -> None:
     first = plan_uniform(SCENARIO, 1, INITIAL_SEED)[0]
     old = make_strategy("uniform", space, INITIAL_SEED).propose()
     assert run_spec(SCENARIO, old.x, run_seed(INITIAL_SEED, 0)).scenario_id == first.scenario_id
-    new = make_strategy("uniform", space, search_seed(INITIAL_SEED, "uniform")).propose()
+    a, b = "evo-uniform-s6-aaaa", "evo-avfuzzer-s6-bbbb"  # two campaigns' ids
+    new = make_strategy("uniform", space, search_seed(INITIAL_SEED, a)).propose()
     assert not np.allclose(new.x, first.params)
-    assert campaign_run_seed(INITIAL_SEED, "uniform", 0) != first.seed
-    assert len({campaign_run_seed(INITIAL_SEED, "uniform", 0),
-                campaign_run_seed(INITIAL_SEED, "uniform", 0, attempt=1),
-                campaign_run_seed(INITIAL_SEED, "avfuzzer", 0)}) == 3
-    # two strategies at one seed: the old streams gave AV-Fuzzer's first member Uniform's first
-    ga = make_strategy("avfuzzer", space, search_seed(INITIAL_SEED, "avfuzzer")).propose()
+    assert campaign_run_seed(INITIAL_SEED, a, 0) != first.seed
+    assert len({campaign_run_seed(INITIAL_SEED, a, 0), campaign_run_seed(INITIAL_SEED, a, 1),
+                campaign_run_seed(INITIAL_SEED, a, 0, attempt=1),
+                campaign_run_seed(INITIAL_SEED, b, 0)}) == 4
+    # two campaigns at one seed: the old streams gave AV-Fuzzer's first member Uniform's first
+    ga = make_strategy("avfuzzer", space, search_seed(INITIAL_SEED, b)).propose()
     assert not np.allclose(ga.x, new.x)
 
 
@@ -53,8 +54,9 @@ def test_uniform_campaign_at_the_batch_seed_acquires_no_held_run(root_copy, seed
 def test_a_proposal_the_root_holds_is_redrawn_and_reported(root_copy, seeded) -> None:
     root = root_copy("planted")
     c = Campaign(root, config(seeded[1], strategy="uniform", seed=2, n_round=2))
-    x = make_strategy("uniform", get_scenario(SCENARIO), search_seed(2, "uniform")).propose().x
-    planted = run_spec(SCENARIO, x, campaign_run_seed(2, "uniform", 0), batch="planted")
+    x = make_strategy("uniform", get_scenario(SCENARIO), search_seed(2, c.campaign_id)
+                      ).propose().x
+    planted = run_spec(SCENARIO, x, campaign_run_seed(2, c.campaign_id, 0), batch="planted")
     simulate_and_log(planted, root)
     ingest(root)
     state = c.start()
@@ -69,4 +71,16 @@ def test_a_proposal_the_root_holds_is_redrawn_and_reported(root_copy, seeded) ->
     got = Warehouse(root).sql("SELECT params, seed FROM scenarios WHERE scenario_id = ?",
                               [row.scenario_ids[0]]).to_pylist()[0]
     np.testing.assert_array_equal(got["params"], x)
-    assert got["seed"] == campaign_run_seed(2, "uniform", 0, attempt=1)
+    assert got["seed"] == campaign_run_seed(2, c.campaign_id, 0, attempt=1)
+
+
+def test_two_campaigns_of_one_strategy_and_seed_share_no_run(root_copy, seeded) -> None:
+    root = root_copy("paired")
+    ids = []
+    for update in ("retrain", "replay"):  # two campaign ids, one strategy, one seed
+        c = Campaign(root, config(seeded[1], strategy="uniform", seed=0, n_round=2,
+                                  update=update))
+        row = c.run_round(c.start())
+        assert sorted(_batch_ids(root, c.campaign_id)) == sorted(row.scenario_ids)
+        ids.append(set(row.scenario_ids))
+    assert len(ids[0]) == len(ids[1]) == 2 and not ids[0] & ids[1]
