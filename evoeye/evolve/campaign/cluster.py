@@ -210,6 +210,9 @@ def _wait_stopped(client: Client, futures: Sequence, say: Callable[[str], None])
     running = [f for f in futures if not f.done()]
     if not running:
         return
+    if not client.scheduler_info()["workers"]:  # nothing runs them: nothing to wait for
+        client.cancel(running)
+        return
     say(f"stopping {len(running)} unfinished campaign(s) on the cluster")
     try:
         wait(running, timeout=STOP_TIMEOUT_S)

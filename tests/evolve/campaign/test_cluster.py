@@ -4,6 +4,7 @@ per campaign, and a cluster without workers."""
 from __future__ import annotations
 
 import os
+import threading
 import time
 
 import pytest
@@ -117,3 +118,33 @@ def test_a_loopback_prefect_api_is_noted_for_a_cluster() -> None:
     assert loopback_api_note("http://localhost:4200/api") is not None
     assert loopback_api_note("http://192.0.2.2:4200/api") is None
     assert loopback_api_note(None) is None
+
+
+def test_a_cluster_whose_workers_all_leave_fails_after_the_timeout(root_copy,
+                                                                   monkeypatch) -> None:
+    monkeypatch.setattr(cluster_mod, "NO_WORKERS_TIMEOUT_S", 3.0)
+    root = root_copy("all-gone")
+    lines: list[str] = []
+    failed: list[BaseException] = []
+
+    def experiment(address: str) -> None:
+        try:
+            run_campaigns(_jobs(root, budget_s=200.0), dask_address=address,
+                          progress=lines.append)
+        except BaseException as exc:  # noqa: BLE001 - handed to the test's thread
+            failed.append(exc)
+
+    with _cluster(1) as cluster, Client(cluster.scheduler_address) as client:
+        run = threading.Thread(target=experiment, args=(cluster.scheduler_address,))
+        run.start()
+        deadline = time.monotonic() + 300
+        while not any(" round 1:" in line for line in lines):
+            assert run.is_alive() and time.monotonic() < deadline, lines
+            time.sleep(0.05)
+        client.retire_workers(close_workers=True, remove=True)  # the only worker, for good
+        cluster.scale(0)
+        run.join(120)
+    assert not run.is_alive()
+    assert len(failed) == 1 and isinstance(failed[0], ClusterError), failed
+    assert "no Dask worker left" in str(failed[0]) and "for 3 s; unfinished" in str(failed[0])
+    assert any(line.startswith("Dask worker") and "left the cluster" in line for line in lines)
