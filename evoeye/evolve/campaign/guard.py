@@ -1,7 +1,8 @@
 """One writer per campaign, and a way to stop one between its steps.
 
-A campaign that runs holds an exclusive `flock` on `.campaign.lock` in its folder
-(`runs/<scenario>/<campaign id>/`), with the holder's host, PID and start time in it. A second
+A campaign that runs holds an exclusive `flock` on its own lock file,
+`warehouse/.locks/campaign-<campaign id>.lock` (beside the warehouse's writer locks, outside the
+folder of its logs), with the holder's host, PID and start time in it. A second
 process that would run the same campaign — a re-run while the first is still going, on any host
 of a cluster whose shared filesystem honours `flock` (docs/distributed.md) — is refused with
 that line. The kernel drops the lock when its holder exits, however it exits.
@@ -17,9 +18,8 @@ from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 
-from evoeye.store.lock import WarehouseLockedError, WriterLock
-
-LEASE_FILE = ".campaign.lock"
+from evoeye.paths import DataRoot
+from evoeye.store.lock import LOCKS_DIR, WarehouseLockedError, WriterLock
 
 
 class CampaignBusyError(RuntimeError):
@@ -30,11 +30,15 @@ class CampaignCancelled(RuntimeError):
     """The campaign was asked to stop (the experiment that started it failed elsewhere)."""
 
 
+def lease_path(root: DataRoot, campaign_id: str) -> Path:
+    return root.warehouse / LOCKS_DIR / f"campaign-{campaign_id}.lock"
+
+
 @contextmanager
-def campaign_lease(folder: Path, campaign_id: str) -> Iterator[None]:
+def campaign_lease(root: DataRoot, campaign_id: str) -> Iterator[None]:
     """Hold the campaign's lock for the block; CampaignBusyError, naming the holder, if another
     process holds it."""
-    path = folder / LEASE_FILE
+    path = lease_path(root, campaign_id)
     try:
         lock = WriterLock(path).__enter__()
     except WarehouseLockedError:

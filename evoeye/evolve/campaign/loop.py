@@ -361,8 +361,8 @@ class Campaign:
         Each warehouse part is decoded once for all rounds (`cached_parts`), the warehouse's
         DuckDB views are installed once per state of it (`shared_connections`), and the rounds'
         garbage collections skip what was loaded before them (`frozen_heap`)."""
-        with campaign_lease(self.root.batch_dir(self.config.scenario, self.campaign_id),
-                            self.campaign_id), cached_parts(), shared_connections():
+        with campaign_lease(self.root, self.campaign_id), cached_parts(), \
+                shared_connections():
             state = self.start()
             done_rounds = 0
             with frozen_heap():

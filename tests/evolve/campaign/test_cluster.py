@@ -72,19 +72,18 @@ def test_a_failed_campaign_stops_the_others_and_a_running_one_is_never_run_twice
     busy, other = (Campaign(root, j.config) for j in (jobs[1], jobs[0]))
     lines: list[str] = []
     with _cluster() as cluster:
-        folder = root.batch_dir(SCENARIO, busy.campaign_id)
         # as if a first run of it still held it
-        with campaign_lease(folder, busy.campaign_id), pytest.raises(ClusterError,
+        with campaign_lease(root, busy.campaign_id), pytest.raises(ClusterError,
                                                                      match="already running"):
             run_campaigns(jobs, dask_address=cluster.scheduler_address, progress=lines.append)
         stopped = len(read_rounds(root, other.campaign_id))
-        with campaign_lease(root.batch_dir(SCENARIO, other.campaign_id), other.campaign_id):
+        with campaign_lease(root, other.campaign_id):
             pass  # free: the other campaign stopped, its worker holds nothing
         time.sleep(2)
         assert len(read_rounds(root, other.campaign_id)) == stopped
     assert not other.finished()  # stopped long before its 600 s budget
     assert "stopping 1 unfinished campaign(s) on the cluster" in lines, lines
-    with campaign_lease(folder, busy.campaign_id), pytest.raises(CampaignBusyError,
+    with campaign_lease(root, busy.campaign_id), pytest.raises(CampaignBusyError,
                                                                  match="pid"):
         busy.run(max_rounds=1)  # the same process again: refused too, naming the holder
 
@@ -102,10 +101,10 @@ def test_a_failed_campaign_stops_the_local_workers_too(root_copy) -> None:
     root = root_copy("local")
     jobs = _jobs(root)
     busy, other = (Campaign(root, j.config) for j in (jobs[1], jobs[0]))
-    with campaign_lease(root.batch_dir(SCENARIO, busy.campaign_id), busy.campaign_id), \
+    with campaign_lease(root, busy.campaign_id), \
             pytest.raises(CampaignBusyError, match="already running"):
         run_campaigns(jobs, workers=2, progress=lambda line: None)
-    with campaign_lease(root.batch_dir(SCENARIO, other.campaign_id), other.campaign_id):
+    with campaign_lease(root, other.campaign_id):
         pass  # its worker process was stopped with the failure
     assert not other.finished()
 
