@@ -147,3 +147,17 @@ def test_a_cluster_whose_workers_all_leave_fails_after_the_timeout(root_copy,
     assert len(failed) == 1 and isinstance(failed[0], ClusterError), failed
     assert "no Dask worker left" in str(failed[0]) and "for 3 s; unfinished" in str(failed[0])
     assert any(line.startswith("Dask worker") and "left the cluster" in line for line in lines)
+
+
+def test_the_worker_view_names_a_version_a_monitor_or_a_root_it_lacks(seeded, tmp_path) -> None:
+    from evoeye import __version__
+    from evoeye.evolve.campaign.cluster import worker_view
+
+    root, g0 = seeded
+    assert worker_view(str(root.path), [g0], __version__)[1] == ""
+    assert worker_view(str(root.path), [g0], "0.0.1")[1] == (
+        f"runs evoeye {__version__}, the client 0.0.1")
+    assert worker_view(str(root.path), ["fusion-elsewhere"], __version__)[1] == (
+        f"cannot see {root.monitors / 'fusion-elsewhere'}")
+    assert worker_view(str(tmp_path / "none"), [g0], __version__)[1] == (
+        f"cannot see {tmp_path / 'none'}")
