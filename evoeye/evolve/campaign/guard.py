@@ -8,8 +8,9 @@ of a cluster whose shared filesystem honours `flock` (docs/distributed.md) — i
 that line. The kernel drops the lock when its holder exits, however it exits.
 
 `Campaign.should_stop` is asked before every run and every monitor update; when it answers yes,
-the campaign raises `CampaignCancelled` and stops there. What it stored is whole (a campaign
-is resumable at any point), so a re-run picks up from its last stored round.
+the campaign raises `CampaignCancelled` and stops there. Where no Dask event carries the
+request (a Prefect task runner), a stop file on the data root does (`stop_file`). What it
+stored is whole (a campaign is resumable at any point): a re-run picks up from its last round.
 """
 
 from __future__ import annotations
@@ -32,6 +33,11 @@ class CampaignCancelled(RuntimeError):
 
 def lease_path(root: DataRoot, campaign_id: str) -> Path:
     return root.warehouse / LOCKS_DIR / f"campaign-{campaign_id}.lock"
+
+
+def stop_file(root: DataRoot, token: str) -> Path:
+    """The file whose existence asks every campaign of an experiment (`token`) to stop."""
+    return root.warehouse / LOCKS_DIR / f"stop-{token}"
 
 
 @contextmanager
