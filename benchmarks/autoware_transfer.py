@@ -16,6 +16,7 @@ the native ones?
    comes from).
 
     python -m benchmarks.autoware_transfer --root /tmp/aw --train-runs 160 --test-runs 80
+    python -m benchmarks.autoware_transfer --root /tmp/aw --stack apollo   # cyber records
 
 The done-criterion: |AUROC(imported) − AUROC(native)| ≤ 0.01. The data roots are kept under
 `--root` (a second run reuses the simulated runs, the bags, the imported runs and the trained
@@ -41,6 +42,8 @@ from evoeye.monitor.fusion import SCORE_BATCH, FusionMonitor
 from evoeye.monitor.registry import list_versions, load_monitor
 from evoeye.monitor.train import train_monitor
 from evoeye.paths import DataRoot
+from evoeye.sources.apollo.export import export_record
+from evoeye.sources.apollo.run import RECORDS
 from evoeye.sources.autoware.compare import (
     FEATURE_GROUPS,
     Matched,
@@ -131,22 +134,32 @@ def main() -> None:
     ap.add_argument("--test-runs", type=int, default=80)
     ap.add_argument("--epochs", type=int, default=20)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--stack", choices=("autoware", "apollo"), default="autoware",
+                    help="export and import as Autoware bags or as Apollo cyber records")
     args = ap.parse_args()
     load_before, t0, cpu0 = os.getloadavg(), time.perf_counter(), time.process_time()
     monitor = _monitor(DataRoot.resolve(args.root / "train"), args.train_runs, args.epochs,
                        args.workers)
     native_root = DataRoot.resolve(args.root / "native")
-    imported_root = DataRoot.resolve(args.root / "imported")
+    apollo = args.stack == "apollo"
+    imported_root = DataRoot.resolve(args.root / ("imported-apollo" if apollo else "imported"))
     run_batch(plan_uniform(SCENARIO, args.test_runs, 2, batch="heldout"), native_root,
               workers=args.workers)
     ingest(native_root)
-    bags_dir = args.root / "bags"
-    bags = [bags_dir / log.stem if (bags_dir / log.stem / "metadata.yaml").exists()
-            else export_run(log, bags_dir, rates="realistic")
-            for log in discover_logs(native_root.runs)]
-    report = import_bags(imported_root, bags)
+    if apollo:
+        records_dir = args.root / "records"
+        bags = [records_dir / f"{log.stem}.record"
+                if (records_dir / f"{log.stem}.record").exists()
+                else export_record(log, records_dir, rates="realistic")
+                for log in discover_logs(native_root.runs)]
+    else:
+        bags_dir = args.root / "bags"
+        bags = [bags_dir / log.stem if (bags_dir / log.stem / "metadata.yaml").exists()
+                else export_run(log, bags_dir, rates="realistic")
+                for log in discover_logs(native_root.runs)]
+    report = import_bags(imported_root, bags, recordings=RECORDS if apollo else None)
     assert not report.failed, report.failed
-    ids = sorted(p.name for p in bags)
+    ids = sorted(p.name.removesuffix(".record") for p in bags)
     m = matched_windows(native_root, imported_root, ids, monitor.context_len)
     a, b = m.native, m.imported
     assert np.array_equal(a["label"], b["label"]), "the imported labels differ"

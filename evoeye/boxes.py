@@ -11,6 +11,9 @@ from __future__ import annotations
 
 import numpy as np
 
+# beyond the two half widths: the lateral corridor an actor ahead is "in" (TTC baselines,
+# criticality, collision mechanisms)
+CORRIDOR_MARGIN_M = 0.3
 _UNIT = np.array([[0.5, 0.5], [-0.5, 0.5], [-0.5, -0.5], [0.5, -0.5]])  # corners, box frame
 
 

@@ -151,34 +151,28 @@ def collision_times(args: argparse.Namespace) -> dict[str, float]:
 
 def justified_frames_of(args: argparse.Namespace, val) -> np.ndarray:
     """(B,) bool: an alarm at the window's frame is *justified* as the supervisor judges an
-    intervention (`evoeye.evaluation.supervision.criticality`: labelled 1, or the run comes
+    intervention (`evoeye.criticality`: labelled 1, or the run comes
     critically close within H — ground-truth TTC-2D < 1.5 s or a required deceleration
     > 4 m/s²), from every actor's ground truth in the run's log. Cached beside the scores."""
-    from evoeye.evaluation.supervision.criticality import (
+    from evoeye.criticality import (
         Criticality,
         frame_risk,
         justified_frames,
     )
-    from evoeye.log.channels import TOPICS
+    from evoeye.log.channels import TOPICS, ground_truth_scene
     from evoeye.log.reader import read_run
-    from evoeye.scene import SceneState
 
     cache = out_dir(args.root) / f"justified-{_frames_key(val)}.npz"
     if cache.exists():
         return np.load(cache)["justified"]
-    fields = ("x_m", "y_m", "heading_rad", "speed_mps", "accel_mps2", "length_m", "width_m")
     out = np.zeros(len(val), bool)
     ttc, decel = np.zeros(len(val)), np.zeros(len(val))  # ground truth, for oracle triggers
     sid = val.scenario_id
     start = np.flatnonzero(np.r_[True, sid[1:] != sid[:-1]])
     logs = {p.stem: p for p in (Path(args.root) / "runs" / SCENARIO).glob("*/*.mcap")}
     for lo, hi in zip(start, np.append(start[1:], len(sid)), strict=True):
-        scenes = [SceneState(m["t_s"], np.asarray(m["actor_id"]),
-                             *(np.asarray(m[f], np.float64) for f in fields),
-                             np.asarray(m["crashed"], bool), m["ego_collision"],
-                             m["collision_actor"])
-                  for _, m in read_run(logs[sid[lo]], [TOPICS.ground_truth]).messages(
-                      TOPICS.ground_truth)]
+        scenes = [ground_truth_scene(m) for _, m in read_run(
+            logs[sid[lo]], [TOPICS.ground_truth]).messages(TOPICS.ground_truth)]
         risk = frame_risk(scenes)
         out[lo:hi] = justified_frames(val.label[lo:hi], risk.critical(Criticality()),
                                       int(round(H_S / 0.05)))

@@ -25,7 +25,7 @@ from pydantic import Field, model_validator
 from evoeye.evolve.campaign.config import CampaignConfig, config_from, option_values
 from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.campaign.report import rounds_markdown
-from evoeye.evolve.campaign.state import CampaignState
+from evoeye.evolve.campaign.state import CampaignState, redrawn_note
 from evoeye.paths import DataRoot
 from evoeye.store.feedback import read_rounds
 from flows.campaign_params import KnownNames, campaign_model
@@ -80,7 +80,11 @@ def make_campaign(params: CampaignRun) -> Campaign:
 def acquire(params: CampaignRun) -> list[str]:
     """Propose → simulate → feedback under G_r, N_round times (or until the budget is spent)."""
     campaign = make_campaign(params)
-    return campaign.acquire(campaign.start())
+    state = campaign.start()
+    new_ids = campaign.acquire(state)
+    if note := redrawn_note(state):
+        get_run_logger().warning(note)
+    return new_ids
 
 
 @task(cache_policy=NONE, retries=1, retry_delay_seconds=2)

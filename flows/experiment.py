@@ -10,12 +10,16 @@ ablation tables are written under `<root>/reports/<name>/` and published as a Ma
 
 from __future__ import annotations
 
+import uuid
+from pathlib import Path
 from typing import Any
 
 from prefect import flow, get_run_logger, task
 from prefect.cache_policies import NONE
+from prefect.futures import as_completed
 from pydantic import Field
 
+from evoeye.evolve.campaign.cluster import check_cluster, loopback_api_note
 from evoeye.evolve.campaign.config import CampaignConfig, config_from
 from evoeye.evolve.campaign.experiment import (
     ABLATION,
@@ -27,6 +31,8 @@ from evoeye.evolve.campaign.experiment import (
     method_of,
     plan_experiment,
 )
+from evoeye.evolve.campaign.guard import stop_file
+from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.campaign.report import markdown, write_experiment_report
 from evoeye.evolve.campaign.workers import (
     CampaignDone,
@@ -76,16 +82,32 @@ ExperimentParams = campaign_model("ExperimentParams", ExperimentRun, __name__,
 
 
 @task(cache_policy=NONE, task_run_name="{name}")
-def campaign(job: CampaignJob, name: str) -> CampaignDone:
-    """One campaign, run (or resumed) to its budget in a worker."""
-    return run_campaign(job, brief, say=print)
+def campaign(job: CampaignJob, name: str, stop: str) -> CampaignDone:
+    """One campaign, run (or resumed) to its budget in a worker, until the file `stop` exists."""
+    return run_campaign(job, brief, say=print, should_stop=Path(stop).exists)
 
 
 @flow(name="evoeye-experiment-campaigns", log_prints=True)
 def campaigns_flow(jobs: list[CampaignJob], names: list[str]) -> list[CampaignDone]:
-    """Every campaign as a task on the flow's task runner (experiment_flow picks it)."""
-    futures = [campaign.submit(job, name) for job, name in zip(jobs, names, strict=True)]
-    return [f.result() for f in futures]
+    """Every campaign as a task on the flow's task runner (experiment_flow picks it). If one
+    fails, the others are asked to stop (a stop file on the root: `guard.py`) and waited for."""
+    if not jobs:
+        return []
+    stop = stop_file(DataRoot.resolve(jobs[0].root), uuid.uuid4().hex[:12])
+    futures = [campaign.submit(job, name, str(stop))
+               for job, name in zip(jobs, names, strict=True)]
+    try:
+        for future in as_completed(futures):  # the first failure, as soon as it happens
+            future.result()
+        return [f.result() for f in futures]
+    except BaseException:
+        stop.parent.mkdir(parents=True, exist_ok=True)
+        stop.touch()
+        for f in futures:
+            f.wait()
+        raise
+    finally:
+        stop.unlink(missing_ok=True)
 
 
 @flow(name="evoeye-experiment", log_prints=True,
@@ -97,9 +119,14 @@ def experiment_flow(params: ExperimentParams | None = None) -> dict[str, Any]:
     plan = plan_experiment(root, params.scenarios, params.base(), strategies=params.strategies,
                            seeds=range(params.repetitions), budget_s=params.budget_s)
     jobs = campaign_jobs(root, plan)
+    if params.dask_address:  # every worker sees the root and runs this evoeye (cluster.py)
+        check_cluster(params.dask_address, str(root.path),
+                      sorted({Campaign(root, c).reference for c in plan}))
     prepare_campaigns(jobs)
     runner = task_runner(params.workers, params.dask_address)
-    with shared_with_workers():
+    with shared_with_workers() as api_url:
+        if params.dask_address and (note := loopback_api_note(api_url)):
+            get_run_logger().warning(note)
         campaigns_flow.with_options(task_runner=runner)(
             jobs, [f"{c.scenario}-{method_of(c)}-s{c.seed}" for c in plan])
     refresh_catalog(root)

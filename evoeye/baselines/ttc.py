@@ -25,7 +25,7 @@ from typing import ClassVar
 import numpy as np
 
 from evoeye.ads.config import PlanningConfig
-from evoeye.boxes import box_corners, first_contact_s
+from evoeye.boxes import CORRIDOR_MARGIN_M, box_corners, first_contact_s
 from evoeye.store.features import PERCEPTION_FEATURES
 from evoeye.store.windows import Windows
 
@@ -34,7 +34,6 @@ COS_DH, SIN_DH = (PERCEPTION_FEATURES.index(k) for k in ("cos_dheading", "sin_dh
 LENGTH, WIDTH = (PERCEPTION_FEATURES.index(k) for k in ("length_m", "width_m"))
 EGO_LENGTH_M = PlanningConfig().ego_length_m  # the ego's footprint, as the ADS knows it
 EGO_WIDTH_M = PlanningConfig().ego_width_m
-CORRIDOR_MARGIN_M = 0.3  # beyond the two half widths: the corridor an obstacle is "in"
 
 
 def min_ttc_s(

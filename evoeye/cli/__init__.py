@@ -9,7 +9,7 @@ from evoeye.cli.app import app
 
 COMMAND_MODULES = (
     "simulate", "warehouse", "monitor", "monitors", "evaluate", "evolve", "demo", "audit",
-    "explain", "results", "findings", "autoware", "watch", "predictability", "supervise",
+    "explain", "results", "findings", "autoware", "apollo", "watch", "predictability", "supervise",
 )
 
 for _name in COMMAND_MODULES:

@@ -23,13 +23,26 @@ MappingOpt = Annotated[Path | None, typer.Option(
     help="TOML file overriding the default topics, vehicle and clock (docs/autoware.md).")]
 
 
-def load_mapping_option(path: Path | None):  # noqa: ANN202 - the type lives in a heavy module
+def load_mapping_option(path: Path | None, base=None):  # noqa: ANN001, ANN202 - heavy types
+    """The mapping a --mapping file gives over `base` (default: Autoware's); a bad file is a
+    UserError."""
     from evoeye.sources.autoware.config import MappingError, load_mapping
 
     try:
-        return load_mapping(path)
+        return load_mapping(path, base)
     except MappingError as exc:
         raise UserError(str(exc), "see docs/autoware.md, \"Mapping file\"") from exc
+
+
+LogsArg = Annotated[list[Path] | None, typer.Argument(
+    help="Run logs to export (default: every run under <root>/runs, or --scenario's).",
+    exists=True, dir_okay=False)]
+ScenarioOpt = Annotated[str | None, typer.Option(
+    "--scenario", callback=scenario_check(recorded=True),
+    help=scenario_help("Only this logical scenario's runs.", recorded=True))]
+RatesOpt = Annotated[str, typer.Option(
+    "--rates", help="realistic: the stack's rates (odometry 50 Hz, objects and planning 10 Hz, "
+    "control 33 Hz); lossless: every topic at 20 Hz.")]
 
 
 @import_app.command("autoware")
@@ -50,42 +63,62 @@ def import_autoware(
 
     data = DataRoot.resolve(root)
     report = import_bags(data, paths, mapping=load_mapping_option(mapping), batch=batch,
-                         on_bag=lambda p: err().print(f"reading {p}"))
+                         on_bag=reading)
+    print_import(report, batch)
+
+
+def reading(path: Path) -> None:
+    """One line on stderr as each recording is read."""
+    from rich.markup import escape
+
+    err().print(f"reading {escape(str(path))}")
+
+
+def print_import(report, batch: str) -> None:  # noqa: ANN001 - ImportReport, a heavy module
+    """What an import did, one line each; exit 3 if any recording was refused."""
+    from rich.markup import escape
+
     console = out()
+    console.soft_wrap = True
     for note in report.notes:
-        console.print(f"[yellow]note[/] {note}")
+        console.print(f"[yellow]note[/] {escape(note)}")
     ingested = sum(len(r.ingested) for r in report.ingest)
     skipped = sum(r.skipped for r in report.ingest)
-    for r in report.ingest:
-        for log, reason in r.quarantined:
-            report.failed.append(f"{log}: {reason}")
     for sid, source in sorted(report.labels.items()):
-        console.print(f"{sid}: labels from {source}")
-    console.print(f"{len(report.labels)} bags converted, {ingested} runs ingested, {skipped} "
-                  f"already in the warehouse (batch {batch})")
+        console.print(f"{sid}: labels from {escape(source)}")
+    console.print(f"{len(report.labels)} recordings converted, {ingested} runs ingested, "
+                  f"{skipped} already in the warehouse (batch {batch})")
     if report.failed:
         for line in report.failed:
-            err().print(f"[red]refused[/] {line}")
+            err().print(f"[red]refused[/] {escape(line)}")
         exit_with(ExitCode.PARTIAL)
 
 
 @export_app.command("autoware")
 def export_autoware(
     output: Annotated[Path, typer.Option("--out", help="Folder for the bags (one per run).")],
-    logs: Annotated[list[Path] | None, typer.Argument(
-        help="Run logs to export (default: every run under <root>/runs, or --scenario's).",
-        exists=True, dir_okay=False)] = None,
+    logs: LogsArg = None,
     root: RootOpt = None,
-    scenario: Annotated[str | None, typer.Option(
-        "--scenario", callback=scenario_check(recorded=True), help=scenario_help(
-            "Only this logical scenario's runs.", recorded=True))] = None,
-    rates: Annotated[str, typer.Option(
-        "--rates", help="realistic: Autoware's rates (odometry 50 Hz, objects and planning "
-        "10 Hz, control 33 Hz); lossless: every topic at 20 Hz.")] = "realistic",
+    scenario: ScenarioOpt = None,
+    rates: RatesOpt = "realistic",
     mapping: MappingOpt = None,
 ) -> None:
     """Write simulated runs as Autoware-typed rosbag2 MCAP bags (with their ground truth)."""
-    from evoeye.sources.autoware.export import RATES, export_run
+    from evoeye.sources.autoware.export import export_run
+
+    logs = logs_to_export(logs, root, scenario, rates)
+    output.mkdir(parents=True, exist_ok=True)
+    chosen = load_mapping_option(mapping)
+    for log in logs:
+        bag = export_run(log, output, mapping=chosen, rates=rates)
+        out().print(f"wrote {bag}")
+
+
+def logs_to_export(logs: list[Path] | None, root: Path | None, scenario: str | None,
+                   rates: str) -> list[Path]:
+    """The run logs an export names (default: every run of the root, or the scenario's);
+    UserError for unknown rates or no log."""
+    from evoeye.sources.autoware.export import RATES
     from evoeye.store.ingest import discover_logs
 
     if rates not in RATES:
@@ -95,8 +128,4 @@ def export_autoware(
         logs = discover_logs(data.runs / scenario if scenario else data.runs)
     if not logs:
         raise UserError("no run log to export", "simulate some first: `evoeye simulate …`")
-    output.mkdir(parents=True, exist_ok=True)
-    chosen = load_mapping_option(mapping)
-    for log in logs:
-        bag = export_run(log, output, mapping=chosen, rates=rates)
-        out().print(f"wrote {bag}")
+    return logs

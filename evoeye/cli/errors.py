@@ -78,11 +78,16 @@ KNOWN_ERRORS: dict[str, str] = {
                                                                     "folder aside",
     "evoeye.evaluation.supervision.sweep.ReproductionError": "re-simulate the batch with this "
                                                              "software version",
+    "evoeye.evolve.campaign.cluster.ClusterError": "docs/distributed.md says what every "
+                                                   "host of a cluster needs",
+    "evoeye.evolve.campaign.guard.CampaignBusyError": "",
     "evoeye.store.lock.WarehouseLockedError": "wait for the other writer to finish, then run "
                                               "again",
-    "evoeye.store.schema.WarehouseLayoutError": "re-ingest: move warehouse/scenarios, "
-                                                "warehouse/frames and warehouse/frame_features "
-                                                "aside, then run `evoeye ingest` again",
+    "evoeye.store.schema.WarehouseLayoutError": "`evoeye ingest` migrates the previous layout "
+                                                "in place; an older one is re-ingested: move "
+                                                "warehouse/scenarios, warehouse/frames and "
+                                                "warehouse/frame_features aside, then run "
+                                                "`evoeye ingest` again",
     "builtins.PermissionError": ROOT_HINT,
     "builtins.NotADirectoryError": ROOT_HINT,
     "builtins.FileExistsError": ROOT_HINT,

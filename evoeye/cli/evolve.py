@@ -97,6 +97,7 @@ def evolve_command(
     from evoeye.evolve.campaign.assess import Assessor
     from evoeye.evolve.campaign.experiment import brief
     from evoeye.evolve.campaign.loop import Campaign
+    from evoeye.evolve.campaign.state import redrawn_note
 
     cfg = _config(options)
     if cfg.budget_s <= 0:
@@ -115,7 +116,8 @@ def evolve_command(
 
     def show(row, state) -> None:
         bar.write(f"round {row.round}: {len(row.scenario_ids)} runs, {row.simulated_s:.0f}/"
-                  f"{cfg.budget_s:.0f} s, monitor {row.monitor_version} | {brief(row.metrics)}")
+                  f"{cfg.budget_s:.0f} s, monitor {row.monitor_version} | {brief(row.metrics)}"
+                  + (f" | {note}" if (note := redrawn_note(state)) else ""))
         bar.update(max(0, min(round(state.spent_s), bar.total) - bar.n))
         bar.set_postfix_str(f"round {row.round}")
 

@@ -26,9 +26,11 @@ def out() -> Console:
 
 
 def err() -> Console:
+    """A stderr console that never breaks a line: a message is one line in a file or a pipe
+    (a terminal wraps it where it must, softly)."""
     from rich.console import Console
 
-    return Console(stderr=True)
+    return Console(stderr=True, soft_wrap=True)
 
 
 def table(title: str | None, columns: list[str], *, left: tuple[str, ...] = (),

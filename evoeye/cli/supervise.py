@@ -41,6 +41,24 @@ def parse_floats(text: str, what: str) -> tuple[float, ...]:
     return values
 
 
+def default_monitors(root: DataRoot, scenario: str, given: list[str] | None) -> list[str]:
+    """The --monitor versions: as given ('none': none), else the newest FusionMonitor trained on
+    the scenario (a campaign's G_0, `initial_monitor`), said on stderr; none without one."""
+    if given:
+        return [] if given == ["none"] else list(given)
+    from evoeye.monitor.families import NoMonitorError, initial_monitor
+
+    try:
+        version = initial_monitor(root, scenario)
+    except NoMonitorError:
+        err().print(f"no FusionMonitor is trained on {scenario}: the triggers are baselines "
+                    f"only (train one: `evoeye train --scenario {scenario}`)")
+        return []
+    err().print(f"monitor {version}: the newest FusionMonitor trained on {scenario} "
+                "(--monitor to choose)")
+    return [version]
+
+
 @app.command("supervise")
 def supervise_command(
     scenario: Annotated[str, typer.Option(
@@ -50,8 +68,10 @@ def supervise_command(
         "test-seed<S>): the same scenarios and seeds, paired.")],
     root: RootOpt = None,
     monitor: Annotated[list[str] | None, typer.Option(
-        "--monitor", help="A trained monitor version as a trigger (the FusionMonitor; "
-        "repeatable, one per monitor name).")] = None,
+        "--monitor", help="A trained monitor version as a trigger (repeatable: the first "
+        "FusionMonitor is the one the headline compares; a second is named by its version; "
+        "'none' for none). Default: the newest FusionMonitor trained on the scenario's train "
+        "split, as a campaign's G_0.")] = None,
     baselines: Annotated[str, typer.Option(
         help="Comma-separated baselines as triggers ('none' for none).")] =
         ",".join(SUPERVISE_BASELINES),
@@ -134,7 +154,8 @@ def supervise_command(
 
     if logs not in LOG_POLICIES:
         raise typer.BadParameter(f"--logs: one of {', '.join(LOG_POLICIES)}, got {logs!r}")
-    sources = [("version", v) for v in monitor or []]
+    data = DataRoot.existing(root)
+    sources = [("version", v) for v in default_monitors(data, scenario, monitor)]
     sources += [("baseline", b) for b in parse_baselines(baselines)]
     if not sources:
         raise typer.BadParameter("no trigger: give --monitor or --baselines")
@@ -145,7 +166,6 @@ def supervise_command(
                                         stage_decel_mps2=stage_decel_mps2, stage_s=stage_s)
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from exc
-    data = DataRoot.existing(root)
     bar = lambda it: tqdm(it, desc=f"supervise {scenario}", unit="run")  # noqa: E731
     try:
         result = supervise(data, scenario, batch, sources, splits=splits,

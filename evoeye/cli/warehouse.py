@@ -72,6 +72,7 @@ def ingest_into(data: DataRoot, runs_per_part: int = RUNS_PER_PART) -> None:
 
     from evoeye.store import ingest
     from evoeye.store.ingest import discover_logs
+    from evoeye.store.schema import LAYOUT_VERSION
 
     if not discover_logs(data.runs):
         err().print(f"[yellow]warning:[/] no run logs under {data.runs}: nothing to ingest "
@@ -90,6 +91,9 @@ def ingest_into(data: DataRoot, runs_per_part: int = RUNS_PER_PART) -> None:
         for bar in bars:
             bar.close()
     console = out()
+    if report.migrated:
+        console.print(f"migrated {len(report.migrated)} warehouse parts to layout "
+                      f"{LAYOUT_VERSION} in place")
     console.print(report_table(report))
     for log, reason in report.quarantined:
         console.print(f"[yellow]quarantined[/] {log}: {reason}")

@@ -26,7 +26,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from evoeye.baselines.ttc import CORRIDOR_MARGIN_M
+from evoeye.boxes import CORRIDOR_MARGIN_M
 from evoeye.sim.counterfactual import struck_from_behind
 from evoeye.sim.episode import Episode
 

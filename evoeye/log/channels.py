@@ -15,6 +15,8 @@ from operator import attrgetter
 from pathlib import Path
 from typing import Any, NamedTuple
 
+import numpy as np
+
 from evoeye.ads.messages import (
     ControlCommand,
     Localization,
@@ -112,6 +114,18 @@ def _fields_encoder(schema_file: str, source: str) -> Encoder:
 
 def _fields_channel(topic: str, schema_file: str, message_type: type, source: str) -> Channel:
     return Channel(topic, schema_file, _fields_encoder(schema_file, source), message_type)
+
+
+SCENE_ARRAYS = ("x_m", "y_m", "heading_rad", "speed_mps", "accel_mps2", "length_m", "width_m")
+
+
+def ground_truth_scene(message: dict[str, Any]) -> SceneState:
+    """A ground-truth message back as the SceneState it was written from, without the
+    occluders (the channel does not carry them)."""
+    return SceneState(float(message["t_s"]), np.asarray(message["actor_id"], np.int64),
+                      *(np.asarray(message[f], np.float64) for f in SCENE_ARRAYS),
+                      np.asarray(message["crashed"], bool), bool(message["ego_collision"]),
+                      int(message["collision_actor"]))
 
 
 def _scene_update(frame: Frame, t_ns: int) -> dict[str, Any]:

@@ -157,10 +157,11 @@ def write_episode(episode: Episode, path: str | os.PathLike,
                   supervisor: Supervision | None = None) -> Path:
     """Write one run's log to `path` atomically and return the path.
 
-    The bytes go to `<path>.<pid>.tmp` in the same folder, are flushed and fsynced, then renamed
-    over `path`; on any error the temporary file is removed and the error re-raised, and a killed
-    process leaves only a `.tmp` file, never a partial log under the final name. Failed runs
-    (status "failed", possibly with zero frames) are written too, so their reason is on disk.
+    The bytes go to `<path>.<pid>@<host>.tmp` in the same folder, are flushed and fsynced, then
+    renamed over `path`; on any error the temporary file is removed and the error re-raised, and
+    a killed process leaves only a `.tmp` file, never a partial log under the final name. Failed
+    runs (status "failed", possibly with zero frames) are written too, so their reason is on
+    disk.
     """
     path = Path(path)
     with atomic_file(path) as f:

@@ -21,12 +21,18 @@ its last eligible one: `collision_lead_s`), never anything a monitor sees at run
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 
 import numpy as np
 from sklearn.metrics import average_precision_score, roc_auc_score
 
+from evoeye.criticality import Criticality, frame_risk
+from evoeye.log import read_run
+from evoeye.log.channels import TOPICS, ground_truth_scene
 from evoeye.monitor.recipes import NEAR_MISSES, SELECTIONS
+from evoeye.paths import DataRoot
+from evoeye.store.catalog import Warehouse
 from evoeye.store.features import CONTROL_FEATURES
 from evoeye.store.windows import Windows
 
@@ -112,3 +118,41 @@ def selection_metric(name: str, scores: np.ndarray, labels: np.ndarray) -> float
     if name == "pauc":
         return float(roc_auc_score(y, scores, max_fpr=PAUC_MAX_FPR))
     raise ValueError(f"unknown selection {name!r}; known: {list(SELECTIONS)}")
+
+
+def critical_times(root: DataRoot, scenario_ids: Sequence[str],
+                   criticality: Criticality = Criticality()  # noqa: B008 (frozen)
+                   ) -> dict[str, np.ndarray]:
+    """Each run's critical frames (`evoeye.criticality`: ground-truth TTC-2D or required
+    deceleration past its bounds), as their times in s, from every actor's ground truth in the
+    run's log. Labels only: a monitor never sees them at run time."""
+    ids = sorted(set(scenario_ids))
+    con = Warehouse(root).connect()
+    try:
+        where = con.sql("SELECT scenario_id, logical_scenario, batch FROM scenarios "
+                        "WHERE list_contains($ids, scenario_id)", params={"ids": ids}).fetchall()
+    finally:
+        con.close()
+    if missing := sorted(set(ids) - {r[0] for r in where}):
+        raise LookupError(f"{len(missing)} run(s) not in the warehouse, e.g. {missing[0]}")
+    out = {}
+    for sid, scenario, batch in where:
+        log = read_run(root.run_log(scenario, batch, sid), [TOPICS.ground_truth])
+        scenes = [ground_truth_scene(m) for _, m in log.messages(TOPICS.ground_truth)]
+        crit = frame_risk(scenes).critical(criticality)
+        out[sid] = np.array([s.t_s for s in scenes])[crit]
+    return out
+
+
+def critical_target(windows: Windows, critical_s: dict[str, np.ndarray]) -> Windows:
+    """`windows` with TrainParams.target "critical": a window is unsafe when its run collides
+    within H (its label) or has a critical frame (`critical_times`) within [t, t + H] — an
+    intervention there is justified, as the supervisor judges one (`justified_frames`)."""
+    label = windows.label.astype(bool).copy()
+    for lo, hi in zip(*windows.run_bounds(), strict=True):
+        times = np.sort(critical_s[str(windows.scenario_id[lo])])
+        t = windows.t_s[lo:hi]
+        first = np.searchsorted(times, t - LEAD_EPS_S)  # the first critical frame at or after t
+        after = np.searchsorted(times, t + windows.horizon_s + LEAD_EPS_S, side="right")
+        label[lo:hi] |= after > first
+    return replace(windows, label=label.astype(np.int8))

@@ -36,6 +36,9 @@ BATCHINGS = ("windows", "chunks")
 SCHEDULES = ("constant", "cosine", "hold-decay")
 SELECTIONS = ("auprc", "pauc")  # the early-stopping criterion (evoeye.monitor.lookahead)
 NEAR_MISSES = ("safe", "ignored", "unsafe")  # how near misses train (evoeye.monitor.lookahead)
+# what a window's label means: a collision within H (Definition 1), or a ground-truth critical
+# approach or a collision within H (`evoeye.criticality`; evoeye.monitor.lookahead)
+TARGETS = ("collision", "critical")
 
 
 @dataclass(frozen=True)
@@ -61,6 +64,7 @@ class TrainParams:
     select_on: str = "auprc"  # SELECTIONS: the validation criterion of early stopping
     min_lead_s: float = 0.0  # unsafe windows closer to their collision do not train
     near_misses: str = "safe"  # NEAR_MISSES: the windows of an emergency without a collision
+    target: str = "collision"  # TARGETS: what the label of a window means, trained and selected
 
     def __post_init__(self) -> None:
         if self.batching not in BATCHINGS:
@@ -72,6 +76,8 @@ class TrainParams:
         if self.near_misses not in NEAR_MISSES:
             raise ValueError(f"unknown near_misses {self.near_misses!r}; known: "
                              f"{list(NEAR_MISSES)}")
+        if self.target not in TARGETS:
+            raise ValueError(f"unknown target {self.target!r}; known: {list(TARGETS)}")
         if self.min_lead_s < 0:
             raise ValueError(f"min_lead_s must be >= 0, got {self.min_lead_s}")
         for name, least in (("epochs", 1), ("patience", 1), ("batch_size", 1),
@@ -85,7 +91,7 @@ class TrainParams:
 
 V1 = TrainParams()
 ADDED_FIELDS = ("recipe", "batching", "chunk_windows", "schedule", "warmup_epochs",
-                "keep_parent", "select_on", "min_lead_s", "near_misses")
+                "keep_parent", "select_on", "min_lead_s", "near_misses", "target")
 RECIPES: dict[str, TrainParams] = {
     "v1": V1,
     "v2": replace(V1, recipe="v2", batching="chunks", chunk_windows=32, batch_size=1024,
@@ -109,7 +115,7 @@ def recipe_params(recipe: str | None = None, **overrides: Any) -> TrainParams:
 
 
 # added for issue 37 (evoeye.monitor.lookahead), after ledger keys recorded every field
-LOOKAHEAD_FIELDS = ("select_on", "min_lead_s", "near_misses")
+LOOKAHEAD_FIELDS = ("select_on", "min_lead_s", "near_misses", "target")
 
 
 def recipe_key(params: TrainParams) -> dict[str, Any]:

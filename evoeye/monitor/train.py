@@ -42,7 +42,7 @@ from evoeye.monitor.card import (
 from evoeye.monitor.device import pick_device
 from evoeye.monitor.fit import FitResult, Progress, fit, kernels, reproducible
 from evoeye.monitor.fusion import FusionMonitor
-from evoeye.monitor.lookahead import PAUC_MAX_FPR
+from evoeye.monitor.lookahead import PAUC_MAX_FPR, critical_target, critical_times
 from evoeye.monitor.model import MODULES, FusionConfig, FusionNet
 from evoeye.monitor.protocol import Thresholds
 from evoeye.monitor.recipes import TrainParams, card_hyperparameters, recipe_params
@@ -144,6 +144,9 @@ def train_monitors(
     train = load_windows(warehouse, train_runs, context_len=config.context_len,
                          horizon_s=horizon_s)
     val = load_windows(warehouse, val_runs, context_len=config.context_len, horizon_s=horizon_s)
+    if base.target == "critical":  # trained and selected on critical approaches too
+        critical = critical_times(root, np.concatenate([train.scenario_id, val.scenario_id]))
+        train, val = critical_target(train, critical), critical_target(val, critical)
     where = pick_device(device)
     norms = None if parent is not None else _fitted_normalizers(train, config)
 

@@ -39,6 +39,7 @@ from evoeye.store.features import FEATURES, FrameFeatures
 from evoeye.store.lock import WarehouseLockedError, WriterLock, key_lock
 from evoeye.store.log_windows import LoggedRun
 from evoeye.store.metadata import check_metadata
+from evoeye.store.migrate import migrate
 from evoeye.store.parts import PartStore
 from evoeye.store.records import (
     FRAME_CLOCK,
@@ -69,6 +70,7 @@ class IngestReport:
     left_out: list[str] = field(default_factory=list)  # logs of a world variant (module doc)
     orphans_removed: list[str] = field(default_factory=list)  # parts of a killed ingest
     catalog_error: str | None = None  # the DuckDB file could not be refreshed (data is in)
+    migrated: list[str] = field(default_factory=list)  # parts brought to LAYOUT_VERSION
 
 
 def discover_logs(runs_dir: Path) -> list[Path]:
@@ -136,6 +138,8 @@ class Ingester:
     def run(self, converted: Sequence[LoggedRun] = ()) -> IngestReport:
         """One pass; `converted`: runs of the logs to ingest already converted (by path)."""
         report = IngestReport()
+        if self.batch is None:  # a whole-warehouse writer brings an old layout up first
+            report.migrated = [self.root.relative(p) for p in migrate(self.root)]
         self.store.check_layout()  # never a part of this layout beside older ones
         given = {self.root.relative(c.path): c for c in converted}
         if self.batch is None:

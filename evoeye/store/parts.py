@@ -21,6 +21,7 @@ from evoeye.paths import DataRoot
 from evoeye.store.schema import (
     LAYOUT_KEY,
     LAYOUT_VERSION,
+    MIGRATABLE,
     PARTITION_KEYS,
     TABLES,
     WarehouseLayoutError,
@@ -61,6 +62,12 @@ def check_part_layout(path: Path, metadata: dict[bytes, bytes] | None = None) ->
     found = part_layout(pq.read_schema(path).metadata if metadata is None else metadata)
     if found != LAYOUT_VERSION:
         warehouse = path.parents[len(PARTITION_KEYS) + 1]  # <root>/warehouse
+        if found in MIGRATABLE:  # evoeye.store.migrate
+            raise WarehouseLayoutError(
+                f"{path}: a warehouse part of layout {found}; this evoeye reads layout "
+                f"{LAYOUT_VERSION} only (docs/warehouse.md, Warehouse layouts) — migrate: run "
+                f"`evoeye ingest` on the data root of {warehouse} once (it rewrites the parts "
+                "in place)")
         raise WarehouseLayoutError(
             f"{path}: a warehouse part of layout {found}; this evoeye reads layout "
             f"{LAYOUT_VERSION} only (docs/warehouse.md, Warehouse layouts) — re-ingest: move "

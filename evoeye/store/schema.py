@@ -34,8 +34,10 @@ DDL_SCHEMA = "ddl"  # the DuckDB schema holding the declared, always empty, tabl
 # warehouse holds parts of one layout only (`check_layout`), so the views need not reconcile
 # schemas file by file. 1: frame_features arrays as FLOAT[] lists (evoeye <= 0.4.0);
 # 2: as little-endian float32 bytes (BLOB); 3: scenarios.ads_profile; 4: scenarios.label_source
-# and the frames' message ages (age_*), for recordings imported from other stacks.
-LAYOUT_VERSION = 4
+# and the frames' message ages (age_*), for recordings imported from other stacks; 5: the actor
+# ids other_actor and gt_collision_actor as BIGINT (`evoeye.store.migrate` rewrites layout 4).
+LAYOUT_VERSION = 5
+MIGRATABLE = (4,)  # layouts whose parts differ from LAYOUT_VERSION's in column types only
 LAYOUT_KEY = b"evoeye.warehouse_layout"
 
 

@@ -70,7 +70,7 @@ CREATE TABLE frames (
     gt_vy_mps              DOUBLE   NOT NULL,
     gt_accel_mps2          DOUBLE   NOT NULL,
     gt_ego_collision       BOOLEAN  NOT NULL,  -- nu(o_t) of Definition 1
-    gt_collision_actor     INTEGER  NOT NULL,  -- -1 if none
+    gt_collision_actor     BIGINT   NOT NULL,  -- -1 if none (64-bit, as the track ids)
     ingest_id              VARCHAR  NOT NULL,  -- the Parquet part these rows were written in
     logical_scenario       VARCHAR  NOT NULL,  -- partition key
     batch                  VARCHAR  NOT NULL   -- partition key

@@ -18,7 +18,8 @@ CREATE TABLE scenarios (
     reason            VARCHAR   NOT NULL,  -- why it failed; '' when ok
     collided          BOOLEAN   NOT NULL,  -- a violation scenario (Definition 1)
     collision_time_s  DOUBLE,              -- tau_col: first frame time with an ego collision
-    other_actor       INTEGER,             -- actor of the first ego collision
+    other_actor       BIGINT,              -- actor of the first ego collision (64-bit: a
+                                           -- UUID-derived id of another stack)
     duration_s        DOUBLE    NOT NULL,  -- simulated time
     min_distance_m    DOUBLE,              -- min ego-actor footprint distance over the run
     label_source      VARCHAR   NOT NULL,  -- what labelled collisions: 'simulator', a recorded

@@ -97,3 +97,22 @@ def test_experiment_flow_runs_named_campaigns_and_writes_the_report(prefect_serv
     assert again["results"][SCENARIO]["evoeye"][0]["rounds"] == res["evoeye"][0]["rounds"]
     assert again["results"][SCENARIO]["reseeded"] == res["reseeded"]
     assert list_versions(root) == versions
+
+
+def test_a_failed_campaign_stops_the_flows_other_campaigns(prefect_server, fresh_root) -> None:
+    from evoeye.evolve.campaign.guard import CampaignBusyError, campaign_lease
+
+    root, g0 = fresh_root
+    params = ExperimentParams(root=str(root.path), scenarios=[SCENARIO],
+                              strategies=["uniform", "evoeye"], repetitions=1, budget_s=600.0,
+                              controls=0, workers=2, n_round=1, epochs=1, split_seed=0,
+                              train_frac=0.5, val_frac=0.25)
+    plan = plan_experiment(root, [SCENARIO], params.base(), strategies=params.strategies,
+                           seeds=[0], budget_s=600.0)
+    busy, other = Campaign(root, plan[1]), Campaign(root, plan[0])
+    with campaign_lease(root, busy.campaign_id), pytest.raises(CampaignBusyError):
+        experiment_flow(params)  # the evoeye campaign is "already running" elsewhere
+    with campaign_lease(root, other.campaign_id):
+        pass  # the uniform campaign stopped with the flow
+    assert not other.finished()
+    assert not list((root.warehouse / ".locks").glob("stop-*"))  # the request is withdrawn

@@ -97,3 +97,26 @@ def _bag_at(path: Path, msgs, identity: dict | None = None) -> Path:
     custom = {RUN_KEY: orjson.dumps({k: identity[k] for k in kept}).decode()} \
         if identity else None
     return write_bag(path, msgs, custom)
+
+
+def assert_same_windows(native_root: DataRoot, imported_root: DataRoot, ids: list[str],
+                        tolerance: float) -> None:
+    """The runs' windows in both warehouses: the same frames and labels (some unsafe), every
+    input within `tolerance` (a lossless round trip's check)."""
+    from evoeye.store import load_windows
+
+    native, back = load_windows(native_root, ids), load_windows(imported_root, ids)
+    assert len(native) == len(back) > 0
+    assert np.array_equal(native.scenario_id, back.scenario_id)
+    assert np.array_equal(native.frame, back.frame)
+    assert np.array_equal(native.label, back.label) and native.label.sum() > 0
+    a, b = native.arrays(), back.arrays()
+    for name in a:
+        assert a[name].shape == b[name].shape, name
+        assert np.abs(a[name].astype(np.float64) - b[name]).max() <= tolerance, name
+
+
+@pytest.fixture(scope="session")
+def same_windows():
+    """same_windows(native_root, imported_root, ids, tolerance): `assert_same_windows`."""
+    return assert_same_windows

@@ -10,8 +10,10 @@ import pytest
 
 from evoeye.sources.autoware.config import Mapping, Vehicle
 from evoeye.sources.autoware.convert import (
+    Context,
     ConversionError,
     Ego,
+    TrackIds,
     objects,
     odometry,
     uuid_int,
@@ -31,10 +33,11 @@ def test_base_link_is_the_rear_axle_centre_behind_the_body_centre(ex) -> None:
     msg = ex.odometry(0, 10.0, 20.0, math.pi / 2, 7.0)  # heading +y
     assert msg.pose.pose.position.x == pytest.approx(10.0)
     assert msg.pose.pose.position.y == pytest.approx(18.5)
-    ego = odometry(msg, Vehicle())
+    ego = odometry(msg, Context())
     assert (ego.x_m, ego.y_m, ego.heading_rad, ego.speed_mps) == pytest.approx(
         (10.0, 20.0, math.pi / 2, 7.0))
-    assert odometry(msg, Vehicle(length_m=4.0, rear_overhang_m=1.0)).y_m == pytest.approx(19.5)
+    short = Context(Vehicle(length_m=4.0, rear_overhang_m=1.0))
+    assert odometry(msg, short).y_m == pytest.approx(19.5)
 
 
 def test_an_object_twist_is_in_the_object_frame(ex) -> None:
@@ -43,7 +46,7 @@ def test_an_object_twist_is_in_the_object_frame(ex) -> None:
                      [2.5], [0.9])
     twist = msg.objects[0].kinematics.twist_with_covariance.twist.linear
     assert (twist.x, twist.y) == pytest.approx((5.0, 0.0))
-    got = objects(msg, Vehicle())
+    got = objects(msg, Context())
     assert got["track_id"] == [7] and got["obj_class"] == ["truck"]
     assert (got["vx_mps"][0], got["vy_mps"][0]) == pytest.approx((0.0, 5.0))
     assert (got["length_m"][0], got["width_m"][0]) == pytest.approx((8.0, 2.5))
@@ -59,8 +62,36 @@ def test_yaw_normalises_a_slightly_off_quaternion_and_refuses_a_wrong_one(ex) ->
 
 
 def test_uuids_keep_evoeye_track_ids_including_negative_ones(ex) -> None:
+    ids = TrackIds()
     for track in (0, 5, -1, 2**40):
-        assert uuid_int(ex.b.uuid(track)) == track
+        assert uuid_int(ex.b.uuid(track)) == track == ids(ex.b.uuid(track))
+
+
+def _uuid(raw: bytes):
+    from evoeye.sources.autoware.typestore import typestore
+
+    return typestore().types["unique_identifier_msgs/msg/UUID"](
+        uuid=np.frombuffer(raw, np.uint8).copy())
+
+
+def test_random_uuids_become_distinct_bigint_ids_stable_within_a_run() -> None:
+    rng = np.random.default_rng(7)
+    raws = [rng.bytes(16) for _ in range(2000)]
+    raws += [raws[0][:8] + rng.bytes(8)]  # the same first 8 bytes: not the same object
+    ids = TrackIds()
+    got = [ids(_uuid(r)) for r in raws]
+    assert len(set(got)) == len(raws)
+    assert all(0 < i < 2**63 for i in got)  # fits BIGINT, never the ego (0) or none (-1)
+    assert [ids(_uuid(r)) for r in raws] == got  # the same object keeps its id
+    assert got[0] == TrackIds()(_uuid(raws[0]))  # and gets it again in another run
+
+
+def test_a_hashed_id_taken_by_another_uuid_is_hashed_again() -> None:
+    a, b = _uuid(bytes(range(16))), _uuid(bytes(range(1, 17)))
+    ids = TrackIds()
+    ids.taken.add(uuid_int(b))  # as if another object of the run had that id already
+    assert ids(a) == uuid_int(a)
+    assert ids(b) == uuid_int(b, salt=1) != uuid_int(b)
 
 
 def test_a_held_prediction_is_resampled_at_the_frame_s_times() -> None:

@@ -86,3 +86,44 @@ def test_following_the_fix_gives_a_warehouse_of_this_layout(old: DataRoot) -> No
     assert sorted(report.ingested) == ["a", "b"]
     PartStore(old).check_layout()
     assert len(load_windows(old, context_len=2)) == 6 + 4
+
+
+@pytest.fixture
+def layout_4(root: DataRoot, add_run) -> DataRoot:
+    """A warehouse as layout 4 left it: the actor ids as INTEGER columns."""
+    add_run("a", n_frames=6, seed=1)
+    add_run("b", n_frames=6, collision_frame=4, seed=2)
+    ingest(root)
+    for table in TABLES:
+        for path in root.table_dir(table).rglob("*.parquet"):
+            data = pq.read_table(path, partitioning=None)
+            for name in ("other_actor", "gt_collision_actor"):
+                if name in data.column_names:
+                    i = data.column_names.index(name)
+                    data = data.set_column(i, pa.field(name, pa.int32()),
+                                           data.column(name).cast(pa.int32()))
+            pq.write_table(data.replace_schema_metadata({LAYOUT_KEY: b"4"}), path)
+    return root
+
+
+def test_a_layout_4_warehouse_is_migrated_in_place_by_ingest(layout_4: DataRoot,
+                                                             add_run) -> None:
+    root = layout_4
+    with pytest.raises(WarehouseLayoutError, match="layout 4; .* migrate: run `evoeye ingest`"):
+        Warehouse(root).sql("SELECT count(*) FROM scenarios")
+    rows = {t: pq.read_table(root.table_dir(t), partitioning=None).sort_by("scenario_id")
+            .to_pylist() for t in ("scenarios", "frames")}
+    add_run("c", n_frames=6, seed=3)
+    report = ingest(root)
+    assert len(report.migrated) == len(TABLES) and report.ingested == ["c"]  # a part each
+    PartStore(root).check_layout()
+    for t in ("scenarios", "frames"):
+        part = next(p for p in root.table_dir(t).rglob("*.parquet")
+                    if "c" not in pq.read_table(p, columns=["scenario_id"], partitioning=None)
+                    .column("scenario_id").to_pylist())
+        migrated = pq.read_table(part, partitioning=None)
+        actor = "other_actor" if t == "scenarios" else "gt_collision_actor"
+        assert migrated.schema.field(actor).type == pa.int64()
+        assert migrated.sort_by("scenario_id").to_pylist() == rows[t]  # every value kept
+    assert Warehouse(root).sql("SELECT count(*) AS n FROM scenarios").column("n")[0].as_py() == 3
+    assert ingest(root).migrated == []  # once only

@@ -23,7 +23,7 @@ from dataclasses import asdict, dataclass, field
 from pathlib import Path
 
 from evoeye import __version__
-from evoeye.evaluation.supervision.criticality import Criticality
+from evoeye.criticality import Criticality
 from evoeye.evaluation.supervision.triggers import TriggerSpec
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.sim.supervisor import FALLBACKS, FallbackConfig

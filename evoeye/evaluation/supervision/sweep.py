@@ -34,13 +34,13 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.atomic import atomic_file
-from evoeye.evaluation.mechanism import mechanism
-from evoeye.evaluation.supervision.criticality import (
+from evoeye.criticality import (
     Criticality,
     frame_risk,
     justified_frames,
     safe_encounters,
 )
+from evoeye.evaluation.mechanism import mechanism
 from evoeye.evaluation.supervision.settings import Settings
 from evoeye.evaluation.supervision.triggers import FRAME_S, TriggerSpec, load_monitor
 from evoeye.log.writer import Supervision, write_episode

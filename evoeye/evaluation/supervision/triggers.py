@@ -30,7 +30,7 @@ from evoeye.evaluation.baselines import rule_names
 from evoeye.evaluation.dataset import load_split, narrow
 from evoeye.evaluation.monitors import BASELINES, check_scores, monitor_context_len
 from evoeye.monitor.calibration import calibrate
-from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES, load_version
+from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES, family_of, load_version
 from evoeye.monitor.protocol import Monitor
 from evoeye.paths import DataRoot
 from evoeye.sim.runner import SimConfig
@@ -63,8 +63,13 @@ class TriggerSpec:
 
     @property
     def label(self) -> str:
-        """How reports name it: a family's label (FusionMonitor), else its name."""
-        return FAMILIES[DEFAULT_FAMILY].label if self.name == DEFAULT_FAMILY else self.name
+        """How reports name it: a family's label (FusionMonitor), with its version when a
+        second version of the family is named by it (`trigger_names`), else its name."""
+        if self.name == DEFAULT_FAMILY:
+            return FAMILIES[DEFAULT_FAMILY].label
+        if self.source == "version" and self.name == self.version:
+            return f"{family_of(self.version).label} {self.version}"
+        return self.name
 
     @property
     def rule_based(self) -> bool:
@@ -150,6 +155,20 @@ def realised(scores: np.ndarray, labels: np.ndarray, thresholds: Sequence[float]
     return fpr, rec
 
 
+def trigger_names(monitors: Sequence[Monitor]) -> list[str]:
+    """Each monitor's trigger name: its own (fusion, ttc, …); a later version of a name already
+    taken is named by its version id, so two FusionMonitors run side by side — the first keeps
+    the name the headline and the paired differences compare from. ValueError for a monitor
+    given twice."""
+    names: list[str] = []
+    for m in monitors:
+        name = m.name if m.name not in names else m.version
+        if name in names:
+            raise ValueError(f"{name} is given twice as a trigger")
+        names.append(name)
+    return names
+
+
 def calibrate_triggers(root: DataRoot, scenario: str,
                        sources: Sequence[tuple[str, str]],
                        splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
@@ -163,20 +182,18 @@ def calibrate_triggers(root: DataRoot, scenario: str,
         trained = (getattr(m, "card", None) or {}).get("logical_scenario")
         if trained not in (None, scenario):
             raise ValueError(f"{m.version} was trained on {trained}, not {scenario}")
-    names = [m.name for m in monitors]
-    if dupes := sorted({n for n in names if names.count(n) > 1}):
-        raise ValueError(f"two triggers named {dupes}: give one monitor of each name")
+    names = trigger_names(monitors)
     L = max(monitor_context_len(m) for m in monitors)
     val = load_split(root, scenario, "val", splits, context_len=L, horizon_s=horizon_s)
     if len(val) == 0:
         raise ValueError(f"{scenario}: the validation split has no frames to calibrate on")
     specs = []
-    for (source, ref), m in zip(sources, monitors, strict=True):
+    for (source, ref), m, name in zip(sources, monitors, names, strict=True):
         raw, scale = trigger_scores(m, narrow(val.windows, monitor_context_len(m)))
         scores = check_scores(m, raw, len(val), unit_interval=scale == "score")
         labels = val.windows.label
         sweep = sweep_thresholds(scores, labels, fprs, recalls)
         fpr, recall = realised(scores, labels, list(sweep))
-        specs.append(TriggerSpec(m.name, source, ref, m.version, tuple(sweep),
+        specs.append(TriggerSpec(name, source, ref, m.version, tuple(sweep),
                                  tuple(sweep.values()), fpr, recall, scale))
     return specs

@@ -25,6 +25,7 @@ from collections.abc import Callable, Collection, Mapping, Sequence
 from dataclasses import dataclass, field, fields
 from typing import Any
 
+from evoeye.seeds import STREAMS_VERSION
 from evoeye.splits import SplitSpec
 
 UPDATE_MODES = ("replay", "finetune", "retrain")  # evoeye.evolve.campaign.loop says what each is
@@ -220,6 +221,7 @@ def campaign_id(config: CampaignConfig, g0: str, initial_ids: Sequence[str], *,
     if cfg["recipe"] == LEGACY_RECIPE:  # the recipe every campaign before it trained by
         cfg.pop("recipe")
     cfg["monitor"] = g0
+    cfg["streams"] = STREAMS_VERSION  # its seed streams (`evoeye.seeds`)
     cfg["initial"] = hashlib.sha256("\n".join(initial_ids).encode()).hexdigest()
     digest = hashlib.sha256(json.dumps(cfg, sort_keys=True).encode()).hexdigest()[:10]
     family = "" if config.family == DEFAULT_FAMILY else f"{config.family}-"

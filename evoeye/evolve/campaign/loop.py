@@ -24,11 +24,15 @@ State and resume. Everything a campaign knows is in the data root: run logs unde
 campaign_rounds table (per round: G_r and the runs acquired, in order). `start()` rebuilds D_r
 (outcomes from the warehouse, no log read again) and the strategy (`replay`) from the last
 stored round; a round interrupted anywhere (mid-run, mid-round, mid-training) is re-done from
-its start — its proposals are deterministic (the strategy's, and run seed k for proposal k),
-logs already on disk are read instead of simulated, so no run is lost, duplicated or charged
+its start — its proposals are deterministic (the strategy's, and run seed k for proposal k,
+both from the campaign's own seed streams, `evoeye.seeds`), logs already on disk are read
+instead of simulated, so no run is lost, duplicated or charged
 twice. A campaign writes only its own keys (its batch's partition, rounds, monitor versions'
 feedback: `evoeye.store.lock`), so campaigns run side by side (`experiment.py`). A run starts
-only if the budget left is at least the longest run (`max_run_s`): no budget is overspent.
+only if the budget left is at least the longest run (`max_run_s`): no budget is overspent. A
+proposal whose run the root already holds (in any batch, or among D_r) gets its run seed
+redrawn (`state.fresh_spec`; the round's `state.redrawn` names them), so every run a campaign
+acquires is new and its batch in the warehouse holds as many runs as it counts records.
 
 A strategy that reads the records' disagreement (`disagreement`) has a committee
 (`committee.py`): K − 1 companions updated beside G_r, whose spread of scores is stored per run.
@@ -49,16 +53,18 @@ from evoeye.atomic import remove_stale_temps
 from evoeye.batch import simulate_and_keep
 from evoeye.evolve.campaign.committee import Committee
 from evoeye.evolve.campaign.config import CampaignConfig, campaign_id
+from evoeye.evolve.campaign.guard import CampaignCancelled, campaign_lease
 from evoeye.evolve.campaign.phases import PhaseClock
 from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
 from evoeye.evolve.campaign.state import (
     CampaignState,
     acquired_runs,
+    fresh_spec,
+    held_runs,
     initial_profile,
     read_initial,
     records_of,
     run_outcome,
-    run_seed,
 )
 from evoeye.evolve.search.records import Records
 from evoeye.evolve.search.registry import (
@@ -78,7 +84,7 @@ from evoeye.monitor.families import (
 from evoeye.monitor.threads import intra_op_threads
 from evoeye.paths import DataRoot
 from evoeye.scenarios import get_scenario
-from evoeye.sim.runner import run_spec
+from evoeye.seeds import search_seed
 from evoeye.store import RunFilter
 from evoeye.store.connections import shared_connections
 from evoeye.store.feedback import (
@@ -114,6 +120,7 @@ class Campaign:
         self._recipe = {"recipe": config.recipe} if self.family.recipes else {}  # its trainings'
         self.assess = assess  # may be set after construction (e.g. from the campaign's ids)
         self._monitors: dict[str, object] = {}
+        self.should_stop: Callable[[], bool] | None = None  # asked before each run and update
         self.clock = PhaseClock()  # wall seconds per phase of this object's calls
 
     # -- identity and initial data -------------------------------------------------------------
@@ -207,8 +214,9 @@ class Campaign:
         n_init = len(self.initial["scenario_id"])
         records = self.with_stored(records, last.monitor_version)
         cfg = self.config
-        strategy = make_strategy(cfg.strategy, self.space, cfg.seed, **strategy_options(
-            cfg.strategy, delta=cfg.delta, batch=cfg.n_round))
+        strategy = make_strategy(cfg.strategy, self.space, search_seed(cfg.seed, self.campaign_id),
+                                 **strategy_options(cfg.strategy, delta=cfg.delta,
+                                                    batch=cfg.n_round))
         mine = records.tail(n_init)
         strategy.replay(mine.params, mine.fitness)
         return CampaignState(self.campaign_id, last.round, last.monitor_version, records,
@@ -239,12 +247,15 @@ class Campaign:
         runs: list[LoggedRun] = []
         members = (None if self.committee is None  # G_r's committee, for the disagreement
                    else [state.monitor, *self.committee.companions(state.round)])
+        held = held_runs(self.root, cfg.scenario, self.campaign_id, state.records)
+        state.redrawn = []
         while len(new) < cfg.n_round and not self.done(state):
+            self.check_stop()
             with self.clock("simulate"):
                 prop = state.strategy.propose(state.records)
-                spec = run_spec(cfg.scenario, prop.x, run_seed(cfg.seed, state.acquired),
-                                batch=self.campaign_id, source=cfg.strategy,
-                                round=state.round + 1, ads=initial_profile(self.initial))
+                spec = fresh_spec(cfg, self.campaign_id, prop.x, state, held,
+                                  ads=initial_profile(self.initial))
+                held[spec.scenario_id] = self.campaign_id
                 result, episode = simulate_and_keep(spec, self.root)
             if result.status == "error":
                 raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
@@ -339,16 +350,19 @@ class Campaign:
         new_ids = self.acquire(state)
         if not new_ids:
             return None
+        self.check_stop()
         version, train_s = self.update_monitor(state)
         return self.finish_round(state, new_ids, version, train_s)
 
     def run(self, max_rounds: int | None = None,
             on_round: Callable[[RoundRow, CampaignState], None] | None = None) -> CampaignState:
-        """Resume, then run rounds until the budget is spent (or `max_rounds` more are done).
+        """Resume, then run rounds until the budget is spent (or `max_rounds` more are done),
+        holding the campaign's lease (`guard.py`: CampaignBusyError if another process runs it).
         Each warehouse part is decoded once for all rounds (`cached_parts`), the warehouse's
         DuckDB views are installed once per state of it (`shared_connections`), and the rounds'
         garbage collections skip what was loaded before them (`frozen_heap`)."""
-        with cached_parts(), shared_connections():
+        with campaign_lease(self.root, self.campaign_id), cached_parts(), \
+                shared_connections():
             state = self.start()
             done_rounds = 0
             with frozen_heap():
@@ -364,6 +378,10 @@ class Campaign:
         return state
 
     # -- helpers ---------------------------------------------------------------------------------
+    def check_stop(self) -> None:
+        if self.should_stop is not None and self.should_stop():
+            raise CampaignCancelled(f"campaign {self.campaign_id} stopped on request")
+
     def _store_feedback(self, version: str, scenario_ids) -> None:
         """Score ingested runs with `version` and store f (runs already stored are skipped)."""
         have = self.stored_feedback(version)

@@ -3,18 +3,21 @@
 from __future__ import annotations
 
 from collections.abc import Callable, Iterable
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, field
 from pathlib import Path
 from typing import Any
 
 import numpy as np
 
-from evoeye.evolve.campaign.config import REPLAY_RATIO
+from evoeye.evolve.campaign.config import REPLAY_RATIO, CampaignConfig
 from evoeye.evolve.search.fitness import criticality
 from evoeye.evolve.search.protocol import Strategy
 from evoeye.evolve.search.records import Records
 from evoeye.log import read_run
 from evoeye.paths import DataRoot
+from evoeye.seeds import campaign_run_seed
+from evoeye.sim.episode import RunSpec
+from evoeye.sim.runner import run_spec
 from evoeye.store import Warehouse
 from evoeye.store.feedback import RoundRow
 from evoeye.store.selection import SplitSpec
@@ -63,6 +66,8 @@ class CampaignState:
     n_init: int
     strategy: Strategy
     rounds: list[RoundRow]
+    # this round's proposals whose run the root already held: (that run's id, its batch)
+    redrawn: list[tuple[str, str]] = field(default_factory=list)
 
     @property
     def spent_s(self) -> float:
@@ -95,8 +100,53 @@ class CampaignState:
 
 
 def run_seed(campaign_seed: int, k: int) -> int:
-    """The simulation seed of proposal k (0-based) of a campaign."""
+    """The simulation seed of proposal k (0-based) of an efficiency curve's generative
+    acquisition: the stream campaigns drew from before `evoeye.seeds` (`[seed, k]`, which meets
+    a batch's at k = 0), kept so that the stored curves' runs keep their ids."""
     return int(np.random.SeedSequence([campaign_seed, k]).generate_state(1)[0])
+
+
+MAX_REDRAWS = 100  # run seeds tried past the first for a proposal whose run the root holds
+
+
+def held_runs(root: DataRoot, scenario: str, campaign_id: str,
+              records: Records) -> dict[str, str]:
+    """scenario_id → batch of the campaign's records (D_init, its earlier rounds' runs) and of
+    every round-0 run of `scenario` the root holds (batches, Test Sets). Other campaigns' runs
+    are left out: they may be written while this one runs, and what it draws must not depend
+    on that (each campaign's streams are its own: `evoeye.seeds`)."""
+    rows = Warehouse(root).sql(
+        "SELECT scenario_id, batch FROM scenarios WHERE logical_scenario = ? AND round = 0",
+        [scenario]).to_pydict()
+    return {**{str(s): campaign_id for s in records.scenario_id},
+            **dict(zip(rows["scenario_id"], rows["batch"], strict=True))}
+
+
+def fresh_spec(cfg: CampaignConfig, campaign_id: str, x: np.ndarray, state: CampaignState,
+               held: dict[str, str], *, ads: str) -> RunSpec:
+    """The run of proposal `x` (number `state.acquired` of the campaign), its run seed redrawn
+    while `held` has the run it gives; each such run is added to `state.redrawn`. Deterministic
+    for the same root, so a resumed round redraws alike."""
+    for attempt in range(MAX_REDRAWS + 1):
+        seed = campaign_run_seed(cfg.seed, campaign_id, state.acquired, attempt)
+        spec = run_spec(cfg.scenario, x, seed, batch=campaign_id, source=cfg.strategy,
+                        round=state.round + 1, ads=ads)
+        if spec.scenario_id not in held:
+            return spec
+        state.redrawn.append((spec.scenario_id, held[spec.scenario_id]))
+    raise RuntimeError(f"campaign {campaign_id}: proposal {state.acquired} gave "
+                       f"{MAX_REDRAWS + 1} runs the data root already holds, the last "
+                       f"{spec.scenario_id} of batch {held[spec.scenario_id]}")
+
+
+def redrawn_note(state: CampaignState) -> str:
+    """'' or what the round's report says of proposals whose run the root already held."""
+    if not state.redrawn:
+        return ""
+    sid, batch = state.redrawn[0]
+    more = f" and {len(state.redrawn) - 1} more" if len(state.redrawn) > 1 else ""
+    return (f"{len(state.redrawn)} proposal(s) gave a run the root already holds ({sid} of "
+            f"batch {batch}{more}): run seed redrawn, no run acquired twice")
 
 
 def run_outcome(run: dict[str, Any]) -> dict[str, Any]:

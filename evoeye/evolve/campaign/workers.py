@@ -18,7 +18,7 @@ import multiprocessing as mp
 import os
 import threading
 from collections.abc import Callable, Iterator, Sequence
-from concurrent.futures import Executor, ProcessPoolExecutor, as_completed
+from concurrent.futures import ProcessPoolExecutor, as_completed
 from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import import_module
@@ -27,7 +27,8 @@ from evoeye.batch import pool_context
 from evoeye.evolve.campaign.assess import Assessor
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.loop import Campaign
-from evoeye.lifeline import die_with_parent
+from evoeye.evolve.campaign.state import redrawn_note
+from evoeye.lifeline import stop_workers, stoppable, stoppable_worker
 from evoeye.paths import DataRoot
 from evoeye.store.feedback import RoundMetrics
 
@@ -89,17 +90,22 @@ def no_metrics(metrics: RoundMetrics | None) -> str:
 
 
 def run_campaign(job: CampaignJob, brief: Brief = no_metrics,
-                 say: Callable[[str], None] | None = None) -> CampaignDone:
+                 say: Callable[[str], None] | None = None,
+                 should_stop: Callable[[], bool] | None = None) -> CampaignDone:
     """Run (or resume) one campaign to its budget; `say` each round's line as it ends (in a
-    local worker, it goes to the process that started the workers)."""
+    local worker, it goes to the process that started the workers); `should_stop`: asked
+    before each run and monitor update (`Campaign.should_stop`)."""
     campaign = _campaign(job)
+    campaign.should_stop = should_stop
     if campaign.finished():  # a cached re-run: nothing to resume, no state to build
         return CampaignDone(job.label, campaign.campaign_id, 0, ())
     say = say or (_LINES.put if _LINES is not None else None)
     lines: list[str] = []
 
     def on_round(row, state) -> None:
-        lines.append(f"{job.label} round {row.round}: {brief(row.metrics)}")
+        note = redrawn_note(state)
+        lines.append(f"{job.label} round {row.round}: {brief(row.metrics)}"
+                     + (f" | {note}" if note else ""))
         if say is not None:
             say(lines[-1])
 
@@ -124,11 +130,11 @@ def dask_setup(worker: object = None) -> None:
 
 def _local_worker(parent: int, lines: mp.Queue) -> None:
     global _LINES
-    die_with_parent(parent)
+    stoppable_worker(parent)
     _LINES = lines
 
 
-def _malloc_env() -> tuple[str | None, str | None]:
+def worker_malloc() -> tuple[str | None, str | None]:
     return os.environ.get(MALLOC_TRIM), os.environ.get(MALLOC_MMAP)
 
 
@@ -145,18 +151,9 @@ def malloc_note(envs: dict[str, tuple[str | None, str | None]]) -> str | None:
 
 
 @contextmanager
-def _executor(workers: int, dask_address: str | None,
-              say: Callable[[str], None]) -> Iterator[Executor]:
-    """`workers` local processes relaying round lines to `say`, or the Dask cluster's workers."""
-    if dask_address:
-        from distributed import Client
-
-        with Client(dask_address) as client:
-            note = malloc_note(client.run(_malloc_env))
-            if note:
-                say(note)
-            yield client.get_executor(pure=False)
-        return
+def _local_pool(workers: int, say: Callable[[str], None]) -> Iterator[ProcessPoolExecutor]:
+    """`workers` local processes relaying round lines to `say`; stopped at once (SIGTERM,
+    `evoeye.lifeline`) if the block fails, so no campaign outlives the command."""
     context = pool_context()
     lines: mp.Queue = context.Queue()
     relay = threading.Thread(target=lambda: [say(m) for m in iter(lines.get, None)],
@@ -166,7 +163,11 @@ def _executor(workers: int, dask_address: str | None,
         with ProcessPoolExecutor(max_workers=workers, mp_context=context,
                                  initializer=_local_worker,
                                  initargs=(os.getpid(), lines)) as pool:
-            yield pool
+            try:
+                yield pool
+            except BaseException:
+                stop_workers(pool)
+                raise
     finally:
         lines.put(None)
         relay.join()
@@ -178,10 +179,10 @@ def run_campaigns(jobs: Sequence[CampaignJob], *, workers: int | None = None,
     """Prepare, then run every campaign: one after another in this process (`workers` 1, no
     address), over `workers` local processes (default: one per CPU), or over the workers of
     the Dask scheduler at `dask_address` (give them one thread each: a campaign per worker at a
-    time). In job order; if one fails, those not started yet are not started."""
+    time; `cluster.py`: preflight, loss, timeout). In job order; if one fails, the others
+    are stopped (those not started yet are not started) and the failure is raised."""
     if workers is not None and workers < 1:
         raise ValueError(f"workers must be at least 1, got {workers}")
-    prepare_campaigns(jobs)
     workers = min(workers or os.cpu_count() or 1, max(len(jobs), 1))
     lock = threading.Lock()  # the workers' lines arrive on a thread of their own
 
@@ -189,21 +190,22 @@ def run_campaigns(jobs: Sequence[CampaignJob], *, workers: int | None = None,
         with lock:
             progress(line)
 
-    if workers == 1 and not dask_address:
+    if dask_address:
+        from evoeye.evolve.campaign.cluster import run_on_dask
+
+        references = sorted({Campaign(DataRoot.resolve(j.root), j.config).reference
+                             for j in jobs})
+        return run_on_dask(jobs, dask_address, brief, say, references,
+                           prepare=lambda: prepare_campaigns(jobs), run=run_campaign)
+    prepare_campaigns(jobs)
+    if workers == 1:
         return [run_campaign(job, brief, progress) for job in jobs]
     done: dict[int, CampaignDone] = {}
-    with _executor(workers, dask_address, say) as pool:
-        futures = {pool.submit(run_campaign, job, brief): i for i, job in enumerate(jobs)}
-        try:
-            for future in as_completed(futures):
-                done[futures[future]] = result = future.result()
-                if dask_address:  # a cluster's workers cannot speak to us as they go
-                    for line in result.lines:
-                        say(line)
-                say(f"{result.label}: campaign {result.campaign_id}, {result.rounds} round(s) "
-                    "run, budget spent")
-        except BaseException:
-            for future in futures:
-                future.cancel()
-            raise
+    with _local_pool(workers, say) as pool:
+        futures = {pool.submit(stoppable, run_campaign, job, brief): i
+                   for i, job in enumerate(jobs)}
+        for future in as_completed(futures):
+            done[futures[future]] = result = future.result()
+            say(f"{result.label}: campaign {result.campaign_id}, {result.rounds} round(s) "
+                "run, budget spent")
     return [done[i] for i in range(len(jobs))]

@@ -5,13 +5,15 @@ decode it when it embeds them (MCAP); otherwise ROS 2 Humble's types and the ven
 ones do (`typestore`). A bag that evoeye exported carries its run's identity (rosbag2
 custom data `evoeye.run`: scenario id, logical scenario, parameters, seed, round, ADS profile):
 it comes back under that id. Any other bag is a run of logical scenario `external`, its id
-from its bytes, so the same bag imported twice is the same run. Labels come from the bag's
-ground truth alone (`labels.py`), never from that record.
+from its content (every message's topic, type, receive time and bytes, `content_digest`), not
+from its storage: the same recording as MCAP and as `.db3`, or imported twice, is one run.
+Labels come from the bag's ground truth alone (`labels.py`), never from that record.
 """
 
 from __future__ import annotations
 
 import hashlib
+from collections.abc import Iterable
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -53,16 +55,44 @@ class ImportedRun:
         return [f.messages for f in self.frames]
 
 
-def bag_digest(path: Path) -> str:
-    """sha1 of the bag's bytes (every file of a bag folder, by name): the bag's identity."""
-    files = sorted(p for p in path.rglob("*") if p.is_file()) if path.is_dir() else [path]
+@dataclass(frozen=True)
+class Content:
+    """What a bag holds, whatever its storage: a digest of its messages and their count per
+    topic."""
+
+    digest: str  # sha1 over (receive ns, topic, type, sha1 of the CDR bytes), sorted
+    counts: dict[str, int]  # messages per topic
+
+
+def content_of(topics: Iterable[str], messages: Iterable[tuple[int, str, str, bytes]]
+               ) -> Content:
+    """The content of a recording of `topics` with `messages` (receive ns, topic, type,
+    serialized bytes), in any order."""
+    rows, counts = [], dict.fromkeys(topics, 0)
+    for log_ns, topic, msgtype, raw in messages:
+        rows.append((log_ns, topic, msgtype, hashlib.sha1(raw).digest()))
+        counts[topic] = counts.get(topic, 0) + 1
     h = hashlib.sha1()
-    for p in files:
-        h.update(p.name.encode())
-        with open(p, "rb") as f:
-            while chunk := f.read(1 << 20):
-                h.update(chunk)
-    return h.hexdigest()
+    for log_ns, topic, msgtype, digest in sorted(rows):
+        h.update(b"%d\0%s\0%s\0" % (log_ns, topic.encode(), msgtype.encode()) + digest)
+    return Content(h.hexdigest(), counts)
+
+
+def content_digest(reader: Any) -> Content:
+    """The bag's content (module doc), read without decoding a message."""
+    return content_of((c.topic for c in reader.connections),
+                      ((log_ns, c.topic, c.msgtype, raw) for c, log_ns, raw in reader.messages()))
+
+
+def _check_counts(path: Path, content: Content, mapping: Mapping) -> None:
+    """BagError for a bag without a message, or a required topic without one."""
+    if not any(content.counts.values()):
+        raise BagError(f"{path}: (bag): no message in the bag (its {len(content.counts)} "
+                       "topics are empty)")
+    for role in REQUIRED_ROLES:
+        topic = getattr(mapping.topics, role)
+        if not content.counts.get(topic):
+            raise BagError(f"{path}: {topic}: no message on a required topic ({role})")
 
 
 def _custom_data(reader: Any) -> dict[str, str]:
@@ -96,14 +126,24 @@ def _check_topics(reader: Any, mapping: Mapping, path: Path) -> list[Any]:
 
 def _identity(path: Path, custom: dict[str, str]) -> dict[str, Any]:
     """The run identity an exported bag carries; {} for any other bag."""
-    if RUN_KEY not in custom:
+    return run_identity(path, custom.get(RUN_KEY), f"custom data {RUN_KEY}")
+
+
+def run_identity(path: Path, text: str | bytes | None, where: str) -> dict[str, Any]:
+    """The run identity of an exported recording (the JSON it carries at `where`), {} if
+    none."""
+    if text is None:
         return {}
     try:
-        record = orjson.loads(custom[RUN_KEY])
+        record = orjson.loads(text)
         return {**{k: record[k] for k in IDENTITY},
                 **{k: record.get(k, default) for k, default in OPTIONAL_IDENTITY.items()}}
     except (orjson.JSONDecodeError, KeyError, TypeError) as e:
-        raise BagError(f"{path}: custom data {RUN_KEY}: malformed ({e})") from None
+        raise BagError(f"{path}: {where}: malformed ({e})") from None
+
+
+def _scenario_id(identity: dict[str, Any], content: Content, software: str = SOFTWARE) -> str:
+    return identity.get("scenario_id", f"{software}_{content.digest[:16]}")
 
 
 def bag_run_id(path: str | Path) -> tuple[str, str]:
@@ -114,31 +154,33 @@ def bag_run_id(path: str | Path) -> tuple[str, str]:
     try:
         with AnyReader([path], default_typestore=typestore()) as reader:
             identity = _identity(path, _custom_data(reader))
+            sid = identity["scenario_id"] if identity else _scenario_id({},
+                                                                         content_digest(reader))
     except BagError:
         raise
     except Exception as e:  # as read_bag: a bag rosbags cannot open
         raise BagError(f"{path}: (bag): unreadable bag ({type(e).__name__}: {e})") from None
-    return (identity.get("logical_scenario", EXTERNAL_SCENARIO),
-            identity.get("scenario_id", f"autoware_{bag_digest(path)[:16]}"))
+    return identity.get("logical_scenario", EXTERNAL_SCENARIO), sid
 
 
-def _metadata(path: Path, custom: dict[str, str], assembler: FrameAssembler,
-              frames: list[Frame], source: str) -> dict[str, Any]:
-    identity = _identity(path, custom)
+def run_metadata(identity: dict[str, Any], content: Content, assembler: FrameAssembler,
+                 frames: list[Frame], source: str, software: str = SOFTWARE) -> dict[str, Any]:
+    """The run record (schemas/mcap/run.v1.json) of a recording's frames: its identity if it
+    carries one (an exported recording), else a run of logical scenario `external`."""
     truth = assembler.truth
     first = next((f for f in frames if f.messages["/sim/ground_truth"]["ego_collision"]), None)
     dt_s = 1.0 / assembler.mapping.rate_hz
     return {
-        "scenario_id": identity.get("scenario_id", f"autoware_{bag_digest(path)[:16]}"),
+        "scenario_id": _scenario_id(identity, content, software),
         "logical_scenario": identity.get("logical_scenario", EXTERNAL_SCENARIO),
         "param_names": identity.get("param_names", []),
         "params": identity.get("params", []),
         "seed": identity.get("seed", 0),
         "batch": "",  # the importer's batch
-        "source": identity.get("source", SOFTWARE),
+        "source": identity.get("source", software),
         "round": identity.get("round", 0),
         "ads_profile": identity.get("ads_profile", DEFAULT_PROFILE),
-        "software_version": SOFTWARE,
+        "software_version": software,
         "rate_hz": assembler.mapping.rate_hz,
         "status": "ok",
         "reason": "",
@@ -160,6 +202,8 @@ def read_bag(path: str | Path, mapping: Mapping | None = None) -> ImportedRun:
     try:
         with AnyReader([path], default_typestore=typestore()) as reader:
             wanted = _check_topics(reader, mapping, path)
+            content = content_digest(reader)
+            _check_counts(path, content, mapping)
             source = label_source(mapping, {c.topic for c in wanted})
             assembler = FrameAssembler(mapping, source)
             frames: list[Frame] = []
@@ -175,6 +219,13 @@ def read_bag(path: str | Path, mapping: Mapping | None = None) -> ImportedRun:
     except Exception as e:  # rosbags raises many kinds on a truncated or corrupt bag
         kind = "unreadable" if not isinstance(e, AnyReaderError | FileNotFoundError) else "bad"
         raise BagError(f"{path}: (bag): {kind} bag ({type(e).__name__}: {e})") from None
+    return imported_run(path, mapping, assembler, frames, _identity(path, custom), content)
+
+
+def imported_run(path: Path, mapping: Mapping, assembler: FrameAssembler, frames: list[Frame],
+                 identity: dict[str, Any], content: Content,
+                 software: str = SOFTWARE) -> ImportedRun:
+    """A recording's converted frames as a run, with its notes; BagError if it has none."""
     if not frames:
         raise BagError(f"{path}: (bag): no frame: the required topics never overlap in time")
     notes = []
@@ -185,7 +236,9 @@ def read_bag(path: str | Path, mapping: Mapping | None = None) -> ImportedRun:
         notes.append(f"{path}: {mapping.topics.trajectory}: all-zero time_from_start in "
                      f"{assembler.recovered_plan_times} trajectories, times rebuilt from arc "
                      "length over speed")
+    source = assembler.label_source
     if source == UNLABELLED:
         notes.append(f"{path}: (bag): no ground truth ({mapping.topics.collision or '-'}, "
                      f"{mapping.topics.ground_truth_objects or '-'}): imported unlabelled")
-    return ImportedRun(path, _metadata(path, custom, assembler, frames, source), frames, notes)
+    metadata = run_metadata(identity, content, assembler, frames, source, software)
+    return ImportedRun(path, metadata, frames, notes)

@@ -102,9 +102,10 @@ def _merged(cls: type, current: Any, table: dict[str, Any], section: str) -> Any
     return replace(current, **values)
 
 
-def load_mapping(path: str | Path | None) -> Mapping:
-    """The defaults, overridden by the TOML file at `path` (None: the defaults)."""
-    mapping = Mapping()
+def load_mapping(path: str | Path | None, base: Mapping | None = None) -> Mapping:
+    """The defaults (`base`: another stack's, e.g. Apollo's), overridden by the TOML file at
+    `path` (None: the defaults). A base without planning-factor topics takes none."""
+    mapping = base or Mapping()
     if path is None:
         return mapping
     try:
@@ -116,13 +117,18 @@ def load_mapping(path: str | Path | None) -> Mapping:
         raise MappingError(f"{path}: unknown sections {unknown}")
     try:
         topics = _merged(Topics, mapping.topics, data.get("topics", {}), "topics")
-        vehicle = _merged(Vehicle, mapping.vehicle, data.get("vehicle", {}), "vehicle")
+        vehicle = _merged(type(mapping.vehicle), mapping.vehicle, data.get("vehicle", {}),
+                          "vehicle")
         clock = data.get("clock", {})
         if set(clock) - {"max_gap_s", "rate_hz"}:
             raise MappingError("[clock] takes max_gap_s and rate_hz")
     except MappingError as e:
         raise MappingError(f"{path}: {e}") from None
-    factors = {str(k): str(v) for k, v in data.get("planning_factors", DEFAULT_FACTORS).items()}
+    if "planning_factors" in data and not mapping.planning_factors:
+        raise MappingError(f"{path}: [planning_factors]: this stack's decision is not on "
+                           "factor topics")
+    factors = {str(k): str(v)
+               for k, v in data.get("planning_factors", mapping.planning_factors).items()}
     bad = {k: v for k, v in factors.items() if v not in PLANNING_DECISIONS}
     if bad:
         raise MappingError(f"{path}: [planning_factors] {bad}: decisions are {PLANNING_DECISIONS}")

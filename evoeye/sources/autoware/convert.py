@@ -5,8 +5,11 @@ Conventions converted here, once:
 * an object's twist is in the object's own frame: rotated by its yaw into the world frame;
 * yaw comes from the quaternion, which must be normalised (|q| within `QUAT_TOLERANCE` of 1;
   a small error is normalised away, a larger one rejects the bag);
-* an object id (UUID) becomes an int64: its first 8 bytes, little-endian, signed — evoeye's own
-  track ids survive an export and import unchanged;
+* an object id (UUID) becomes an int64 track id (`TrackIds`), distinct within the run: a UUID
+  whose last 8 bytes are zero (as evoeye exports its track ids) is its first 8 bytes,
+  little-endian, signed, so evoeye's own ids survive an export and import unchanged; any other
+  UUID is a 63-bit hash of its 16 bytes (a random UUID's first bytes alone would not fit the
+  warehouse's INTEGER columns of old, nor stay distinct for structured UUIDs);
 * the time of a message is its header stamp (its `stamp` field where it has no header), never
   the bag's receive time, except for a message type with no stamp at all (std_msgs/Bool).
 
@@ -15,9 +18,10 @@ Converters are picked by type name (`CONVERTERS`), the current and the `autoware
 
 from __future__ import annotations
 
+import hashlib
 import math
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
@@ -47,9 +51,49 @@ def yaw(q: Any) -> float:
     return math.atan2(2.0 * (w * z + x * y), 1.0 - 2.0 * (y * y + z * z))
 
 
-def uuid_int(uuid: Any) -> int:
-    """A unique_identifier_msgs/UUID as an int64 (its first 8 bytes, little-endian)."""
-    return int.from_bytes(bytes(np.asarray(uuid.uuid, np.uint8)[:8]), "little", signed=True)
+RESERVED_IDS = (0, -1)  # the ego (actor 0) and "none"
+
+
+def uuid_int(uuid: Any, salt: int = 0) -> int:
+    """A unique_identifier_msgs/UUID as an int64: evoeye's own (its last 8 bytes zero) → its
+    first 8 bytes, little-endian, signed; any other → a 63-bit hash of its bytes and `salt`."""
+    raw = bytes(np.asarray(uuid.uuid, np.uint8))
+    if raw[8:] == bytes(8) and salt == 0:
+        return int.from_bytes(raw[:8], "little", signed=True)
+    digest = hashlib.blake2b(raw, digest_size=8, salt=salt.to_bytes(16, "little")).digest()
+    return int.from_bytes(digest, "little") >> 1
+
+
+@dataclass
+class TrackIds:
+    """A run's object UUIDs → track ids, distinct within the run: a hashed id already taken by
+    another UUID (or reserved) is hashed again with the next salt. Ids depend only on the
+    UUIDs and the order they first appear in, so `import` and `watch` give the same."""
+
+    by_uuid: dict[bytes, int] = field(default_factory=dict)
+    taken: set[int] = field(default_factory=set)
+
+    def __call__(self, uuid: Any) -> int:
+        raw = bytes(np.asarray(uuid.uuid, np.uint8))
+        if raw in self.by_uuid:
+            return self.by_uuid[raw]
+        track, salt = uuid_int(uuid), 0
+        own = raw[8:] == bytes(8)  # evoeye's ids, -1 and 0 included, are kept as they are
+        while track in self.taken or (not own and track in RESERVED_IDS):
+            salt += 1
+            own = False
+            track = uuid_int(uuid, salt)
+        self.by_uuid[raw] = track
+        self.taken.add(track)
+        return track
+
+
+@dataclass(frozen=True)
+class Context:
+    """What a converter needs beside the message: the vehicle and the run's track ids."""
+
+    vehicle: Vehicle = field(default_factory=Vehicle)
+    ids: TrackIds = field(default_factory=TrackIds)
 
 
 @dataclass(frozen=True)
@@ -60,17 +104,18 @@ class Ego:
     y_m: float
     heading_rad: float
     speed_mps: float
+    accel_mps2: float | None = None  # a pose that carries it (Apollo's); else another topic's
 
 
-def odometry(msg: Any, vehicle: Vehicle) -> Ego:
+def odometry(msg: Any, ctx: Context) -> Ego:
     pose = msg.pose.pose
     h = yaw(pose.orientation)
-    ahead = vehicle.centre_ahead_m
+    ahead = ctx.vehicle.centre_ahead_m
     return Ego(pose.position.x + ahead * math.cos(h), pose.position.y + ahead * math.sin(h), h,
                float(msg.twist.twist.linear.x))
 
 
-def acceleration(msg: Any, vehicle: Vehicle) -> float:
+def acceleration(msg: Any, ctx: Context) -> float:
     return float(msg.accel.accel.linear.x)
 
 
@@ -81,7 +126,7 @@ def _class_name(classification: list[Any]) -> str:
     return CLASS_NAMES[best.label] if best.label < len(CLASS_NAMES) else "unknown"
 
 
-def objects(msg: Any, vehicle: Vehicle) -> dict[str, Any]:
+def objects(msg: Any, ctx: Context) -> dict[str, Any]:
     """TrackedObjects → the columns of evoeye.Obstacles (without t_s)."""
     rows = []
     for o in msg.objects:
@@ -90,7 +135,7 @@ def objects(msg: Any, vehicle: Vehicle) -> dict[str, Any]:
         h = yaw(pose.orientation)
         v = kin.twist_with_covariance.twist.linear  # object frame: x forward, y left
         c, s = math.cos(h), math.sin(h)
-        rows.append((uuid_int(o.object_id), _class_name(o.classification), pose.position.x,
+        rows.append((ctx.ids(o.object_id), _class_name(o.classification), pose.position.x,
                      pose.position.y, h, c * v.x - s * v.y, s * v.x + c * v.y,
                      o.shape.dimensions.x, o.shape.dimensions.y, o.existence_probability))
     names = ("track_id", "obj_class", "x_m", "y_m", "heading_rad", "vx_mps", "vy_mps",
@@ -114,7 +159,7 @@ class PredictedObject:
     paths: tuple[PredictedPath, ...]  # most confident first
 
 
-def predicted(msg: Any, vehicle: Vehicle) -> list[PredictedObject]:
+def predicted(msg: Any, ctx: Context) -> list[PredictedObject]:
     out = []
     for o in msg.objects:
         paths = []
@@ -126,7 +171,7 @@ def predicted(msg: Any, vehicle: Vehicle) -> list[PredictedObject]:
             paths.append(PredictedPath(float(p.confidence), np.arange(len(p.path)) * step_s,
                                        xy.reshape(-1, 2)))
         paths.sort(key=lambda p: -p.confidence)  # stable: equal confidences keep their order
-        out.append(PredictedObject(uuid_int(o.object_id), float(o.shape.dimensions.x),
+        out.append(PredictedObject(ctx.ids(o.object_id), float(o.shape.dimensions.x),
                                    float(o.shape.dimensions.y), tuple(paths)))
     return out
 
@@ -140,6 +185,9 @@ class Trajectory:
     speed_mps: np.ndarray
     accel_mps2: np.ndarray
     times_recovered: bool  # the times were all zero and come from arc length over speed
+    # a stack whose trajectory message carries the decision (Apollo's DecisionResult):
+    # (decision, target speed m/s or None, leader track id); None: from the factor topics
+    decision: tuple[str, float | None, int] | None = None
 
 
 def _times_from_arc_length(x: np.ndarray, y: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -153,7 +201,7 @@ def _times_from_arc_length(x: np.ndarray, y: np.ndarray, v: np.ndarray) -> np.nd
     return np.concatenate(([0.0], np.cumsum(dt)))
 
 
-def trajectory(msg: Any, vehicle: Vehicle) -> Trajectory:
+def trajectory(msg: Any, ctx: Context) -> Trajectory:
     pts = msg.points
     if not pts:
         raise ConversionError("trajectory has no points")
@@ -170,40 +218,40 @@ def trajectory(msg: Any, vehicle: Vehicle) -> Trajectory:
         i = int(np.flatnonzero(np.diff(t) <= 0.0)[0])
         raise ConversionError(f"trajectory times are not increasing (point {i + 1} at "
                               f"{t[i + 1]:.3f} s after {t[i]:.3f} s)")
-    ahead = vehicle.centre_ahead_m  # trajectory poses are base_link poses too
+    ahead = ctx.vehicle.centre_ahead_m  # trajectory poses are base_link poses too
     return Trajectory(t, x + ahead * np.cos(h), y + ahead * np.sin(h), h, v, a, recovered)
 
 
-def control(msg: Any, vehicle: Vehicle) -> tuple[float, float]:
+def control(msg: Any, ctx: Context) -> tuple[float, float]:
     """(steering_rad, accel_cmd_mps2) of a Control (or AckermannControlCommand)."""
     return float(msg.lateral.steering_tire_angle), float(msg.longitudinal.acceleration)
 
 
-def factor(msg: Any, vehicle: Vehicle) -> int | None:
+def factor(msg: Any, ctx: Context) -> int | None:
     """None if the PlanningFactorArray has no factor; else the object the first one is about
     (its first OBJECT safety factor's id), -1 if none."""
     if not msg.factors:
         return None
     for s in msg.factors[0].safety_factors.factors:
         if s.type == 2:  # SafetyFactor.OBJECT
-            return uuid_int(s.object_id)
+            return ctx.ids(s.object_id)
     return -1
 
 
-def mrm_state(msg: Any, vehicle: Vehicle) -> bool:
+def mrm_state(msg: Any, ctx: Context) -> bool:
     """True while a minimum-risk manoeuvre operates (MrmState.MRM_OPERATING)."""
     return int(msg.state) == 2
 
 
-def velocity_limit(msg: Any, vehicle: Vehicle) -> float:
+def velocity_limit(msg: Any, ctx: Context) -> float:
     return float(msg.max_velocity)
 
 
-def collision(msg: Any, vehicle: Vehicle) -> bool:
+def collision(msg: Any, ctx: Context) -> bool:
     return bool(msg.data)
 
 
-Converter = Callable[[Any, Vehicle], Any]
+Converter = Callable[[Any, Context], Any]
 # role → {type name → converter}: the current names and the pre-2024 autoware_auto_* names
 _BY_ROLE: dict[str, dict[str, Converter]] = {
     "odometry": {"nav_msgs/msg/Odometry": odometry},

@@ -17,6 +17,7 @@ frame), control 33 Hz (the command in force) — and ground truth at 20 Hz.
 from __future__ import annotations
 
 import math
+from collections.abc import Iterator
 from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
@@ -200,15 +201,16 @@ class Exporter:
         return b.t["autoware_planning_msgs/msg/Trajectory"](header=b.header(t_ns), points=pts)
 
     def control(self, t_ns: int, c: dict, speed: float) -> Any:
-        b = self.b
+        b, now = self.b, self.b.time(t_ns)  # control_time: the command is meant at once
         lat = b.t["autoware_control_msgs/msg/Lateral"](
-            stamp=b.time(t_ns), steering_tire_angle=float(c["steering_rad"]),
+            stamp=now, control_time=now, steering_tire_angle=float(c["steering_rad"]),
             steering_tire_rotation_rate=0.0, is_defined_steering_tire_rotation_rate=False)
         lon = b.t["autoware_control_msgs/msg/Longitudinal"](
-            stamp=b.time(t_ns), velocity=float(speed), acceleration=float(c["accel_cmd_mps2"]),
-            jerk=0.0, is_defined_acceleration=True, is_defined_jerk=False)
-        return b.t["autoware_control_msgs/msg/Control"](stamp=b.time(t_ns), lateral=lat,
-                                                        longitudinal=lon)
+            stamp=now, control_time=now, velocity=float(speed),
+            acceleration=float(c["accel_cmd_mps2"]), jerk=0.0, is_defined_acceleration=True,
+            is_defined_jerk=False)
+        return b.t["autoware_control_msgs/msg/Control"](stamp=now, control_time=now,
+                                                        lateral=lat, longitudinal=lon)
 
     def factors(self, t_ns: int, topic: str, meant: str, plan: dict) -> Any:
         b, t = self.b, self.b.t
@@ -255,17 +257,13 @@ def _times(first_ns: int, last_ns: int, period_ns: int) -> range:
     return range(first_ns, last_ns + 1, period_ns)
 
 
-def bag_messages(log: Path, mapping: Mapping, rates: Rates, collision: bool = False
-                 ) -> tuple[dict[str, Any], list[tuple[int, str, str, Any]]]:
-    """The run's metadata and its bag messages [(log ns, topic, type, message)], time-sorted."""
-    meta, frames = run_messages(log)
-    ex, T = Exporter(mapping), mapping.topics
+def schedule(frames: list[dict[str, dict[str, Any]]], rates: Rates
+             ) -> Iterator[tuple[str, int, Any]]:
+    """When a stack at `rates` publishes what, over a run's frames: (kind, t ns, what), kind
+    `odometry` (the localization, linear in time between two frames), `control` (the frame
+    in force), `objects`, `planning` and `truth` (the frame); odometry first, then control,
+    then frame by frame (a stable sort by time keeps this order among equal times)."""
     times = [round(f[TOPICS.localization]["t_s"] * 1e9) for f in frames]
-    out: list[tuple[int, int, str, str, Any]] = []
-
-    def add(t_ns: int, order: int, topic: str, msgtype: str, msg: Any) -> None:
-        if topic:
-            out.append((t_ns, order, topic, msgtype, msg))
 
     def frame_at(t_ns: int) -> int:  # the latest frame not after t_ns
         return int(np.searchsorted(times, t_ns, side="right")) - 1
@@ -276,23 +274,46 @@ def bag_messages(log: Path, mapping: Mapping, rates: Rates, collision: bool = Fa
         if times[k] < t_ns and k + 1 < len(frames):
             w = (t_ns - times[k]) / (times[k + 1] - times[k])
             loc = _interp_loc(loc, frames[k + 1][TOPICS.localization], w)
-        add(t_ns, 1, T.odometry, "nav_msgs/msg/Odometry",
-            ex.odometry(t_ns, loc["x_m"], loc["y_m"], loc["heading_rad"], loc["speed_mps"]))
-        add(t_ns, 2, T.acceleration, "geometry_msgs/msg/AccelWithCovarianceStamped",
-            ex.acceleration(t_ns, loc["accel_mps2"]))
+        yield "odometry", t_ns, loc
     for t_ns in _times(times[0], times[-1], rates.control_ns):
-        f = frames[frame_at(t_ns)]
-        add(t_ns, 3, T.control, "autoware_control_msgs/msg/Control",
-            ex.control(t_ns, f[TOPICS.control], f[TOPICS.localization]["speed_mps"]))
+        yield "control", t_ns, frames[frame_at(t_ns)]
     for t_ns, f in zip(times, frames, strict=True):
         offset = t_ns - times[0]
-        plan, obs = f[TOPICS.plan], f[TOPICS.obstacles]
         if offset % rates.objects_ns == 0:
+            yield "objects", t_ns, f
+        if offset % rates.planning_ns == 0:
+            yield "planning", t_ns, f
+        yield "truth", t_ns, f
+
+
+def bag_messages(log: Path, mapping: Mapping, rates: Rates, collision: bool = False
+                 ) -> tuple[dict[str, Any], list[tuple[int, str, str, Any]]]:
+    """The run's metadata and its bag messages [(log ns, topic, type, message)], time-sorted."""
+    meta, frames = run_messages(log)
+    ex, T = Exporter(mapping), mapping.topics
+    out: list[tuple[int, int, str, str, Any]] = []
+
+    def add(t_ns: int, order: int, topic: str, msgtype: str, msg: Any) -> None:
+        if topic:
+            out.append((t_ns, order, topic, msgtype, msg))
+
+    for kind, t_ns, f in schedule(frames, rates):
+        if kind == "odometry":
+            add(t_ns, 1, T.odometry, "nav_msgs/msg/Odometry",
+                ex.odometry(t_ns, f["x_m"], f["y_m"], f["heading_rad"], f["speed_mps"]))
+            add(t_ns, 2, T.acceleration, "geometry_msgs/msg/AccelWithCovarianceStamped",
+                ex.acceleration(t_ns, f["accel_mps2"]))
+        elif kind == "control":
+            add(t_ns, 3, T.control, "autoware_control_msgs/msg/Control",
+                ex.control(t_ns, f[TOPICS.control], f[TOPICS.localization]["speed_mps"]))
+        elif kind == "objects":
+            obs = f[TOPICS.obstacles]
             add(t_ns, 0, T.objects, "autoware_perception_msgs/msg/TrackedObjects",
                 ex.obstacles(t_ns, obs))
             add(t_ns, 0, T.predicted, "autoware_perception_msgs/msg/PredictedObjects",
                 ex.predicted(t_ns, f[TOPICS.predictions], obs))
-        if offset % rates.planning_ns == 0:
+        elif kind == "planning":
+            plan = f[TOPICS.plan]
             add(t_ns, 0, T.trajectory, "autoware_planning_msgs/msg/Trajectory",
                 ex.trajectory(t_ns, plan))
             for topic, meant in mapping.planning_factors.items():
@@ -301,15 +322,16 @@ def bag_messages(log: Path, mapping: Mapping, rates: Rates, collision: bool = Fa
             add(t_ns, 0, T.velocity_limit, "autoware_internal_planning_msgs/msg/VelocityLimit",
                 ex.velocity_limit(t_ns, plan))
             add(t_ns, 0, T.mrm_state, "autoware_adapi_v1_msgs/msg/MrmState", ex.mrm(t_ns, plan))
-        gt = f[TOPICS.ground_truth]
-        add(t_ns, 0, T.ground_truth_objects, "autoware_perception_msgs/msg/TrackedObjects",
-            ex.truth_objects(t_ns, gt))
-        add(t_ns, 0, T.ground_truth_ego, "nav_msgs/msg/Odometry",
-            ex.odometry(t_ns, gt["x_m"][0], gt["y_m"][0], gt["heading_rad"][0],
-                        gt["speed_mps"][0]))
-        if collision:
-            add(t_ns, 0, T.collision, "std_msgs/msg/Bool",
-                ex.b.t["std_msgs/msg/Bool"](data=bool(gt["ego_collision"])))
+        else:
+            gt = f[TOPICS.ground_truth]
+            add(t_ns, 0, T.ground_truth_objects, "autoware_perception_msgs/msg/TrackedObjects",
+                ex.truth_objects(t_ns, gt))
+            add(t_ns, 0, T.ground_truth_ego, "nav_msgs/msg/Odometry",
+                ex.odometry(t_ns, gt["x_m"][0], gt["y_m"][0], gt["heading_rad"][0],
+                            gt["speed_mps"][0]))
+            if collision:
+                add(t_ns, 0, T.collision, "std_msgs/msg/Bool",
+                    ex.b.t["std_msgs/msg/Bool"](data=bool(gt["ego_collision"])))
     out.sort(key=lambda m: (m[0], m[1]))
     return meta, [(t, topic, msgtype, msg) for t, _, topic, msgtype, msg in out]
 

@@ -5,8 +5,10 @@ for the next poll), chunks are opened as they land, and messages come out in fil
 the receive order `FrameAssembler` wants. Record with `--storage-config-file` holding
 `noChunking: true` (docs/autoware.md) and each message is on disk at once; with chunking a
 message waits for its chunk (about 1 MB). CDR is decoded with rosbags, by the definitions the
-file embeds (falling back to the vendored Autoware and ROS 2 Humble types). In a folder of split
-bags (`<name>_0.mcap`, `<name>_1.mcap`, …) a file is finished when the next one appears.
+file embeds, as `evoeye import` decodes it (`typestore.bag_typestore`: the vendored Autoware and
+ROS 2 Humble types only for a file that embeds none). A message that does not decode, or a file
+that is not MCAP, is a `SourceError` naming the topic. In a folder of split bags
+(`<name>_0.mcap`, `<name>_1.mcap`, …) a file is finished when the next one appears.
 """
 
 from __future__ import annotations
@@ -24,7 +26,8 @@ from mcap.records import Channel, Footer, Message, Schema
 from mcap.stream_reader import StreamReader
 from mcap.writer import MCAP0_MAGIC
 
-from evoeye.sources.autoware.typestore import typestore
+from evoeye.sources.autoware.frames import SourceError
+from evoeye.sources.autoware.typestore import bag_typestore
 
 _HEAD = struct.Struct("<BQ")  # opcode, record length
 SPLIT_INDEX = re.compile(r"_(\d+)\.mcap$")
@@ -45,12 +48,8 @@ class McapFollower:
 
     def _typestore(self) -> Any:
         if self._store is None:
-            from rosbags.typesys import get_types_from_msg
-
-            self._store = typestore()
-            for s in self._schemas.values():
-                if s.encoding == "ros2msg" and s.name not in self._store.fielddefs:
-                    self._store.register(get_types_from_msg(s.data.decode(), s.name))
+            self._store = bag_typestore((s.name, s.encoding, s.data.decode())
+                                        for s in self._schemas.values())
         return self._store
 
     def _complete(self, data: bytes) -> int:
@@ -73,7 +72,7 @@ class McapFollower:
             if len(data) < len(MCAP0_MAGIC):
                 return []
             if data[: len(MCAP0_MAGIC)] != MCAP0_MAGIC:
-                raise ValueError(f"{self.path}: not an MCAP file (bad leading magic)")
+                raise SourceError("(bag)", "not an MCAP file (bad leading magic)")
             data = data[len(MCAP0_MAGIC):]
             self.offset = len(MCAP0_MAGIC)
         end = self._complete(data)
@@ -99,7 +98,11 @@ class McapFollower:
         elif isinstance(record, Message):
             topic, msgtype = self._channels.get(record.channel_id, ("", ""))
             if self.topics is None or topic in self.topics:
-                msg = self._typestore().deserialize_cdr(record.data, msgtype)
+                try:
+                    msg = self._typestore().deserialize_cdr(record.data, msgtype)
+                except Exception as e:  # rosbags raises several kinds on bytes it cannot read
+                    raise SourceError(topic, f"cannot decode {msgtype} "
+                                             f"({type(e).__name__}: {e})") from None
                 out.append((topic, msgtype, msg, record.log_time))
         elif isinstance(record, Footer):
             self.finished = True
@@ -112,18 +115,20 @@ def _split_files(folder: Path) -> list[Path]:
 
 
 def follow(path: Path, *, topics: set[str] | None = None, poll_s: float = 0.005,
-           idle_s: float = 5.0, sleep: Callable[[float], None] = time.sleep
-           ) -> Iterator[Decoded]:
+           idle_s: float = 5.0, sleep: Callable[[float], None] = time.sleep,
+           follower: Callable[[Path, set[str] | None], Any] = McapFollower,
+           split_files: Callable[[Path], list[Path]] = _split_files) -> Iterator[Decoded]:
     """The messages of a growing MCAP file (or folder of split bags), in file order; ends when
-    the (last) file is finished and nothing new appears for `idle_s`, or stays idle that long."""
+    the (last) file is finished and nothing new appears for `idle_s`, or stays idle that long.
+    Another format: its `follower` (with `poll()`, `path`, `finished`) and `split_files`."""
     done: list[Path] = []
-    current: McapFollower | None = None
+    current: Any = None
     idle_since = time.monotonic()
     while True:
-        files = _split_files(path) if path.is_dir() else ([path] if path.exists() else [])
+        files = split_files(path) if path.is_dir() else ([path] if path.exists() else [])
         pending = [f for f in files if f not in done]
         if current is None and pending:
-            current = McapFollower(pending[0], topics)
+            current = follower(pending[0], topics)
         got = current.poll() if current is not None else []
         yield from got
         if current is not None and not got:

@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from collections import deque
-from collections.abc import Iterator
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass, field
 from typing import Any
 
@@ -28,7 +28,14 @@ from evoeye.log import TOPICS
 from evoeye.log.channels import AGES_TOPIC
 from evoeye.sources.autoware import grids
 from evoeye.sources.autoware.config import REQUIRED_ROLES, Mapping
-from evoeye.sources.autoware.convert import ConversionError, Ego, converter, stamp_ns
+from evoeye.sources.autoware.convert import (
+    Context,
+    ConversionError,
+    Ego,
+    TrackIds,
+    converter,
+    stamp_ns,
+)
 from evoeye.sources.autoware.labels import GroundTruth
 
 ORIGIN_M = 1000.0
@@ -59,6 +66,9 @@ class FrameAssembler:
 
     mapping: Mapping
     label_source: str
+    lookup: Callable[[str, str], Any] = converter  # (role, type name) → converter (another
+    # stack's: `evoeye.sources.apollo.convert.converter`)
+    stamp: Callable[[Any], int | None] = stamp_ns  # a message's own time, ns
     roles: dict[str, str] = field(init=False)  # topic → role
     held: dict[str, deque] = field(init=False)  # role → deque of (stamp ns, value)
     frames: int = 0  # emitted so far
@@ -77,6 +87,7 @@ class FrameAssembler:
         v = self.mapping.vehicle
         self.truth = GroundTruth(self.label_source, v.length_m, v.width_m)
         self.period_ns = round(1e9 / self.mapping.rate_hz)
+        self.context = Context(v, TrackIds())  # one run's track ids, shared by every topic
 
     def push(self, topic: str, msgtype: str, msg: Any, log_ns: int) -> Iterator[Frame]:
         """Take one message; yield the frames it closes (an odometry message stamped later)."""
@@ -84,10 +95,10 @@ class FrameAssembler:
         if role is None:
             return
         try:
-            value = converter(role.partition(":")[0], msgtype)(msg, self.mapping.vehicle)
+            value = self.lookup(role.partition(":")[0], msgtype)(msg, self.context)
         except ConversionError as e:
             raise SourceError(topic, str(e)) from None
-        stamp = stamp_ns(msg)
+        stamp = self.stamp(msg)
         stamp = log_ns if stamp is None else stamp
         held = self.held[role]
         if held and stamp < held[-1][0]:
@@ -155,7 +166,8 @@ class FrameAssembler:
                   ) -> dict[str, dict[str, Any]]:
         origin, v = self.origin, self.mapping.vehicle
         ego: Ego = got["odometry"][1]
-        accel = got["acceleration"][1] if got.get("acceleration") else self._accel[2]
+        accel = got["acceleration"][1] if got.get("acceleration") else \
+            ego.accel_mps2 if ego.accel_mps2 is not None else self._accel[2]
         objects = got["objects"][1]
         if not objects["track_id"]:
             self.empty_object_frames += 1
@@ -187,10 +199,15 @@ class FrameAssembler:
         }
 
     def _decision(self, got: dict[str, Any]) -> dict[str, Any]:
-        """decision, target speed and leader: an operating MRM brakes in an emergency; else the
-        first factor topic with a factor names the decision; cruise if none has one. The
-        target speed is the velocity limit in force (the plan's top speed without one)."""
+        """decision, target speed and leader: those the trajectory carries, if it does (Apollo);
+        else an operating MRM brakes in an emergency, or the first factor topic with a factor
+        names the decision, cruise if none has one. The target speed is the velocity limit in
+        force (the plan's top speed without one)."""
         traj = got["trajectory"][1]
+        if traj.decision is not None:
+            decision, target, leader = traj.decision
+            target = float(traj.speed_mps.max()) if target is None else target
+            return {"decision": decision, "target_speed_mps": target, "leader_track_id": leader}
         limit = got.get("velocity_limit")
         target = limit[1] if limit else float(traj.speed_mps.max())
         decision, leader = "cruise", -1

@@ -16,7 +16,7 @@ from pathlib import Path
 
 from evoeye.log.writer import write_run
 from evoeye.paths import DataRoot, check_batch_name
-from evoeye.sources.autoware.bag import BagError, bag_run_id, read_bag
+from evoeye.sources.autoware.bag import BagError, ImportedRun, bag_run_id, read_bag
 from evoeye.sources.autoware.config import Mapping
 from evoeye.store.ingest import IngestReport, ingest_batch, refresh_catalog
 
@@ -48,21 +48,35 @@ def find_bags(paths: Sequence[Path]) -> list[Path]:
     return out
 
 
+@dataclass(frozen=True)
+class Recordings:
+    """How one stack's recordings are found, identified and converted (Autoware's by default;
+    Apollo's: `evoeye.sources.apollo.run.RECORDS`). Each raises BagError on one it refuses."""
+
+    find: Callable[[Sequence[Path]], list[Path]] = find_bags
+    run_id: Callable[[Path], tuple[str, str]] = bag_run_id  # (logical scenario, scenario id)
+    read: Callable[..., ImportedRun] = read_bag  # (path, mapping) → the run
+
+
 def import_bags(root: DataRoot, paths: Sequence[Path], *, mapping: Mapping | None = None,
                 batch: str = DEFAULT_BATCH,
-                on_bag: Callable[[Path], None] | None = None) -> ImportReport:
-    """Convert every bag of `paths`, write its run log, and ingest the batches written."""
+                on_bag: Callable[[Path], None] | None = None,
+                recordings: Recordings | None = None) -> ImportReport:
+    """Convert every recording of `paths`, write its run log, and ingest the batches
+    written."""
+    recordings = recordings or Recordings()
     check_batch_name(batch)
     report = ImportReport()
     partitions: set[tuple[str, str]] = set()
-    for bag in find_bags(paths):
+    bag_of: dict[str, Path] = {}  # run log (relative to the root) → its bag
+    for bag in recordings.find(paths):
         if on_bag is not None:
             on_bag(bag)
         try:
-            scenario, sid = bag_run_id(bag)
+            scenario, sid = recordings.run_id(bag)
             log = root.run_log(scenario, batch, sid)
             if not log.exists():  # converted before: its log is the run
-                run = read_bag(bag, mapping)
+                run = recordings.read(bag, mapping)
                 log.parent.mkdir(parents=True, exist_ok=True)
                 write_run(dict(run.metadata, batch=batch), run.messages(), log)
                 report.notes += run.notes
@@ -71,9 +85,13 @@ def import_bags(root: DataRoot, paths: Sequence[Path], *, mapping: Mapping | Non
             report.failed.append(str(e))
             continue
         report.logs.append(log)
+        bag_of[root.relative(log)] = bag
         partitions.add((scenario, batch))
     for partition in sorted(partitions):
-        report.ingest.append(ingest_batch(root, partition))
+        ingested = ingest_batch(root, partition)
+        report.ingest.append(ingested)
+        for log, reason in ingested.quarantined:  # the log is moved aside: nothing went in
+            report.failed.append(f"{bag_of.get(log, log)}: (bag): not ingested ({reason})")
     if partitions:
         refresh_catalog(root)  # a batch ingest leaves the DuckDB file's views alone
     return report

@@ -18,20 +18,26 @@ HERE = Path(__file__).resolve().parent
 DURATION_S = 1.0
 
 
-def golden_bag(out_dir: Path) -> Path:
-    """The golden bag folder `<out_dir>/golden`."""
+def golden_log(folder: Path) -> Path:
+    """The first second of a simulated highway-cut-in run, as a run log in `folder`."""
     from evoeye.log import write_episode
     from evoeye.scenarios import get_scenario
     from evoeye.sim.runner import SimConfig, run_episode, run_spec
-    from evoeye.sources.autoware.config import Mapping
-    from evoeye.sources.autoware.export import RATES, bag_messages, write_bag
 
     space = get_scenario("highway-cut-in")
     spec = run_spec(space.name, space.sample(np.random.default_rng(0)), 0, batch="golden")
     episode = run_episode(spec, SimConfig(duration_s=DURATION_S))
+    return write_episode(episode, Path(folder) / "run.mcap")
+
+
+def golden_bag(out_dir: Path) -> Path:
+    """The golden bag folder `<out_dir>/golden`."""
+    from evoeye.sources.autoware.config import Mapping
+    from evoeye.sources.autoware.export import RATES, bag_messages, write_bag
+
     with tempfile.TemporaryDirectory() as tmp:
-        log = write_episode(episode, Path(tmp) / "run.mcap")
-        _, messages = bag_messages(log, Mapping(), RATES["lossless"], collision=True)
+        _, messages = bag_messages(golden_log(Path(tmp)), Mapping(), RATES["lossless"],
+                                   collision=True)
     return write_bag(out_dir / "golden", messages)
 
 

@@ -23,7 +23,7 @@ RUNNER = CliRunner()
 def _args(sup, *extra: str, batch: str | None = None) -> list[str]:
     s = sup.splits
     return ["supervise", "--root", str(sup.root.path), "--scenario", sup.scenario,
-            "--batch", batch or sup.batch, "--baselines", "ttc-2d",
+            "--batch", batch or sup.batch, "--baselines", "ttc-2d", "--monitor", "none",
             "--fprs", ",".join(str(f) for f in sup.fprs), "--split-seed", str(s.seed),
             "--train-frac", str(s.train_frac), "--val-frac", str(s.val_frac), *extra]
 

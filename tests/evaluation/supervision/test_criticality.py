@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from evoeye.evaluation.supervision.criticality import (
+from evoeye.criticality import (
     Criticality,
     justified_frames,
     safe_encounters,

@@ -7,6 +7,7 @@ import shutil
 import signal
 import subprocess
 import sys
+import threading
 import time
 
 import pytest
@@ -120,3 +121,31 @@ def test_a_malloc_note_only_for_workers_with_a_fixed_trim_and_no_mmap_threshold(
     assert malloc_note({"a": (None, None), "b": ("134217728", "134217728")}) is None
     note = malloc_note({"a": ("65536", None), "b": (None, None), "c": ("65536", "1")})
     assert note is not None and "1 of 3 Dask workers" in note and "=65536" in note
+
+
+def test_a_lost_dask_worker_is_reported_and_changes_no_record(root_copy, uninterrupted) -> None:
+    from distributed import Client, LocalCluster
+
+    root = root_copy("lost")
+    lines: list[str] = []
+    base = CampaignConfig(SCENARIO, n_round=1, epochs=1, splits=SPLITS)
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
+                      dashboard_address=None) as cluster, \
+            Client(cluster.scheduler_address) as client:
+        run = threading.Thread(target=run_experiment, args=(root, [SCENARIO], base), kwargs=dict(
+            strategies=METHODS, seeds=[0], budget_s=BUDGET_S, controls=0,
+            dask_address=cluster.scheduler_address, progress=lines.append))
+        run.start()
+        deadline = time.monotonic() + 600
+        while not any(" round 1:" in line for line in lines):
+            assert run.is_alive() and time.monotonic() < deadline
+            time.sleep(0.05)
+        victim = next(w for w, keys in client.processing().items() if keys)
+        os.kill(client.run(os.getpid, workers=[victim])[victim], signal.SIGKILL)
+        run.join(600)
+    moved = [line for line in lines if line.startswith(f"Dask worker {victim} left")]
+    assert len(moved) == 1 and "move to another worker" in moved[0], lines
+    assert "results are unaffected" in moved[0]
+    for method in METHODS:  # every round's line, the moved campaign's included
+        assert any(f"{method} seed 0 round 1:" in line for line in lines), (method, lines)
+    assert records(root) == uninterrupted

@@ -1,5 +1,9 @@
 """How close a run came to a collision, frame by frame, from its ground truth: the judge of
-whether an intervention was needed.
+whether an intervention was needed (the supervisor's, `evoeye.evaluation.supervision`), and a
+target a monitor can learn (`TrainParams.target = "critical"`, `evoeye.monitor.lookahead`).
+
+Pure numpy over ground-truth scenes, beside `evoeye.scene` and `evoeye.boxes`: every layer that
+holds scenes may judge them.
 
 An AEB engineer does not call a brake on a near miss a nuisance. So an intervention at frame k
 is *justified* when the unsupervised run, within H after k, collides (Definition 1's label) or
@@ -28,8 +32,7 @@ from dataclasses import asdict, dataclass
 
 import numpy as np
 
-from evoeye.baselines.ttc import CORRIDOR_MARGIN_M
-from evoeye.boxes import box_corners, first_contact_s
+from evoeye.boxes import CORRIDOR_MARGIN_M, box_corners, first_contact_s
 from evoeye.scene import SceneState
 
 
