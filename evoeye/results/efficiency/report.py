@@ -68,6 +68,21 @@ def curve_table(summary: dict) -> list[str]:
     return lines
 
 
+def detectable_table(summary: dict) -> list[str]:
+    """Per strategy, the paired MDE against Uniform (80 % power, two-sided α 0.05, paired t)
+    over the seeds run, on the area and at each checkpoint, with the differences' SD."""
+    keys = ["area", *map(str, summary["budgets"][1:])]
+
+    def cell(d: dict | None) -> str:
+        if not d or d["mde"] is None:
+            return "–"
+        return f"{100 * d['mde']:.1f} (SD {100 * d['sd_diff']:.1f}, n = {d['n']})"
+
+    rows = [[_label(name), *(cell(s["detectable"].get(k)) for k in keys)]
+            for name, s in summary["strategies"].items() if "detectable" in s]
+    return md_table(["strategy", *(k if k == "area" else f"{k} runs" for k in keys)], rows)
+
+
 def where_table(where: dict) -> list[str]:
     """Per strategy, where its acquired runs fell (the mean over seeds at its last common
     budget): the share that collided, then the safe ones by their smallest gap to another
@@ -106,6 +121,10 @@ def regime_markdown(regime: str, result: dict) -> str:
         set_name, kind = key.split("/")
         lines += [f"### AUPRC on {SET_WORDS[set_name]}: {KIND_WORDS[kind]}", "",
                   *curve_table(summary), ""]
+        if key == "test/scratch":
+            lines += ["Minimum detectable effect against Uniform (points; 80 % power, two-sided "
+                      "α 0.05, paired t over these seeds): a difference smaller than it is not "
+                      "shown either way.", "", *detectable_table(summary), ""]
     lines += ["### Where each strategy sampled", "", *where_table(result["where"]), ""]
     if result.get("failed"):
         lines += ["### Curves that failed", "", "Left out of every table above; a re-run of the "
