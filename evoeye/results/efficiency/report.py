@@ -12,6 +12,7 @@ from html import escape
 from evoeye.evaluation.plots import band_chart
 from evoeye.results.efficiency.config import ORACLE, ORACLE_UNIFORM, REFERENCE, parse_regime
 from evoeye.results.efficiency.curves import MARGIN_BINS_M
+from evoeye.results.efficiency.found import PER
 from evoeye.results.markdown import diff_cell, md_table, mean_cell, pct
 
 SET_WORDS = {"test": "the Test Set", "boundary": "the boundary set"}
@@ -83,6 +84,26 @@ def detectable_table(summary: dict) -> list[str]:
     return md_table(["strategy", *(k if k == "area" else f"{k} runs" for k in keys)], rows)
 
 
+def found_table(found: dict[str, dict]) -> list[str]:
+    """Per strategy and checkpoint, the collisions per 100 runs acquired [95 % CI over seeds],
+    and Uniform's multiple."""
+    budgets = list(found)
+    names = list(dict.fromkeys(n for b in budgets for n in found[b]))
+
+    def cell(f: dict | None) -> str:
+        if not f or f["per_run"]["value"] is None:
+            return "–"
+        r = f["per_run"]
+        text = f"{PER * r['value']:.1f}"
+        if r["low"] is not None:
+            text += f" [{PER * r['low']:.1f}, {PER * r['high']:.1f}]"
+        ratio = f.get("vs_reference", {}).get("ratio")
+        return text + (f" ×{ratio:.2f}" if ratio is not None else "")
+
+    rows = [[_label(n), *(cell(found[b].get(n)) for b in budgets)] for n in names]
+    return md_table(["strategy", *(f"by {b} runs" for b in budgets)], rows)
+
+
 def where_table(where: dict) -> list[str]:
     """Per strategy, where its acquired runs fell (the mean over seeds at its last common
     budget): the share that collided, then the safe ones by their smallest gap to another
@@ -126,6 +147,12 @@ def regime_markdown(regime: str, result: dict) -> str:
                       "α 0.05, paired t over these seeds): a difference smaller than it is not "
                       "shown either way.", "", *detectable_table(summary), ""]
     lines += ["### Where each strategy sampled", "", *where_table(result["where"]), ""]
+    if result.get("found"):
+        lines += ["### Failures found", "", "Collisions per 100 runs acquired beyond the initial "
+                  "set [95 % CI, bootstrap over seeds] and the multiple of Uniform's (in "
+                  "generative mode a run acquired is a run simulated; the oracle and its "
+                  "control trained on several increments per step and kept one).", "",
+                  *found_table(result["found"]), ""]
     if result.get("failed"):
         lines += ["### Curves that failed", "", "Left out of every table above; a re-run of the "
                   "same command retries them alone.", "",

@@ -51,6 +51,8 @@ def test_the_study_runs_in_workers_resumes_and_writes_its_files(tiny_regime, tin
     text = (folder / "efficiency.md").read_text()
     assert "## highway-cut-in, default ADS" in text and "uniform (reference)" in text
     assert "Oracle − its uniform-only control: area" in text
+    assert "### Failures found" in text and "Minimum detectable effect" in text
+    assert regime["found"]["14"]["boundary"]["runs"] == 2 * (14 - 6)  # two seeds, initial apart
     assert "Does acquisition earn its budget?" in (folder / "findings.md").read_text()
     assert (folder / "results.html").read_text().count("<svg") == 3  # one chart per summary
     assert json.loads((folder / "results.json").read_text())["efficiency"]["config"][
