@@ -28,7 +28,8 @@ INTRO = (
     "*Uniform's budget ×*: the budget Uniform's mean curve needs to reach the strategy's final "
     "mean, over the strategy's budget (≥ 1.5: Uniform needs 1.5× the runs; censored \">\" "
     "past Uniform's last point), with its bootstrap 95 % CI. The oracle picks by true benefit "
-    "(outcomes and errors it could not know): the ceiling of what choosing runs can gain. Its "
+    "(outcomes and errors it could not know), greedily among a few increments per step: a "
+    "lower bound on what choosing runs can gain, not a ceiling. Its "
     "control chooses the same way among uniform draws only: what a best-of-k choice gains "
     "from the spread of small-data monitors alone. The oracle's gain over its control is what "
     "choosing the kind of run adds.")
@@ -37,7 +38,7 @@ MODE_WORDS = {"pool": "picked from a pool of pre-simulated uniform runs",
 
 
 def _label(name: str) -> str:
-    return {ORACLE: "oracle (ceiling)", ORACLE_UNIFORM: "oracle-uniform (its control)",
+    return {ORACLE: "oracle (lower bound)", ORACLE_UNIFORM: "oracle-uniform (its control)",
             REFERENCE: "uniform (reference)"}.get(name, name)
 
 
