@@ -119,8 +119,8 @@ def results_command(
     first_study_seed: Annotated[int, typer.Option(
         min=0, help="Sample-efficiency study: its first seed (seeds K … K+N−1).")] = 0,
     oracle: Annotated[bool, typer.Option(
-        help="Sample-efficiency study: draw the oracle ceiling's curves and its control's "
-             "(pool mode).")] = E.oracle,
+        help="Sample-efficiency study: draw the greedy oracle's curves (a lower bound on what "
+             "choosing runs can gain) and its control's (pool mode).")] = E.oracle,
     study_update: Annotated[str, typer.Option(
         help=f"Sample-efficiency study: how the per-round monitor the strategies' feedback "
              f"comes from is updated, {' or '.join(UPDATES)} (fine-tuned, or trained again "
@@ -144,7 +144,7 @@ def results_command(
 ) -> None:
     """Regenerate RQ1, the monitor ablation, RQ2, the evolution ablations and AEM-Evo — and,
     with --part efficiency, the sample-efficiency study (learning curves of acquisition
-    strategies against Uniform and an oracle ceiling) — each comparison with its mean, 95 % CI
+    strategies against Uniform and a greedy oracle) — each comparison with its mean, 95 % CI
     and p; re-running reuses every finished unit."""
     from evoeye.results.efficiency.part import failed_units
     from evoeye.results.run import run_results, write_results

@@ -27,7 +27,8 @@ by pair (seed by seed). The choices, and why:
   measured pair correlation ρ. The Wilcoxon test's power uses its asymptotic relative efficiency
   to the t-test, 3/π for normal differences (Lehmann; G*Power's A.R.E. method): n pairs for the
   Wilcoxon count as 3n/π for the t-test. That is asymptotic; below it, the floor on p rules: with
-  2 / 2^n > α the test can never reject, and its power is 0.
+  2 / 2^n > α the test can never reject, and its power is 0. The minimum detectable effect is
+  that power inverted: the true difference found with the asked power at the pairs run.
 """
 
 from __future__ import annotations
@@ -37,7 +38,7 @@ from collections.abc import Sequence
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from scipy import stats
+from scipy import optimize, stats
 
 CONFIDENCE = 0.95
 N_RESAMPLES = 9999
@@ -211,7 +212,28 @@ def paired_power(n_pairs: int, diff: float, sd_diff: float, *, alpha: float = 0.
     df = max(n - 1.0, 1e-9)
     ncp = abs(diff) / sd_diff * math.sqrt(n)
     crit = float(stats.t.ppf(1.0 - alpha / 2.0, df))
-    return float(stats.nct.sf(crit, df, ncp) + stats.nct.cdf(-crit, df, ncp))
+    wrong_side = float(stats.nct.cdf(-crit, df, ncp))  # NaN where it underflows (large ncp)
+    return float(stats.nct.sf(crit, df, ncp)) + (0.0 if math.isnan(wrong_side) else wrong_side)
+
+
+def minimum_detectable_effect(n_pairs: int, sd_diff: float, *, power: float = 0.8,
+                              alpha: float = 0.05, test: str = "t") -> float:
+    """The smallest true mean difference a two-sided paired test at level alpha detects with
+    probability `power` over n_pairs pairs whose differences have SD sd_diff (in sd_diff's
+    units): `paired_power` inverted. inf where no difference can reach that power (too few
+    pairs for the Wilcoxon floor on p)."""
+    if not 0.0 < power < 1.0:
+        raise ValueError(f"need 0 < power < 1, got {power}")
+    if sd_diff == 0:
+        return 0.0
+    if paired_power(n_pairs, sd_diff, sd_diff, alpha=alpha, test=test) == 0.0:
+        return math.inf
+    hi = sd_diff
+    while paired_power(n_pairs, hi, sd_diff, alpha=alpha, test=test) < power:
+        hi *= 2.0
+    return float(optimize.brentq(
+        lambda d: paired_power(n_pairs, d, sd_diff, alpha=alpha, test=test) - power,
+        0.0, hi, xtol=1e-10 * sd_diff))
 
 
 def smallest_design(alpha: float = 0.05, test: str = "wilcoxon") -> int:

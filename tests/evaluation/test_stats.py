@@ -20,6 +20,7 @@ from evoeye.evaluation.stats import (
     finite_mean,
     mean_ci,
     median_ci,
+    minimum_detectable_effect,
     paired_power,
     paired_warnings_p,
     pairs_needed,
@@ -252,3 +253,26 @@ def test_paired_warnings_compare_only_the_runs_one_monitor_alone_warned_of() -> 
     assert paired_warnings_p([True, False], [False, True]) == 1.0
     with pytest.raises(ValueError, match="one flag each"):
         paired_warnings_p([True], [True, False])
+
+
+@pytest.mark.parametrize(("effect", "pairs"), [(0.3, 90), (0.5, 34), (0.8, 15), (1.0, 10)])
+def test_the_minimum_detectable_effect_inverts_the_published_tables(effect, pairs) -> None:
+    # the G*Power designs above: `pairs` pairs detect d_z = effect, one pair fewer does not
+    assert minimum_detectable_effect(pairs, 1.0) <= effect < minimum_detectable_effect(
+        pairs - 1, 1.0)
+    mde = minimum_detectable_effect(pairs, 2.0)  # in the SD's units
+    assert paired_power(pairs, mde, 2.0, test="t") == pytest.approx(0.8, abs=1e-6)
+
+
+def test_the_minimum_detectable_effect_is_the_normal_formula_at_many_pairs() -> None:
+    # (z_0.975 + z_0.8) · SD / √n = (1.95996 + 0.84162) · 2 / 100 = 0.056032
+    assert minimum_detectable_effect(10_000, 2.0) == pytest.approx(0.056032, rel=1e-3)
+    assert minimum_detectable_effect(40, 2.0) < minimum_detectable_effect(10, 2.0)
+    assert minimum_detectable_effect(10, 0.0) == 0.0
+
+
+def test_no_effect_is_detectable_below_the_wilcoxon_floor() -> None:
+    assert math.isinf(minimum_detectable_effect(5, 1.0, test="wilcoxon"))
+    assert minimum_detectable_effect(10, 1.0, test="wilcoxon") > minimum_detectable_effect(10, 1.0)
+    with pytest.raises(ValueError, match="power"):
+        minimum_detectable_effect(10, 1.0, power=1.0)

@@ -2,7 +2,8 @@
 
 Learning curves from a small initial set, judged on sets no strategy shaped (a large uniform
 Test Set, a boundary set built once by bisection), pool-based screening with a greedy oracle
-ceiling, and generative confirmation; per regime (a logical scenario driven by an ADS profile).
+(a lower bound on what choosing runs can gain), and generative confirmation; per regime (a
+logical scenario driven by an ADS profile).
 
     EfficiencyConfig                      what runs, at what size (config.py)
     prepare_regime(root, regime, config)  its data: pool, val, oracle and Test Sets, boundary set

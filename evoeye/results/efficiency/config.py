@@ -75,7 +75,7 @@ class EfficiencyConfig:
     update: str = "replay"  # the per-round monitor: fine-tuned (replay) or trained again
     strategies: tuple[str, ...] = STRATEGIES
     seeds: tuple[int, ...] = tuple(range(10))  # campaign seeds, paired across strategies
-    oracle: bool = True  # the greedy oracle ceiling and its uniform-only control (pool mode)
+    oracle: bool = True  # the greedy oracle (a lower bound), its uniform-only control (pool)
     oracle_candidates: int = 6  # increments tried at each step of the oracle
     initial_runs: int = 40
     checkpoints: tuple[int, ...] = (80, 160, 320)  # total runs, initial runs included

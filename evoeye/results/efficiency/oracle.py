@@ -1,5 +1,5 @@
-"""The oracle ceiling: a greedy chooser that knows every pool run's outcome and picks by true
-benefit, so its curve bounds what any choice of runs from this pool can gain over Uniform.
+"""The oracle: a greedy chooser that knows every pool run's outcome and picks by true benefit,
+so its gain over Uniform is a lower bound on what choosing runs from this pool can gain.
 
 At each step from one budget to the next it tries `oracle_candidates` increments of the step's
 size from the unused pool and keeps the one whose from-scratch monitor scores the highest
@@ -13,9 +13,10 @@ AUPRC on the oracle set (uniform runs of their own, neither the Test Set nor the
 The kept monitor is the checkpoint's: trained with the seed every strategy's checkpoint
 monitor gets, so it is judged on the Test and boundary sets like theirs. The oracle's choices
 use the outcomes and errors of runs before they are acquired, which no strategy can know: it
-is a ceiling, not a strategy. It is greedy (one step at a time) and tries a handful of
-increments, so it is a lower bound of the true optimum — a ceiling that Uniform already
-reaches says that choosing runs cannot help much here.
+is a bound, not a strategy. It is greedy (one step at a time, one step per checkpoint) and tries
+a handful of increments, so it is a lower bound of the best choice, never a ceiling: an oracle
+that barely beats Uniform says this greedy search found little, not that no choice of runs can
+gain more.
 
 Its control, `oracle-uniform`, is the same greedy search with every candidate a uniform draw:
 as many candidates, judged on the same set. A best-of-k choice among equally likely increments

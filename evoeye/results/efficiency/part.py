@@ -3,8 +3,9 @@
 For each regime: its curves (`runner.run_regime`), three summaries — Test Set AUPRC of the
 monitors trained from scratch (the study's measure), boundary-set AUPRC of the same monitors,
 and Test Set AUPRC of the per-round monitor when it is replay-updated — and where each
-strategy's acquired runs fell. The curves keep their figures per seed and budget (the
-acquired ids stay in the ledger).
+strategy's acquired runs fell and how many failures they held at each checkpoint
+(`found.py`). The curves keep their figures per seed and budget (the acquired ids stay in the
+ledger).
 """
 
 from __future__ import annotations
@@ -16,6 +17,7 @@ import numpy as np
 from evoeye.paths import DataRoot
 from evoeye.results.efficiency.config import CEILINGS, EfficiencyConfig
 from evoeye.results.efficiency.findings import efficiency_findings
+from evoeye.results.efficiency.found import failures_found
 from evoeye.results.efficiency.runner import run_regime
 from evoeye.results.efficiency.summary import summarise
 from evoeye.results.ledger import Ledger
@@ -56,6 +58,7 @@ def regime_results(result: dict, config: EfficiencyConfig) -> dict:
             config.reference_checkpoints, kind, (set_name, "auprc"))
     return {"sets": result["sets"], "curves": curves, "summaries": summaries,
             "where": where_sampled(curves, config.checkpoints[-1]),
+            "found": {str(b): failures_found(curves, b) for b in config.checkpoints},
             "failed": result.get("failed", [])}
 
 

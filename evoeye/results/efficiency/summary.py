@@ -14,6 +14,8 @@ efficiency), and each as a paired difference with Uniform over the seeds.
   Uniform's runs for the same figure. A strategy above Uniform's last point is censored
   ("> factor"). Its CI comes from a bootstrap over seeds (both curves resampled by the same
   seeds), 2.5 and 97.5 percentiles.
+* What the seeds could detect (`power.py`): per strategy, the paired minimum detectable effect
+  against Uniform on the area and at each checkpoint.
 * The oracle against its uniform-only control (`oracle.py`): the paired difference of their
   areas and final figures, what choosing the kind of run adds to a best-of-k choice.
 """
@@ -27,6 +29,7 @@ import numpy as np
 
 from evoeye.evaluation.stats import compare_paired, mean_ci
 from evoeye.results.efficiency.config import ORACLE, ORACLE_UNIFORM, REFERENCE
+from evoeye.results.efficiency.power import detectable
 
 N_BOOT = 2000
 CURVE_METRIC = ("test", "auprc")
@@ -118,6 +121,10 @@ def summarise(curves: dict[str, dict[str, dict]], seeds: Sequence[int], initial_
             entry["final_vs_reference"] = compare_paired(common[:, -1],
                                                          ref[:, len(budgets) - 1]).to_dict()
             entry["efficiency"] = efficiency(common[:, -1], ref, ref_budgets, budgets[-1], rng)
+            entry["detectable"] = {"area": detectable(area(common, budgets),
+                                                      area(ref[:, : len(budgets)], budgets)),
+                                   **{str(b): detectable(common[:, j], ref[:, j])
+                                      for j, b in enumerate(budgets) if j > 0}}
         out["strategies"][name] = entry
     if ORACLE in rows and ORACLE_UNIFORM in rows:
         oracle, control = rows[ORACLE], rows[ORACLE_UNIFORM]

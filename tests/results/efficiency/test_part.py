@@ -9,6 +9,8 @@ from evoeye.results.config import ResultsConfig
 from evoeye.results.efficiency import runner
 from evoeye.results.efficiency.part import failed_units, regime_results, run_efficiency
 from evoeye.results.efficiency.report import regime_markdown
+from evoeye.results.efficiency.restate import main as restate_main
+from evoeye.results.efficiency.restate import restate
 from evoeye.results.ledger import Ledger
 from evoeye.results.run import assemble, write_results
 from evoeye.results.study import Study
@@ -51,10 +53,13 @@ def test_the_study_runs_in_workers_resumes_and_writes_its_files(tiny_regime, tin
     text = (folder / "efficiency.md").read_text()
     assert "## highway-cut-in, default ADS" in text and "uniform (reference)" in text
     assert "Oracle − its uniform-only control: area" in text
+    assert "### Failures found" in text and "Minimum detectable effect" in text
+    assert regime["found"]["14"]["boundary"]["runs"] == 2 * (14 - 6)  # two seeds, initial apart
     assert "Does acquisition earn its budget?" in (folder / "findings.md").read_text()
     assert (folder / "results.html").read_text().count("<svg") == 3  # one chart per summary
-    assert json.loads((folder / "results.json").read_text())["efficiency"]["config"][
-        "strategies"] == ["uniform", "boundary"]
+    stored = json.loads((folder / "results.json").read_text())["efficiency"]
+    assert stored["config"]["strategies"] == ["uniform", "boundary"]
+    assert restate(stored).strip() == text.strip()  # the stored curves give the same page
 
 
 def test_a_curve_that_fails_is_named_left_out_and_retried_alone(tiny_regime, tiny_config,
@@ -83,3 +88,10 @@ def test_a_curve_that_fails_is_named_left_out_and_retried_alone(tiny_regime, tin
     again = run_efficiency(root, config, workers=1, ledger=ledger)
     assert again["regimes"][config.regimes[0]]["failed"] == [] and not failed_units(again)
     assert ledger.computed["efficiency-curve"] == 1 and ledger.found["efficiency-curve"] == 1
+
+
+def test_restate_names_a_file_without_the_study(tmp_path, capsys) -> None:
+    other = tmp_path / "rq1.json"
+    other.write_text(json.dumps({"rq1": {}}))
+    assert restate_main([str(other)]) == 2
+    assert capsys.readouterr().err.strip() == f"{other}: no efficiency part in this results JSON"
