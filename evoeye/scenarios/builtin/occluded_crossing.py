@@ -10,6 +10,7 @@ from evoeye.scenarios.registry import AuditBands, ScenarioSpec
 from evoeye.scenarios.space import LogicalScenario, Parameter
 
 P = Parameter
+SHIPPED = "evoeye.monitor.pretrained"  # its version folders, each card naming its scenario
 
 
 def _walker(name: str, what: str) -> tuple[Parameter, ...]:
@@ -54,5 +55,6 @@ SCENARIO = ScenarioSpec(
     # 24 % on the tuning seed; the band is that ± about 2.5 binomial SDs of 200 runs, rounded
     # (docs/results/realism.md)
     bands=AuditBands(collision_rate=(0.15, 0.40)),
+    demo_monitor=SHIPPED,
     demo_runs=120,
 )
