@@ -94,13 +94,11 @@ def _network() -> tuple[RoadNetwork, RoadMap, Path]:
     return net, road_map_from_network("occluded-crossing", net, [("0", "1", 0)]), ego_path
 
 
-@functools.cache
 def _across(x_m: float, from_y_m: float) -> Path:
     """A straight crossing at x from `from_y_m` over to the other side, as far again."""
     return Path(np.array([[x_m, from_y_m], [x_m, -from_y_m]]))
 
 
-@functools.cache
 def _turn(x_m: float) -> Path:
     """Along the open pavement the ego's way, a left turn at x and straight across."""
     y0, r = PAVEMENT_Y_M["open"], TURN_RADIUS_M
