@@ -67,8 +67,9 @@ def test_killed_batch_resumes_without_duplicates(tmp_path):
         assert read_run(p).metadata["scenario_id"] == p.stem
 
 
-def test_the_same_seed_gives_byte_identical_logs(tmp_path):
-    specs = plan_uniform("unprotected-intersection", 2, seed=5)
+@pytest.mark.parametrize("scenario", ["unprotected-intersection", "occluded-crossing"])
+def test_the_same_seed_gives_byte_identical_logs(tmp_path, scenario):
+    specs = plan_uniform(scenario, 2, seed=5)
     run_batch(specs, DataRoot.resolve(tmp_path / "a"))
     run_batch(specs, DataRoot.resolve(tmp_path / "b"), workers=2)
     for s in specs:

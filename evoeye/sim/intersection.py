@@ -147,7 +147,7 @@ def _box_entry_s() -> float:
     return sum(net.get_lane(idx).length for idx in EGO_ROUTE[:2])
 
 
-def _start_s(path: Path, speed_mps: float, s_conflict: float, t_arrive_s: float,
+def start_for_arrival(path: Path, speed_mps: float, s_conflict: float, t_arrive_s: float,
              driver: DriverModel) -> float:
     """Where to start on `path` to reach s_conflict after t_arrive_s at the path's speed profile
     (the desired speed, curve-limited)."""
@@ -175,7 +175,7 @@ def build_intersection(p: dict[str, float], rng: np.random.Generator) -> tuple[W
         path = _path(tuple(_route(src, dst)))
         s_npc, s_ego_conflict = _conflict(src, dst)
         t_ego = (s_ego_conflict - s_ego) / EGO_CRUISE_MPS
-        s0 = _start_s(path, speed, s_npc, t_ego + p[f"{name}_offset_s"], driver)
+        s0 = start_for_arrival(path, speed, s_npc, t_ego + p[f"{name}_offset_s"], driver)
         for other in sorted(placed.get(src, []), reverse=True):  # same approach: keep spacing
             if abs(other - s0) < MIN_SPACING_M:
                 s0 = other - MIN_SPACING_M

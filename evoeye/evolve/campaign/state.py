@@ -80,8 +80,11 @@ class CampaignState:
     def training_runs(self, update: str, seed: int) -> list[str]:
         """The runs of D_r the monitor update trains on: every ok record, or with `update`
         "replay" the round's new ok runs after a sample of as many earlier ones (seeded by the
-        campaign `seed` and the round); none when the round has no ok run (G_r stays)."""
+        campaign `seed` and the round); none when the round has no ok run, or when no ok run of
+        D_r collided (one class, nothing to learn: G_r stays)."""
         ok = self.records.scenario_id[self.ok]
+        if not self.records.collided[self.ok].any():
+            return []
         seen = {*self.records.scenario_id[:self.n_init],
                 *(s for r in self.rounds for s in r.scenario_ids)}
         is_new = np.array([s not in seen for s in ok], dtype=bool)

@@ -79,6 +79,18 @@ def test_a_round_without_an_ok_run_keeps_its_monitor(root_copy, seeded, update: 
     assert c.update_monitor(state) == (state.monitor, 0.0)
 
 
+@pytest.mark.parametrize("update", ["retrain", "replay", "finetune"])
+def test_records_without_a_collision_keep_the_monitor(root_copy, seeded, update: str) -> None:
+    """A tiny D_r with no collision has one class only: training on it would fail."""
+    c = Campaign(root_copy("no-collision"), config(seeded[1], strategy="uniform", update=update))
+    state = c.start()
+    c.acquire(state)
+    assert state.training_runs(c.config.update, c.config.seed)  # a collision among them …
+    state.records.collided[:] = False
+    assert state.training_runs(c.config.update, c.config.seed) == []  # … and without one
+    assert c.update_monitor(state) == (state.monitor, 0.0)
+
+
 def test_disagreement_campaign_keeps_a_committee_and_each_runs_spread(root_copy, seeded) -> None:
     """K = 3: two companions per round, found again by later campaigns for round 0, and every
     record's disagreement is the spread of the committee's scores on its warehouse windows."""
