@@ -28,6 +28,15 @@ def _csv(text: str) -> tuple[str, ...]:
     return tuple(n.strip() for n in text.split(",") if n.strip() and n.strip() != "none")
 
 
+def study_scenarios(scenario: list[str] | None, initial_runs: list[str] | None
+                    ) -> tuple[str, ...]:
+    """--scenario as given; without it every registered scenario, but the paper's alone for
+    `--initial-runs paper` (the paper's data sizes exist for its scenarios only)."""
+    if scenario:
+        return tuple(scenario)
+    return tuple(PAPER_INITIAL_RUNS) if initial_runs == ["paper"] else tuple(D.scenarios)
+
+
 @app.command("results")
 def results_command(
     root: Annotated[Path | None, typer.Option(
@@ -56,8 +65,9 @@ def results_command(
         help="Simulate (or resume) this many initial runs per scenario, batch "
              "uniform-seed<sim-seed> (0: use the warehouse's): N for every scenario, "
              "SCENARIO=N for one, or 'paper' for the paper's "
-             f"({', '.join(f'{n} on {s}' for s, n in PAPER_INITIAL_RUNS.items())}); "
-             "repeatable.  [default: 0]")] = None,
+             f"({', '.join(f'{n} on {s}' for s, n in PAPER_INITIAL_RUNS.items())}; alone and "
+             "without --scenario, the study runs on those scenarios); repeatable.  "
+             "[default: 0]")] = None,
     sim_seed: Annotated[int, typer.Option(min=0, help="Seed of the initial runs.")] =
         D.sim_seed,
     rq1_runs: Annotated[int, typer.Option(
@@ -152,7 +162,7 @@ def results_command(
     try:
         runs = parse_initial_runs(initial_runs or [])
         config = ResultsConfig(
-            scenarios=tuple(scenario or D.scenarios), parts=tuple(part or D.parts),
+            scenarios=study_scenarios(scenario, initial_runs), parts=tuple(part or D.parts),
             training_seeds=tuple(range(training_seeds)),
             campaign_seeds=tuple(range(campaign_seeds)), final_seeds=final_seeds, final=final,
             initial_runs=runs, sim_seed=sim_seed, rq1_runs=rq1_runs,

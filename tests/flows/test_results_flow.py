@@ -57,6 +57,8 @@ def test_bad_parameters_are_refused_before_anything_runs() -> None:
 def test_initial_runs_per_scenario_reach_the_config() -> None:
     from evoeye.results.config import PAPER_INITIAL_RUNS
 
-    assert ResultsParams(initial_runs=PAPER_INITIAL_RUNS).config().initial_runs == \
-        PAPER_INITIAL_RUNS
+    paper = ResultsParams(scenarios=list(PAPER_INITIAL_RUNS), initial_runs=PAPER_INITIAL_RUNS)
+    assert paper.config().initial_runs == PAPER_INITIAL_RUNS
+    with pytest.raises(ValueError, match="give every scenario initial runs"):
+        ResultsParams(initial_runs=PAPER_INITIAL_RUNS)  # every registered one: S3 has none
     assert ResultsParams(initial_runs=40).config().runs_of("unprotected-intersection") == 40

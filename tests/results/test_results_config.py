@@ -141,3 +141,13 @@ def test_per_scenario_initial_runs_reach_each_scenario_and_rq1s_own_data() -> No
 def test_unknown_names_are_refused(kwargs: dict, message: str) -> None:
     with pytest.raises(ValueError, match=message):
         ResultsConfig(**kwargs).check_names()
+
+
+def test_the_papers_data_sizes_run_on_the_papers_scenarios_alone() -> None:
+    from evoeye.cli.results import study_scenarios
+    from evoeye.scenarios import SCENARIOS
+
+    assert study_scenarios(None, ["paper"]) == tuple(PAPER_INITIAL_RUNS)
+    assert set(PAPER_INITIAL_RUNS) < set(SCENARIOS)  # a registered scenario has no paper size
+    assert study_scenarios(None, None) == tuple(SCENARIOS)
+    assert study_scenarios(["occluded-crossing"], ["paper"]) == ("occluded-crossing",)
