@@ -8,16 +8,12 @@ scoring: one conversion per log), updates the monitor on D_r, refreshes the feed
 record with G_{r+1} and stores the round. The campaign stops when no run fits in the budget
 left.
 
-Monitor update (Algorithm 1, line 12: Train(G_r, D_r)). A round with no new run to learn from
-keeps G_r.
-* `update="retrain"` (the default): from scratch on every run of D_r, by G_0's recipe; the
-  cheaper updates below drift (docs/evolution.md has the measurements). It learns only from
-  D_r: a G_0 trained on runs the root does not hold (a shipped monitor) is evolved by `replay`.
-* `update="replay"` (the paper's, and RQ2's): G_{r+1} starts from G_r's weights and input
-  normalisers and trains at most two epochs on the round's new runs plus a seeded sample of as
-  many earlier runs of D_r (experience replay). Its cost grows with N_round, not with D_r. At
-  least one collision run is in the sample when D_r has one.
-* `update="finetune"`: the same start, a few epochs on every run of D_r.
+Monitor update (Algorithm 1, line 12: Train(G_r, D_r)); a round with no new run to learn from
+keeps G_r. `update="retrain"` (the default) trains from scratch on every run of D_r by G_0's
+recipe; `"replay"` (the paper's, RQ2's) fine-tunes G_r at most two epochs on the round's runs plus
+as many replayed ones (a collision among them when D_r has one); `"finetune"` a few epochs on
+all of D_r (docs/evolution.md measures them). Retraining learns only from D_r: a G_0 trained on
+runs the root does not hold (a shipped monitor) is evolved by `replay`.
 
 State and resume. Everything a campaign knows is in the data root: run logs under
 `runs/<scenario>/<campaign id>/`, the feedback table (f_r per run and monitor version) and the
@@ -26,8 +22,7 @@ campaign_rounds table (per round: G_r and the runs acquired, in order). `start()
 stored round; a round interrupted anywhere (mid-run, mid-round, mid-training) is re-done from
 its start — its proposals are deterministic (the strategy's, and run seed k for proposal k,
 both from the campaign's own seed streams, `evoeye.seeds`), logs already on disk are read
-instead of simulated, so no run is lost, duplicated or charged
-twice. A campaign writes only its own keys (its batch's partition, rounds, monitor versions'
+instead of simulated, so no run is lost, duplicated or charged twice. A campaign writes only its own keys (its batch's partition, rounds, monitor versions'
 feedback: `evoeye.store.lock`), so campaigns run side by side (`experiment.py`). A run starts
 only if the budget left is at least the longest run (`max_run_s`): no budget is overspent. A
 proposal whose run the root already holds (in any batch, or among D_r) gets its run seed
