@@ -20,14 +20,15 @@ State and resume. Everything a campaign knows is in the data root: run logs unde
 campaign_rounds table (per round: G_r and the runs acquired, in order). `start()` rebuilds D_r
 (outcomes from the warehouse, no log read again) and the strategy (`replay`) from the last
 stored round; a round interrupted anywhere (mid-run, mid-round, mid-training) is re-done from
-its start — its proposals are deterministic (the strategy's, and run seed k for proposal k,
-both from the campaign's own seed streams, `evoeye.seeds`), logs already on disk are read
-instead of simulated, so no run is lost, duplicated or charged twice. A campaign writes only its own keys (its batch's partition, rounds, monitor versions'
-feedback: `evoeye.store.lock`), so campaigns run side by side (`experiment.py`). A run starts
-only if the budget left is at least the longest run (`max_run_s`): no budget is overspent. A
-proposal whose run the root already holds (in any batch, or among D_r) gets its run seed
-redrawn (`state.fresh_spec`; the round's `state.redrawn` names them), so every run a campaign
-acquires is new and its batch in the warehouse holds as many runs as it counts records.
+its start — its proposals are deterministic (the strategy's, and run seed k for proposal k, both
+from the campaign's own seed streams, `evoeye.seeds`), logs already on disk are read instead of
+simulated, so no run is lost, duplicated or charged twice. A campaign writes only its own keys
+(its batch's partition, rounds, monitor versions' feedback: `evoeye.store.lock`), so campaigns
+run side by side (`experiment.py`). A run starts only if the budget left is at least the longest
+run (`max_run_s`): no budget is overspent. A proposal whose run the root already holds (in any
+batch, or among D_r) gets its run seed redrawn (`state.fresh_spec`; the round's `state.redrawn`
+names them), so every run a campaign acquires is new and its batch in the warehouse holds as
+many runs as it counts records.
 
 A strategy that reads the records' disagreement (`disagreement`) has a committee
 (`committee.py`): K − 1 companions updated beside G_r, whose spread of scores is stored per run.
@@ -50,7 +51,7 @@ from evoeye.evolve.campaign.committee import Committee
 from evoeye.evolve.campaign.config import CampaignConfig, campaign_id
 from evoeye.evolve.campaign.guard import CampaignCancelled, campaign_lease
 from evoeye.evolve.campaign.phases import PhaseClock
-from evoeye.evolve.campaign.scoring import warehouse_feedback, windows_feedback
+from evoeye.evolve.campaign.scoring import fresh_run_feedback, warehouse_feedback
 from evoeye.evolve.campaign.state import (
     CampaignState,
     acquired_runs,
@@ -92,7 +93,7 @@ from evoeye.store.feedback import (
 )
 from evoeye.store.feedback import write_round as store_round
 from evoeye.store.ingest import IngestReport, ingest_batch, refresh_catalog
-from evoeye.store.log_windows import LoggedRun, episode_run, read_logged_run
+from evoeye.store.log_windows import LoggedRun
 from evoeye.store.windows import cached_parts
 
 Trainer = Callable[..., str]  # train_monitor's signature
@@ -242,6 +243,8 @@ class Campaign:
         runs: list[LoggedRun] = []
         members = (None if self.committee is None  # G_r's committee, for the disagreement
                    else [state.monitor, *self.committee.companions(state.round)])
+        spread = None if not members else (
+            lambda windows: self.committee.disagreement(members, windows))
         held = held_runs(self.root, cfg.scenario, self.campaign_id, state.records)
         state.redrawn = []
         while len(new) < cfg.n_round and not self.done(state):
@@ -255,15 +258,9 @@ class Campaign:
             if result.status == "error":
                 raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
                                    f"{result.reason}")
-            with self.clock("score"):  # a log a resumed round finds on disk is read
-                run = (read_logged_run(result.path, monitor.context_len, cfg.horizon_s)
-                       if episode is None else
-                       episode_run(episode, result.path, monitor.context_len, cfg.horizon_s))
-                scored = run.ok and run.windows is not None
-                fb = windows_feedback(monitor, run.windows, cfg.feedback).feedback[0] if scored \
-                    else np.nan
-                d = self.committee.disagreement(members, run.windows).feedback[0] \
-                    if scored and members else np.nan
+            with self.clock("score"):
+                run, fb, d = fresh_run_feedback(monitor, result.path, episode, cfg.horizon_s,
+                                                cfg.feedback, spread)
             outcome = run_outcome(run.metadata)
             state.strategy.tell(prop.x, outcome["fitness"])
             state.records = state.records.append(np.asarray(run.metadata["params"], float),

@@ -13,6 +13,8 @@ import numpy as np
 from evoeye.evolve.campaign.config import FEEDBACK_MODES
 from evoeye.evolve.search.feedback import ScenarioFeedback, prior_corrected, scenario_feedback
 from evoeye.paths import DataRoot
+from evoeye.sim.episode import Episode
+from evoeye.store.log_windows import LoggedRun, episode_run, read_logged_run
 from evoeye.store.windows import Windows, load_windows
 
 
@@ -40,3 +42,17 @@ def warehouse_feedback(root: DataRoot, monitor, scenario_ids, horizon_s: float,
     windows = load_windows(root, list(scenario_ids), context_len=monitor.context_len,
                            horizon_s=horizon_s)
     return windows_feedback(monitor, windows, mode)
+
+
+def fresh_run_feedback(monitor, path, episode: Episode | None, horizon_s: float, mode: str,
+                       disagreement=None) -> tuple[LoggedRun, float, float]:
+    """A just-simulated run converted (from its Episode, or from its log when a resumed round
+    finds it on disk) and its f_r under `monitor` and, with `disagreement` (windows → its
+    ScenarioFeedback), the committee's spread; NaN for a run without windows."""
+    run = (read_logged_run(path, monitor.context_len, horizon_s) if episode is None
+           else episode_run(episode, path, monitor.context_len, horizon_s))
+    if not (run.ok and run.windows is not None):
+        return run, np.nan, np.nan
+    fb = windows_feedback(monitor, run.windows, mode).feedback[0]
+    d = np.nan if disagreement is None else disagreement(run.windows).feedback[0]
+    return run, float(fb), float(d)
