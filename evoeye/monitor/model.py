@@ -25,6 +25,12 @@ import torch
 from torch import nn
 
 from evoeye.monitor.inputs import ABLATIONS, MODULES
+from evoeye.monitor.kinematics import (
+    FRAME_KINEMATIC_FEATURES,
+    KINEMATIC_FEATURES,
+    frame_kinematics,
+    obstacle_kinematics,
+)
 from evoeye.store.features import (
     CONTROL_FEATURES,
     FEATURES,
@@ -60,6 +66,8 @@ class FusionConfig:
     temporal_hidden: int = 48
     temporal_dim: int = 32  # h_t
     dropout: float = 0.0  # on the frame feature z_t and on the temporal MLP's hidden layer
+    # relative kinematics derived from the perception inputs (evoeye.monitor.kinematics)
+    kinematics: bool = False
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "modules", tuple(self.modules))
@@ -79,8 +87,12 @@ class FusionConfig:
                    plan_points=spec.plan_points, **kwargs)
 
     def to_dict(self) -> dict:
+        """Every field; `kinematics` only where it is on, so a network made before it keeps
+        its checkpoint and version id."""
         d = asdict(self)
         d["modules"] = list(self.modules)
+        if not self.kinematics:
+            del d["kinematics"]
         return d
 
 
@@ -139,7 +151,10 @@ class FusionNet(nn.Module):
     def __init__(self, config: FusionConfig):
         super().__init__()
         self.config = c = config
-        n_perc, n_pred = len(PERCEPTION_FEATURES), c.pred_points * len(PREDICTION_FEATURES)
+        self.kinematic = c.kinematics and "perception" in c.modules
+        n_kin = len(KINEMATIC_FEATURES) if self.kinematic else 0
+        n_perc = len(PERCEPTION_FEATURES) + n_kin
+        n_pred = c.pred_points * len(PREDICTION_FEATURES)
         n_plan = c.plan_points * (len(PLAN_FEATURES) + 1) + len(PLAN_INFO_FEATURES)  # + mask
         self.norm = nn.ModuleDict()
         self.encoders = nn.ModuleDict()
@@ -148,6 +163,9 @@ class FusionNet(nn.Module):
             self.norm["perception"] = Normalizer((n_perc,))
             self.encoders["perception"] = SetEncoder(n_perc, c.obstacle_dim)
             widths.append(c.obstacle_dim)
+        if self.kinematic:
+            self.norm["kinematics"] = Normalizer((len(FRAME_KINEMATIC_FEATURES),))
+            widths.append(len(FRAME_KINEMATIC_FEATURES))
         if "prediction" in c.modules:
             self.norm["prediction"] = Normalizer((n_pred,))
             self.encoders["prediction"] = SetEncoder(n_pred, c.obstacle_dim)
@@ -172,7 +190,12 @@ class FusionNet(nn.Module):
         """Fit every input normaliser on these frames (only obstacles and points present)."""
         a = frames.arrays()
         if "perception" in self.norm:
-            self.norm["perception"].fit(a["perception"][a["perception_mask"]])
+            perception, mask = a["perception"], a["perception_mask"]
+            if self.kinematic:
+                perception, frame = (x.numpy() for x in self._with_kinematics(
+                    torch.from_numpy(perception).float(), torch.from_numpy(mask)))
+                self.norm["kinematics"].fit(frame)
+            self.norm["perception"].fit(perception[mask])
         if "prediction" in self.norm:
             pred = a["prediction"][a["prediction_mask"]]
             self.norm["prediction"].fit(pred.reshape(len(pred), -1) if len(pred) else pred)
@@ -192,9 +215,13 @@ class FusionNet(nn.Module):
         own (leading axes (B, L) for windows, (N,) for frames)."""
         z = []
         if "perception" in self.encoders:
+            if self.kinematic:  # (B, L, n, 9 + 7) and the frame's (B, L, 2)
+                perception, frame = self._with_kinematics(perception, perception_mask)
             x = self.norm["perception"](perception)  # (B, L, n, 9)
             x = torch.where(perception_mask.unsqueeze(-1), x, 0.0)
             z.append(self.encoders["perception"](x, perception_mask))  # (B, L, Dₒ)
+            if self.kinematic:
+                z.append(self.norm["kinematics"](frame))
         if "prediction" in self.encoders:
             x = self.norm["prediction"](prediction.flatten(-2))  # (B, L, n, K·2)
             x = torch.where(prediction_mask.unsqueeze(-1), x, 0.0)
@@ -207,6 +234,13 @@ class FusionNet(nn.Module):
         if "control" in self.encoders:
             z.append(self.encoders["control"](self.norm["control"](control)))  # (B, L, D꜀)
         return self.frame(torch.cat(z, dim=-1))  # (B, L, D)
+
+    @staticmethod
+    def _with_kinematics(perception: torch.Tensor,
+                         mask: torch.Tensor) -> tuple[torch.Tensor, torch.Tensor]:
+        """The perception inputs with each obstacle's kinematics appended, and the frame's."""
+        kin = obstacle_kinematics(perception)
+        return torch.cat([perception, kin], dim=-1), frame_kinematics(kin, mask)
 
     def forward(
         self, perception: torch.Tensor, perception_mask: torch.Tensor,

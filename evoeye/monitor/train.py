@@ -80,6 +80,7 @@ def train_monitor(
     horizon_s: float = DEFAULT_HORIZON_S,
     modules: Sequence[str] | None = None,
     dropout: float | None = None,
+    kinematics: bool | None = None,
     seed: int = 0,
     splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
     train_runs: Runs = None,
@@ -95,14 +96,15 @@ def train_monitor(
 
     Default data: the `scenario` runs of the train / val splits of `splits`; `train_runs` /
     `val_runs` (a RunFilter, SQL returning scenario_id, or ids) select any other subsets.
-    `context_len` (default 5), `modules` (default all four) and `dropout` (default
-    FusionConfig's) come from the parent when fine-tuning. The hyper-parameters are those of
-    `recipe` (default `recipes.DEFAULT_RECIPE`) with `overrides` (TrainParams fields: epochs=…,
-    lr=…); a full `params` replaces all three and `seed`. `device`: `pick_device`'s.
+    `context_len` (default 5), `modules` (default all four), `dropout` and `kinematics`
+    (default FusionConfig's) come from the parent when fine-tuning. The hyper-parameters are
+    those of `recipe` (default `recipes.DEFAULT_RECIPE`) with `overrides` (TrainParams fields:
+    epochs=…, lr=…); a full `params` replaces all three and `seed`. `device`: `pick_device`'s.
     """
     seed = params.seed if params is not None else seed
     return train_monitors(root, scenario, seeds=[seed], context_len=context_len,
-                          horizon_s=horizon_s, modules=modules, dropout=dropout, splits=splits,
+                          horizon_s=horizon_s, modules=modules, dropout=dropout,
+                          kinematics=kinematics, splits=splits,
                           train_runs=train_runs, val_runs=val_runs, init_from=init_from,
                           params=params, progress=progress, recipe=recipe, device=device,
                           **overrides)[0]
@@ -117,6 +119,7 @@ def train_monitors(
     horizon_s: float = DEFAULT_HORIZON_S,
     modules: Sequence[str] | None = None,
     dropout: float | None = None,
+    kinematics: bool | None = None,
     splits: SplitSpec = SplitSpec(),  # noqa: B008 (frozen dataclass)
     train_runs: Runs = None,
     val_runs: Runs = None,
@@ -139,7 +142,7 @@ def train_monitors(
     base = params or recipe_params(recipe, **overrides)
     train_runs, val_runs = _selections(scenario, splits, train_runs, val_runs)
     parent = load_monitor(root, init_from) if init_from else None
-    config = _config(parent, context_len, modules, dropout)
+    config = _config(parent, context_len, modules, dropout, kinematics)
     warehouse = Warehouse(root)
     train = load_windows(warehouse, train_runs, context_len=config.context_len,
                          horizon_s=horizon_s)
@@ -208,17 +211,22 @@ def _tagged(progress: Progress | None, seed: int) -> Progress | None:
 
 
 def _config(parent: FusionMonitor | None, context_len: int | None,
-            modules: Sequence[str] | None, dropout: float | None) -> FusionConfig:
+            modules: Sequence[str] | None, dropout: float | None,
+            kinematics: bool | None = None) -> FusionConfig:
     """The network's config: the parent's (which the options must not contradict), or one
     made of the options."""
     if parent is not None:
         config = parent.net.config
         if context_len not in (None, config.context_len) or dropout not in (
-                None, config.dropout) or (modules is not None and tuple(modules) != config.modules):
+                None, config.dropout) or (modules is not None and tuple(modules) != config.modules
+                                          ) or kinematics not in (None, config.kinematics):
             raise ValueError(f"a fine-tuned monitor keeps its parent's L = {config.context_len}, "
-                             f"modules {config.modules} and dropout {config.dropout}")
+                             f"modules {config.modules}, dropout {config.dropout} and "
+                             f"kinematics {config.kinematics}")
         return config
     extra = {} if dropout is None else {"dropout": dropout}
+    if kinematics is not None:
+        extra["kinematics"] = kinematics
     return FusionConfig(context_len=context_len or DEFAULT_CONTEXT_LEN,
                         modules=tuple(modules or MODULES), **extra)
 
