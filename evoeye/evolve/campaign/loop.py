@@ -314,7 +314,7 @@ class Campaign:
         scratch with G_0's context length) and the fixed val split, as the update trains; with
         `importance_weights`, each run weighted by its p/q in `state`'s records."""
         cfg = self.config
-        weights = ({"run_weights": state.run_weights()}
+        weights = ({"run_weights": state.records.ratio_by_run()}
                    if cfg.importance_weights and state is not None else {})
         return self._train(self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
                            horizon_s=cfg.horizon_s, seed=seed, splits=cfg.splits,

@@ -77,11 +77,6 @@ class CampaignState:
     def acquired(self) -> int:
         return self.records.n - self.n_init
 
-    def run_weights(self) -> dict[str, float]:
-        """scenario_id → p/q of every record (1 where no proposal density is known)."""
-        ratio = self.records.importance_ratio()
-        return {str(s): float(w) for s, w in zip(self.records.scenario_id, ratio, strict=True)}
-
     def training_runs(self, update: str, seed: int) -> list[str]:
         """The runs of D_r the monitor update trains on: every ok record, or with `update`
         "replay" the round's new ok runs after a sample of as many earlier ones (seeded by the

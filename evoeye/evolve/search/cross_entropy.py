@@ -49,7 +49,6 @@ the space's resolution, approximate for a finite pool (its rows are themselves a
 from __future__ import annotations
 
 import math
-import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -58,7 +57,7 @@ from scipy.stats import beta
 from evoeye.evolve.search.pool import CandidatePool
 from evoeye.evolve.search.protocol import Proposal, StrategyError
 from evoeye.evolve.search.records import Records
-from evoeye.evolve.search.strategies import CountedStrategy
+from evoeye.evolve.search.strategies import BatchedStrategy
 from evoeye.scenarios import LogicalScenario
 
 ALPHA = 0.2  # the uniform's share of every proposal: p/q ≤ 1/ALPHA
@@ -179,39 +178,25 @@ def ce_update(previous: DefensiveMixture, u: np.ndarray, log_w: np.ndarray,
     return DefensiveMixture(previous.alpha, BetaProduct(mean, sd))
 
 
-class CrossEntropyIS(CountedStrategy):
+class CrossEntropyIS(BatchedStrategy):
     """Cross-entropy adaptive importance sampling with a defensive mixture (module doc)."""
 
     name = "ce-is"
 
     def __init__(self, space: LogicalScenario, seed: int, batch: int = 20,
                  alpha: float = ALPHA, rho: float = RHO) -> None:
-        if batch < 1:
-            raise StrategyError(f"{self.name}: batch must be >= 1, got {batch}")
         if not 0.0 < alpha <= 1.0:
             raise StrategyError(f"{self.name}: alpha must be in (0, 1], got {alpha}")
         if not 0.0 < rho < 1.0:
             raise StrategyError(f"{self.name}: rho must be in (0, 1), got {rho}")
-        super().__init__(space, seed)
-        self.batch, self.alpha, self.rho = batch, alpha, rho
+        super().__init__(space, seed, batch)
+        self.alpha, self.rho = alpha, rho
         self.log_span = float(np.log(space.high - space.low).sum())  # u → θ: density / Π span
         self._mixtures: list[DefensiveMixture] = []  # per batch, rebuilt from the records
-        self._served: tuple[int, list[Proposal]] | None = None
-
-    # -- the protocol ----------------------------------------------------------------------------
-    def propose(self, records: Records) -> Proposal:
-        return self._serve(records, None)
-
-    def propose_in(self, records: Records, pool: CandidatePool, unused: np.ndarray) -> Proposal:
-        """Pool mode: the batch is drawn among the rows unused when it started (module doc)."""
-        return self._serve(records, pool)
-
-    def available(self) -> int:
-        return sys.maxsize
 
     def replay(self, params: np.ndarray, fitness: np.ndarray) -> None:
         super().replay(params, fitness)
-        self._mixtures, self._served = [], None
+        self._mixtures = []
 
     # -- densities -------------------------------------------------------------------------------
     def mixture(self, b: int, records: Records, n_init: int) -> DefensiveMixture:
@@ -250,25 +235,12 @@ class CrossEntropyIS(CountedStrategy):
         return log_q, log_p
 
     # -- batches ---------------------------------------------------------------------------------
-    def _serve(self, records: Records, pool: CandidatePool | None) -> Proposal:
-        if records.params.shape[1] != self.space.dim:
-            raise StrategyError(f"{self.name}: records have {records.params.shape[1]} "
-                                f"parameters, {self.space.name} has {self.space.dim}")
-        k = self.proposals
-        n_init = records.n - k
+    def _choose(self, records: Records, b: int, pool: CandidatePool | None) -> list[Proposal]:
+        n_init = records.n - b * self.batch  # `records`: D_init and batches 0 .. b − 1
         if n_init < 0:
-            raise StrategyError(f"{self.name}: {k} proposals but only {records.n} records "
+            raise StrategyError(f"{self.name}: batch {b} but only {records.n} records "
                                 "(record every proposal)")
-        b, j = divmod(k, self.batch)
-        if self._served is None or self._served[0] != b:
-            self._served = (b, self._draw(b, self.mixture(b, records, n_init),
-                                          records.head(n_init + b * self.batch), pool))
-        served = self._served[1]
-        if j >= len(served):
-            raise StrategyError(f"{self.name}: the pool of {len(pool or ())} candidates is "
-                                "used up")
-        self.proposals += 1
-        return served[j]
+        return self._draw(b, self.mixture(b, records, n_init), records, pool)
 
     def _draw(self, b: int, q: DefensiveMixture, basis: Records,
               pool: CandidatePool | None) -> list[Proposal]:

@@ -91,6 +91,11 @@ class Records:
         known = np.isfinite(self.log_q) & np.isfinite(self.log_p)
         return np.where(known, np.exp(np.where(known, self.log_p - self.log_q, 0.0)), 1.0)
 
+    def ratio_by_run(self) -> dict[str, float]:
+        """scenario_id → p/q (`importance_ratio`) of every run."""
+        return dict(zip(map(str, self.scenario_id), self.importance_ratio().tolist(),
+                        strict=True))
+
     def with_feedback(self, feedback: np.ndarray) -> Records:
         """The same runs with every feedback refreshed (after a monitor update)."""
         return replace(self, feedback=np.asarray(feedback, dtype=float))
