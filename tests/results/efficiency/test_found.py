@@ -65,3 +65,14 @@ def test_failure_rates_weigh_uniform_by_its_counts_and_a_weighted_strategy_by_it
     assert c["vs_reference"]["relative_error"] == pytest.approx(
         c["relative_error"] / u["relative_error"])
     assert c["relative_error"] < u["relative_error"]
+
+
+def test_the_rates_table_shows_each_estimate_its_spread_and_uniforms_multiple() -> None:
+    from evoeye.results.efficiency.report import rates_table
+
+    rates = {"320": {"uniform": {"mean": 0.01, "spread": 0.6, "relative_error": 0.5},
+                     "ce-is": {"mean": 0.011, "spread": 0.2, "relative_error": 0.2,
+                               "vs_reference": {"spread": 1 / 3, "relative_error": 0.4}}}}
+    table = "\n".join(rates_table(rates))
+    assert "| uniform (reference) | 1.00 % (±0.60) |" in table
+    assert "| ce-is | 1.10 % (±0.20) ×0.33 |" in table
