@@ -130,6 +130,10 @@ def supervise_command(
     workers: Annotated[int, typer.Option(min=1, help="Worker processes.")] = 1,
     limit: Annotated[int | None, typer.Option(min=1, help="Only the batch's first N runs.")] =
         None,
+    skip: Annotated[int, typer.Option(
+        min=0, help="Report on --batch's runs after its first N (with --limit: runs N+1 … "
+        "limit): a confirmation on runs an earlier look has not seen. The selection batch "
+        "keeps its first --limit runs.")] = 0,
     name: Annotated[str | None, typer.Option(
         help="Report folder name under <root>/reports (default supervision-<UTC time>).")] =
         None,
@@ -174,7 +178,7 @@ def supervise_command(
                            fallback=fallback_config,
                            consecutive=consecutive, horizon_s=horizon_s, logs=logs,
                            logs_into_runs=logs_into_runs, workers=workers, limit=limit,
-                           progress=bar, select_batch=select_batch,
+                           skip=skip, progress=bar, select_batch=select_batch,
                            oracle_leads_s=() if oracle_leads == "none"
                            else parse_floats(oracle_leads, "--oracle-leads"))
         errors = result.errors + (result.select.errors if result.select else [])
@@ -187,6 +191,7 @@ def supervise_command(
         raise UserError(str(exc).strip("'\""), "check --scenario, --batch, --monitor and the "
                         "split options, and that `evoeye ingest` has run") from exc
     summary["folder"] = str(result.folder)
+    summary["skipped_runs"] = skip
     summary["errors"] = [{"scenario_id": s, "reason": r} for s, r in errors]
     files = write_report(data, [summary], name)
     written = write_docs(docs, summary) if docs else []

@@ -32,7 +32,7 @@ def supervise(root: DataRoot, scenario: str, batch: str, sources: Sequence[tuple
               fallback: FallbackConfig = FallbackConfig(),  # noqa: B008 (frozen dataclass)
               consecutive: int = 1, horizon_s: float = DEFAULT_HORIZON_S,
               logs: str = "collided", logs_into_runs: bool = False, workers: int = 1,
-              limit: int | None = None,
+              limit: int | None = None, skip: int = 0,
               progress: Callable[[Iterable], Iterable] | None = None,
               oracle_leads_s: Sequence[float] = ORACLE_LEADS_S,
               select_batch: str | None = None) -> SupervisionResult:
@@ -43,7 +43,8 @@ def supervise(root: DataRoot, scenario: str, batch: str, sources: Sequence[tuple
     are supervised too, under the same triggers and thresholds (`.select`): the runs operating
     points are chosen on. ValueError if a run of either batch is in the train or validation
     split — a trigger must not be judged on the runs it learned or was calibrated on — or if
-    the two batches are one."""
+    the two batches are one. `skip` leaves out the first runs of `batch` (not of the selection
+    batch): a confirmation on runs no earlier look has seen."""
     check_held_out(root, scenario, batch, splits)
     if select_batch is not None:
         if select_batch == batch:
@@ -58,7 +59,8 @@ def supervise(root: DataRoot, scenario: str, batch: str, sources: Sequence[tuple
     select = None if select_batch is None else run_supervision(
         root, replace(settings, batch=select_batch), workers=workers, progress=progress,
         limit=limit)
-    result = run_supervision(root, settings, workers=workers, progress=progress, limit=limit)
+    result = run_supervision(root, settings, workers=workers, progress=progress, limit=limit,
+                             skip=skip)
     return replace(result, select=select)
 
 

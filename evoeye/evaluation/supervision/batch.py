@@ -83,10 +83,14 @@ class Plan:
     jobs: list[RunJob]
 
 
-def plan_supervision(root: DataRoot, settings: Settings, limit: int | None = None) -> Plan:
+def plan_supervision(root: DataRoot, settings: Settings, limit: int | None = None,
+                     skip: int = 0) -> Plan:
     """Open the supervision's folder (its killed writers' `.tmp` files removed) and list the
-    batch's runs (the first `limit`, if given) and the jobs of those without a record."""
-    runs = batch_runs(root, settings.scenario, settings.batch)[:limit]
+    batch's runs (the first `limit`, if given, after the first `skip`: runs a screening has
+    seen, left out of a confirmation) and the jobs of those without a record."""
+    if skip < 0:
+        raise ValueError(f"--skip must be >= 0, got {skip}")
+    runs = batch_runs(root, settings.scenario, settings.batch)[:limit][skip:]
     folder = open_folder(root, settings)
     _stale(folder)
     jobs = [RunJob(str(root.path), str(folder), settings, spec, meta) for spec, meta in runs
@@ -106,12 +110,13 @@ def collect(settings: Settings, plan: Plan, errors: list[tuple[str, str]],
 
 def run_supervision(root: DataRoot, settings: Settings, *, workers: int = 1,
                     progress: Callable[[Iterable], Iterable] | None = None,
-                    limit: int | None = None) -> SupervisionResult:
-    """Supervise every run of the batch (the first `limit`, if given) not done yet."""
+                    limit: int | None = None, skip: int = 0) -> SupervisionResult:
+    """Supervise every run of the batch (the first `limit`, if given, after the first
+    `skip`) not done yet."""
     if workers < 1:
         raise ValueError(f"--workers must be at least 1, got {workers}")
     t0 = time.perf_counter()
-    plan = plan_supervision(root, settings, limit)
+    plan = plan_supervision(root, settings, limit, skip)
     errors: list[tuple[str, str]] = []
     wrap = progress or (lambda it: it)
     if workers == 1:

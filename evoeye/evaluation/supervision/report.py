@@ -179,7 +179,9 @@ def curve_table(summary: dict, trigger: str) -> Table:
 def _setup(summary: dict) -> str:
     s = summary["settings"]
     fb, sims = s["fallback"], summary["simulations"]
-    return (f"Batch `{summary['batch']}`, each run paired with its unsupervised run; "
+    skipped = summary.get("skipped_runs", 0)
+    after = f" (its runs after the first {skipped})" if skipped else ""
+    return (f"Batch `{summary['batch']}`{after}, each run paired with its unsupervised run; "
             f"{summary.get('safe_encounters', 0)} safe hazardous encounters; alarm at "
             f"K = {s['consecutive']} frame(s) above the threshold; fallback: braking ramped at "
             f"{fb['jerk_mps3']:g} m/s³ to {fb['decel_mps2']:g} m/s² after {fb['onset_s']:g} s, "

@@ -182,3 +182,15 @@ def test_operating_points_are_never_chosen_on_the_batch_reported_on(sup) -> None
     with pytest.raises(ValueError, match="not held out"):  # runs the monitors learned from
         supervise(sup.root, sup.scenario, sup.batch, TRIGGERS, splits=sup.splits,
                   fprs=sup.fprs, select_batch="b000")
+
+
+def test_skip_reports_on_the_runs_after_the_first_and_reuses_their_records(sup, result) -> None:
+    order = [s.scenario_id for s, _ in plan_supervision(sup.root, result.settings).runs]
+    later = supervise(sup.root, sup.scenario, sup.batch, TRIGGERS, splits=sup.splits,
+                      fprs=sup.fprs, logs="all", skip=1, limit=3)
+    assert [r["scenario_id"] for r in later.records] == order[1:3]
+    assert later.done_before == 2 and later.folder == result.folder  # the same records
+    by_id = {r["scenario_id"]: r for r in result.records}
+    assert all(r == by_id[r["scenario_id"]] for r in later.records)
+    with pytest.raises(ValueError, match="--skip"):
+        plan_supervision(sup.root, result.settings, skip=-1)
