@@ -17,6 +17,12 @@ by name, so a recipe, once used, is never changed: a better one gets a new name.
   comparison with v1 on RQ1's data.
 * "v3" (the default) — v2's FusionMonitor training, unchanged (the same weights; the card
   names v3); what changed is the AEM baseline's part (`evoeye.baselines.aem.AEM_RECIPES`).
+* "lookahead-v1" — a monitor for a safety supervisor's trigger (docs/lookahead.md): v3's
+  training on the "critical" target (a collision or a critical approach within H, the
+  supervisor's own judge of a justified intervention) and a network of its own
+  (`RECIPE_NETWORKS`): a context of L = 20 frames (1 s) and the perceived relative kinematics
+  (`evoeye.monitor.kinematics`). In the closed loop it warns early enough to act, rarely; its
+  frame metrics against Definition 1 are not RQ1's, so it is not the default.
 
 `keep_parent` is no recipe's choice but a caller's (a campaign's `keep_parent` option): the
 weights a training starts from — a fine-tune's (`init_from`) parent — are epoch 0 of its early
@@ -101,6 +107,12 @@ RECIPES: dict[str, TrainParams] = {
                   lr=3e-3, schedule="hold-decay", epochs=20, patience=20),
 }
 RECIPES["v3"] = replace(RECIPES["v2"], recipe="v3")  # v2's FusionMonitor; the AEM's part changed
+RECIPES["lookahead-v1"] = replace(RECIPES["v3"], recipe="lookahead-v1", target="critical")
+# the network a recipe fixes (FusionConfig fields) where the caller gives none; a fine-tune
+# keeps its parent's
+RECIPE_NETWORKS: dict[str, dict[str, Any]] = {
+    "lookahead-v1": {"context_len": 20, "kinematics": True},
+}
 DEFAULT_RECIPE = "v3"
 LEGACY_RECIPE = "v1"  # what a record made before recipes had names was trained with
 

@@ -45,7 +45,12 @@ from evoeye.monitor.fusion import FusionMonitor
 from evoeye.monitor.lookahead import PAUC_MAX_FPR, critical_target, critical_times
 from evoeye.monitor.model import MODULES, FusionConfig, FusionNet
 from evoeye.monitor.protocol import Thresholds
-from evoeye.monitor.recipes import TrainParams, card_hyperparameters, recipe_params
+from evoeye.monitor.recipes import (
+    RECIPE_NETWORKS,
+    TrainParams,
+    card_hyperparameters,
+    recipe_params,
+)
 from evoeye.monitor.registry import load_monitor, save_version
 from evoeye.monitor.side_by_side import can_fork, map_forked
 from evoeye.paths import DataRoot
@@ -146,6 +151,10 @@ def train_monitors(
     base = params or recipe_params(recipe, **overrides)
     train_runs, val_runs = _selections(scenario, splits, train_runs, val_runs)
     parent = load_monitor(root, init_from) if init_from else None
+    if parent is None:  # the recipe's network, where the caller says nothing else
+        preset = RECIPE_NETWORKS.get(base.recipe, {})
+        context_len = context_len if context_len is not None else preset.get("context_len")
+        kinematics = kinematics if kinematics is not None else preset.get("kinematics")
     config = _config(parent, context_len, modules, dropout, kinematics)
     warehouse = Warehouse(root)
     train = load_windows(warehouse, train_runs, context_len=config.context_len,

@@ -116,3 +116,19 @@ def test_a_trained_version_carries_the_option_to_onnx(tiny, tmp_path) -> None:
     (logit,) = session.run([LOGIT], {name: arrays[name] for name in INPUTS})
     np.testing.assert_allclose(logit, monitor.logits(windows)[:len(logit)], rtol=1e-4,
                                atol=1e-4)
+
+
+def test_the_lookahead_recipe_trains_its_own_network_on_critical_approaches(tiny) -> None:
+    from evoeye.monitor.train import train_monitor
+
+    version = train_monitor(tiny.root, SCENARIO, horizon_s=HORIZON_S, seed=0,
+                            recipe="lookahead-v1", epochs=2, patience=2, batch_size=64)
+    monitor = load_monitor(tiny.root, version)
+    config, hyper = monitor.net.config, monitor.card["hyperparameters"]
+    assert (config.context_len, config.kinematics) == (20, True)
+    assert hyper["recipe"] == "lookahead-v1" and hyper["target"] == "critical"
+    # the caller's choice wins over the recipe's network
+    short = load_monitor(tiny.root, train_monitor(
+        tiny.root, SCENARIO, horizon_s=HORIZON_S, seed=0, recipe="lookahead-v1", context_len=5,
+        epochs=2, patience=2, batch_size=64))
+    assert (short.net.config.context_len, short.net.config.kinematics) == (5, True)

@@ -43,7 +43,7 @@ def test_the_default_recipe_is_v3_and_overrides_apply_on_top() -> None:
 
 
 @pytest.mark.parametrize(("recipe", "overrides", "message"), [
-    ("v9", {}, r"unknown training recipe 'v9'; known: \['v1', 'v2', 'v3'\]"),
+    ("v9", {}, r"unknown training recipe 'v9'; known: \['lookahead-v1', 'v1', 'v2', 'v3'\]"),
     ("v2", {"learning_rate": 1.0}, r"unknown training parameter\(s\) \['learning_rate'\]"),
     ("v2", {"batching": "runs"}, "unknown batching 'runs'"),
     ("v2", {"schedule": "step"}, "unknown schedule 'step'"),
