@@ -33,7 +33,7 @@ FEEDBACK_MODES = ("raw", "prior-corrected")  # ŷ as the monitor scores it, or �
 FINETUNE_EPOCHS, FINETUNE_PATIENCE = 10, 4
 REPLAY_EPOCHS, REPLAY_PATIENCE = 2, 1  # per round: passes over the new runs and their replay
 REPLAY_RATIO = 1.0  # earlier runs replayed per new run of the round
-WARM_EPOCHS, WARM_PATIENCE = 3, 2  # per round: passes over every record, from G_r's weights
+WARM_EPOCHS, WARM_PATIENCE = 1, 1  # per round: one pass over D_r from G_r's weights
 DEFAULT_FAMILY = "fusion"  # evoeye.monitor.families.DEFAULT_FAMILY
 DEFAULT_RECIPE, LEGACY_RECIPE = "v3", "v1"  # evoeye.monitor.recipes
 DEFAULT_DELTA = 0.2  # evoeye.scenarios.DEFAULT_DELTA
@@ -134,13 +134,13 @@ class CampaignConfig:
                                  "version).")
     n_round: int = option(20, "Runs per round (N_round).", ge=1)
     update: str = option("retrain", "Monitor update per round: retrain (from scratch on every "
-                         "record), warm (G_r on every record, a few epochs), replay (fine-tune "
+                         "record), warm (G_r on every record, one epoch), replay (fine-tune "
                          "G_r on the round's runs and as many earlier ones) or finetune (G_r on "
                          "every record, up to 10 epochs).", names="update")
-    epochs: int | None = option(None, "Epochs per monitor update (default: 2 with replay, 3 "
+    epochs: int | None = option(None, "Epochs per monitor update (default: 2 with replay, 1 "
                                 "warm, 10 fine-tuning, the trainer's when retraining).", ge=1)
     patience: int | None = option(None, "Early-stopping patience per update (default: 1 with "
-                                  "replay, 2 warm, 4 fine-tuning, the trainer's when "
+                                  "replay, 1 warm, 4 fine-tuning, the trainer's when "
                                   "retraining).", ge=1)
     delta: float = option(DEFAULT_DELTA, "Neighbourhood radius δ of the density-aware "
                           "strategies, a share of each parameter's range.", gt=0.0, le=1.0)

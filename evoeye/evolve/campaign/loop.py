@@ -10,7 +10,7 @@ left.
 
 Monitor update (Algorithm 1, line 12: Train(G_r, D_r)); a round with no new run to learn from
 keeps G_r. `update="retrain"` (the default) trains from scratch on every run of D_r by G_0's
-recipe; `"warm"` trains G_r itself three epochs on every run of D_r; `"replay"` (the paper's,
+recipe; `"warm"` trains G_r itself one epoch on every run of D_r; `"replay"` (the paper's,
 RQ2's) fine-tunes G_r at most two epochs on the round's runs plus as many replayed ones (a
 collision among them when D_r has one); `"finetune"` up to ten epochs on all of D_r
 (docs/evolution.md measures them). Retraining learns only from D_r: a G_0 trained on
