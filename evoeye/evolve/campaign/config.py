@@ -34,6 +34,8 @@ FINETUNE_EPOCHS, FINETUNE_PATIENCE = 10, 4
 REPLAY_EPOCHS, REPLAY_PATIENCE = 2, 1  # per round: passes over the new runs and their replay
 REPLAY_RATIO = 1.0  # earlier runs replayed per new run of the round
 WARM_EPOCHS, WARM_PATIENCE = 1, 1  # per round: one pass over D_r from G_r's weights
+# (these defaults are what a campaign id of update "warm" means, as REPLAY_* and FINETUNE_*
+# are for theirs: never change them; other values are `epochs` / `patience` options)
 DEFAULT_FAMILY = "fusion"  # evoeye.monitor.families.DEFAULT_FAMILY
 DEFAULT_RECIPE, LEGACY_RECIPE = "v3", "v1"  # evoeye.monitor.recipes
 DEFAULT_DELTA = 0.2  # evoeye.scenarios.DEFAULT_DELTA
