@@ -18,7 +18,7 @@ from __future__ import annotations
 
 import copy
 import time
-from collections.abc import Callable, Iterator
+from collections.abc import Callable, Iterator, Mapping
 from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any
@@ -31,6 +31,7 @@ from evoeye.monitor.adam import Adam
 from evoeye.monitor.batching import BATCHINGS, lr_schedule
 from evoeye.monitor.card import ranking_metrics
 from evoeye.monitor.fusion import FusionMonitor
+from evoeye.monitor.importance import window_weights
 from evoeye.monitor.lookahead import selection_metric, training_windows
 from evoeye.monitor.model import FusionNet
 from evoeye.monitor.recipes import TrainParams
@@ -55,6 +56,7 @@ class FitResult:
     time_s: float  # wall seconds of the loop
     cpu_s: float  # CPU seconds of the thread that ran it (load inflates wall time, not this)
     phases: dict[str, dict[str, float]]  # FIT_PHASES: {"wall_s", "cpu_s"} of each
+    importance: dict | None = None  # the weights' summary with `importance_weights` (card)
 
 
 def _deterministic(mode: bool) -> None:
@@ -112,11 +114,14 @@ def check_windows(train: Windows, val: Windows) -> int:
 
 def fit(net: FusionNet, train: Windows, val: Windows,
         params: TrainParams = TrainParams(),  # noqa: B008 (frozen dataclass)
-        progress: Progress | None = None) -> FitResult:
+        progress: Progress | None = None,
+        run_weights: Mapping[str, float] | None = None) -> FitResult:
     """Train `net` in place on `train`, on the device it sits on, early-stopped on `val`
     AUPRC; the best epoch's net. With `params.keep_parent` the weights it starts from are
     epoch 0, kept (best_epoch 0) unless an epoch beats them: a fine-tune that only loses keeps
-    its parent.
+    its parent. With `params.importance_weights` each window's loss is weighted by its run's
+    p/q from `run_weights` (scenario id → p/q; a run missing: 1), as `evoeye.monitor.importance`
+    says; ValueError for `run_weights` without that option.
 
     Call under `reproducible` (train_monitor does) for seeded, repeatable weights; without
     dropout the loop draws no number from the global RNG, so `kernels` is enough.
@@ -124,8 +129,18 @@ def fit(net: FusionNet, train: Windows, val: Windows,
     train = training_windows(train, params.min_lead_s, params.near_misses)
     n_pos = check_windows(train, val)
     device = next(net.parameters()).device
-    pos_weight = params.pos_weight or (len(train) - n_pos) / n_pos
-    loss_fn = nn.BCEWithLogitsLoss(pos_weight=torch.tensor(pos_weight, device=device))
+    weights, importance = None, None
+    if params.importance_weights:
+        w, importance = window_weights(train.scenario_id, run_weights)
+        weights = torch.from_numpy(w).to(device)
+        unsafe = train.label.astype(bool)
+        pos_weight = params.pos_weight or float(w[~unsafe].sum() / w[unsafe].sum())
+    elif run_weights is not None:
+        raise ValueError("run weights given, but the training's importance_weights is off")
+    else:
+        pos_weight = params.pos_weight or (len(train) - n_pos) / n_pos
+    loss_fn = nn.BCEWithLogitsLoss(pos_weight=torch.tensor(pos_weight, device=device),
+                                   reduction="mean" if weights is None else "none")
     opt = Adam(net.parameters(), lr=params.lr, weight_decay=params.weight_decay)
     gen = torch.Generator().manual_seed(params.seed)
     batches = BATCHINGS[params.batching](train, params, device)
@@ -158,6 +173,8 @@ def fit(net: FusionNet, train: Windows, val: Windows,
                 batch = batches.gather(idx)
             with clock("forward"):
                 loss = loss_fn(batches.forward(net, batch), batch.label)
+                if weights is not None:  # (b,) losses, each times its window's weight
+                    loss = (loss * weights[torch.from_numpy(idx).to(device)]).mean()
             with clock("backward"):
                 opt.zero_grad()
                 loss.backward()
@@ -181,4 +198,4 @@ def fit(net: FusionNet, train: Windows, val: Windows,
     net.load_state_dict(best_state)
     net.eval()
     return FitResult(net, best_epoch, history, pos_weight, time.perf_counter() - t0,
-                     time.thread_time() - c0, clock.rounded())
+                     time.thread_time() - c0, clock.rounded(), importance)

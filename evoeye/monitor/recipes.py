@@ -65,6 +65,8 @@ class TrainParams:
     min_lead_s: float = 0.0  # unsafe windows closer to their collision do not train
     near_misses: str = "safe"  # NEAR_MISSES: the windows of an emergency without a collision
     target: str = "collision"  # TARGETS: what the label of a window means, trained and selected
+    # each window's loss times its run's self-normalised, clipped p/q (evoeye.monitor.importance)
+    importance_weights: bool = False
 
     def __post_init__(self) -> None:
         if self.batching not in BATCHINGS:
@@ -91,7 +93,8 @@ class TrainParams:
 
 V1 = TrainParams()
 ADDED_FIELDS = ("recipe", "batching", "chunk_windows", "schedule", "warmup_epochs",
-                "keep_parent", "select_on", "min_lead_s", "near_misses", "target")
+                "keep_parent", "select_on", "min_lead_s", "near_misses", "target",
+                "importance_weights")
 RECIPES: dict[str, TrainParams] = {
     "v1": V1,
     "v2": replace(V1, recipe="v2", batching="chunks", chunk_windows=32, batch_size=1024,
@@ -116,14 +119,16 @@ def recipe_params(recipe: str | None = None, **overrides: Any) -> TrainParams:
 
 # added for issue 37 (evoeye.monitor.lookahead), after ledger keys recorded every field
 LOOKAHEAD_FIELDS = ("select_on", "min_lead_s", "near_misses", "target")
+IMPORTANCE_FIELDS = ("importance_weights",)  # added for issue 38 (evoeye.monitor.importance)
+LATER_FIELDS = (*LOOKAHEAD_FIELDS, *IMPORTANCE_FIELDS)
 
 
 def recipe_key(params: TrainParams) -> dict[str, Any]:
     """Every field but the seed, as a ledger key records a training's recipe — the
-    LOOKAHEAD_FIELDS only where they differ from their defaults, so keys made before them
-    still find their units."""
+    LATER_FIELDS only where they differ from their defaults, so keys made before them still
+    find their units."""
     return {k: v for k, v in asdict(params).items()
-            if k != "seed" and (k not in LOOKAHEAD_FIELDS or v != getattr(V1, k))}
+            if k != "seed" and (k not in LATER_FIELDS or v != getattr(V1, k))}
 
 
 def card_hyperparameters(params: TrainParams) -> dict[str, Any]:

@@ -22,7 +22,7 @@ a GPU when there is one.
 from __future__ import annotations
 
 import copy
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, replace
 from datetime import UTC, datetime
@@ -89,6 +89,7 @@ def train_monitor(
     progress: Progress | None = None,
     recipe: str | None = None,
     device: str | torch.device | None = None,
+    run_weights: Mapping[str, float] | None = None,
     **overrides: Any,
 ) -> str:
     """Train (or fine-tune, with `init_from`) a FusionMonitor and save it; its version id.
@@ -99,13 +100,15 @@ def train_monitor(
     FusionConfig's) come from the parent when fine-tuning. The hyper-parameters are those of
     `recipe` (default `recipes.DEFAULT_RECIPE`) with `overrides` (TrainParams fields: epochs=…,
     lr=…); a full `params` replaces all three and `seed`. `device`: `pick_device`'s.
+    `run_weights`: scenario id → p/q of training runs, with `importance_weights=True`
+    (`evoeye.monitor.importance`).
     """
     seed = params.seed if params is not None else seed
     return train_monitors(root, scenario, seeds=[seed], context_len=context_len,
                           horizon_s=horizon_s, modules=modules, dropout=dropout, splits=splits,
                           train_runs=train_runs, val_runs=val_runs, init_from=init_from,
                           params=params, progress=progress, recipe=recipe, device=device,
-                          **overrides)[0]
+                          run_weights=run_weights, **overrides)[0]
 
 
 def train_monitors(
@@ -126,6 +129,7 @@ def train_monitors(
     recipe: str | None = None,
     device: str | torch.device | None = None,
     parallel: int | None = None,
+    run_weights: Mapping[str, float] | None = None,
     **overrides: Any,
 ) -> list[str]:
     """`train_monitor` once per seed, on data loaded once; the version ids, in `seeds`' order,
@@ -162,7 +166,7 @@ def train_monitors(
         with reproducible(seed, p.threads, where.type == "cpu") if net is None else kernels(
                 p.threads, where.type == "cpu"):
             net = net or start(seed)
-            result = fit(net, train, val, p, report)
+            result = fit(net, train, val, p, report, run_weights)
             scores = FusionMonitor(result.net, "training", None,  # type: ignore[arg-type]
                                    device=where).score(val)
         return Trained(p, result, scores, calibrate_on_validation(scores, val))
@@ -249,6 +253,7 @@ def _card(t: Trained, scenario: str | None, horizon_s: float, init_from: str | N
                      "time_s": round(result.time_s, 2), "cpu_s": round(result.cpu_s, 2),
                      "device": str(device), "phases": result.phases,
                      "history": result.history},
+        **({} if result.importance is None else {"importance": result.importance}),
         **thresholds_to_card(t.thresholds),
         "metrics": {"val": split_metrics(t.scores, val.label, t.thresholds)},
     }
@@ -257,11 +262,12 @@ def _card(t: Trained, scenario: str | None, horizon_s: float, init_from: str | N
 def fit_windows(train: Windows, val: Windows, params: TrainParams | None = None, *,
                 config: FusionConfig | None = None, parent: FusionNet | None = None,
                 progress: Progress | None = None,
-                device: str | torch.device | None = None) -> Trained:
+                device: str | torch.device | None = None,
+                run_weights: Mapping[str, float] | None = None) -> Trained:
     """Train a new FusionNet of `config` (default sizes; normalisers fitted on the training
     frames), or fine-tune a copy of `parent`, on windows in memory, with `params` (default: the
     default recipe's), and calibrate it on `val`. Seeded by `params.seed`; nothing is saved
-    (`train_monitor` saves)."""
+    (`train_monitor` saves). `run_weights` as `fit`'s."""
     params = params or recipe_params()
     where = pick_device(device)
     with reproducible(params.seed, params.threads, where.type == "cpu"):
@@ -271,7 +277,7 @@ def fit_windows(train: Windows, val: Windows, params: TrainParams | None = None,
             net = FusionNet(FusionConfig.for_spec(train.spec,
                                                   **_sizes(config or FusionConfig())))
             net.fit_normalizers(_frames_of(train))
-        result = fit(net.to(where), train, val, params, progress)
+        result = fit(net.to(where), train, val, params, progress, run_weights)
         scores = FusionMonitor(result.net, "training", None,  # type: ignore[arg-type]
                                device=where).score(val)
     return Trained(params, result, scores, calibrate_on_validation(scores, val))

@@ -135,13 +135,13 @@ def test_the_options_are_checked_and_earlier_recipes_keep_their_cards() -> None:
 def test_ledger_keys_of_earlier_recipes_do_not_change() -> None:
     from dataclasses import asdict
 
-    from evoeye.monitor.recipes import LOOKAHEAD_FIELDS, recipe_key
+    from evoeye.monitor.recipes import LATER_FIELDS, recipe_key
     from evoeye.results.efficiency.learner import Learner
 
     for name in ("v1", "v2", "v3"):
         params = recipe_params(name, seed=7)
         before = {k: v for k, v in asdict(params).items()  # what the keys held before
-                  if k != "seed" and k not in LOOKAHEAD_FIELDS}
+                  if k != "seed" and k not in LATER_FIELDS}
         assert recipe_key(params) == before
         assert Learner(None, {}, params).recipe == before  # type: ignore[arg-type]
     assert recipe_key(recipe_params("v3", min_lead_s=0.5))["min_lead_s"] == 0.5

@@ -135,6 +135,6 @@ class Committee:
         fine_tune = cfg.update != "retrain"
         versions = [c.train_monitor_version(
             list(ids), seed=cfg.seed * 1000 + r + COMPANION_SEED_STRIDE * j,
-            init_from=previous if fine_tune else None) if ids else previous
+            init_from=previous if fine_tune else None, state=state) if ids else previous
             for j, previous in enumerate(before, start=1)]
         write_committee(c.root, c.campaign_id, r, versions)

@@ -160,6 +160,10 @@ class CampaignConfig:
     committee: int = option(COMMITTEE, "Monitors whose disagreement the `disagreement` "
                             "strategy reads: G_r and committee − 1 companions trained beside "
                             "it (each round costs as many monitor updates).", ge=2)
+    importance_weights: bool = option(False, "Train every monitor update with each run's "
+                                      "self-normalised, clipped weight p/q (exact for runs "
+                                      "of an importance-sampling strategy such as ce-is, 1 "
+                                      "for runs drawn from the scenario distribution).")
     recipe: str = option(DEFAULT_RECIPE, "Training recipe of the monitor updates (and of a G_0 "
                          "the campaign trains itself): v1 (every campaign before recipes had "
                          "names), v2, or v3 (v2's FusionMonitor training, a faster AEM).",
@@ -182,6 +186,9 @@ class CampaignConfig:
         if self.family != DEFAULT_FAMILY and self.strategy in _committee_strategies():
             raise ValueError(f"the {self.strategy} strategy's committee is of FusionMonitors: "
                              f"it cannot evolve the {self.family} family")
+        if self.importance_weights and self.family != DEFAULT_FAMILY:
+            raise ValueError(f"importance weights train FusionMonitors: the {self.family} "
+                             "family has no weighted training")
         if self.monitor:
             from evoeye.monitor.families import family_of
 
@@ -202,6 +209,8 @@ class CampaignConfig:
             out["patience"] = patience
         if self.keep_parent and self.update != "retrain":
             out["keep_parent"] = True
+        if self.importance_weights:
+            out["importance_weights"] = True
         return out
 
 
@@ -223,6 +232,8 @@ def campaign_id(config: CampaignConfig, g0: str, initial_ids: Sequence[str], *,
         cfg.pop("committee")
     if not cfg["keep_parent"]:  # Algorithm 1's update, every campaign's before the option
         cfg.pop("keep_parent")
+    if not cfg["importance_weights"]:  # likewise: unweighted training
+        cfg.pop("importance_weights")
     if cfg["recipe"] == LEGACY_RECIPE:  # the recipe every campaign before it trained by
         cfg.pop("recipe")
     cfg["monitor"] = g0

@@ -215,6 +215,8 @@ class Campaign:
                                                     batch=cfg.n_round))
         mine = records.tail(n_init)
         strategy.replay(mine.params, mine.fitness)
+        if hasattr(strategy, "log_densities"):  # its proposals' q, recomputed bit for bit
+            records = records.with_densities(*strategy.log_densities(records, n_init))
         return CampaignState(self.campaign_id, last.round, last.monitor_version, records,
                              ok, n_init, strategy, rounds)
 
@@ -265,6 +267,7 @@ class Campaign:
             state.strategy.tell(prop.x, outcome["fitness"])
             state.records = state.records.append(np.asarray(run.metadata["params"], float),
                                                  feedback=float(fb), disagreement=float(d),
+                                                 log_q=prop.log_q, log_p=prop.log_p,
                                                  **outcome)
             state.ok = np.append(state.ok, run.ok)
             new.append(spec.scenario_id)
@@ -301,18 +304,23 @@ class Campaign:
                 return state.monitor, 0.0
             version = self.train_monitor_version(
                 ids, seed=self.config.seed * 1000 + state.round + 1,
-                init_from=state.monitor if self.config.update != "retrain" else None)
+                init_from=state.monitor if self.config.update != "retrain" else None,
+                state=state)
         return version, time.perf_counter() - t0
 
-    def train_monitor_version(self, ids: list[str], *, seed: int, init_from: str | None) -> str:
+    def train_monitor_version(self, ids: list[str], *, seed: int, init_from: str | None,
+                              state: CampaignState | None = None) -> str:
         """A version of the family trained on runs `ids` (fine-tuned from `init_from`, or from
-        scratch with G_0's context length) and the fixed val split, as the update trains."""
+        scratch with G_0's context length) and the fixed val split, as the update trains; with
+        `importance_weights`, each run weighted by its p/q in `state`'s records."""
         cfg = self.config
+        weights = ({"run_weights": state.records.ratio_by_run()}
+                   if cfg.importance_weights and state is not None else {})
         return self._train(self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
                            horizon_s=cfg.horizon_s, seed=seed, splits=cfg.splits,
                            init_from=init_from, context_len=None if init_from else
                            self.monitor(self.g0).context_len, **self._recipe,
-                           **cfg.train_overrides())
+                           **cfg.train_overrides(), **weights)
 
     @intra_op_threads()
     def finish_round(self, state: CampaignState, new_ids: list[str], version: str,

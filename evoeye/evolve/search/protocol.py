@@ -53,6 +53,10 @@ class Proposal:
     parent: int | None = None  # row in the records of the seed that was mutated, if any
     p_local: float | None = None  # p_δ(seed) for the density-aware strategies
     pool_index: int | None = None  # pool mode: the row of the candidate pool x is
+    # an importance-sampling strategy's exact densities at x, in parameter units: the
+    # proposal's q and the scenario distribution's p (None: drawn as p, weight 1)
+    log_q: float | None = None
+    log_p: float | None = None
 
 
 @runtime_checkable

@@ -14,7 +14,10 @@ class Records:
     Only `params` and `feedback` steer the density-aware strategies; the other columns are what
     the loop needs anyway (AV-Fuzzer fitness, collisions, the simulated time charged), and
     `disagreement`, which only the `disagreement` strategy reads: how much K monitors disagree
-    on the run (mean over its contexts of the spread of their scores), NaN where unknown.
+    on the run (mean over its contexts of the spread of their scores), NaN where unknown;
+    `log_q` and `log_p`, the densities of the proposal a run was drawn from and of the scenario
+    distribution at its θ (an importance-sampling strategy's, `Proposal.log_q`), NaN for a run
+    drawn from p itself: its weight p/q is 1 (`importance_ratio`).
     """
 
     params: np.ndarray  # (n, dim) concrete scenarios, parameter units
@@ -24,6 +27,8 @@ class Records:
     duration_s: np.ndarray | None = None  # (n,) simulated seconds of each run
     scenario_id: np.ndarray | None = None  # (n,) str, to align refreshed feedback with the runs
     disagreement: np.ndarray | None = None  # (n,) spread of K monitors' scores; NaN = unknown
+    log_q: np.ndarray | None = None  # (n,) log density of the run's proposal; NaN = p itself
+    log_p: np.ndarray | None = None  # (n,) log density of p at the run's θ; NaN = as log_q
 
     def __post_init__(self) -> None:
         params = np.asarray(self.params, dtype=float)
@@ -38,6 +43,8 @@ class Records:
             "duration_s": _column(self.duration_s, n, 0.0, float, "duration_s"),
             "scenario_id": _column(self.scenario_id, n, "", object, "scenario_id"),
             "disagreement": _column(self.disagreement, n, np.nan, float, "disagreement"),
+            "log_q": _column(self.log_q, n, np.nan, float, "log_q"),
+            "log_p": _column(self.log_p, n, np.nan, float, "log_p"),
         }
         for name, value in cols.items():
             object.__setattr__(self, name, value)
@@ -63,6 +70,8 @@ class Records:
         duration_s: float = 0.0,
         scenario_id: str = "",
         disagreement: float = np.nan,
+        log_q: float | None = None,
+        log_p: float | None = None,
     ) -> Records:
         """A new table with one more run at the end (O(n) copy; n is a few thousand at most)."""
         return Records(
@@ -73,7 +82,19 @@ class Records:
             duration_s=np.append(self.duration_s, duration_s),
             scenario_id=np.append(self.scenario_id, np.array([scenario_id], dtype=object)),
             disagreement=np.append(self.disagreement, disagreement),
+            log_q=np.append(self.log_q, np.nan if log_q is None else log_q),
+            log_p=np.append(self.log_p, np.nan if log_p is None else log_p),
         )
+
+    def importance_ratio(self) -> np.ndarray:
+        """(n,) p/q of every run: exp(log_p − log_q), 1 where no proposal density is known."""
+        known = np.isfinite(self.log_q) & np.isfinite(self.log_p)
+        return np.where(known, np.exp(np.where(known, self.log_p - self.log_q, 0.0)), 1.0)
+
+    def ratio_by_run(self) -> dict[str, float]:
+        """scenario_id → p/q (`importance_ratio`) of every run."""
+        return dict(zip(map(str, self.scenario_id), self.importance_ratio().tolist(),
+                        strict=True))
 
     def with_feedback(self, feedback: np.ndarray) -> Records:
         """The same runs with every feedback refreshed (after a monitor update)."""
@@ -82,6 +103,11 @@ class Records:
     def with_disagreement(self, disagreement: np.ndarray) -> Records:
         """The same runs with every disagreement refreshed (after the monitors' update)."""
         return replace(self, disagreement=np.asarray(disagreement, dtype=float))
+
+    def with_densities(self, log_q: np.ndarray, log_p: np.ndarray) -> Records:
+        """The same runs with their proposal densities (e.g. recomputed on resume)."""
+        return replace(self, log_q=np.asarray(log_q, dtype=float),
+                       log_p=np.asarray(log_p, dtype=float))
 
     def tail(self, start: int) -> Records:
         """Rows from `start` on, e.g. the records one strategy acquired after D_init."""

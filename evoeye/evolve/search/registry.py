@@ -5,7 +5,8 @@
 * beyond the paper: `sobol` (low-discrepancy Uniform, `sobol.py`), `boundary` (level-set
   sampling of the safety margin, `boundary.py`), `disagreement` (where a committee of monitors
   disagrees, `disagreement.py`), and `evoeye-knn` / `evoeye-forest` (the paper's loop with a
-  smoothed feedback potential, `smoothed.py`).
+  smoothed feedback potential, `smoothed.py`), and `ce-is` (cross-entropy adaptive importance
+  sampling with a defensive mixture: exact weights p/q for rare events, `cross_entropy.py`).
 
 `make_strategy(…, pool=rows)` restricts any of them to a finite pool of candidates (`pool.py`).
 """
@@ -20,6 +21,7 @@ import numpy as np
 
 from evoeye.evolve.search.avfuzzer import AVFuzzer
 from evoeye.evolve.search.boundary import BoundaryStrategy
+from evoeye.evolve.search.cross_entropy import CrossEntropyIS
 from evoeye.evolve.search.disagreement import DisagreementStrategy
 from evoeye.evolve.search.mutation import ConstantPotential, NeighbourhoodPotential, SeedPotential
 from evoeye.evolve.search.pool import CandidatePool, PooledStrategy
@@ -42,11 +44,13 @@ STRATEGIES: dict[str, StrategyFactory] = {
     "disagreement": DisagreementStrategy,
     "evoeye-knn": smoothed("evoeye-knn"),
     "evoeye-forest": smoothed("evoeye-forest"),
+    "ce-is": CrossEntropyIS,
 }
 # Strategies whose proposals never read the records' feedback: the feedback mode cannot change
 # what they acquire (the monitor updates are the same too), so it is not part of their identity.
 # (`disagreement` reads the committee's scores, which the feedback mode rescales.)
-FEEDBACK_BLIND = frozenset({"uniform", "avfuzzer", "no-feedback", "sobol", "boundary"})
+FEEDBACK_BLIND = frozenset({"uniform", "avfuzzer", "no-feedback", "sobol", "boundary",
+                            "ce-is"})
 # Strategies whose records need the committee's disagreement (`Records.disagreement`).
 READS_DISAGREEMENT = frozenset({"disagreement"})
 

@@ -127,3 +127,52 @@ def density_strategy(potential: Callable[[float], Potential],
         return DensityStrategy(space, seed, potential(delta), name, delta, epsilon)
 
     return make
+
+
+class BatchedStrategy(CountedStrategy):
+    """A strategy that chooses a batch of `batch` proposals at a time from the records before
+    it (protocol.py, "Batches"); subclasses define `_choose`."""
+
+    name = ""
+
+    def __init__(self, space: LogicalScenario, seed: int, batch: int = 20) -> None:
+        if batch < 1:
+            raise StrategyError(f"{self.name}: batch must be >= 1, got {batch}")
+        super().__init__(space, seed)
+        self.batch = batch
+        self._served: tuple[int, list[Proposal]] | None = None  # (batch index, its proposals)
+
+    def _choose(self, records: Records, b: int, pool: CandidatePool | None) -> list[Proposal]:
+        """Batch b's proposals from `records`, the rows there were at its first proposal (in
+        pool mode, among the rows they leave unused)."""
+        raise NotImplementedError
+
+    def propose(self, records: Records) -> Proposal:
+        return self._serve(records, None)
+
+    def propose_in(self, records: Records, pool: CandidatePool, unused: np.ndarray) -> Proposal:
+        """Pool mode: the batch is chosen among the rows unused when it started."""
+        return self._serve(records, pool)
+
+    def replay(self, params: np.ndarray, fitness: np.ndarray) -> None:
+        super().replay(params, fitness)
+        self._served = None
+
+    def _serve(self, records: Records, pool: CandidatePool | None) -> Proposal:
+        if records.params.shape[1] != self.space.dim:
+            raise StrategyError(f"{self.name}: records have {records.params.shape[1]} "
+                                f"parameters, {self.space.name} has {self.space.dim}")
+        b, j = divmod(self.proposals, self.batch)
+        basis = records.n - j
+        if basis < 0:
+            raise StrategyError(f"{self.name}: {j} proposals of this batch but only "
+                                f"{records.n} records (record every proposal)")
+        if self._served is None or self._served[0] != b:
+            self._served = (b, self._choose(records.head(basis), b, pool))
+        served = self._served[1]
+        if j >= len(served):
+            raise StrategyError(f"{self.name}: the pool of {len(pool or ())} candidates is "
+                                "used up")
+        self.proposals += 1
+        return served[j]
+

@@ -29,7 +29,7 @@ from evoeye.evolve.search.pool import CandidatePool
 from evoeye.evolve.search.protocol import Proposal, StrategyError
 from evoeye.evolve.search.records import Records
 from evoeye.evolve.search.sobol import sobol_points
-from evoeye.evolve.search.strategies import CountedStrategy
+from evoeye.evolve.search.strategies import BatchedStrategy
 from evoeye.scenarios import LogicalScenario
 
 EXPLORE = 0.25  # share of each batch drawn uniformly
@@ -76,58 +76,23 @@ def diverse_top(u: np.ndarray, score: np.ndarray, n: int, rng: np.random.Generat
     return top[picked]
 
 
-class BatchedSurrogate(CountedStrategy):
+class BatchedSurrogate(BatchedStrategy):
     """A strategy that fits a surrogate once per batch; subclasses define `score`."""
 
     name = ""
 
     def __init__(self, space: LogicalScenario, seed: int, batch: int = 20,
                  explore: float = EXPLORE) -> None:
-        if batch < 1:
-            raise StrategyError(f"{self.name}: batch must be >= 1, got {batch}")
         if not 0.0 <= explore <= 1.0:
             raise StrategyError(f"{self.name}: explore must be in [0, 1], got {explore}")
-        super().__init__(space, seed)
-        self.batch = batch
+        super().__init__(space, seed, batch)
         self.explore = explore
-        self._served: tuple[int, list[Proposal]] | None = None  # (batch index, its proposals)
 
     def score(self, records: Records, u: np.ndarray,
               rng: np.random.Generator) -> np.ndarray | None:
         """Acquisition score (c,) of candidates u (c, dim) normalised, higher is better; None
         when the records cannot fit the surrogate yet."""
         raise NotImplementedError
-
-    # -- the protocol ----------------------------------------------------------------------------
-    def propose(self, records: Records) -> Proposal:
-        return self._serve(records, None)
-
-    def propose_in(self, records: Records, pool: CandidatePool, unused: np.ndarray) -> Proposal:
-        """Pool mode: the batch is chosen among the rows unused when it started."""
-        return self._serve(records, pool)
-
-    def replay(self, params: np.ndarray, fitness: np.ndarray) -> None:
-        super().replay(params, fitness)
-        self._served = None
-
-    # -- batches ---------------------------------------------------------------------------------
-    def _serve(self, records: Records, pool: CandidatePool | None) -> Proposal:
-        if records.params.shape[1] != self.space.dim:
-            raise StrategyError(f"{self.name}: records have {records.params.shape[1]} "
-                                f"parameters, {self.space.name} has {self.space.dim}")
-        b, j = divmod(self.proposals, self.batch)
-        basis = records.n - j
-        if basis < 0:
-            raise StrategyError(f"{self.name}: {j} proposals of this batch but only "
-                                f"{records.n} records (record every proposal)")
-        if self._served is None or self._served[0] != b:
-            self._served = (b, self._choose(records.head(basis), b, pool))
-        served = self._served[1]
-        if j >= len(served):
-            raise StrategyError(f"{self.name}: the pool of {len(pool or ())} candidates is "
-                                "used up")
-        self.proposals += 1
-        return served[j]
 
     def _choose(self, records: Records, b: int, pool: CandidatePool | None) -> list[Proposal]:
         """Batch b: model picks and uniform draws, in a seeded random order."""

@@ -92,12 +92,18 @@ class EfficiencyConfig:
     recipe: str = DEFAULT_RECIPE  # the training recipe of every monitor of the study
     epochs: int | None = None  # every training (None: the recipe's)
     patience: int | None = None
+    # every monitor trained with its runs' p/q (exact for ce-is's runs, 1 for the others)
+    importance_weights: bool = False
 
     @property
-    def train_overrides(self) -> dict[str, int]:
-        """TrainParams fields every from-scratch monitor of the study gets."""
-        return {k: v for k, v in (("epochs", self.epochs), ("patience", self.patience))
-                if v is not None}
+    def train_overrides(self) -> dict[str, int | bool]:
+        """TrainParams fields every monitor of the study gets."""
+        out: dict[str, int | bool] = {
+            k: v for k, v in (("epochs", self.epochs), ("patience", self.patience))
+            if v is not None}
+        if self.importance_weights:
+            out["importance_weights"] = True
+        return out
 
     def __post_init__(self) -> None:
         for name in ("regimes", "strategies", "seeds", "checkpoints", "reference_checkpoints"):

@@ -31,6 +31,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from evoeye.evaluation.failure_rate import failure_rate
 from evoeye.evolve.search.records import Records
 from evoeye.evolve.search.registry import (
     FEEDBACK_BLIND,
@@ -93,16 +94,20 @@ class Context:
     say: Say = field(default=lambda msg: None)
 
     def scratch_figures(self, ids, budget: int, seed: int,
-                        monitor: FusionMonitor | None = None) -> dict:
+                        monitor: FusionMonitor | None = None,
+                        weights: dict[str, float] | None = None) -> dict:
         """{set: metrics} of the monitor trained from scratch on `ids` with the checkpoint's
-        seed (a ledger unit; `monitor`: that very monitor, if trained already)."""
+        seed (a ledger unit; `monitor`: that very monitor, if trained already; `weights`: the
+        runs' p/q, which train it if the recipe says so, and key it then)."""
         tseed = training_seed(seed, budget)
         inputs = {"regime": self.regime, "sets": self.fingerprint, "runs": ids_digest(ids),
                   "n": len(ids), "seed": tseed, "recipe": self.learner.recipe}
+        if self.learner.params.importance_weights:
+            inputs["weights"] = ids_digest(f"{s}={(weights or {}).get(s, 1.0)!r}" for s in ids)
 
         def train() -> dict:
             self.say(f"{self.regime}: from scratch on {len(ids)} runs, seed {tseed}")
-            trained = monitor or self.learner.scratch(self.bank.windows(ids), tseed)
+            trained = monitor or self.learner.scratch(self.bank.windows(ids), tseed, weights)
             return self.learner.judge(trained)
 
         return self.ledger.remember("efficiency-scratch", inputs, train)
@@ -121,19 +126,32 @@ class Trajectory:
 MARGIN_BINS_M = (0.5, 1.0, 2.0, 4.0, 7.0)  # upper edges of the safe runs' gap bins; then ≥ 7
 
 
-def acquired_summary(collided: np.ndarray, fitness: np.ndarray) -> dict:
+def acquired_summary(collided: np.ndarray, fitness: np.ndarray,
+                     ratio: np.ndarray | None = None) -> dict:
     """Where acquired runs fell: how many collided, how near the boundary the others came
     (their criticality × 10 m is the footprint gap, capped at 10 m), and the safe runs per
-    gap bin (MARGIN_BINS_M)."""
+    gap bin (MARGIN_BINS_M); with the runs' exact p/q (`ratio`, an importance-sampling
+    strategy's), the unbiased estimate of P(collision) under p they give (`failure_rate`)."""
     collided = np.asarray(collided, bool)
     gap = np.asarray(fitness, float) * 10.0
     safe = ~collided
     bins = np.bincount(np.searchsorted(MARGIN_BINS_M, gap[safe], side="right"),
                        minlength=len(MARGIN_BINS_M) + 1)
-    return {"runs": int(len(collided)), "collided": int(collided.sum()),
-            "safe_by_gap": [int(b) for b in bins],
-            "near_miss_2m": int((safe & (gap < 2.0)).sum()),
-            "mean_gap_m": float(np.nanmean(np.where(safe, gap, np.nan))) if safe.any() else None}
+    out = {"runs": int(len(collided)), "collided": int(collided.sum()),
+           "safe_by_gap": [int(b) for b in bins],
+           "near_miss_2m": int((safe & (gap < 2.0)).sum()),
+           "mean_gap_m": float(np.nanmean(np.where(safe, gap, np.nan))) if safe.any() else None}
+    if ratio is not None:
+        out["failure_rate"] = failure_rate(collided, ratio).to_dict()
+    return out
+
+
+def exact_ratio(records: Records, start: int) -> np.ndarray | None:
+    """p/q of the records from `start` on if every one of them carries its proposal's
+    density (an importance-sampling strategy's runs), else None."""
+    acquired = records.tail(start)
+    return acquired.importance_ratio() if np.isfinite(acquired.log_q).all() else None
+
 
 
 def run_curve(ctx: Context, strategy: str, seed: int, acquirer: Acquirer) -> dict:
@@ -181,9 +199,10 @@ def _retrain(ctx: Context, t: Trajectory, seed: int) -> None:
     run so far, with the seed a checkpoint at that many runs gets (members: offset seeds)."""
     ids = list(t.records.scenario_id)
     train, tseed = ctx.bank.windows(ids), training_seed(seed, len(ids))
-    t.monitor = ctx.learner.scratch(train, tseed)
+    weights = t.records.ratio_by_run()
+    t.monitor = ctx.learner.scratch(train, tseed, weights)
     if t.committee:
-        t.committee = [t.monitor, *(ctx.learner.scratch(train, tseed + 1_000_003 * j)
+        t.committee = [t.monitor, *(ctx.learner.scratch(train, tseed + 1_000_003 * j, weights)
                                     for j in range(1, len(t.committee)))]
     _refreshed(ctx, t)
 
@@ -200,9 +219,10 @@ def _update(ctx: Context, t: Trajectory, new: int, seed: int, round_: int) -> No
     if not (train.label.any() and (~train.label.astype(bool)).any()):
         return  # one class only: nothing an update can learn from; the monitor stays
     useed = seed * 1000 + round_
-    t.monitor = ctx.learner.update(t.monitor, train, useed)
+    weights = records.ratio_by_run()
+    t.monitor = ctx.learner.update(t.monitor, train, useed, weights)
     if t.committee:
-        t.committee = [t.monitor, *(ctx.learner.update(m, train, useed + 1_000_003 * j)
+        t.committee = [t.monitor, *(ctx.learner.update(m, train, useed + 1_000_003 * j, weights)
                                     for j, m in enumerate(t.committee[1:], start=1))]
     _refreshed(ctx, t)
 
@@ -226,7 +246,8 @@ def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> d
             run = acquirer.acquire(prop, seed, t.records.n - cfg.initial_runs)
             t.records = t.records.append(run.x, feedback=np.nan, fitness=run.fitness,
                                          collided=run.collided, duration_s=run.duration_s,
-                                         scenario_id=run.scenario_id)
+                                         scenario_id=run.scenario_id, log_q=prop.log_q,
+                                         log_p=prop.log_p)
             t.kinds.append(prop.kind)
             strategy.tell(run.x, run.fitness)
         if retrains:
@@ -237,13 +258,18 @@ def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> d
             ids = list(t.records.scenario_id)
             ctx.say(f"{ctx.regime}: {strategy_name} seed {seed} at {len(ids)} runs")
             scratch = ctx.scratch_figures(ids, len(ids), seed,
-                                          t.monitor if retrains else None)
+                                          t.monitor if retrains else None,
+                                          t.records.ratio_by_run())
             out["budgets"][str(len(ids))] = {
                 "scratch": scratch,
                 "update": scratch if retrain else ctx.learner.judge(t.monitor),
                 "acquired": acquired_summary(t.records.collided[cfg.initial_runs:],
-                                             t.records.fitness[cfg.initial_runs:]),
+                                             t.records.fitness[cfg.initial_runs:],
+                                             exact_ratio(t.records, cfg.initial_runs)),
             }
     out["acquired_ids"] = [str(s) for s in t.records.scenario_id[cfg.initial_runs:]]
     out["kinds"] = t.kinds
+    acquired = t.records.tail(cfg.initial_runs)
+    if np.isfinite(acquired.log_q).any():  # its runs' exact densities, to weigh them again
+        out["log_q"], out["log_p"] = acquired.log_q.tolist(), acquired.log_p.tolist()
     return out

@@ -9,6 +9,7 @@ monitor.
 
 from __future__ import annotations
 
+from collections.abc import Mapping
 from dataclasses import dataclass, field, replace
 
 import numpy as np
@@ -35,17 +36,25 @@ class Learner:
         """The training recipe (every hyper-parameter but the seed), for ledger keys."""
         return recipe_key(self.params)
 
-    def scratch(self, train: Windows, seed: int) -> FusionMonitor:
-        """A FusionMonitor trained from scratch on `train` with `seed`."""
-        return self._monitor(fit_windows(train, self.val, replace(self.params, seed=seed)),
+    def scratch(self, train: Windows, seed: int,
+                weights: Mapping[str, float] | None = None) -> FusionMonitor:
+        """A FusionMonitor trained from scratch on `train` with `seed` (with the recipe's
+        `importance_weights`, each run weighted by its p/q in `weights`)."""
+        return self._monitor(fit_windows(train, self.val, replace(self.params, seed=seed),
+                                         run_weights=self._weights(weights)),
                              f"scratch-{seed}")
 
-    def update(self, parent: FusionMonitor, train: Windows, seed: int) -> FusionMonitor:
+    def update(self, parent: FusionMonitor, train: Windows, seed: int,
+               weights: Mapping[str, float] | None = None) -> FusionMonitor:
         """The paper's update rule (`evoeye evolve --update replay`): `parent` fine-tuned for
         at most REPLAY_EPOCHS on `train` (the round's runs and their replay sample)."""
         params = replace(self.params, seed=seed, epochs=REPLAY_EPOCHS, patience=REPLAY_PATIENCE)
-        return self._monitor(fit_windows(train, self.val, params, parent=parent.net),
+        return self._monitor(fit_windows(train, self.val, params, parent=parent.net,
+                                         run_weights=self._weights(weights)),
                              f"{parent.version}+{seed}")
+
+    def _weights(self, weights: Mapping[str, float] | None) -> Mapping[str, float] | None:
+        return weights if self.params.importance_weights else None
 
     def _monitor(self, trained, version: str) -> FusionMonitor:
         card = {"hyperparameters": {"pos_weight": trained.result.pos_weight}}

@@ -4,8 +4,9 @@ For each regime: its curves (`runner.run_regime`), three summaries — Test Set 
 monitors trained from scratch (the study's measure), boundary-set AUPRC of the same monitors,
 and Test Set AUPRC of the per-round monitor when it is replay-updated — and where each
 strategy's acquired runs fell and how many failures they held at each checkpoint
-(`found.py`). The curves keep their figures per seed and budget (the acquired ids stay in the
-ledger).
+(`found.py`), and where a strategy's runs carry their exact p/q (`ce-is`), its unbiased
+estimate of the failure rate under p against Uniform's at equal budget. The curves keep their
+figures per seed and budget (the acquired ids stay in the ledger).
 """
 
 from __future__ import annotations
@@ -17,7 +18,7 @@ import numpy as np
 from evoeye.paths import DataRoot
 from evoeye.results.efficiency.config import CEILINGS, EfficiencyConfig
 from evoeye.results.efficiency.findings import efficiency_findings
-from evoeye.results.efficiency.found import failures_found
+from evoeye.results.efficiency.found import failure_rates, failures_found
 from evoeye.results.efficiency.runner import run_regime
 from evoeye.results.efficiency.summary import summarise
 from evoeye.results.ledger import Ledger
@@ -56,10 +57,14 @@ def regime_results(result: dict, config: EfficiencyConfig) -> dict:
         summaries[f"{set_name}/{kind}"] = summarise(
             chosen, config.seeds, config.initial_runs, config.checkpoints,
             config.reference_checkpoints, kind, (set_name, "auprc"))
-    return {"sets": result["sets"], "curves": curves, "summaries": summaries,
-            "where": where_sampled(curves, config.checkpoints[-1]),
-            "found": {str(b): failures_found(curves, b) for b in config.checkpoints},
-            "failed": result.get("failed", [])}
+    out = {"sets": result["sets"], "curves": curves, "summaries": summaries,
+           "where": where_sampled(curves, config.checkpoints[-1]),
+           "found": {str(b): failures_found(curves, b) for b in config.checkpoints},
+           "failed": result.get("failed", [])}
+    if any("failure_rate" in b.get("acquired", {}) for seeds in curves.values()
+           for c in seeds.values() for b in c["budgets"].values()):
+        out["rates"] = {str(b): failure_rates(curves, b) for b in config.checkpoints}
+    return out
 
 
 def regime_part(root: DataRoot, regime: str, config: EfficiencyConfig, *, workers: int = 1,

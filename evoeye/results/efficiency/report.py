@@ -105,6 +105,26 @@ def found_table(found: dict[str, dict]) -> list[str]:
     return md_table(["strategy", *(f"by {b} runs" for b in budgets)], rows)
 
 
+def rates_table(rates: dict[str, dict]) -> list[str]:
+    """Per strategy with an unbiased estimate of P(collision) under p and checkpoint: the mean
+    estimate over seeds (%), its spread over seeds / mean, and that spread's ratio to Uniform's
+    at the same budget."""
+    budgets = list(rates)
+    names = list(dict.fromkeys(n for b in budgets for n in rates[b]))
+
+    def cell(r: dict | None) -> str:
+        if not r:
+            return "–"
+        text = f"{100 * r['mean']:.2f} %"
+        if r["spread"] is not None:
+            text += f" (±{r['spread']:.2f})"
+        ratio = (r.get("vs_reference") or {}).get("spread")
+        return text + (f" ×{ratio:.2f}" if ratio is not None else "")
+
+    rows = [[_label(n), *(cell(rates[b].get(n)) for b in budgets)] for n in names]
+    return md_table(["strategy", *(f"by {b} runs" for b in budgets)], rows)
+
+
 def where_table(where: dict) -> list[str]:
     """Per strategy, where its acquired runs fell (the mean over seeds at its last common
     budget): the share that collided, then the safe ones by their smallest gap to another
@@ -154,6 +174,13 @@ def regime_markdown(regime: str, result: dict) -> str:
                   "generative mode a run acquired is a run simulated; the oracle and its "
                   "control trained on several increments per step and kept one).", "",
                   *found_table(result["found"]), ""]
+    if result.get("rates"):
+        lines += ["### The failure rate under p", "", "The unbiased estimate of P(collision) "
+                  "each strategy's acquired runs give (Uniform: the share that collided; "
+                  "ce-is: weighted by their exact p/q), its mean over seeds, (± its SD over "
+                  "seeds / the mean: the relative error the seeds show) and that relative "
+                  "error's multiple of Uniform's at the same budget.", "",
+                  *rates_table(result["rates"]), ""]
     if result.get("failed"):
         lines += ["### Curves that failed", "", "Left out of every table above; a re-run of the "
                   "same command retries them alone.", "",

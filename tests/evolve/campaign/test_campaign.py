@@ -327,3 +327,27 @@ def test_aem_evo_fine_tunes_the_autoencoder_and_scores_feedback_with_it(root_cop
         assert fb[one] == pytest.approx(np.abs(risk[k] - w.label[k]).mean())
     hard = rows[1].metrics.hard
     assert hard["frames"] == assess(seeded[1]).hard["frames"] > 0
+
+
+def test_ce_is_campaign_trains_with_its_runs_weights_and_a_resume_recomputes_them(
+        root_copy, seeded, monkeypatch) -> None:
+    # 13 runs are too few for a dimension to pass the screening: let every one adapt
+    monkeypatch.setattr("evoeye.evolve.search.cross_entropy.SCREEN_Z", 0.0)
+    cfg = config(seeded[1], strategy="ce-is", importance_weights=True, n_round=4)
+    seen: list[dict[str, float]] = []
+
+    def train(*args, **kwargs):
+        seen.append(kwargs["run_weights"])
+        assert kwargs["importance_weights"] is True
+        return FAMILIES["fusion"].train(*args, **kwargs)
+
+    root = root_copy("ce-is")
+    state = Campaign(root, cfg, train=train).run(max_rounds=3)
+    acquired = state.records.tail(state.n_init)
+    assert np.isfinite(acquired.log_q).all() and np.isfinite(acquired.log_p).all()
+    ratio = dict(zip(state.records.scenario_id, state.records.importance_ratio(), strict=True))
+    assert len(seen) == 3 and seen[-1] == ratio  # the last update: every record's p/q
+    assert all(ratio[s] == 1.0 for s in state.records.scenario_id[:state.n_init])
+    assert (state.records.importance_ratio()[-4:] != 1.0).all()  # round 3 drew from a fit q
+    again = Campaign(root, cfg).start()  # rebuilt from the tables and the seed
+    np.testing.assert_array_equal(again.records.log_q, state.records.log_q)

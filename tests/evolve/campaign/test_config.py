@@ -116,8 +116,22 @@ def test_keep_parent_reaches_a_fine_tuned_update_only_and_adds_nothing_when_off(
     # off, the option adds nothing to the id (the seed streams' version is hashed in: seeds.py)
     legacy = {k: v for k, v in dataclasses.asdict(base).items()
               if k not in ("budget_s", "reference", "feedback", "family", "committee",
-                           "keep_parent")}
+                           "keep_parent", "importance_weights")}
     legacy.update(monitor="fusion-x", initial=hashlib.sha256(b"a\nb").hexdigest(),
                   streams=STREAMS_VERSION)
     digest = hashlib.sha256(json.dumps(legacy, sort_keys=True).encode()).hexdigest()[:10]
     assert cid(base) == f"evo-evoeye-s0-{digest}" != cid(kept)
+
+
+def test_importance_weights_reach_every_update_and_add_nothing_to_the_id_when_off() -> None:
+    base = CampaignConfig("highway-cut-in", strategy="ce-is")
+    weighted = replace(base, importance_weights=True)
+    assert "importance_weights" not in base.train_overrides()
+    assert weighted.train_overrides() == {**base.train_overrides(), "importance_weights": True}
+
+    def cid(config: CampaignConfig) -> str:
+        return campaign_id(config, "fusion-x", ["a"], feedback_blind=True, committee=False)
+
+    assert cid(base) != cid(weighted)  # off: nothing in the id (the keep_parent test above)
+    with pytest.raises(ValueError, match="importance weights train FusionMonitors"):
+        CampaignConfig("highway-cut-in", family="aem", importance_weights=True)

@@ -53,7 +53,8 @@ def test_retrain_trains_the_per_round_monitor_again_only_where_feedback_is_read(
     trainings = []
     real = ctx.learner.scratch
     monkeypatch.setattr(ctx.learner, "scratch",
-                        lambda train, seed: trainings.append(seed) or real(train, seed))
+                        lambda train, seed, weights=None: trainings.append(seed)
+                        or real(train, seed, weights))
     blind = run_curve(ctx, "uniform", 0, PoolAcquirer(ctx.bank))
     checkpoints = len(ctx.config.checkpoints_of("uniform"))
     assert len(trainings) == 1 + checkpoints  # G_0 and one per checkpoint: no per-round ones
@@ -120,3 +121,24 @@ def test_an_initial_set_always_holds_a_collision_and_keeps_a_first_draw_that_has
     assert any(not collided[rows].any() for rows in first.values())  # the case is exercised
     with pytest.raises(ValueError, match="no collision run"):
         initial_rows(np.zeros(100, bool), 10, 0)
+
+
+def test_a_ce_is_curve_keeps_its_runs_densities_and_trains_with_their_weights(
+        context, tmp_path, monkeypatch) -> None:
+    weighted = replace(context.learner, params=replace(context.learner.params,
+                                                       importance_weights=True))
+    ctx = replace(context, learner=weighted, ledger=Ledger(DataRoot.resolve(tmp_path / "w")))
+    given = []
+    real = weighted.scratch
+    monkeypatch.setattr(weighted, "scratch", lambda train, seed, weights=None:
+                        given.append(weights) or real(train, seed, weights))
+    curve = run_curve(ctx, "ce-is", 0, PoolAcquirer(ctx.bank))
+    n = len(curve["acquired_ids"])
+    assert len(curve["log_q"]) == len(curve["log_p"]) == n and np.isfinite(curve["log_q"]).all()
+    for budget in ctx.config.checkpoints:
+        rate = curve["budgets"][str(budget)]["acquired"]["failure_rate"]
+        assert rate["n"] == budget - ctx.config.initial_runs and rate["method"] == "is"
+    ratio = np.exp(np.array(curve["log_p"]) - np.array(curve["log_q"]))
+    last = given[-1]  # the last checkpoint's monitor: every run, the acquired ones by p/q
+    np.testing.assert_allclose([last[s] for s in curve["acquired_ids"]], ratio)
+    assert "log_q" not in run_curve(context, "uniform", 0, PoolAcquirer(context.bank))

@@ -4,7 +4,8 @@ from __future__ import annotations
 
 import pytest
 
-from evoeye.results.efficiency.found import failures_found
+from evoeye.evaluation.failure_rate import failure_rate
+from evoeye.results.efficiency.found import failure_rates, failures_found
 from evoeye.results.efficiency.report import found_table
 
 
@@ -47,3 +48,31 @@ def test_the_table_shows_collisions_per_100_runs_and_uniforms_multiple() -> None
     table = "\n".join(found_table(found))
     assert "| uniform (reference) | 2.5 [" in table
     assert "| boundary | 7.5 [" in table and "×3.00" in table
+
+
+def test_failure_rates_weigh_uniform_by_its_counts_and_a_weighted_strategy_by_its_own() -> None:
+    uniform = {str(s): curve({320: (c, 280)}) for s, c in enumerate((2, 4, 3))}
+    weighted = {}
+    for s, w in enumerate((0.05, 0.04, 0.06)):
+        weighted[str(s)] = curve({320: (140, 280)})
+        weighted[str(s)]["budgets"]["320"]["acquired"]["failure_rate"] = failure_rate(
+            [True] * 140 + [False] * 140, [w] * 140 + [1.0] * 140).to_dict()
+    rates = failure_rates({"uniform": uniform, "ce-is": weighted, "boundary": uniform}, 320)
+    assert set(rates) == {"uniform", "ce-is"}  # boundary's runs carry no weights: no estimate
+    assert rates["uniform"]["mean"] == pytest.approx(9 / 840)
+    assert rates["ce-is"]["mean"] == pytest.approx(0.025)  # 140 · 0.05 / 280, on average
+    u, c = rates["uniform"], rates["ce-is"]
+    assert c["vs_reference"]["relative_error"] == pytest.approx(
+        c["relative_error"] / u["relative_error"])
+    assert c["relative_error"] < u["relative_error"]
+
+
+def test_the_rates_table_shows_each_estimate_its_spread_and_uniforms_multiple() -> None:
+    from evoeye.results.efficiency.report import rates_table
+
+    rates = {"320": {"uniform": {"mean": 0.01, "spread": 0.6, "relative_error": 0.5},
+                     "ce-is": {"mean": 0.011, "spread": 0.2, "relative_error": 0.2,
+                               "vs_reference": {"spread": 1 / 3, "relative_error": 0.4}}}}
+    table = "\n".join(rates_table(rates))
+    assert "| uniform (reference) | 1.00 % (±0.60) |" in table
+    assert "| ce-is | 1.10 % (±0.20) ×0.33 |" in table
