@@ -1,15 +1,20 @@
 """A campaign's rounds, profiled: where the wall time goes, and its cost against simulation alone.
 
-One campaign (`--strategy`, default evoeye; `--update`, default replay; N_round = `--n-round`) runs
-`--rounds` rounds on a private copy of a data root holding the scenario's initial runs and a
+One campaign (`--strategy`, default evoeye; `--update`, default retrain; N_round = `--n-round`)
+runs `--rounds` rounds on a private copy of a data root holding the scenario's initial runs and a
 G_0 (`--root`; without it, `--runs` uniform runs are simulated, ingested and a G_0 trained in a
 temporary folder first). Each round is broken into the campaign's phases
 (`evoeye.evolve.campaign.phases`): simulate, score, ingest, train, refresh, assess, state. Then
 the very runs the campaign acquired are simulated and logged again, alone, one after another in
-this process: the campaign's cost is its wall time over that (target ≤ 1.5×, issue 12). Round 0
-(G_0 scores D_init and is assessed) is paid once per campaign and shown apart. Wall seconds
-and this process's CPU seconds are both given: on a shared machine the CPU ratio is the one
-that load distorts less (everything runs in this one process, torch on one thread).
+this process: the campaign's cost is its wall time over that (target ≤ 1.5×, issues 12 and 41).
+Round 0 (G_0 scores D_init and is assessed) is paid once per campaign and shown apart. Wall
+seconds and this process's CPU seconds are both given: on a shared machine the CPU ratio is the
+one that load distorts less (everything runs in this one process, torch on one thread).
+
+With several `--update` modes and `--seeds`, one campaign runs per seed and mode (interleaved,
+seed by seed), each mode's cost is summarised (total, simulation alone, the update's training,
+their ratios), and each mode's last G_r is compared with the first mode's on the Test Set:
+the paired difference of AUPRC (and AUROC) over the seeds, with a 95 % t interval.
 """
 
 from __future__ import annotations
@@ -21,6 +26,8 @@ import tempfile
 import time
 from collections.abc import Mapping
 from pathlib import Path
+
+import numpy as np
 
 from benchmarks.machine import describe
 from evoeye.batch import plan_uniform, run_batch, simulate_and_log
@@ -120,47 +127,112 @@ def table(kind: str, rounds: list[dict], first: dict) -> dict:
     return total
 
 
+def run_one(src: DataRoot, cfg: CampaignConfig, rounds: int, tmp: Path) -> dict:
+    """One campaign on a private copy of `src`, profiled, and its runs simulated again alone."""
+    root = copy_root(src, tmp / "data")
+    per_round, first = profile(root, cfg, rounds)
+    campaign_id = Campaign(root, cfg).campaign_id
+    quality = [(r.round, r.metrics.test, r.metrics.hard.get("auprc"))
+               for r in read_rounds(root, campaign_id) if r.metrics]
+    alone_s, alone_cpu_s, n_runs = simulate_alone(root, campaign_id, cfg.scenario,
+                                                  DataRoot.resolve(tmp / "alone"))
+    return {"campaign_id": campaign_id, "rounds": per_round, "first": first,
+            "quality": quality, "alone": (alone_s, alone_cpu_s), "runs": n_runs}
+
+
+def report(cfg: CampaignConfig, result: dict) -> dict:
+    """Print one campaign's tables; its summary (CPU seconds, ratios, last G_r's Test Set)."""
+    print(f"\ncampaign {result['campaign_id']}: {cfg.scenario}, {cfg.strategy}, N_round "
+          f"{cfg.n_round}, update {cfg.update}, epochs {cfg.epochs or 'default'}, "
+          f"patience {cfg.patience or 'default'}")
+    print("G_r's AUPRC (Test Set / Hard Set) by round: " + ", ".join(
+        f"{r}: {_pct(t.get('auprc'))} / {_pct(h)}" for r, t, h in result["quality"]))
+    rounds, first = result["rounds"], result["first"]
+    wall = table("wall", [w for w, _ in rounds], first[0])
+    cpu = table("CPU", [c for _, c in rounds], first[1])
+    alone_s, alone_cpu_s = result["alone"]
+    print(f"\nsimulate + log the same {result['runs']} runs alone: {alone_s:.2f} s wall, "
+          f"{alone_cpu_s:.2f} s CPU")
+    print(f"campaign cost, rounds 1+: {wall['total'] / alone_s:.2f}× wall, "
+          f"{cpu['total'] / alone_cpu_s:.2f}× CPU (target ≤ {TARGET}×); with round 0: "
+          f"{(wall['total'] + first[0]['total']) / alone_s:.2f}× wall, "
+          f"{(cpu['total'] + first[1]['total']) / alone_cpu_s:.2f}× CPU")
+    last = result["quality"][-1][1]
+    return {"update": cfg.update, "seed": cfg.seed, "total": cpu["total"], "alone": alone_cpu_s,
+            "train": cpu["train"], "wall": wall["total"], "alone_wall": alone_s,
+            "auprc": last.get("auprc"), "auroc": last.get("auroc")}
+
+
+def paired(diffs: list[float]) -> str:
+    """Mean of paired differences (in points) with its 95 % t interval."""
+    from scipy import stats
+
+    d = 100 * np.asarray(diffs, float)
+    if len(d) < 2:
+        return f"{d.mean():+.2f}"
+    half = stats.t.ppf(0.975, len(d) - 1) * d.std(ddof=1) / np.sqrt(len(d))
+    return f"{d.mean():+.2f} [{d.mean() - half:+.2f}, {d.mean() + half:+.2f}]"
+
+
+def summary(rows: list[dict], updates: list[str]) -> None:
+    """Per mode: mean cost and ratios; each mode's last Test AUPRC / AUROC against the first's."""
+    print("\n| update | seeds | total CPU s | simulate alone CPU s | train CPU s | × alone (CPU) "
+          "| × alone (wall) | Test AUPRC | paired Δ AUPRC vs "
+          f"{updates[0]} [95 % CI] | paired Δ AUROC [95 % CI] |")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    base = {r["seed"]: r for r in rows if r["update"] == updates[0]}
+    for update in updates:
+        mine = [r for r in rows if r["update"] == update]
+        mean = {k: float(np.mean([r[k] for r in mine])) for k in
+                ("total", "alone", "train", "wall", "alone_wall")}
+        auprc = [r["auprc"] for r in mine if r["auprc"] is not None]
+        both = [(r, base[r["seed"]]) for r in mine if r["seed"] in base]
+        delta = "—" if update == updates[0] else paired(
+            [a["auprc"] - b["auprc"] for a, b in both])
+        delta_roc = "—" if update == updates[0] else paired(
+            [a["auroc"] - b["auroc"] for a, b in both])
+        print(f"| {update} | {','.join(str(r['seed']) for r in mine)} | {mean['total']:.2f} "
+              f"| {mean['alone']:.2f} | {mean['train']:.2f} "
+              f"| {mean['total'] / mean['alone']:.2f}× | {mean['wall'] / mean['alone_wall']:.2f}× "
+              f"| {_pct(float(np.mean(auprc)) if auprc else None)} | {delta} | {delta_roc} |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--root", type=Path, help="data root with initial runs and a G_0, split "
                     "as this script splits them (seed 0, train 0.5, val 0.25)")
-    ap.add_argument("--update", default="replay", help="campaign option")
+    ap.add_argument("--update", nargs="+", default=["retrain"],
+                    help="campaign option, MODE or MODE:EPOCHS; several: one campaign each, "
+                    "compared with the first")
+    ap.add_argument("--seeds", type=int, nargs="+", default=[0], help="campaign seeds")
     ap.add_argument("--scenario", default="highway-cut-in")
     ap.add_argument("--strategy", default="evoeye")
     ap.add_argument("--rounds", type=int, default=3)
     ap.add_argument("--n-round", type=int, default=20)
     ap.add_argument("--epochs", type=int, help="campaign option (default: its own)")
     ap.add_argument("--patience", type=int, help="campaign option (default: its own)")
+    ap.add_argument("--test-batch", help="a round-0 batch of the root held out as the Test Set")
     ap.add_argument("--runs", type=int, default=60, help="initial runs without --root")
     args = ap.parse_args()
     print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}")
-    splits = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25)
+    splits = SplitSpec(seed=0, train_frac=0.5, val_frac=0.25, test_batch=args.test_batch)
+    rows = []
     with tempfile.TemporaryDirectory(prefix="bench-campaign-") as tmp:
         src = (DataRoot.existing(args.root) if args.root
                else seed_root(Path(tmp) / "seed", [args.scenario], args.runs, splits))
-        root = copy_root(src, Path(tmp) / "data")
-        cfg = CampaignConfig(args.scenario, strategy=args.strategy, budget_s=1e9,
-                             n_round=args.n_round, splits=splits, epochs=args.epochs,
-                             patience=args.patience, update=args.update)
-        rounds, first = profile(root, cfg, args.rounds)
-        campaign_id = Campaign(root, cfg).campaign_id
-        quality = [(r.round, r.metrics.test.get("auprc"), r.metrics.hard.get("auprc"))
-                   for r in read_rounds(root, campaign_id) if r.metrics]
-        alone_s, alone_cpu_s, n_runs = simulate_alone(root, campaign_id, args.scenario,
-                                                      DataRoot.resolve(Path(tmp) / "alone"))
-    print(f"\ncampaign {campaign_id}: {args.scenario}, {args.strategy}, N_round {args.n_round}, "
-          f"update {args.update}, epochs {args.epochs or 'default'}, "
-          f"patience {args.patience or 'default'}")
-    print("G_r's AUPRC (Test Set / Hard Set) by round: " + ", ".join(
-        f"{r}: {_pct(t)} / {_pct(h)}" for r, t, h in quality))
-    wall = table("wall", [w for w, _ in rounds], first[0])
-    cpu = table("CPU", [c for _, c in rounds], first[1])
-    print(f"\nsimulate + log the same {n_runs} runs alone: {alone_s:.2f} s wall, "
-          f"{alone_cpu_s:.2f} s CPU")
-    print(f"campaign cost, rounds 1+: {wall['total'] / alone_s:.2f}× wall, "
-          f"{cpu['total'] / alone_cpu_s:.2f}× CPU (target ≤ {TARGET}×); with round 0: "
-          f"{(wall['total'] + first[0]['total']) / alone_s:.2f}× wall, "
-          f"{(cpu['total'] + first[1]['total']) / alone_cpu_s:.2f}× CPU")
+        for seed in args.seeds:
+            for update in args.update:
+                mode, _, epochs = update.partition(":")
+                cfg = CampaignConfig(args.scenario, strategy=args.strategy, budget_s=1e9,
+                                     seed=seed, n_round=args.n_round, splits=splits,
+                                     epochs=int(epochs) if epochs else args.epochs,
+                                     patience=args.patience, update=mode)
+                work = Path(tmp) / f"{mode}-{epochs}-s{seed}"
+                rows.append({**report(cfg, run_one(src, cfg, args.rounds, work)),
+                             "update": update})
+                shutil.rmtree(work)
+    if len(rows) > 1:
+        summary(rows, args.update)
     print(f"load average after: {os.getloadavg()[0]:.2f}")
 
 

@@ -49,7 +49,8 @@ class TrackingPerception:
             self.tracker.step(self._pending[0].z)
         trk = self.tracker
         rows = trk.confirmed.nonzero()[0]
-        s = trk.state[:, rows]  # (13, n), a copy: every published row is contiguous
+        s = trk.state.take(rows, axis=1)  # (13, n), a C-ordered copy: every published row is
+        # contiguous, which orjson writes whole (`state[:, rows]` is Fortran-ordered)
         if self.lead_s:
             s[X:VX] += s[VX:VY + 1] * self.lead_s  # predicted to the publication time
         return Obstacles(

@@ -87,6 +87,9 @@ class Channel:
     schema_file: str
     encode: Encoder
     message_type: type | None  # the dataclass mirrored field for field by the schema, if any
+    # The message object itself, when orjson writes it as exactly `encode`'s dict (a dataclass
+    # whose fields are the schema's, in order): the writer skips building the dict.
+    message: Callable[[Any], Any] | None = None
 
     @property
     def schema(self) -> dict[str, Any]:
@@ -113,7 +116,9 @@ def _fields_encoder(schema_file: str, source: str) -> Encoder:
 
 
 def _fields_channel(topic: str, schema_file: str, message_type: type, source: str) -> Channel:
-    return Channel(topic, schema_file, _fields_encoder(schema_file, source), message_type)
+    same_fields = getattr(message_type, "field_names", tuple)() == schema_fields(schema_file)
+    return Channel(topic, schema_file, _fields_encoder(schema_file, source), message_type,
+                   attrgetter(source) if same_fields else None)
 
 
 SCENE_ARRAYS = ("x_m", "y_m", "heading_rad", "speed_mps", "accel_mps2", "length_m", "width_m")

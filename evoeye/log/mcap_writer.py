@@ -2,18 +2,20 @@
 
 `mcap.writer.Writer` spends ~5 µs of Python per message (a record object, a dozen small stream
 writes, a growing in-memory buffer), a quarter of the logging budget. This writer packs a
-message record with one `struct.pack` and keeps a chunk as a list of byte strings; every other
-record is written with the `mcap.records` classes, in the same order and with the same indexes
-(chunk, message, attachment and metadata indexes, statistics, summary offsets and CRCs), so its
-output equals `mcap.writer.Writer`'s byte for byte for the same calls and the same compressor (a
-test checks this). It also lets the zstd level be chosen, which `mcap.writer.Writer` does not.
+message record with one `struct.pack` and keeps a chunk as a list of byte strings; `add_frame`
+adds the messages that share one log time in one call, and a chunk's message indexes are packed
+whole (mcap's `MessageIndex.write` makes three stream writes per message). Every other record is
+written with the `mcap.records` classes, in the same order and with the same indexes (chunk,
+message, attachment and metadata indexes, statistics, summary offsets and CRCs), so its output
+equals `mcap.writer.Writer`'s byte for byte for the same calls and the same compressor (a test
+checks this). It also lets the zstd level be chosen, which `mcap.writer.Writer` does not.
 """
 
 from __future__ import annotations
 
 import struct
 import zlib
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from typing import BinaryIO
 
 import lz4.frame
@@ -29,7 +31,6 @@ from mcap.records import (
     DataEnd,
     Footer,
     Header,
-    MessageIndex,
     Metadata,
     MetadataIndex,
     Schema,
@@ -40,6 +41,7 @@ from mcap.writer import MCAP0_MAGIC
 
 _MESSAGE = struct.Struct("<BQHIQQ")  # opcode, record length, channel, sequence, log, publish time
 _MESSAGE_FIXED = _MESSAGE.size - 9  # message fields before the data, counted in its length
+_INDEX_HEAD = struct.Struct("<BQHI")  # opcode, record length, channel, length of the entries
 
 
 def compressor(name: str, level: int = 3) -> Callable[[bytes], bytes] | None:
@@ -82,7 +84,7 @@ class McapWriter:
     def _new_chunk(self) -> None:
         self._parts: list[bytes] = []  # the chunk's uncompressed records
         self._size = 0  # their total length
-        self._index: dict[int, list[tuple[int, int]]] = {}  # channel -> [(log time, offset)]
+        self._index: dict[int, list[int]] = {}  # channel -> [log time, offset, log time, …]
         self._chunk_start = 0
         self._chunk_end = 0
 
@@ -124,13 +126,15 @@ class McapWriter:
             compressed_size=len(packed),
             uncompressed_size=len(data),
         )
-        builder = RecordBuilder()
-        index_start = start + length
-        for channel_id, records in self._index.items():
-            index.message_index_offsets[channel_id] = index_start + builder.count
-            MessageIndex(channel_id=channel_id, records=records).write(builder)
-        index.message_index_length = builder.count
-        self._stream.write(builder.end())
+        parts, size = [], 0
+        for channel_id, entries in self._index.items():
+            index.message_index_offsets[channel_id] = start + length + size
+            n = len(entries)  # two 8-byte numbers per message
+            parts.append(_INDEX_HEAD.pack(Opcode.MESSAGE_INDEX, 6 + 8 * n, channel_id, 8 * n))
+            parts.append(struct.pack(f"<{n}Q", *entries))
+            size += _INDEX_HEAD.size + 8 * n
+        index.message_index_length = size
+        self._stream.write(b"".join(parts))
         self._chunk_indexes.append(index)
         self._new_chunk()
 
@@ -210,7 +214,7 @@ class McapWriter:
         else:
             self._chunk_start = min(self._chunk_start, log_time)
             self._chunk_end = max(self._chunk_end, log_time)
-        self._index.setdefault(channel_id, []).append((log_time, self._size))
+        self._index.setdefault(channel_id, []).extend((log_time, self._size))
         header = _MESSAGE.pack(
             Opcode.MESSAGE,
             _MESSAGE_FIXED + len(data),
@@ -224,6 +228,30 @@ class McapWriter:
         self._size += len(header) + len(data)
         if self._size > self._chunk_size:
             self._finish_chunk()
+
+    def add_frame(self, channel_ids: Sequence[int], log_time: int, data: Sequence[bytes],
+                  sequence: int = 0) -> None:
+        """`add_message(channel_ids[i], log_time, data[i], log_time, sequence)` for each i, in
+        order, in one call: the same bytes (a chunk may close after any of the messages)."""
+        if self._index:  # the open chunk's and the file's time range, once for the frame
+            self._chunk_start = min(self._chunk_start, log_time)
+            self._chunk_end = max(self._chunk_end, log_time)
+            self._start_time = min(self._start_time, log_time)
+            self._end_time = max(self._end_time, log_time)
+        counts, pack = self._message_counts, _MESSAGE.pack
+        for channel_id, payload in zip(channel_ids, data, strict=True):
+            if not self._index:  # the first message of a chunk starts its bookkeeping
+                self.add_message(channel_id, log_time, payload, log_time, sequence)
+                continue
+            counts[channel_id] = counts.get(channel_id, 0) + 1
+            self._message_count += 1
+            self._index.setdefault(channel_id, []).extend((log_time, self._size))
+            header = pack(Opcode.MESSAGE, _MESSAGE_FIXED + len(payload), channel_id, sequence,
+                          log_time, log_time)
+            self._parts += (header, payload)
+            self._size += len(header) + len(payload)
+            if self._size > self._chunk_size:
+                self._finish_chunk()
 
     def finish(self) -> None:
         """Write the last chunk, the data end, the summary and the footer."""

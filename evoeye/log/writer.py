@@ -116,15 +116,18 @@ def write_stream(episode: Episode, stream: BinaryIO,
     )
     t0_ns = log_time_ns(episode.frames[0].scene.t_s) if episode.frames else 0
     writer.add_message(map_id, t0_ns, dumps(MAP_CHANNEL.encode(episode.road_map, t0_ns)), t0_ns)
-    encoders = [(cid, ch.encode) for cid, ch in zip(frame_ids, FRAME_CHANNELS, strict=True)]
-    extras = [(cid, ch.encode) for cid, ch in zip(extra_ids, extra, strict=True)]
-    add = writer.add_message
+    # per frame channel: the message object orjson writes (`Channel.message`, no dict), else
+    # its encoder's dict
+    direct = [(ch.message, None) if ch.message else (None, ch.encode) for ch in FRAME_CHANNELS]
+    extras = [ch.encode for ch in extra]
+    ids, add = [*frame_ids, *extra_ids], writer.add_frame
     for seq, frame in enumerate(episode.frames):
         t_ns = log_time_ns(frame.scene.t_s)
-        for cid, encode in encoders:
-            add(cid, t_ns, dumps(encode(frame, t_ns)), t_ns, seq)
-        for cid, encode in extras:
-            add(cid, t_ns, dumps(encode((frame, supervisor.states[seq]), t_ns)), t_ns, seq)
+        data = [dumps(message(frame) if message else encode(frame, t_ns))
+                for message, encode in direct]
+        if extras:
+            data += [dumps(encode((frame, supervisor.states[seq]), t_ns)) for encode in extras]
+        add(ids, t_ns, data, seq)
     writer.finish()
 
 

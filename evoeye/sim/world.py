@@ -70,10 +70,10 @@ class World:
     # -- reading -------------------------------------------------------------------------------
     def _state(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
         vs = self.vehicles
-        pos = np.array([v.position for v in vs], dtype=float)
+        x, y = np.array([v.position for v in vs], dtype=float).T.copy()  # contiguous rows
         heading = np.array([v.heading for v in vs], dtype=float)
         speed = np.array([v.speed for v in vs], dtype=float)
-        return pos[:, 0], pos[:, 1], heading, speed
+        return x, y, heading, speed
 
     def scene(self) -> SceneState:
         """Ground truth now. Acceleration is the one applied over the last step."""

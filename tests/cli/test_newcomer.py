@@ -67,7 +67,8 @@ def test_a_failed_training_says_what_the_warehouse_holds(tmp_path: Path) -> None
 @pytest.mark.parametrize(("command", "names"), [
     ("simulate", tuple(SCENARIOS)),
     ("demo", tuple(SCENARIOS)),
-    ("evolve", STRATEGY_NAMES + ("replay", "finetune", "retrain", "raw", "prior-corrected")),
+    ("evolve", STRATEGY_NAMES + ("replay", "finetune", "retrain", "warm", "raw",
+                                  "prior-corrected")),
     ("experiment", METHOD_NAMES),
 ])
 def test_options_with_a_fixed_set_of_values_list_it_in_help(command: str, names) -> None:

@@ -20,7 +20,7 @@ def test_params_reject_unknown_strategy() -> None:
     with pytest.raises(ValidationError, match="unknown feedback"):
         EvolveParams(feedback="calibrated")
     with pytest.raises(ValidationError, match="unknown update"):
-        EvolveParams(update="warm")
+        EvolveParams(update="lukewarm")
 
 
 def test_round_tasks_pass_parameters_and_run_ids_not_state() -> None:

@@ -13,8 +13,9 @@ from evoeye.log.mcap_writer import McapWriter, compressor
 CHUNK_SIZE = 16 * 1024  # small, so the calls below span many chunks
 
 
-def drive(writer: Writer | McapWriter) -> None:
-    """The same sequence of calls for both writers, interleaving channels and record kinds."""
+def drive(writer: Writer | McapWriter, frames: bool = False) -> None:
+    """The same sequence of calls for both writers, interleaving channels and record kinds;
+    with `frames`, each frame's messages go in one `McapWriter.add_frame` call."""
     writer.start(profile="", library="test")
     a = writer.register_schema("a", "jsonschema", b'{"type": "object"}')
     b = writer.register_schema("b", "jsonschema", b"{}")
@@ -24,10 +25,15 @@ def drive(writer: Writer | McapWriter) -> None:
         create_time=0, log_time=5, name="m", media_type="application/json", data=b"{}"
     )
     for frame in range(600):
-        for i, channel in enumerate(channels):
-            if (frame + i) % 3:  # channels skip frames, so chunks index different channel sets
-                data = b'{"v":%d}' % frame * (1 + i * 7 + frame % 11)
-                writer.add_message(channel, frame * 50_000_000, data, frame * 50_000_000, frame)
+        # channels skip frames, so chunks index different channel sets
+        sent = [(channel, b'{"v":%d}' % frame * (1 + i * 7 + frame % 11))
+                for i, channel in enumerate(channels) if (frame + i) % 3]
+        t_ns = frame * 50_000_000
+        if frames:
+            writer.add_frame([c for c, _ in sent], t_ns, [d for _, d in sent], frame)
+        else:
+            for channel, data in sent:
+                writer.add_message(channel, t_ns, data, t_ns, frame)
     writer.add_metadata("second", {})
     writer.finish()
 
@@ -40,6 +46,14 @@ def test_same_bytes_as_mcap_writer(theirs: CompressionType, ours: str) -> None:
     expected, got = io.BytesIO(), io.BytesIO()
     drive(Writer(expected, chunk_size=CHUNK_SIZE, compression=theirs))
     drive(McapWriter(got, compression=ours, level=3, chunk_size=CHUNK_SIZE))
+    assert got.getvalue() == expected.getvalue()
+
+
+@pytest.mark.parametrize("chunk_size", [CHUNK_SIZE, 700, 1])  # chunks close inside frames
+def test_add_frame_writes_what_add_message_writes(chunk_size: int) -> None:
+    expected, got = io.BytesIO(), io.BytesIO()
+    drive(Writer(expected, chunk_size=chunk_size, compression=CompressionType.LZ4))
+    drive(McapWriter(got, compression="lz4", chunk_size=chunk_size), frames=True)
     assert got.getvalue() == expected.getvalue()
 
 

@@ -28,11 +28,14 @@ from typing import Any
 from evoeye.seeds import STREAMS_VERSION
 from evoeye.splits import SplitSpec
 
-UPDATE_MODES = ("replay", "finetune", "retrain")  # evoeye.evolve.campaign.loop says what each is
+UPDATE_MODES = ("replay", "finetune", "retrain", "warm")  # evoeye.evolve.campaign.loop: each
 FEEDBACK_MODES = ("raw", "prior-corrected")  # ŷ as the monitor scores it, or σ(logit − log w)
 FINETUNE_EPOCHS, FINETUNE_PATIENCE = 10, 4
 REPLAY_EPOCHS, REPLAY_PATIENCE = 2, 1  # per round: passes over the new runs and their replay
 REPLAY_RATIO = 1.0  # earlier runs replayed per new run of the round
+WARM_EPOCHS, WARM_PATIENCE = 1, 1  # per round: one pass over D_r from G_r's weights
+# (these defaults are what a campaign id of update "warm" means, as REPLAY_* and FINETUNE_*
+# are for theirs: never change them; other values are `epochs` / `patience` options)
 DEFAULT_FAMILY = "fusion"  # evoeye.monitor.families.DEFAULT_FAMILY
 DEFAULT_RECIPE, LEGACY_RECIPE = "v3", "v1"  # evoeye.monitor.recipes
 DEFAULT_DELTA = 0.2  # evoeye.scenarios.DEFAULT_DELTA
@@ -133,13 +136,14 @@ class CampaignConfig:
                                  "version).")
     n_round: int = option(20, "Runs per round (N_round).", ge=1)
     update: str = option("retrain", "Monitor update per round: retrain (from scratch on every "
-                         "record), replay (fine-tune G_r on the round's runs and as many earlier "
-                         "ones) or finetune (G_r on every record).", names="update")
-    epochs: int | None = option(None, "Epochs per monitor update (default: 2 with replay, 10 "
-                                "fine-tuning, the trainer's when retraining).", ge=1)
+                         "record), warm (G_r on every record, one epoch), replay (fine-tune "
+                         "G_r on the round's runs and as many earlier ones) or finetune (G_r on "
+                         "every record, up to 10 epochs).", names="update")
+    epochs: int | None = option(None, "Epochs per monitor update (default: 2 with replay, 1 "
+                                "warm, 10 fine-tuning, the trainer's when retraining).", ge=1)
     patience: int | None = option(None, "Early-stopping patience per update (default: 1 with "
-                                  "replay, 4 fine-tuning, the trainer's when retraining).",
-                                  ge=1)
+                                  "replay, 1 warm, 4 fine-tuning, the trainer's when "
+                                  "retraining).", ge=1)
     delta: float = option(DEFAULT_DELTA, "Neighbourhood radius δ of the density-aware "
                           "strategies, a share of each parameter's range.", gt=0.0, le=1.0)
     feedback: str = option("raw", "ŷ in f_r = mean |ŷ − y|: raw monitor scores, or "
@@ -150,8 +154,8 @@ class CampaignConfig:
                          "Set).", names="family")
     reference: str | None = option(None, "Another family than fusion: the FusionMonitor G_0 "
                                    "whose Hard Set judges (default: the newest).")
-    keep_parent: bool = option(False, "A fine-tuned update (replay, finetune) keeps G_r unless "
-                               "one of its epochs beats G_r on the validation split (off: "
+    keep_parent: bool = option(False, "A fine-tuned update (warm, replay, finetune) keeps G_r "
+                               "unless one of its epochs beats G_r on the validation split (off: "
                                "Algorithm 1's update, which always replaces it).")
     committee: int = option(COMMITTEE, "Monitors whose disagreement the `disagreement` "
                             "strategy reads: G_r and committee − 1 companions trained beside "
@@ -196,7 +200,8 @@ class CampaignConfig:
         """TrainParams fields of one monitor update."""
         out = {}
         default = {"finetune": (FINETUNE_EPOCHS, FINETUNE_PATIENCE),
-                   "replay": (REPLAY_EPOCHS, REPLAY_PATIENCE)}.get(self.update, (None, None))
+                   "replay": (REPLAY_EPOCHS, REPLAY_PATIENCE),
+                   "warm": (WARM_EPOCHS, WARM_PATIENCE)}.get(self.update, (None, None))
         epochs, patience = self.epochs or default[0], self.patience or default[1]
         if epochs:
             out["epochs"] = epochs

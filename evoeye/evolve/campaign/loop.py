@@ -10,10 +10,10 @@ left.
 
 Monitor update (Algorithm 1, line 12: Train(G_r, D_r)); a round with no new run to learn from
 keeps G_r. `update="retrain"` (the default) trains from scratch on every run of D_r by G_0's
-recipe; `"replay"` (the paper's, RQ2's) fine-tunes G_r at most two epochs on the round's runs plus
-as many replayed ones (a collision among them when D_r has one); `"finetune"` a few epochs on
-all of D_r (docs/evolution.md measures them). Retraining learns only from D_r: a G_0 trained on
-runs the root does not hold (a shipped monitor) is evolved by `replay`.
+recipe; `"warm"` trains G_r itself one epoch on all of D_r; `"replay"` (the paper's, RQ2's)
+fine-tunes G_r at most two epochs on the round's runs plus as many replayed ones (a collision
+among them when D_r has one); `"finetune"` up to ten epochs on all of D_r (docs/evolution.md
+measures them). Retraining learns only from D_r: a shipped G_0 is evolved by `replay`.
 
 State and resume. Everything a campaign knows is in the data root: run logs under
 `runs/<scenario>/<campaign id>/`, the feedback table (f_r per run and monitor version) and the

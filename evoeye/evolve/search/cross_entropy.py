@@ -32,7 +32,7 @@ others stay uniform.
 
 Why scipy rather than openturns: openturns (which has CE-IS, NAIS and subset simulation) is not
 installed here and would be a large compiled dependency for what is ≈ 40 lines on
-`scipy.stats.truncnorm`; its algorithms also own the sampling loop (they call the model
+`scipy.stats.beta`; its algorithms also own the sampling loop (they call the model
 themselves), while a strategy here must propose one run at a time, resumably.
 
 Determinism and resume. Batch b's draws come from `default_rng([seed, b])` and its proposal

@@ -15,6 +15,8 @@ from evoeye.evolve.campaign.config import (
     FINETUNE_PATIENCE,
     REPLAY_EPOCHS,
     REPLAY_PATIENCE,
+    WARM_EPOCHS,
+    WARM_PATIENCE,
     CampaignConfig,
 )
 from evoeye.evolve.campaign.loop import Campaign
@@ -43,12 +45,14 @@ def test_config_rejects_unknown_strategy_and_update() -> None:
     with pytest.raises(ValueError, match="strategy"):
         CampaignConfig(SCENARIO, strategy="random-walk")
     with pytest.raises(ValueError, match="update"):
-        CampaignConfig(SCENARIO, update="warm")
+        CampaignConfig(SCENARIO, update="lukewarm")
     assert CampaignConfig(SCENARIO).update == "retrain"
     assert CampaignConfig(SCENARIO, update="replay").train_overrides() == {
         "epochs": REPLAY_EPOCHS, "patience": REPLAY_PATIENCE}
     assert CampaignConfig(SCENARIO, update="finetune").train_overrides() == {
         "epochs": FINETUNE_EPOCHS, "patience": FINETUNE_PATIENCE}
+    assert CampaignConfig(SCENARIO, update="warm").train_overrides() == {
+        "epochs": WARM_EPOCHS, "patience": WARM_PATIENCE}
     assert CampaignConfig(SCENARIO, update="retrain").train_overrides() == {}
     with pytest.raises(ValueError, match="committee is of FusionMonitors"):
         CampaignConfig(SCENARIO, strategy="disagreement", family="aem")

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from campaign_helpers import config
 
+from evoeye.evolve.campaign.config import WARM_EPOCHS
 from evoeye.evolve.campaign.loop import Campaign
 from evoeye.monitor.families import FAMILIES
 from evoeye.store import load_windows
@@ -54,6 +55,26 @@ def test_finetune_trains_on_every_record(root_copy, seeded) -> None:
     assert trained == [ok] and len(ok) == len(c.initial["scenario_id"]) + 2
 
 
+def test_warm_trains_every_record_from_the_last_monitor_briefly(root_copy, seeded) -> None:
+    calls: list[tuple[list[str], str | None, int]] = []
+
+    def train(*args, train_runs, init_from, epochs, **kwargs) -> str:
+        calls.append((list(train_runs), init_from, epochs))
+        return FAMILIES["fusion"].train(*args, train_runs=train_runs, init_from=init_from,
+                                        epochs=epochs, **kwargs)
+
+    c = Campaign(root_copy("warm"), config(seeded[1], strategy="uniform", update="warm",
+                                           epochs=None),
+                 train=train)
+    state = c.run(max_rounds=2)
+    ok = [s for s, good in zip(state.records.scenario_id, state.ok, strict=True) if good]
+    first, second = state.rounds[1].monitor_version, state.rounds[2].monitor_version
+    assert [(parent, epochs) for _, parent, epochs in calls] == [
+        (state.rounds[0].monitor_version, WARM_EPOCHS), (first, WARM_EPOCHS)]
+    assert calls[1][0] == ok and len(ok) == len(c.initial["scenario_id"]) + 4
+    assert second != first
+
+
 def test_retrain_the_default_trains_from_scratch_on_every_record(root_copy, seeded) -> None:
     calls: list[tuple[list[str], str | None]] = []
 
@@ -69,7 +90,7 @@ def test_retrain_the_default_trains_from_scratch_on_every_record(root_copy, seed
     assert calls == [(ok, None)] and len(ok) == len(c.initial["scenario_id"]) + 2
 
 
-@pytest.mark.parametrize("update", ["retrain", "replay", "finetune"])
+@pytest.mark.parametrize("update", ["retrain", "replay", "finetune", "warm"])
 def test_a_round_without_an_ok_run_keeps_its_monitor(root_copy, seeded, update: str) -> None:
     c = Campaign(root_copy("failed"), config(seeded[1], strategy="uniform", update=update))
     state = c.start()
@@ -79,7 +100,7 @@ def test_a_round_without_an_ok_run_keeps_its_monitor(root_copy, seeded, update: 
     assert c.update_monitor(state) == (state.monitor, 0.0)
 
 
-@pytest.mark.parametrize("update", ["retrain", "replay", "finetune"])
+@pytest.mark.parametrize("update", ["retrain", "replay", "finetune", "warm"])
 def test_records_without_a_collision_keep_the_monitor(root_copy, seeded, update: str) -> None:
     """A tiny D_r with no collision has one class only: training on it would fail."""
     c = Campaign(root_copy("no-collision"), config(seeded[1], strategy="uniform", update=update))
