@@ -47,6 +47,16 @@ class FeedbackRows:
         if not (len(self.scenario_id) == len(self.feedback) == len(self.n_contexts)):
             raise ValueError("scenario_id, feedback and n_contexts must have one entry per run")
 
+    @classmethod
+    def finite(cls, logical_scenario: str, monitor_version: str, feedback_mode: str, ids,
+               values, n_contexts=None) -> FeedbackRows:
+        """The rows of the runs whose value is finite (`n_contexts` default 0)."""
+        ids, values = np.asarray(ids, dtype=object), np.asarray(values, float)
+        keep = np.isfinite(values)
+        n = np.zeros(len(ids), int) if n_contexts is None else np.asarray(n_contexts)
+        return cls(logical_scenario, monitor_version, feedback_mode, ids[keep], values[keep],
+                   n[keep])
+
 
 def read_feedback(root: DataRoot, monitor_version: str | None = None,
                   feedback_mode: str | None = None) -> pa.Table:

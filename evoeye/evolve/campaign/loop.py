@@ -8,12 +8,9 @@ scoring: one conversion per log), updates the monitor on D_r, refreshes the feed
 record with G_{r+1} and stores the round. The campaign stops when no run fits in the budget
 left.
 
-Monitor update (Algorithm 1, line 12: Train(G_r, D_r)); a round with no new run to learn from
-keeps G_r. `update="retrain"` (the default) trains from scratch on every run of D_r by G_0's
-recipe; `"warm"` trains G_r itself one epoch on all of D_r; `"replay"` (the paper's, RQ2's)
-fine-tunes G_r at most two epochs on the round's runs plus as many replayed ones (a collision
-among them when D_r has one); `"finetune"` up to ten epochs on all of D_r (docs/evolution.md
-measures them). Retraining learns only from D_r: a shipped G_0 is evolved by `replay`.
+Monitor update (Algorithm 1, line 12: Train(G_r, D_r)) as `CampaignConfig.update` says: from
+scratch on D_r by default, or G_r fine-tuned (the option's help and docs/evolution.md say how
+each mode trains and what it costs); a round with no new run to learn from keeps G_r.
 
 State and resume. Everything a campaign knows is in the data root: run logs under
 `runs/<scenario>/<campaign id>/`, the feedback table (f_r per run and monitor version) and the
@@ -396,12 +393,9 @@ class Campaign:
     def write_feedback(self, version: str, ids, values, n_contexts=None,
                        mode: str | None = None) -> None:
         """Store per-run values (the finite ones) under `version` in `mode` (default: ours)."""
-        ids, values = np.asarray(ids, dtype=object), np.asarray(values, float)
-        keep = np.isfinite(values)
-        n = np.zeros(len(ids), int) if n_contexts is None else np.asarray(n_contexts)
-        write_feedback(self.root, FeedbackRows(self.config.scenario, version,
-                                               mode or self.config.feedback, ids[keep],
-                                               values[keep], n[keep]))
+        write_feedback(self.root, FeedbackRows.finite(self.config.scenario, version,
+                                                      mode or self.config.feedback, ids, values,
+                                                      n_contexts))
 
     def with_stored(self, records: Records, version: str) -> Records:
         """`records` with the feedback (and the committee's disagreement) stored under G_r =
