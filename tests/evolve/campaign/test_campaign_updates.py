@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 import pytest
-from campaign_helpers import config
+from campaign_helpers import SCENARIO, SPLITS, config
 
 from evoeye.evolve.campaign.config import WARM_EPOCHS
 from evoeye.evolve.campaign.loop import Campaign
@@ -140,3 +140,26 @@ def test_disagreement_campaign_keeps_a_committee_and_each_runs_spread(root_copy,
         != c.campaign_id
     assert Campaign(root, config(seeded[1], committee=4)).campaign_id \
         == Campaign(root, config(seeded[1])).campaign_id
+
+
+def test_retraining_keeps_the_network_of_g0_kinematics_included(root_copy, seeded) -> None:
+    from evoeye.monitor import train_monitor
+    from evoeye.monitor.registry import load_monitor
+
+    root = root_copy("kinematics")
+    g0 = train_monitor(root, SCENARIO, seed=0, splits=SPLITS, epochs=1, kinematics=True)
+    asked: list[dict] = []
+
+    def train(*args, **kwargs) -> str:
+        asked.append({k: kwargs.get(k) for k in ("context_len", "kinematics", "init_from")})
+        return FAMILIES["fusion"].train(*args, **kwargs)
+
+    state = Campaign(root, config(g0, strategy="uniform"), train=train).run(max_rounds=1)
+    assert asked == [{"context_len": 5, "kinematics": True, "init_from": None}]
+    assert load_monitor(root, state.monitor).net.config.kinematics  # G_1 derives them too
+    # a G_0 without them is retrained without them, as before
+    plain: list[dict] = []
+    Campaign(root_copy("plain"), config(seeded[1], strategy="uniform"),
+             train=lambda *a, **k: plain.append(k) or FAMILIES["fusion"].train(*a, **k)
+             ).run(max_rounds=1)
+    assert "kinematics" not in plain[0] and plain[0]["context_len"] == 5
