@@ -15,6 +15,7 @@ from evoeye.monitor.recipes import (
     RECIPES,
     TrainParams,
     card_hyperparameters,
+    recipe_network,
     recipe_params,
 )
 
@@ -42,8 +43,23 @@ def test_the_default_recipe_is_v3_and_overrides_apply_on_top() -> None:
     assert replace(RECIPES["v3"], recipe="v2") == RECIPES["v2"]
 
 
+def test_lookahead_v2_is_v1_with_the_context_its_scenario_needs() -> None:
+    assert replace(RECIPES["lookahead-v2"], recipe="lookahead-v1") == RECIPES["lookahead-v1"]
+    assert recipe_network("lookahead-v2", "unprotected-intersection") == {
+        "context_len": 5, "kinematics": True}
+    for scenario in ("highway-cut-in", "occluded-crossing"):  # not listed: lookahead-v1's
+        assert recipe_network("lookahead-v2", scenario) == recipe_network("lookahead-v1",
+                                                                          scenario)
+    assert recipe_network("lookahead-v1", "unprotected-intersection")["context_len"] == 20
+    assert recipe_network("v3", "unprotected-intersection") == {}
+    from evoeye.scenarios import SCENARIOS  # every scenario a recipe names is a registered one
+
+    assert {s for by in recipes.SCENARIO_NETWORKS.values() for s in by} <= set(SCENARIOS)
+
+
 @pytest.mark.parametrize(("recipe", "overrides", "message"), [
-    ("v9", {}, r"unknown training recipe 'v9'; known: \['lookahead-v1', 'v1', 'v2', 'v3'\]"),
+    ("v9", {}, r"unknown training recipe 'v9'; known: \['lookahead-v1', 'lookahead-v2', 'v1', "
+               r"'v2', 'v3'\]"),
     ("v2", {"learning_rate": 1.0}, r"unknown training parameter\(s\) \['learning_rate'\]"),
     ("v2", {"batching": "runs"}, "unknown batching 'runs'"),
     ("v2", {"schedule": "step"}, "unknown schedule 'step'"),
