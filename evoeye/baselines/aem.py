@@ -79,6 +79,9 @@ AEM_RECIPES = {
                     warmup_epochs=0.5),
     "v3": AEMConfig(recipe="v3", epochs=3, batch_size=32),
 }
+# the lookahead recipes change the FusionMonitor's target and network only: v3's AEM, the same
+# weights and ledger units
+AEM_RECIPES |= {name: AEM_RECIPES["v3"] for name in ("lookahead-v1", "lookahead-v2")}
 
 
 def aem_config(recipe: str | None = None, **overrides: Any) -> AEMConfig:

@@ -117,3 +117,13 @@ def test_refuses_a_wrong_context_length_or_no_normal_window(windows_of, obs) -> 
         train_aem(w, np.ones(10, bool), AEMConfig(context_len=5))
     with pytest.raises(ValueError, match="collision-free"):
         train_aem(w, np.zeros(10, bool), SMALL)
+
+
+def test_every_training_recipe_has_an_aem_part() -> None:
+    # `evoeye results --recipe R` trains the AEM with R's part: a recipe without one crashed
+    from evoeye.baselines.aem import AEM_RECIPES, aem_config
+    from evoeye.monitor.recipes import RECIPES
+
+    assert set(AEM_RECIPES) == set(RECIPES)
+    for name in ("lookahead-v1", "lookahead-v2"):  # they change the FusionMonitor only
+        assert aem_config(name) == aem_config("v3")
