@@ -55,7 +55,7 @@ def train_command(
     root: RootOpt = None,
     context_len: Annotated[int | None, typer.Option(
         "--context-len", min=1, help=f"L, frames per context (default {DEFAULT_CONTEXT_LEN}, "
-        "or the parent's).")] = None,
+        "the lookahead recipes' own, or the parent's).")] = None,
     horizon_s: Annotated[float, typer.Option("--horizon-s", min=0.0,
                                              help="Label horizon H, s.")] = DEFAULT_HORIZON_S,
     modules: Annotated[str | None, typer.Option(
