@@ -13,7 +13,12 @@ import pytest
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.evaluation.mechanism import MECHANISMS
 from evoeye.evaluation.supervision import check_held_out, supervise
-from evoeye.evaluation.supervision.batch import batch_runs, plan_supervision, record_path
+from evoeye.evaluation.supervision.batch import (
+    batch_runs,
+    plan_supervision,
+    record_path,
+    run_supervision,
+)
 from evoeye.evaluation.supervision.sweep import (
     ReproductionError,
     RunJob,
@@ -194,3 +199,12 @@ def test_skip_reports_on_the_runs_after_the_first_and_reuses_their_records(sup, 
     assert all(r == by_id[r["scenario_id"]] for r in later.records)
     with pytest.raises(ValueError, match="--skip"):
         plan_supervision(sup.root, result.settings, skip=-1)
+
+
+def test_a_run_list_supervises_only_those_runs_of_the_batch(sup, result) -> None:
+    order = [s.scenario_id for s, _ in plan_supervision(sup.root, result.settings).runs]
+    some = run_supervision(sup.root, result.settings, ids=[order[3], order[1]])
+    assert [r["scenario_id"] for r in some.records] == [order[1], order[3]]  # batch order
+    assert some.done_before == 2 and some.folder == result.folder  # the same records
+    with pytest.raises(ValueError, match="1 run.s. not in batch sup of highway-cut-in, e.g. x"):
+        plan_supervision(sup.root, result.settings, ids=[order[0], "x"])
