@@ -30,6 +30,7 @@ from evoeye.monitor.families import DEFAULT_FAMILY
 from evoeye.paths import DataRoot
 from evoeye.sim.supervisor import FallbackConfig
 from evoeye.store import RunFilter, SplitSpec, Warehouse, select_runs
+from evoeye.store.windows import DEFAULT_HORIZON_S
 
 BUDGETS_PER_H = (1.0, 5.0)  # false interventions per hour of safe driving
 BASELINE = "ttc-2d"  # the rule-based trigger beside the monitor
@@ -90,8 +91,8 @@ def resolved(summary: dict, budget: float) -> bool:
     return budget * (summary["selection_safe_h"] or 0.0) >= 1.0
 
 
-def _n(count: int, noun: str) -> str:
-    return f"{count} {noun}{'' if count == 1 else 's'}"
+def _n(count: float, noun: str) -> str:
+    return f"{count:g} {noun}{'' if count == 1 else 's'}"
 
 
 def _pct(share: float | None) -> str:
@@ -126,8 +127,8 @@ def _point(summary: dict, budgets: list[float]) -> str:
     """Where the operating point was chosen, in words, for these budgets."""
     sel, h = summary["selection_runs"], summary["selection_safe_h"] or 0.0
     if resolved(summary, budgets[0]):
-        return (f"at the threshold chosen on the {sel} validation runs for ≤ {budgets[0]:g} "
-                "false intervention an hour")
+        return (f"at the threshold chosen on the {sel} validation runs for ≤ "
+                f"{_n(budgets[0], 'false intervention')} an hour")
     asked = " or ".join(f"≤ {b:g}" for b in budgets)
     why = (f"one false intervention is already {1 / h:.0f} an hour" if h > 0 else
            "they hold none of it")
@@ -182,11 +183,11 @@ def loop_words(summary: dict) -> list[str]:
 
 LOOP_NOTE = ("'In the loop' re-simulates this demo's test runs with each trigger driving the "
              "fallback, each run paired with its unsupervised self; a false intervention is a "
-             "brake that changed the command where the unsupervised run neither collided within "
-             "3 s nor came critically close; the oracle brakes a fixed time before each known "
-             "collision (docs/supervisor.md). Thresholds: a short sweep of the strict end, "
-             "calibrated on the validation frames; budgets: " + ", ".join(
-                 f"≤ {b:g}" for b in BUDGETS_PER_H) + " false interventions per hour.")
+             "brake that changed the command where the unsupervised run neither collided "
+             f"within {DEFAULT_HORIZON_S:g} s nor came critically close; the oracle brakes a "
+             "fixed time before each known collision (docs/supervisor.md). Thresholds: a short "
+             "sweep of the strict end, calibrated on the validation frames; budgets: "
+             + ", ".join(f"≤ {b:g}" for b in BUDGETS_PER_H) + " false interventions per hour.")
 
 
 def write_loop_report(folder: Path, summaries: list[dict]) -> ReportFiles:

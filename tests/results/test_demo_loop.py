@@ -91,7 +91,7 @@ def test_a_budget_the_validation_runs_resolve_is_named_and_the_rest_said_unresol
     assert [demo_loop.resolved(s, b) for b in demo_loop.BUDGETS_PER_H] == [False, True]
     unresolved, five = demo_loop.loop_words(s)
     assert "cannot resolve ≤ 1 an hour: one false intervention is already 2 an hour" in unresolved
-    assert "for ≤ 5 false intervention an hour, the FusionMonitor prevented 10 of 10" in five
+    assert "for ≤ 5 false interventions an hour, the FusionMonitor prevented 10 of 10" in five
     assert "with 0 false interventions in" in unresolved  # the middle threshold
     assert "with 2 false interventions in" in five and "Paired difference" in five
     assert re.search(r"exact McNemar p = [0-9.e-]+\.$", five)
@@ -131,3 +131,21 @@ def test_the_demo_supervises_its_own_validation_and_test_runs_apart(tmp_path) ->
     assert demo_loop.loop_words(s)[0].startswith("  In the loop: used as the trigger of a 9 m/s²")
     files = demo_loop.write_loop_report(tmp_path, [s])
     assert "In the loop" in files.markdown.read_text() and files.json.is_file()
+
+
+def test_the_demo_summary_carries_the_loop_and_says_where_its_report_is(tmp_path) -> None:
+    from tests.results.test_demo_summary import SCENARIO, _report
+
+    s = summarise_supervision(SETTINGS, runs("t", 30, 8, {}), demo_loop.BUDGETS_PER_H,
+                              resamples=200, select=runs("v", 10, 4, {6: 1}))
+    s["errors"] = []
+    result = demo.DemoResult(DataRoot.resolve(tmp_path), [_report(12, 14)], {},
+                             tmp_path / "reports" / "demo", loop={SCENARIO: s})
+    text = demo.summary_text(result)
+    block = text.split("FusionMonitor warned of 12 of 14 collisions")[1].split("\n\n")[0]
+    assert demo_loop.loop_words(s)[0] in block.splitlines()  # under its scenario
+    assert demo_loop.LOOP_NOTE in text
+    assert dict(result.paths())["the monitor in the loop (Markdown, HTML, JSON)"] == (
+        tmp_path / "reports" / "demo" / "supervision.html")
+    skipped = demo.DemoResult(result.root, result.reports, {})
+    assert "In the loop" not in demo.summary_text(skipped)
