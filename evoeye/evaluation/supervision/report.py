@@ -138,10 +138,22 @@ def chosen_on(summary: dict) -> str:
     if summary.get("operating_points") == "validation":
         return (f"Each trigger's operating point at a budget was chosen on "
                 f"{summary['selection_runs']} other supervised runs (validation) and is reported "
-                "here as it is on these runs: its false interventions may exceed the budget.")
+                "here as it is on these runs: its false interventions may exceed the budget."
+                + _resolution(summary.get("selection_safe_h")))
     return ("Each trigger's operating point at a budget was chosen on these very runs (no "
             "selection batch was given): optimistic, since the choice saw the runs it is "
             "reported on.")
+
+
+def _resolution(hours: float | None) -> str:
+    """What the selection runs' calm hours resolve: one false intervention there per hour."""
+    if hours is None:
+        return ""
+    if hours <= 0:
+        return (" They hold no driving where no intervention was justified: every budget means "
+                "none there.")
+    return (f" Their {hours:.2f} h of driving where no intervention was justified make one false "
+            f"intervention {1 / hours:.2g} per hour: a budget below that means none there.")
 
 
 def _p(difference: dict) -> str:
