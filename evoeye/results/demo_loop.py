@@ -5,10 +5,12 @@ Per scenario, the shipped FusionMonitor and TTC-2D each trigger the default (pro
 fallback — in-lane emergency braking at 9 m/s², reached at 30 m/s³ — on the demo's own runs,
 each paired with its unsupervised run, beside the oracle that brakes τ s before each known
 collision. The thresholds are a short sweep of the strict end (`FPRS`, `RECALLS`), calibrated
-on the validation split's frames; the runs supervised are the validation split's and the test
-split's (`SPLITS` of `evoeye.results.demo`). At each budget (`BUDGETS_PER_H`) a trigger's
-operating point is chosen on the validation runs and reported on the test runs only
-(`summarise_supervision`'s `select`): no figure comes from a choice that saw its runs.
+on the validation split's frames. Two supervisions, of the validation split's runs and of the
+test split's (`SPLITS` of `evoeye.results.demo`): the first runs every threshold and chooses
+each trigger's operating point at each budget (`BUDGETS_PER_H`); the second runs only the
+chosen thresholds, and the oracle, on the test runs, where they are reported
+(`summarise_supervision`'s `select`): no figure comes from a choice that saw its runs, and no
+simulation is spent on a threshold no budget chose.
 
 A budget of β false interventions per hour is *resolved* when the validation runs' hours of
 driving where no intervention was justified allow at least one (β·h ≥ 1); below that every
@@ -17,15 +19,26 @@ budget means "none on the validation runs", and the words say so instead of nami
 
 from __future__ import annotations
 
+from contextlib import nullcontext
+from dataclasses import replace
 from pathlib import Path
 
 from evoeye.evaluation.headline import MIN_COLLISIONS, label
 from evoeye.evaluation.report import ReportFiles
-from evoeye.evaluation.supervision.batch import batch_runs, run_supervision
+from evoeye.evaluation.supervision.batch import (
+    SupervisionResult,
+    batch_runs,
+    run_supervision,
+    worker_pool,
+)
 from evoeye.evaluation.supervision.report import write_files
 from evoeye.evaluation.supervision.settings import Settings
 from evoeye.evaluation.supervision.summary import summarise_supervision
-from evoeye.evaluation.supervision.triggers import calibrate_triggers, oracle_trigger
+from evoeye.evaluation.supervision.triggers import (
+    TriggerSpec,
+    calibrate_triggers,
+    oracle_trigger,
+)
 from evoeye.monitor.families import DEFAULT_FAMILY
 from evoeye.paths import DataRoot
 from evoeye.sim.supervisor import FallbackConfig
@@ -69,21 +82,63 @@ def supervise_demo(root: DataRoot, scenario: str, version: str, batch: str, spli
                            f"{_n(len(ids['test']), 'test run')}; it needs both"}
     triggers = calibrate_triggers(root, scenario, [("version", version), ("baseline", BASELINE)],
                                   splits, FPRS, recalls=RECALLS)
-    settings = Settings(scenario, batch, (*triggers, oracle_trigger(ORACLE_LEADS_S)),
-                        FallbackConfig(), splits=splits, logs="none")
-    # one pass over both splits: one pool of workers, not two
-    done = run_supervision(root, settings, workers=workers, ids=ids["val"] + ids["test"])
-    test = set(ids["test"])
-    select = [r for r in done.records if r["scenario_id"] not in test]
-    mine = [r for r in done.records if r["scenario_id"] in test]
-    if not any(r["status"] == "ok" for r in mine) or not any(r["status"] == "ok"
-                                                              for r in select):
-        return {"scenario": scenario, "skipped": f"{_n(len(done.errors), 'run')} could not be "
-                f"supervised, leaving a split without a run ({done.folder})"}
-    summary = summarise_supervision(settings, mine, BUDGETS_PER_H, select=select)
-    summary["folder"] = str(done.folder)
-    summary["errors"] = [{"scenario_id": s, "reason": r} for s, r in done.errors]
+    # 1. every threshold on the validation runs (no oracle: it is no trigger to choose)
+    choose = Settings(scenario, batch, tuple(triggers), FallbackConfig(), splits=splits,
+                      logs="none")
+    with nullcontext() if workers == 1 else worker_pool(workers) as pool:  # one for both
+        val = run_supervision(root, choose, workers=workers, ids=ids["val"], pool=pool)
+        if not any(r["status"] == "ok" for r in val.records):
+            return _unmeasured(scenario, val)
+        chosen = _chosen(choose, val.records)
+        # 2. on the test runs only the thresholds chosen there, and the oracle
+        report = Settings(scenario, batch, (*(narrowed(t, chosen[t.name]) for t in triggers),
+                                            oracle_trigger(ORACLE_LEADS_S)),
+                          FallbackConfig(), splits=splits, logs="none")
+        test = run_supervision(root, report, workers=workers, ids=ids["test"], pool=pool)
+    if not any(r["status"] == "ok" for r in test.records):
+        return _unmeasured(scenario, test)
+    summary = summarise_supervision(report, test.records, BUDGETS_PER_H,
+                                    select=narrowed_records(val.records, triggers, chosen))
+    summary["folder"], summary["selection_folder"] = str(test.folder), str(val.folder)
+    summary["errors"] = [{"scenario_id": s, "reason": r} for s, r in val.errors + test.errors]
     return summary
+
+
+def _unmeasured(scenario: str, done: SupervisionResult) -> dict:
+    return {"scenario": scenario, "skipped": f"{_n(len(done.errors), 'run')} could not be "
+            f"supervised, leaving a split without a run ({done.folder})"}
+
+
+def _chosen(settings: Settings, records: list[dict]) -> dict[str, list[float]]:
+    """Per trigger, the thresholds these (validation) runs choose at the budgets, ascending;
+    its strictest if it stays off at every budget (a trigger needs one threshold)."""
+    rows = summarise_supervision(settings, records, BUDGETS_PER_H, resamples=1)["at_budget"]
+    return {t.name: sorted({r["threshold"] for r in rows if r["trigger"] == t.name
+                            and r["threshold"] is not None} or {t.thresholds[-1]})
+            for t in settings.triggers}
+
+
+def narrowed(trigger: TriggerSpec, keep: list[float]) -> TriggerSpec:
+    """The trigger at only the thresholds `keep` (a subset of its own, ascending)."""
+    at = [trigger.thresholds.index(t) for t in keep]
+    return replace(trigger, **{k: tuple(getattr(trigger, k)[j] for j in at) for k in
+                               ("thresholds", "targets", "val_fprs", "val_recalls")})
+
+
+def narrowed_records(records: list[dict], triggers: list[TriggerSpec],
+                     keep: dict[str, list[float]]) -> list[dict]:
+    """The runs' records as a supervision at only the thresholds `keep` would have them."""
+    at = {t.name: [t.thresholds.index(x) for x in keep[t.name]] for t in triggers}
+    out = []
+    for r in records:
+        if r["status"] != "ok":
+            out.append(r)
+            continue
+        mine = {name: {**t, **{k: [t[k][j] for j in at[name]]
+                               for k in ("sim_of", "first_alarm_frame")}}
+                for name, t in r["triggers"].items() if name in at}
+        out.append({**r, "triggers": mine})
+    return out
 
 
 def resolved(summary: dict, budget: float) -> bool:

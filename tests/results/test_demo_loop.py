@@ -4,11 +4,13 @@ operating point chosen on the validation runs, said in a safety supervisor's ter
 from __future__ import annotations
 
 import re
+from pathlib import Path
 
 import numpy as np
 import pytest
 
-from evoeye.evaluation.supervision.settings import Settings
+from evoeye.evaluation.supervision.batch import run_supervision
+from evoeye.evaluation.supervision.settings import Settings, read_settings
 from evoeye.evaluation.supervision.summary import summarise_supervision
 from evoeye.evaluation.supervision.triggers import oracle_trigger
 from evoeye.paths import DataRoot
@@ -120,14 +122,20 @@ def test_the_demo_supervises_its_own_validation_and_test_runs_apart(tmp_path) ->
     assert (s["runs"], s["selection_runs"]) == (len(ids["test"]), len(ids["val"]))
     assert s["settings"]["fallback"]["decel_mps2"] == 9.0  # the production fallback
     assert [t["name"] for t in s["settings"]["triggers"]] == ["fusion", "ttc-2d", "oracle"]
-    # every reported threshold is the one the validation runs alone choose
-    settings = Settings.of(s["settings"])
-    from evoeye.evaluation.supervision.batch import run_supervision
-
-    val = run_supervision(root, settings, ids=ids["val"]).records  # done: read back
-    alone = summarise_supervision(settings, val, demo_loop.BUDGETS_PER_H, resamples=100)
+    # the validation runs were supervised at every threshold, apart; each reported threshold
+    # is the one they alone choose, and the test runs only ran those
+    choose = read_settings(Path(s["selection_folder"]))
+    assert s["selection_folder"] != s["folder"] and "oracle" not in [t.name for t in
+                                                                     choose.triggers]
+    val = run_supervision(root, choose, ids=ids["val"])  # done: read back
+    assert val.done_before == len(ids["val"])
+    alone = summarise_supervision(choose, val.records, demo_loop.BUDGETS_PER_H, resamples=100)
     assert ([(r["trigger"], r["threshold"]) for r in s["at_budget"]]
             == [(r["trigger"], r["threshold"]) for r in alone["at_budget"]])
+    for t in s["settings"]["triggers"][:2]:
+        picked = {r["threshold"] for r in alone["at_budget"] if r["trigger"] == t["name"]}
+        assert set(t["thresholds"]) == (picked - {None} or {choose.trigger(t["name"])
+                                                            .thresholds[-1]})
     assert demo_loop.loop_words(s)[0].startswith("  In the loop: used as the trigger of a 9 m/s²")
     files = demo_loop.write_loop_report(tmp_path, [s])
     assert "In the loop" in files.markdown.read_text() and files.json.is_file()
@@ -149,3 +157,22 @@ def test_the_demo_summary_carries_the_loop_and_says_where_its_report_is(tmp_path
         tmp_path / "reports" / "demo" / "supervision.html")
     skipped = demo.DemoResult(result.root, result.reports, {})
     assert "In the loop" not in demo.summary_text(skipped)
+
+
+def test_records_narrowed_to_the_chosen_thresholds_choose_them_again() -> None:
+    select = runs("v", 10, 4, {6: 1}, middle_misses=1)
+    for r in select:
+        r["unsupervised"]["calm_s"] = 180.0  # ≤ 5 resolved: the two budgets choose apart
+    plain = Settings("highway-cut-in", "demo", SETTINGS.triggers[:2])
+    full = summarise_supervision(plain, select, demo_loop.BUDGETS_PER_H, resamples=1)
+    chosen = demo_loop._chosen(plain, select)
+    assert chosen == {"fusion": [THRESHOLDS[0], THRESHOLDS[1]], "ttc-2d": [THRESHOLDS[0]]}
+    triggers = list(plain.triggers)
+    narrow = Settings("highway-cut-in", "demo", tuple(demo_loop.narrowed(t, chosen[t.name])
+                                                      for t in triggers))
+    assert narrow.trigger("fusion").targets == ("FPR 0.05", "FPR 0.01")
+    again = summarise_supervision(narrow, demo_loop.narrowed_records(select, triggers, chosen),
+                                  demo_loop.BUDGETS_PER_H, resamples=1)
+    key = ("budget_per_h", "trigger", "threshold", "prevented_share", "false_interventions")
+    assert [[r[k] for k in key] for r in again["at_budget"]] == [
+        [r[k] for k in key] for r in full["at_budget"]]

@@ -18,7 +18,8 @@ import multiprocessing as mp
 import os
 import time
 from collections.abc import Callable, Collection, Iterable
-from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -116,12 +117,21 @@ def collect(settings: Settings, plan: Plan, errors: list[tuple[str, str]],
                              len(plan.runs) - len(plan.jobs), wall_s)
 
 
+def worker_pool(workers: int) -> ProcessPoolExecutor:
+    """Spawned worker processes that die with this one (module doc); one pool can serve several
+    supervisions (`run_supervision(pool=...)`), each worker loading its triggers once."""
+    return ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
+                               initializer=die_with_parent, initargs=(os.getpid(),))
+
+
 def run_supervision(root: DataRoot, settings: Settings, *, workers: int = 1,
                     progress: Callable[[Iterable], Iterable] | None = None,
                     limit: int | None = None, skip: int = 0,
-                    ids: Collection[str] | None = None) -> SupervisionResult:
+                    ids: Collection[str] | None = None,
+                    pool: Executor | None = None) -> SupervisionResult:
     """Supervise every run of the batch (of `ids`, if given; the first `limit`, if given,
-    after the first `skip`) not done yet."""
+    after the first `skip`) not done yet: here if `workers` is 1, else on `pool` (a
+    `worker_pool`, kept open) or on a pool of `workers` made for it."""
     if workers < 1:
         raise ValueError(f"--workers must be at least 1, got {workers}")
     t0 = time.perf_counter()
@@ -135,9 +145,8 @@ def run_supervision(root: DataRoot, settings: Settings, *, workers: int = 1,
             except Exception as exc:  # noqa: BLE001 - reported per run, the batch goes on
                 errors.append((job.spec.scenario_id, f"{type(exc).__name__}: {exc}"))
     else:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
-                                 initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
-            futures: dict[Future, RunJob] = {pool.submit(supervise_run, j): j
+        with nullcontext(pool) if pool is not None else worker_pool(workers) as running:
+            futures: dict[Future, RunJob] = {running.submit(supervise_run, j): j
                                              for j in plan.jobs}
             for fut in wrap(as_completed(futures)):
                 try:

@@ -18,6 +18,7 @@ from evoeye.evaluation.supervision.batch import (
     plan_supervision,
     record_path,
     run_supervision,
+    worker_pool,
 )
 from evoeye.evaluation.supervision.sweep import (
     ReproductionError,
@@ -208,3 +209,20 @@ def test_a_run_list_supervises_only_those_runs_of_the_batch(sup, result) -> None
     assert some.done_before == 2 and some.folder == result.folder  # the same records
     with pytest.raises(ValueError, match="1 run.s. not in batch sup of highway-cut-in, e.g. x"):
         plan_supervision(sup.root, result.settings, ids=[order[0], "x"])
+
+
+def test_one_pool_of_workers_serves_two_supervisions_and_stays_open(sup, result) -> None:
+    from dataclasses import replace
+
+    order = [s.scenario_id for s, _ in plan_supervision(sup.root, result.settings).runs]
+    here = replace(result.settings, logs="none", software_version="pool-a")
+    there = replace(here, software_version="pool-b")  # another key: a folder of its own
+    with worker_pool(2) as pool:
+        a = run_supervision(sup.root, here, workers=2, ids=order[:2], pool=pool)
+        b = run_supervision(sup.root, there, workers=2, ids=order[:2], pool=pool)
+        assert pool.submit(sum, [1, 2]).result() == 3  # still open
+    assert a.errors == b.errors == [] and a.folder != b.folder
+    assert a.records == b.records and len(a.records) == 2
+    by_id = {r["scenario_id"]: r for r in result.records}  # what the runs gave in-process
+    assert [r["unsupervised"] for r in a.records] == [by_id[i]["unsupervised"]
+                                                      for i in order[:2]]
