@@ -176,3 +176,18 @@ def test_records_narrowed_to_the_chosen_thresholds_choose_them_again() -> None:
     key = ("budget_per_h", "trigger", "threshold", "prevented_share", "false_interventions")
     assert [[r[k] for k in key] for r in again["at_budget"]] == [
         [r[k] for k in key] for r in full["at_budget"]]
+
+
+def test_validation_runs_without_calm_driving_resolve_nothing_and_say_so() -> None:
+    select = runs("v", 6, 6, {})  # every validation run collides: no calm driving at all
+    for r in select:
+        r["unsupervised"]["calm_s"] = 0.0
+    s = summarise_supervision(SETTINGS, runs("t", 12, 4, {}), demo_loop.BUDGETS_PER_H,
+                              resamples=50, select=select)
+    s["errors"] = []
+    (line,) = demo_loop.loop_words(s)
+    assert ("their 0.00 h of driving where none was justified cannot resolve ≤ 1 or ≤ 5 an "
+            "hour: they hold none of it") in line
+    # no false-intervention rate on them: no threshold can be chosen, each trigger stays off
+    assert ("the FusionMonitor stayed off: none of its thresholds stayed within that on the "
+            "validation runs. TTC-2D, its threshold chosen the same way, stayed off") in line
