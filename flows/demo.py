@@ -2,7 +2,8 @@
 
 The steps of `evoeye.results.demo`, each a flow or task run: simulate fresh runs of every logical
 scenario that ships a demo monitor (or of `--scenario`'s) and ingest them; measure the
-FusionMonitor shipped with evoeye against the rule-based baselines on their test runs; one
+FusionMonitor shipped with evoeye against the rule-based baselines on their test runs; the
+FusionMonitor and TTC-2D as triggers of an emergency brake on those runs (the closed loop); one
 evolution round per scenario from the shipped monitor; then the report and the plain-words
 summary, printed at the end and published as an artifact. With no PREFECT_API_URL one temporary
 API server serves the whole run.
@@ -48,6 +49,13 @@ def evaluate_shipped(root: DataRoot, scenario: str) -> dict:
     return steps.evaluate_shipped(root, scenario)
 
 
+@task(cache_policy=NONE, task_run_name="in-the-loop-{scenario}")
+def supervise_shipped(root: DataRoot, scenario: str, workers: int) -> dict:
+    """The shipped monitor and TTC-2D as triggers of the production fallback on the test runs,
+    every operating point chosen on the validation runs."""
+    return steps.supervise_shipped(root, scenario, workers)
+
+
 @flow(name="evoeye-demo", log_prints=True, flow_run_name=named(DemoParams.run_name))
 def demo_flow(params: DemoParams) -> dict[str, Any]:
     """The demo end to end; its summary, and where the results are."""
@@ -62,6 +70,7 @@ def demo_flow(params: DemoParams) -> dict[str, Any]:
                                            workers=params.workers, batch=steps.BATCH))
     ingest_flow(IngestParams(root=root))
     result = steps.DemoResult(data, [evaluate_shipped(data, s) for s in scenarios])
+    result.loop = {s: supervise_shipped(data, s, params.workers) for s in scenarios}
     for scenario in scenarios:
         cfg = steps.campaign_config(data, scenario, params.evolve_runs)
         out = evolution_flow(EvolveParams.of(cfg, root, max_rounds=1, assess=True))

@@ -46,11 +46,13 @@ def demo(
         "--evolve-runs", min=1, help="Runs of the evolution round, per scenario.")] = 4,
 ) -> None:
     """Simulate fresh runs, measure the shipped FusionMonitor against the rule-based baselines,
-    run one evolution round, and say in plain words what they achieve.
+    use each as the trigger of an emergency brake, run one evolution round, and say in plain
+    words what they achieve.
 
     Per scenario: collisions warned of, how early, and false alarms per hour of safe driving,
-    each with its 95 % interval; then what the evolution round changed. Exits 3 if any run
-    failed or any log was quarantined.
+    each with its 95 % interval; in the loop, collisions prevented and caused and false
+    interventions per hour, beside the oracle; then what the evolution round changed. Exits 3
+    if any run failed or any log was quarantined.
     """
     from evoeye.results import demo as steps
 
@@ -69,15 +71,18 @@ def demo(
         ingest_into(data)
     except typer.Exit as partial:
         code = ExitCode(partial.exit_code)
-    with StepBar("demo", total=2 * len(names)) as bar:
-        reports, rounds = [], {}
+    with StepBar("demo", total=3 * len(names)) as bar:
+        reports, rounds, loop = [], {}, {}
         for name in names:
             bar(f"{name}: the shipped FusionMonitor against the rule-based baselines")
             reports.append(steps.evaluate_shipped(data, name))
         for name in names:
+            bar(f"{name}: the FusionMonitor and TTC-2D as triggers of an emergency brake")
+            loop[name] = steps.supervise_shipped(data, name, workers)
+        for name in names:
             bar(f"{name}: one evolution round of {evolve_runs} runs")
             rounds[name] = steps.run_round(data, name, evolve_runs)
-    result = steps.DemoResult(data, reports, rounds)
+    result = steps.DemoResult(data, reports, rounds, loop=loop)
     steps.write_summary(result)
     console = out()
     console.print("\n" + steps.summary_text(result), markup=False, highlight=False)

@@ -6,11 +6,14 @@
    seed), so these are fresh to them.
 2. Per scenario, evaluate the shipped FusionMonitor against the rule-based baselines on the test
    runs, every threshold calibrated on the validation runs (`SPLITS`).
-3. Per scenario, one round of BlindSpotEvolver from the shipped monitor (G_0): propose
+3. Per scenario, the shipped monitor in the loop (`demo_loop`): it and TTC-2D each trigger the
+   production fallback on the test runs, every operating point chosen on the validation runs;
+   collisions prevented and caused, false interventions per hour, the lead, beside the oracle.
+4. Per scenario, one round of BlindSpotEvolver from the shipped monitor (G_0): propose
    `evolve_runs` runs where G_0 errs, simulate them, fine-tune G_1 on the demo's training runs
    and the new ones, and assess G_0 and G_1 on the test runs and on G_0's Hard Set.
-4. Write the report (`<root>/reports/demo/`) and the plain-words summary (`summary.md` beside
-   it), which the command prints.
+5. Write the reports (`<root>/reports/demo/`: the evaluation's and the loop's) and the
+   plain-words summary (`summary.md` beside them), which the command prints.
 
 The command line and the flow (`flows/demo.py`) run the same steps; this module holds what they
 share: the settings, the evaluation, the campaign of each round and the summary.
@@ -29,6 +32,13 @@ from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.report import change_words
 from evoeye.monitor.pretrained import install, packaged_cards, packaged_versions
 from evoeye.paths import DataRoot
+from evoeye.results.demo_loop import (
+    LOOP_NOTE,
+    REPORT_STEM,
+    loop_words,
+    supervise_demo,
+    write_loop_report,
+)
 from evoeye.scenarios import SCENARIO_SPECS, simulable
 from evoeye.store import SplitSpec
 from evoeye.store.feedback import RoundRow
@@ -43,20 +53,25 @@ EVOLVE_SEED = 0
 
 @dataclass
 class DemoResult:
-    """What the demo produced: the evaluation dicts, each scenario's rounds, where it all is."""
+    """What the demo produced: the evaluation dicts, each scenario's rounds and closed-loop
+    summary (`demo_loop`), where it all is."""
 
     root: DataRoot
     reports: list[dict]
     rounds: dict[str, list[RoundRow]] = field(default_factory=dict)
     report_dir: Path | None = None
+    loop: dict[str, dict] = field(default_factory=dict)
 
     def paths(self) -> list[tuple[str, Path]]:
         out = [("MCAP logs (open in Foxglove or Lichtblick)", self.root.runs),
                ("warehouse (Parquet + DuckDB; `evoeye sql`)", self.root.warehouse),
                ("monitors and their cards", self.root.monitors)]
         if self.report_dir is not None:
-            out += [("report (Markdown, HTML, JSON)", self.report_dir / "report.html"),
-                    ("this summary", self.report_dir / SUMMARY_FILE)]
+            out += [("report (Markdown, HTML, JSON)", self.report_dir / "report.html")]
+            if self.loop:
+                out.append(("the monitor in the loop (Markdown, HTML, JSON)",
+                            self.report_dir / f"{REPORT_STEM}.html"))
+            out.append(("this summary", self.report_dir / SUMMARY_FILE))
         return out
 
 
@@ -113,6 +128,13 @@ def evaluate_shipped(root: DataRoot, scenario: str) -> dict:
     return report.to_dict()
 
 
+def supervise_shipped(root: DataRoot, scenario: str, workers: int = 1) -> dict:
+    """The shipped monitor and TTC-2D as triggers of the production fallback on the demo's test
+    runs, every operating point chosen on its validation runs (`demo_loop`)."""
+    return supervise_demo(root, scenario, shipped_monitor(root, scenario), BATCH, SPLITS,
+                          workers)
+
+
 def campaign_config(root: DataRoot, scenario: str, runs: int = EVOLVE_RUNS) -> CampaignConfig:
     """The demo's evolution round: BlindSpotEvolver from the shipped monitor, `runs` runs,
     fine-tuned by the replay update (the shipped monitor learned from runs this root does not
@@ -132,6 +154,8 @@ def write_summary(result: DemoResult) -> None:
 
     files = write_report(result.root, result.reports, REPORT)
     result.report_dir = files.folder
+    if result.loop:
+        write_loop_report(files.folder, list(result.loop.values()))
     (files.folder / SUMMARY_FILE).write_text(summary_text(result) + "\n", encoding="utf-8")
 
 
@@ -171,11 +195,16 @@ def summary_text(result: DemoResult) -> str:
              point_note(result.reports), ""]
     for report in result.reports:
         lines += summary(report)
+        loop = result.loop.get(report["logical_scenario"])
+        if loop is not None:
+            lines += loop_words(loop)
         rows = result.rounds.get(report["logical_scenario"])
         if rows is not None:
             lines.append(f"  Evolution: {change_words(rows)}")
         lines.append("")
     lines.append(WHICH.format(runs=_trained_on(r["logical_scenario"] for r in result.reports)))
+    if result.loop:
+        lines.append(LOOP_NOTE)
     if any(r["dataset"]["test"]["violations"] < MIN_COLLISIONS for r in result.reports):
         lines.append(f"Fewer than {MIN_COLLISIONS} test collisions in a scenario: its figures "
                      "carry wide intervals and no monitor is called better there.")

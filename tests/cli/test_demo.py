@@ -24,6 +24,7 @@ def test_demo_prints_the_summary_per_scenario_and_where_the_results_are(tmp_path
     for scenario in shipped:
         assert f"{scenario_words(scenario)} — " in text
     assert text.count("Best rule-based baseline (") == text.count("Evolution: ") == len(shipped)
+    assert text.count("  In the loop: ") >= len(shipped)  # measured, or said why not
     where = text.split("Where the results are:")[1]
     assert str(root.runs) in where and str(root.path / "reports" / "demo") in where
     summary = (root.path / "reports" / "demo" / "summary.md").read_text()

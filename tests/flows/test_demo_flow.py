@@ -25,12 +25,15 @@ def test_the_demo_flow_ends_with_its_summary_and_where_the_results_are(
         block = text.split(f"{scenario_words(scenario)} — ")[1].split("\n\n")[0]
         assert "FusionMonitor warned of " in block and " of safe driving (" in block
         assert "Best rule-based baseline (" in block
+        assert "  In the loop: used as the trigger of a 9 m/s² emergency brake" in block
         assert "Evolution: 1 round(s) added 2 runs" in block
         assert "too few to compare" in block  # 12 runs: a handful of test collisions
     paths = dict(out["paths"])
     summary = Path(paths["this summary"])
     assert summary.read_text().strip() == text.strip()
     assert Path(paths["report (Markdown, HTML, JSON)"]).is_file()
+    assert "In the loop" in Path(paths["the monitor in the loop (Markdown, HTML, JSON)"]
+                                 ).read_text()
     shipped = len(steps.plan()[0])
     assert len(list(root.runs.rglob("*.mcap"))) == shipped * (12 + 2)  # demo runs + the rounds'
     assert text in latest_artifact("evoeye-demo")

@@ -17,8 +17,9 @@ from __future__ import annotations
 import multiprocessing as mp
 import os
 import time
-from collections.abc import Callable, Iterable
-from concurrent.futures import Future, ProcessPoolExecutor, as_completed
+from collections.abc import Callable, Collection, Iterable
+from concurrent.futures import Executor, Future, ProcessPoolExecutor, as_completed
+from contextlib import nullcontext
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -84,13 +85,21 @@ class Plan:
 
 
 def plan_supervision(root: DataRoot, settings: Settings, limit: int | None = None,
-                     skip: int = 0) -> Plan:
+                     skip: int = 0, ids: Collection[str] | None = None) -> Plan:
     """Open the supervision's folder (its killed writers' `.tmp` files removed) and list the
-    batch's runs (the first `limit`, if given, after the first `skip`: runs a screening has
-    seen, left out of a confirmation) and the jobs of those without a record."""
+    batch's runs (only those of `ids` if given, e.g. one split's; the first `limit`, if given,
+    after the first `skip`: runs a screening has seen, left out of a confirmation) and the jobs
+    of those without a record. ValueError for an id the batch does not hold."""
     if skip < 0:
         raise ValueError(f"--skip must be >= 0, got {skip}")
-    runs = batch_runs(root, settings.scenario, settings.batch)[:limit][skip:]
+    runs = batch_runs(root, settings.scenario, settings.batch)
+    if ids is not None:
+        missing = set(ids) - {spec.scenario_id for spec, _ in runs}
+        if missing:
+            raise ValueError(f"{len(missing)} run(s) not in batch {settings.batch} of "
+                             f"{settings.scenario}, e.g. {min(missing)}")
+        runs = [(spec, m) for spec, m in runs if spec.scenario_id in ids]
+    runs = runs[:limit][skip:]
     folder = open_folder(root, settings)
     _stale(folder)
     jobs = [RunJob(str(root.path), str(folder), settings, spec, meta) for spec, meta in runs
@@ -108,15 +117,25 @@ def collect(settings: Settings, plan: Plan, errors: list[tuple[str, str]],
                              len(plan.runs) - len(plan.jobs), wall_s)
 
 
+def worker_pool(workers: int) -> ProcessPoolExecutor:
+    """Spawned worker processes that die with this one (module doc); one pool can serve several
+    supervisions (`run_supervision(pool=...)`), each worker loading its triggers once."""
+    return ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
+                               initializer=die_with_parent, initargs=(os.getpid(),))
+
+
 def run_supervision(root: DataRoot, settings: Settings, *, workers: int = 1,
                     progress: Callable[[Iterable], Iterable] | None = None,
-                    limit: int | None = None, skip: int = 0) -> SupervisionResult:
-    """Supervise every run of the batch (the first `limit`, if given, after the first
-    `skip`) not done yet."""
+                    limit: int | None = None, skip: int = 0,
+                    ids: Collection[str] | None = None,
+                    pool: Executor | None = None) -> SupervisionResult:
+    """Supervise every run of the batch (of `ids`, if given; the first `limit`, if given,
+    after the first `skip`) not done yet: here if `workers` is 1, else on `pool` (a
+    `worker_pool`, kept open) or on a pool of `workers` made for it."""
     if workers < 1:
         raise ValueError(f"--workers must be at least 1, got {workers}")
     t0 = time.perf_counter()
-    plan = plan_supervision(root, settings, limit, skip)
+    plan = plan_supervision(root, settings, limit, skip, ids)
     errors: list[tuple[str, str]] = []
     wrap = progress or (lambda it: it)
     if workers == 1:
@@ -126,9 +145,8 @@ def run_supervision(root: DataRoot, settings: Settings, *, workers: int = 1,
             except Exception as exc:  # noqa: BLE001 - reported per run, the batch goes on
                 errors.append((job.spec.scenario_id, f"{type(exc).__name__}: {exc}"))
     else:
-        with ProcessPoolExecutor(max_workers=workers, mp_context=mp.get_context("spawn"),
-                                 initializer=die_with_parent, initargs=(os.getpid(),)) as pool:
-            futures: dict[Future, RunJob] = {pool.submit(supervise_run, j): j
+        with nullcontext(pool) if pool is not None else worker_pool(workers) as running:
+            futures: dict[Future, RunJob] = {running.submit(supervise_run, j): j
                                              for j in plan.jobs}
             for fut in wrap(as_completed(futures)):
                 try:

@@ -138,10 +138,22 @@ def chosen_on(summary: dict) -> str:
     if summary.get("operating_points") == "validation":
         return (f"Each trigger's operating point at a budget was chosen on "
                 f"{summary['selection_runs']} other supervised runs (validation) and is reported "
-                "here as it is on these runs: its false interventions may exceed the budget.")
+                "here as it is on these runs: its false interventions may exceed the budget."
+                + _resolution(summary.get("selection_safe_h")))
     return ("Each trigger's operating point at a budget was chosen on these very runs (no "
             "selection batch was given): optimistic, since the choice saw the runs it is "
             "reported on.")
+
+
+def _resolution(hours: float | None) -> str:
+    """What the selection runs' calm hours resolve: one false intervention there per hour."""
+    if hours is None:
+        return ""
+    if hours <= 0:
+        return (" They hold no driving where no intervention was justified: every budget means "
+                "none there.")
+    return (f" Their {hours:.2f} h of driving where no intervention was justified make one false "
+            f"intervention {1 / hours:.2g} per hour: a budget below that means none there.")
 
 
 def _p(difference: dict) -> str:
@@ -195,9 +207,12 @@ def _triggers(summary: dict) -> list[tuple[str, str]]:
     return list(dict.fromkeys((p["trigger"], p["label"]) for p in summary["points"]))
 
 
-def markdown_report(summaries: list[dict], figures: dict[str, str] | None = None) -> str:
-    """Every scenario's supervision; `figures` maps a scenario to its curve figure's file."""
+def markdown_report(summaries: list[dict], figures: dict[str, str] | None = None,
+                    preface: tuple[str, ...] = ()) -> str:
+    """Every scenario's supervision; `figures` maps a scenario to its curve figure's file;
+    `preface`: paragraphs before the headlines (e.g. the demo's plain words)."""
     parts = ["# Monitor in the loop: the supervisor's operating curves", ""]
+    parts += [line for p in preface for line in (p, "")]
     parts += [line for s in summaries for line in (headline(s), "")] + [TERMS, ""]
     for s in summaries:
         parts += [f"## {s['scenario']}", "", _setup(s), "", chosen_on(s), ""]
@@ -238,10 +253,12 @@ def lead_svg(summary: dict) -> str:
                       title=f"Prevented against lead, beside the oracle, {summary['scenario']}")
 
 
-def html_report(summaries: list[dict], title: str = "evoeye supervision report") -> str:
+def html_report(summaries: list[dict], title: str = "evoeye supervision report",
+                preface: tuple[str, ...] = ()) -> str:
     """One self-contained HTML page: inline CSS and SVG, no scripts, no external resources."""
     stamp = f"{datetime.now(UTC):%Y-%m-%d %H:%M} UTC"
     body = [f"<h1>{escape(title)}</h1>", f'<p class="note">Generated {stamp}.</p>']
+    body += [f"<p>{escape(p)}</p>" for p in preface]
     body += [f"<p>{escape(headline(s)).replace('**', '')}</p>" for s in summaries]
     body.append(f'<p class="note">{escape(TERMS)}</p>')
     for s in summaries:
@@ -263,9 +280,15 @@ def html_report(summaries: list[dict], title: str = "evoeye supervision report")
 def write_report(root: DataRoot, summaries: list[dict], name: str | None = None) -> ReportFiles:
     """supervision.md, report.html and report.json under `<root>/reports/<name>/`."""
     files = ReportFiles.under(root, name, "supervision", "supervision.md")
-    files.markdown.write_text(markdown_report(summaries), encoding="utf-8")
-    files.html.write_text(html_report(summaries, f"evoeye supervision — {files.folder.name}"),
-                          encoding="utf-8")
+    return write_files(files, summaries, f"evoeye supervision — {files.folder.name}")
+
+
+def write_files(files: ReportFiles, summaries: list[dict], title: str,
+                preface: tuple[str, ...] = ()) -> ReportFiles:
+    """The report's Markdown, HTML and JSON as `files` names them (`preface`: paragraphs before
+    the headlines, in both pages)."""
+    files.markdown.write_text(markdown_report(summaries, preface=preface), encoding="utf-8")
+    files.html.write_text(html_report(summaries, title, preface), encoding="utf-8")
     files.json.write_text(json.dumps(summaries, indent=1) + "\n", encoding="utf-8")
     return files
 

@@ -346,6 +346,8 @@ def summarise_supervision(settings: Settings, records: list[dict],
         "points": points, "at_budget": budget_rows, "differences": differences,
         "oracle": ceiling, "operating_points": "test" if select is None else "validation",
         "selection_runs": None if sel is None else len(sel),
+        "selection_safe_h": None if sel is None else float(  # what resolves a budget there
+            sum(r["unsupervised"]["calm_s"] for r in sel) / 3600.0),
         "simulations": {"shared": sims + len(ok), "alarmed": alarmed + len(ok),
                         "naive": len(ok) * (1 + sum(len(t.thresholds) for t in settings.triggers))},
         "resamples": resamples, "confidence": CONFIDENCE, "budgets_per_h": list(budgets),
@@ -353,7 +355,8 @@ def summarise_supervision(settings: Settings, records: list[dict],
     }
 
 
-POINT_FIELDS = ("threshold", "scale", "prevented_share", "false_interventions_per_h",
+POINT_FIELDS = ("threshold", "scale", "prevented_share", "collisions_prevented",
+                "false_interventions", "false_interventions_per_h",
                 "false_interventions_ci", "false_interventions_poisson_ci", "false_alarms_per_h",
                 "collisions_caused", "lead_s", "lead_ci", "prevented_by_mechanism")
 
@@ -373,6 +376,7 @@ def _point_fields(p: dict | None) -> dict:
     """An operating point's figures; supervision off for None."""
     if p is None:
         return {"threshold": None, "scale": None, "prevented_share": 0.0,
+                "collisions_prevented": 0, "false_interventions": 0,
                 "false_interventions_per_h": 0.0,
                 "false_interventions_ci": [0.0, 0.0], "false_interventions_poisson_ci": [0.0, 0.0],
                 "false_alarms_per_h": 0.0, "collisions_caused": 0, "lead_s": None,

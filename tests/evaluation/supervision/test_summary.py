@@ -203,6 +203,11 @@ def test_operating_points_are_chosen_on_the_selection_runs_and_reported_on_these
     from evoeye.evaluation.supervision.report import markdown_report
 
     assert "chosen on 40 other supervised runs" in markdown_report([s])
+    hours = 40 * SAFE_S / 3600  # what resolves a budget on them: one there is 5 an hour
+    assert s["selection_safe_h"] == pytest.approx(hours)
+    assert (f"Their {hours:.2f} h of driving where no intervention was justified make one false "
+            f"intervention {1 / hours:.2g} per hour: a budget below that means none there."
+            ) in markdown_report([s])
     assert "chosen on these very runs" in markdown_report([leaky])  # and says so
     assert next(r for r in leaky["at_budget"] if r["trigger"] == "fusion")["threshold"] == 0.9
 

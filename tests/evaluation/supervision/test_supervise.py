@@ -13,7 +13,13 @@ import pytest
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.evaluation.mechanism import MECHANISMS
 from evoeye.evaluation.supervision import check_held_out, supervise
-from evoeye.evaluation.supervision.batch import batch_runs, plan_supervision, record_path
+from evoeye.evaluation.supervision.batch import (
+    batch_runs,
+    plan_supervision,
+    record_path,
+    run_supervision,
+    worker_pool,
+)
 from evoeye.evaluation.supervision.sweep import (
     ReproductionError,
     RunJob,
@@ -194,3 +200,29 @@ def test_skip_reports_on_the_runs_after_the_first_and_reuses_their_records(sup, 
     assert all(r == by_id[r["scenario_id"]] for r in later.records)
     with pytest.raises(ValueError, match="--skip"):
         plan_supervision(sup.root, result.settings, skip=-1)
+
+
+def test_a_run_list_supervises_only_those_runs_of_the_batch(sup, result) -> None:
+    order = [s.scenario_id for s, _ in plan_supervision(sup.root, result.settings).runs]
+    some = run_supervision(sup.root, result.settings, ids=[order[3], order[1]])
+    assert [r["scenario_id"] for r in some.records] == [order[1], order[3]]  # batch order
+    assert some.done_before == 2 and some.folder == result.folder  # the same records
+    with pytest.raises(ValueError, match="1 run.s. not in batch sup of highway-cut-in, e.g. x"):
+        plan_supervision(sup.root, result.settings, ids=[order[0], "x"])
+
+
+def test_one_pool_of_workers_serves_two_supervisions_and_stays_open(sup, result) -> None:
+    from dataclasses import replace
+
+    order = [s.scenario_id for s, _ in plan_supervision(sup.root, result.settings).runs]
+    here = replace(result.settings, logs="none", software_version="pool-a")
+    there = replace(here, software_version="pool-b")  # another key: a folder of its own
+    with worker_pool(2) as pool:
+        a = run_supervision(sup.root, here, workers=2, ids=order[:2], pool=pool)
+        b = run_supervision(sup.root, there, workers=2, ids=order[:2], pool=pool)
+        assert pool.submit(sum, [1, 2]).result() == 3  # still open
+    assert a.errors == b.errors == [] and a.folder != b.folder
+    assert a.records == b.records and len(a.records) == 2
+    by_id = {r["scenario_id"]: r for r in result.records}  # what the runs gave in-process
+    assert [r["unsupervised"] for r in a.records] == [by_id[i]["unsupervised"]
+                                                      for i in order[:2]]
