@@ -1,13 +1,14 @@
 """RQ1 and the monitor ablation over the study's training seeds.
 
-Per logical scenario and training seed s: the full FusionMonitor (L = 5, every module input)
-trained with seed s, each trained baseline (AEM, the context-only control) fitted with seed s,
-and the rules (TTC, TTC-2D, RSS, RSS-2s), which have no seed and so the same figures for every
-s. The ablation trains every variant (L ∈ context_lens with every input; the input subsets at
-L = 5) with the same seeds; its "L=5" row is the RQ1 FusionMonitor (the same units), its
-reference rows are the RQ1 baselines that `ablation.REFERENCES` names. Methods and variants
-trained with the same seed on the same data are compared pair by pair (`evoeye.results.tables`).
-A recipe's seeds the ledger lacks train together (`units.trained_versions`): the same versions.
+Per logical scenario and training seed s: the full FusionMonitor (every module input; L = 5, or
+the context the study's recipe fixes on the scenario, `fusion_context_len`) trained with seed s,
+each trained baseline (AEM, the context-only control) fitted with seed s, and the rules (TTC,
+TTC-2D, RSS, RSS-2s), which have no seed and so the same figures for every s. The ablation
+trains every variant (L ∈ context_lens with every input; the input subsets at L = 5) with the
+same seeds; its "L=5" row is the RQ1 FusionMonitor (the same units), its reference rows are the
+RQ1 baselines that `ablation.REFERENCES` names. Methods and variants trained with the same seed
+on the same data are compared pair by pair (`evoeye.results.tables`). A recipe's seeds the
+ledger lacks train together (`units.trained_versions`): the same versions.
 """
 
 from __future__ import annotations
@@ -20,6 +21,14 @@ from evoeye.results.units import baseline, test_figures, trained_versions, train
 
 FUSION_LABEL = FAMILIES[DEFAULT_FAMILY].label  # "FusionMonitor"
 FULL_CONTEXT_LEN = 5
+
+
+def fusion_context_len(recipe: str, scenario: str) -> int:
+    """RQ1's FusionMonitor context on `scenario`: the one `recipe`'s network fixes there (the
+    lookahead recipes'), else FULL_CONTEXT_LEN."""
+    from evoeye.monitor.recipes import recipe_network
+
+    return recipe_network(recipe, scenario).get("context_len", FULL_CONTEXT_LEN)
 
 
 def _fusion_rows(study: Study, scenario: str, context_len: int,
@@ -50,7 +59,8 @@ def rq1(study: Study, scenario: str) -> dict:
     """{"seeds", "methods": {name: {"versions", "figures"}}}: the FusionMonitor, then every
     baseline of the config, each with one entry per training seed."""
     study.say(f"{scenario}: RQ1 over training seeds {list(study.config.training_seeds)}")
-    methods = {FUSION_LABEL: _fusion_rows(study, scenario, FULL_CONTEXT_LEN, MODULES)}
+    methods = {FUSION_LABEL: _fusion_rows(
+        study, scenario, fusion_context_len(study.config.recipe, scenario), MODULES)}
     for name in study.config.baselines:
         methods[name] = _baseline_rows(study, scenario, name)
     return {"seeds": list(study.config.training_seeds), "methods": methods}
