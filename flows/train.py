@@ -12,7 +12,7 @@ from pydantic import BaseModel, Field, field_validator
 
 from evoeye.evaluation.table import pct
 from evoeye.monitor.inputs import parse_modules
-from evoeye.monitor.recipes import DEFAULT_RECIPE, recipe_params
+from evoeye.monitor.recipes import COMMAND_RECIPE, recipe_params
 from evoeye.paths import DataRoot
 from evoeye.store import SplitSpec
 from flows.published import named, publish, train_markdown
@@ -25,12 +25,12 @@ class TrainFlowParams(BaseModel):
     scenario: str | None = "highway-cut-in"
     train_sql: str | None = None  # SQL returning scenario_id: overrides the train split
     val_sql: str | None = None  # … and the validation split
-    context_len: int | None = Field(None, ge=1, le=64)  # None: 5, or the parent's
+    context_len: int | None = Field(None, ge=1, le=64)  # None: the recipe's, or the parent's
     horizon_s: float = Field(3.0, gt=0.0)
     modules: str | None = None  # an ABLATIONS name or a comma list of MODULES; None: all
     seed: int = 0
     split_seed: int = 0
-    recipe: str = DEFAULT_RECIPE  # evoeye.monitor.recipes; the fields below override it
+    recipe: str = COMMAND_RECIPE  # evoeye.monitor.recipes; the fields below override it
     epochs: int | None = Field(None, ge=1)  # None: the recipe's
     patience: int | None = Field(None, ge=1)
     batch_size: int | None = Field(None, ge=1)

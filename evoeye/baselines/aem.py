@@ -81,7 +81,7 @@ AEM_RECIPES = {
 }
 # the lookahead recipes change the FusionMonitor's target and network only: v3's AEM, the same
 # weights and ledger units
-AEM_RECIPES |= {name: AEM_RECIPES["v3"] for name in ("lookahead-v1", "lookahead-v2")}
+AEM_RECIPES |= {name: AEM_RECIPES["v3"] for name in ("lookahead-v1",)}
 
 
 def aem_config(recipe: str | None = None, **overrides: Any) -> AEMConfig:

@@ -5,7 +5,7 @@ ADS_PROFILE_NAMES = ("default", "cautious", "firm-yield")  # evoeye.ads.profiles
 WORLD_NAMES = ("default", "follower")  # evoeye.sim.worlds.WORLD_NAMES
 SPLIT_SEED, TRAIN_FRAC, VAL_FRAC = 0, 0.5, 0.125  # evoeye.store.SplitSpec()
 # evoeye.monitor.recipes
-RECIPE_NAMES, DEFAULT_RECIPE = ("v1", "v2", "v3", "lookahead-v1", "lookahead-v2"), "v3"
+RECIPE_NAMES, COMMAND_RECIPE = ("v1", "v2", "v3", "lookahead-v1"), "lookahead-v1"
 STRATEGY_NAMES = ("evoeye", "no-feedback", "no-density", "uniform", "avfuzzer", "sobol",
                   "boundary", "disagreement", "evoeye-knn",
                   "evoeye-forest", "ce-is")  # evoeye.evolve.search.STRATEGIES

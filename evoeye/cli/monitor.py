@@ -10,8 +10,8 @@ import typer
 from evoeye.cli.app import app
 from evoeye.cli.choices import scenario_check, scenario_help
 from evoeye.cli.defaults import ABLATION_NAMES as ABLATIONS
+from evoeye.cli.defaults import COMMAND_RECIPE, RECIPE_NAMES, SPLIT_SEED, TARGET_FPRS, WARNING_K
 from evoeye.cli.defaults import CONTEXT_LEN as DEFAULT_CONTEXT_LEN
-from evoeye.cli.defaults import DEFAULT_RECIPE, RECIPE_NAMES, SPLIT_SEED, TARGET_FPRS, WARNING_K
 from evoeye.cli.defaults import HORIZON_S as DEFAULT_HORIZON_S
 from evoeye.cli.defaults import MODULE_NAMES as MODULES
 from evoeye.cli.errors import UserError
@@ -66,7 +66,8 @@ def train_command(
         SPLIT_SEED,
     recipe: Annotated[str, typer.Option(
         help=f"Training recipe, one of {', '.join(RECIPE_NAMES)}; the options below override "
-             "its values.")] = DEFAULT_RECIPE,
+             "its values (default: the monitor a supervisor's trigger needs, "
+             "docs/lookahead.md).")] = COMMAND_RECIPE,
     epochs: Annotated[int | None, typer.Option(
         min=1, help="At most this many epochs (default: the recipe's).")] = None,
     patience: Annotated[int | None, typer.Option(

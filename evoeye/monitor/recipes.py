@@ -15,21 +15,17 @@ by name, so a recipe, once used, is never changed: a better one gets a new name.
   correlated, so it learns less per epoch than random windows; the higher learning rate and the
   decay make up for it. BENCHMARKS.md has the measurements that chose it, and the paired
   comparison with v1 on RQ1's data.
-* "v3" (the default) — v2's FusionMonitor training, unchanged (the same weights; the card
-  names v3); what changed is the AEM baseline's part (`evoeye.baselines.aem.AEM_RECIPES`).
+* "v3" (DEFAULT_RECIPE: `train_monitor`'s, RQ1's, the campaigns' and the studies') — v2's
+  FusionMonitor training, unchanged (the same weights; the card names v3); what changed is the
+  AEM baseline's part (`evoeye.baselines.aem.AEM_RECIPES`).
 * "lookahead-v1" — a monitor for a safety supervisor's trigger (docs/lookahead.md): v3's
   training on the "critical" target (a collision or a critical approach within H, the
   supervisor's own judge of a justified intervention) and a network of its own
   (`RECIPE_NETWORKS`): a context of L = 20 frames (1 s) and the perceived relative kinematics
   (`evoeye.monitor.kinematics`). In the closed loop it warns early enough to act, rarely; its
-  frame metrics against Definition 1 are not RQ1's, so it is not the default.
-* "lookahead-v2" — lookahead-v1 with the context the scenario's danger needs
-  (`recipe_network`): on crossing traffic (unprotected-intersection) L = 5 frames, where a
-  crossing car's approach is in its lateral closing speed at any one frame and the 1 s context
-  prevented less in the closed loop; elsewhere lookahead-v1's L = 20 (a lead's braking builds up
-  over a second). Each scenario's context was chosen on the supervisor's selection runs and
-  confirmed on Test Sets of fresh seeds (docs/lookahead.md); a scenario not listed has had no
-  such choice made and gets L = 20.
+  frame metrics against Definition 1 are below v3's (docs/lookahead.md has RQ1 with it), so
+  v3 stays `train_monitor`'s default and the studies'; `evoeye train` trains lookahead-v1 unless
+  told (`COMMAND_RECIPE`).
 
 `keep_parent` is no recipe's choice but a caller's (a campaign's `keep_parent` option): the
 weights a training starts from — a fine-tune's (`init_from`) parent — are epoch 0 of its early
@@ -119,21 +115,12 @@ RECIPES["lookahead-v1"] = replace(RECIPES["v3"], recipe="lookahead-v1", target="
 # keeps its parent's
 RECIPE_NETWORKS: dict[str, dict[str, Any]] = {
     "lookahead-v1": {"context_len": 20, "kinematics": True},
-    "lookahead-v2": {"context_len": 20, "kinematics": True},
 }
-RECIPES["lookahead-v2"] = replace(RECIPES["lookahead-v1"], recipe="lookahead-v2")
-# where a recipe's network differs by scenario: {recipe: {scenario: FusionConfig fields}}
-SCENARIO_NETWORKS: dict[str, dict[str, dict[str, Any]]] = {
-    "lookahead-v2": {"unprotected-intersection": {"context_len": 5}},
-}
-DEFAULT_RECIPE = "v3"
+DEFAULT_RECIPE = "v3"  # train_monitor's, and what RQ1, campaigns and the studies record with
+# what `evoeye train` and flows.train train unless told: the monitor a safety supervisor's
+# trigger needs (docs/lookahead.md)
+COMMAND_RECIPE = "lookahead-v1"
 LEGACY_RECIPE = "v1"  # what a record made before recipes had names was trained with
-
-
-def recipe_network(recipe: str, scenario: str) -> dict[str, Any]:
-    """The FusionConfig fields recipe `recipe` fixes on `scenario` (none for most recipes)."""
-    return {**RECIPE_NETWORKS.get(recipe, {}),
-            **SCENARIO_NETWORKS.get(recipe, {}).get(scenario, {})}
 
 
 def recipe_params(recipe: str | None = None, **overrides: Any) -> TrainParams:

@@ -46,9 +46,9 @@ from evoeye.monitor.lookahead import PAUC_MAX_FPR, critical_target, critical_tim
 from evoeye.monitor.model import MODULES, FusionConfig, FusionNet
 from evoeye.monitor.protocol import Thresholds
 from evoeye.monitor.recipes import (
+    RECIPE_NETWORKS,
     TrainParams,
     card_hyperparameters,
-    recipe_network,
     recipe_params,
 )
 from evoeye.monitor.registry import load_monitor, save_version
@@ -152,7 +152,7 @@ def train_monitors(
     train_runs, val_runs = _selections(scenario, splits, train_runs, val_runs)
     parent = load_monitor(root, init_from) if init_from else None
     if parent is None:  # the recipe's network, where the caller says nothing else
-        preset = recipe_network(base.recipe, scenario)
+        preset = RECIPE_NETWORKS.get(base.recipe, {})
         context_len = context_len if context_len is not None else preset.get("context_len")
         kinematics = kinematics if kinematics is not None else preset.get("kinematics")
     config = _config(parent, context_len, modules, dropout, kinematics)

@@ -55,7 +55,7 @@ PAPER_TEST_RUNS = {n: s.paper_runs[0] for n, s in SCENARIO_SPECS.items() if s.pa
 PAPER_INITIAL_RUNS = {n: s.paper_runs[1] for n, s in SCENARIO_SPECS.items() if s.paper_runs}
 # training recipes (evoeye.monitor.recipes RECIPES, DEFAULT_RECIPE, LEGACY_RECIPE): a config
 # recorded before the recipe was one of its fields was trained with the legacy one
-RECIPES = ("v1", "v2", "v3", "lookahead-v1", "lookahead-v2")
+RECIPES = ("v1", "v2", "v3", "lookahead-v1")
 DEFAULT_RECIPE, LEGACY_RECIPE = "v3", "v1"
 RQ1_RUNS = 1300  # initial runs RQ1 and the monitor ablation train on, at least (module doc)
 TEST_SHARES = (0.8, 0.2)  # train, val shares of the initial runs when a test batch is held out

@@ -1,7 +1,7 @@
 """RQ1 and the monitor ablation over the study's training seeds.
 
 Per logical scenario and training seed s: the full FusionMonitor (every module input; L = 5, or
-the context the study's recipe fixes on the scenario, `fusion_context_len`) trained with seed s,
+the context the study's recipe fixes, `fusion_context_len`) trained with seed s,
 each trained baseline (AEM, the context-only control) fitted with seed s, and the rules (TTC,
 TTC-2D, RSS, RSS-2s), which have no seed and so the same figures for every s. The ablation
 trains every variant (L ∈ context_lens with every input; the input subsets at L = 5) with the
@@ -23,12 +23,12 @@ FUSION_LABEL = FAMILIES[DEFAULT_FAMILY].label  # "FusionMonitor"
 FULL_CONTEXT_LEN = 5
 
 
-def fusion_context_len(recipe: str, scenario: str) -> int:
-    """RQ1's FusionMonitor context on `scenario`: the one `recipe`'s network fixes there (the
-    lookahead recipes'), else FULL_CONTEXT_LEN."""
-    from evoeye.monitor.recipes import recipe_network
+def fusion_context_len(recipe: str) -> int:
+    """RQ1's FusionMonitor context: the one `recipe`'s network fixes (lookahead-v1's), else
+    FULL_CONTEXT_LEN."""
+    from evoeye.monitor.recipes import RECIPE_NETWORKS
 
-    return recipe_network(recipe, scenario).get("context_len", FULL_CONTEXT_LEN)
+    return RECIPE_NETWORKS.get(recipe, {}).get("context_len", FULL_CONTEXT_LEN)
 
 
 def _fusion_rows(study: Study, scenario: str, context_len: int,
@@ -60,7 +60,7 @@ def rq1(study: Study, scenario: str) -> dict:
     baseline of the config, each with one entry per training seed."""
     study.say(f"{scenario}: RQ1 over training seeds {list(study.config.training_seeds)}")
     methods = {FUSION_LABEL: _fusion_rows(
-        study, scenario, fusion_context_len(study.config.recipe, scenario), MODULES)}
+        study, scenario, fusion_context_len(study.config.recipe), MODULES)}
     for name in study.config.baselines:
         methods[name] = _baseline_rows(study, scenario, name)
     return {"seeds": list(study.config.training_seeds), "methods": methods}

@@ -79,11 +79,10 @@ class Study:
     @property
     def context_len(self) -> int:
         """The longest context any monitor of the study reads (windows are loaded at it): the
-        ablation's, and RQ1's FusionMonitor's under the study's recipe on each scenario."""
+        ablation's, and RQ1's FusionMonitor's under the study's recipe."""
         from evoeye.results.rq1 import fusion_context_len
 
-        return max((5, *self.config.context_lens,
-                    *(fusion_context_len(self.config.recipe, s) for s in self.config.scenarios)))
+        return max((5, *self.config.context_lens, fusion_context_len(self.config.recipe)))
 
     def runs(self, scenario: str, split: str) -> RunFilter:
         """A split's runs; train holds round-0 runs only (the initial data, D_init)."""

@@ -13,7 +13,7 @@ def test_help_defaults_equal_their_sources() -> None:
     from evoeye.monitor.families import evolvable_families
     from evoeye.monitor.inputs import ABLATIONS, MODULES
     from evoeye.monitor.protocol import TARGET_FPRS, WARNING_K
-    from evoeye.monitor.recipes import DEFAULT_RECIPE, RECIPES
+    from evoeye.monitor.recipes import COMMAND_RECIPE, RECIPES
     from evoeye.sim.worlds import WORLD_NAMES
     from evoeye.store import SplitSpec
     from evoeye.store.ingest import DEFAULT_RUNS_PER_PART
@@ -28,7 +28,7 @@ def test_help_defaults_equal_their_sources() -> None:
         "TARGET_FPRS": TARGET_FPRS, "WARNING_K": WARNING_K,
         "RUNS_PER_PART": DEFAULT_RUNS_PER_PART,
         "MODULE_NAMES": MODULES, "ABLATION_NAMES": tuple(ABLATIONS),
-        "RECIPE_NAMES": tuple(RECIPES), "DEFAULT_RECIPE": DEFAULT_RECIPE,
+        "RECIPE_NAMES": tuple(RECIPES), "COMMAND_RECIPE": COMMAND_RECIPE,
         "STRATEGY_NAMES": tuple(STRATEGIES), "FAMILY_NAMES": tuple(evolvable_families()),
         "METHOD_NAMES": tuple(methods()),
     }

@@ -22,6 +22,11 @@ def test_train_command_prints_version_metrics_and_card(tiny) -> None:
     card = read_card(tiny.root, version)
     assert card["context_len"] == 3 and card["modules"] == ["perception", "prediction"]
     assert card["hyperparameters"]["seed"] == 4 and card["training"]["epochs_run"] == 2
+    # by default the command trains the monitor a supervisor's trigger needs (its kinematics
+    # and critical target; the caller's --context-len won over the recipe's)
+    hyper = card["hyperparameters"]
+    assert (hyper["recipe"], hyper["target"], card["config"]["kinematics"]) == (
+        "lookahead-v1", "critical", True)
     assert "epoch   2" in result.output and "AUROC" in result.output
     assert f"monitors/{version}/card.json" in result.output.replace("\n", "")
 

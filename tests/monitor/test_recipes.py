@@ -15,7 +15,6 @@ from evoeye.monitor.recipes import (
     RECIPES,
     TrainParams,
     card_hyperparameters,
-    recipe_network,
     recipe_params,
 )
 
@@ -43,23 +42,17 @@ def test_the_default_recipe_is_v3_and_overrides_apply_on_top() -> None:
     assert replace(RECIPES["v3"], recipe="v2") == RECIPES["v2"]
 
 
-def test_lookahead_v2_is_v1_with_the_context_its_scenario_needs() -> None:
-    assert replace(RECIPES["lookahead-v2"], recipe="lookahead-v1") == RECIPES["lookahead-v1"]
-    assert recipe_network("lookahead-v2", "unprotected-intersection") == {
-        "context_len": 5, "kinematics": True}
-    for scenario in ("highway-cut-in", "occluded-crossing"):  # not listed: lookahead-v1's
-        assert recipe_network("lookahead-v2", scenario) == recipe_network("lookahead-v1",
-                                                                          scenario)
-    assert recipe_network("lookahead-v1", "unprotected-intersection")["context_len"] == 20
-    assert recipe_network("v3", "unprotected-intersection") == {}
-    from evoeye.scenarios import SCENARIOS  # every scenario a recipe names is a registered one
-
-    assert {s for by in recipes.SCENARIO_NETWORKS.values() for s in by} <= set(SCENARIOS)
+def test_the_command_trains_the_trigger_recipe_and_the_studies_keep_v3() -> None:
+    # `evoeye train` trains lookahead-v1 (its network: RECIPE_NETWORKS); train_monitor, RQ1,
+    # campaigns and the studies keep v3, what their recorded figures were made with
+    assert (recipes.COMMAND_RECIPE, recipes.DEFAULT_RECIPE) == ("lookahead-v1", "v3")
+    assert recipes.RECIPE_NETWORKS[recipes.COMMAND_RECIPE] == {"context_len": 20,
+                                                               "kinematics": True}
+    assert RECIPES["lookahead-v1"].target == "critical"
 
 
 @pytest.mark.parametrize(("recipe", "overrides", "message"), [
-    ("v9", {}, r"unknown training recipe 'v9'; known: \['lookahead-v1', 'lookahead-v2', 'v1', "
-               r"'v2', 'v3'\]"),
+    ("v9", {}, r"unknown training recipe 'v9'; known: \['lookahead-v1', 'v1', 'v2', 'v3'\]"),
     ("v2", {"learning_rate": 1.0}, r"unknown training parameter\(s\) \['learning_rate'\]"),
     ("v2", {"batching": "runs"}, "unknown batching 'runs'"),
     ("v2", {"schedule": "step"}, "unknown schedule 'step'"),

@@ -71,16 +71,13 @@ def test_seeds_trained_together_are_the_seeds_trained_one_by_one(root, monkeypat
 
 
 def test_rq1_trains_the_context_a_lookahead_recipe_fixes(root) -> None:
-    from evoeye.monitor.recipes import recipe_network
+    from evoeye.monitor.recipes import RECIPE_NETWORKS
     from evoeye.results.rq1 import FULL_CONTEXT_LEN, fusion_context_len
 
     # RQ1's FusionMonitor passes its context to the training: under a lookahead recipe it is
-    # the recipe's own on the scenario (a fixed L = 5 trained another network than the recipe's)
-    for scenario in ("highway-cut-in", "unprotected-intersection"):
-        assert fusion_context_len("lookahead-v2", scenario) == recipe_network(
-            "lookahead-v2", scenario)["context_len"]
-        assert fusion_context_len("v3", scenario) == FULL_CONTEXT_LEN
-    assert fusion_context_len("lookahead-v2", "highway-cut-in") == 20
+    # the recipe's own (a fixed L = 5 trained another network than the recipe's)
+    assert fusion_context_len("lookahead-v1") == RECIPE_NETWORKS["lookahead-v1"]["context_len"]
+    assert fusion_context_len("lookahead-v1") == 20 and fusion_context_len("v3") == FULL_CONTEXT_LEN
     # and the study loads its windows long enough for it
     assert _study(root, "v3").context_len == max(FULL_CONTEXT_LEN, *ResultsConfig().context_lens)
-    assert _study(root, "lookahead-v2").context_len == 20
+    assert _study(root, "lookahead-v1").context_len == 20

@@ -33,7 +33,7 @@ def test_the_literal_defaults_are_their_sources() -> None:
     assert (SplitSpec().train_frac, SplitSpec().val_frac) == config.DEFAULT_SHARES
     assert tuple(RECIPES) == config.RECIPES
     # the sample-efficiency study's copy too: `evoeye results` builds its config whatever the
-    # part, so a recipe missing there refused `--part rq1 --recipe lookahead-v2`
+    # part, so a recipe missing there refused `--part rq1 --recipe lookahead-v1`
     from evoeye.results.efficiency import config as efficiency
 
     assert tuple(RECIPES) == efficiency.RECIPES and efficiency.DEFAULT_RECIPE == DEFAULT_RECIPE

@@ -46,7 +46,7 @@ ORACLE_UNIFORM = "oracle-uniform"  # the oracle's control: it chooses among unif
 CEILINGS = (ORACLE, ORACLE_UNIFORM)  # curves that know outcomes: no strategy, no update rule
 DEFAULT_PROFILE = "default"  # evoeye.ads.profiles.DEFAULT_PROFILE
 # evoeye.monitor.recipes (importing it loads torch)
-RECIPES, DEFAULT_RECIPE = ("v1", "v2", "v3", "lookahead-v1", "lookahead-v2"), "v3"
+RECIPES, DEFAULT_RECIPE = ("v1", "v2", "v3", "lookahead-v1"), "v3"
 
 
 def parse_regime(regime: str) -> tuple[str, str]:
