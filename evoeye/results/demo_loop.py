@@ -194,7 +194,7 @@ def _point(summary: dict, budgets: list[float]) -> str:
 
 def _comparison(summary: dict, budget: float) -> str:
     d = next((d for d in summary["differences"] if d["budget_per_h"] == budget
-              and d["b"] == BASELINE), None)
+              and d["a"] == DEFAULT_FAMILY and d["b"] == BASELINE), None)
     if d is None:
         return ""
     n = summary["collisions_unsupervised"]

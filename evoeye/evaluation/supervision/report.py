@@ -72,7 +72,8 @@ def headline(summary: dict, budget: float | None = None) -> str:
             f"{summary['safe_h']:.2f} h of safe driving): at ≤ {budget:g} false intervention "
             "per hour of safe driving, ")
     fusion = rows.get(DEFAULT_FAMILY)
-    diffs = [d for d in summary["differences"] if d["budget_per_h"] == budget and d["rule_based"]]
+    diffs = [d for d in summary["differences"] if d["budget_per_h"] == budget and d["rule_based"]
+             and d["a"] == DEFAULT_FAMILY]
     if fusion is None or not diffs:
         best = max(rows.values(), key=lambda r: r["prevented_share"])
         return head + (f"{best['label']} prevents the most collisions: "
@@ -162,15 +163,24 @@ def _p(difference: dict) -> str:
     return "" if p is None else f" p {p:.2g}"
 
 
-def differences_table(summary: dict) -> Table:
+def differences_table(summary: dict, headline: bool = True) -> Table:
+    """The headline FusionMonitor against every other trigger (`headline`), or each other
+    trained trigger against every rule-based one."""
     budgets = summary["budgets_per_h"]
-    by = {(d["b"], d["budget_per_h"]): d for d in summary["differences"]}
-    names = list(dict.fromkeys(d["b"] for d in summary["differences"]))
+    diffs = [d for d in summary["differences"] if (d["a"] == DEFAULT_FAMILY) == headline]
+    by = {(d["a"], d["b"], d["budget_per_h"]): d for d in diffs}
+    pairs = list(dict.fromkeys((d["a"], d["b"]) for d in diffs))
     labels = {p["trigger"]: p["label"] for p in summary["points"]}
-    rows = [[labels[n] + ("" if by[n, budgets[0]]["rule_based"] else " (trained)")]
-            + [f"{100 * by[n, b]['difference']:+.1f}{ci(by[n, b]['ci'], signed=True)}"
-               f"{_p(by[n, b])}" for b in budgets] for n in names]
-    return Table(["FusionMonitor − trigger"] + [f"≤ {b:g}/h, points" for b in budgets], rows)
+    rows = [[(labels[b] + ("" if by[a, b, budgets[0]]["rule_based"] else " (trained)"))
+             if headline else f"{labels[a]} − {labels[b]}"]
+            + [f"{100 * by[a, b, x]['difference']:+.1f}{ci(by[a, b, x]['ci'], signed=True)}"
+               f"{_p(by[a, b, x])}" for x in budgets] for a, b in pairs]
+    first = "FusionMonitor − trigger" if headline else "trained − rule-based trigger"
+    return Table([first] + [f"≤ {b:g}/h, points" for b in budgets], rows)
+
+
+def has_other_differences(summary: dict) -> bool:
+    return any(d["a"] != DEFAULT_FAMILY for d in summary["differences"])
 
 
 def curve_table(summary: dict, trigger: str) -> Table:
@@ -228,6 +238,9 @@ def markdown_report(summaries: list[dict], figures: dict[str, str] | None = None
         if s["differences"]:
             parts += ["Paired differences in collisions prevented (FusionMonitor − trigger), "
                       "points [95 % CI]:", "", differences_table(s).markdown(), ""]
+        if has_other_differences(s):
+            parts += ["Each other trained trigger against the rule-based ones, points [95 % CI]:",
+                      "", differences_table(s, headline=False).markdown(), ""]
         if figures and s["scenario"] in figures:
             parts += [f"![operating curves, {s['scenario']}]({figures[s['scenario']]})", ""]
         if figures and f"{s['scenario']}/lead" in figures:
@@ -272,6 +285,8 @@ def html_report(summaries: list[dict], title: str = "evoeye supervision report",
             body.append(oracle_table(s).html())
         if s["differences"]:
             body.append(differences_table(s).html())
+        if has_other_differences(s):
+            body.append(differences_table(s, headline=False).html())
         for name, label in _triggers(s):
             body += [f"<h3>{escape(label)}</h3>", curve_table(s, name).html()]
     return html_page(title, body)

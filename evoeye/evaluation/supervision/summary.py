@@ -270,6 +270,16 @@ def beside_oracle(ceiling: list[dict], point: dict) -> dict:
             "share_of_oracle": mine / at if at else None}
 
 
+def _pairs(settings: Settings, names: list[str]) -> list[tuple[str, str]]:
+    """The paired comparisons (a, b): the headline FusionMonitor against every other trigger,
+    then each other trained trigger against every rule-based one (is it, too, ahead of them?)."""
+    out = [(DEFAULT_FAMILY, n) for n in names if n != DEFAULT_FAMILY] if (
+        DEFAULT_FAMILY in names) else []
+    rules = [n for n in names if settings.trigger(n).rule_based]
+    return out + [(a, r) for a in names if a != DEFAULT_FAMILY
+                  and not settings.trigger(a).rule_based for r in rules]
+
+
 def summarise_supervision(settings: Settings, records: list[dict],
                           budgets: tuple[float, ...] = BUDGETS_PER_H,
                           resamples: int = RESAMPLES, seed: int = 0,
@@ -316,16 +326,12 @@ def summarise_supervision(settings: Settings, records: list[dict],
                                 "label": settings.trigger(name).label,
                                 "prevented_ci": _ci(chosen[name]), **best,
                                 **beside_oracle(ceiling, best)})
-        if DEFAULT_FAMILY in chosen:
-            for name in chosen:
-                if name == DEFAULT_FAMILY:
-                    continue
-                d = chosen[DEFAULT_FAMILY] - chosen[name]
-                point = share[DEFAULT_FAMILY] - share[name]
-                differences.append({"budget_per_h": b, "a": DEFAULT_FAMILY, "b": name,
-                                    "rule_based": settings.trigger(name).rule_based,
-                                    "difference": point, "ci": _ci(d),
-                                    "p": paired_warnings_p(saved[DEFAULT_FAMILY], saved[name])})
+        for a, name in _pairs(settings, list(chosen)):
+            differences.append({"budget_per_h": b, "a": a, "b": name,
+                                "rule_based": settings.trigger(name).rule_based,
+                                "difference": share[a] - share[name],
+                                "ci": _ci(chosen[a] - chosen[name]),
+                                "p": paired_warnings_p(saved[a], saved[name])})
     sims = sum(len(r["triggers"][t.name]["sims"]) for r in ok for t in settings.triggers)
     alarmed = sum(f is not None for r in ok for t in settings.triggers
                   for f in r["triggers"][t.name]["first_alarm_frame"])

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
+from evoeye.evaluation.supervision.report import markdown_report
 from evoeye.evaluation.supervision.settings import Settings
 from evoeye.evaluation.supervision.summary import (
     ROW_FIELDS,
@@ -224,3 +225,28 @@ def test_collisions_are_counted_and_prevented_by_mechanism(data) -> None:
     fusion = next(r for r in s["at_budget"] if r["trigger"] == "fusion")
     assert fusion["prevented_by_mechanism"] == {"braking-lead": 5, "cut-in": 3}  # runs 0–7
     assert "| braking-lead | 5 | 5 |" in markdown_report([s])
+
+
+def test_a_second_trained_trigger_is_paired_with_every_rule_too(data) -> None:
+    settings, records = data
+    # a second monitor that prevents what ttc prevents at every threshold, plus run 1 where
+    # ttc prevents nothing, with fusion's false interventions
+    two = []
+    for r in records:
+        second = dict(r["triggers"]["fusion"])
+        if r["unsupervised"]["collided"]:
+            saves = r["scenario_id"] in ("r01",) or not r["triggers"]["ttc"]["sims"][0]["collided"]
+            s = sim(not saves, lead_s=1.0)
+            second = {**second, "sims": [s], "sim_of": [0, 0, 0]}
+        two.append({**r, "triggers": {**r["triggers"], "m2": second}})
+    both = Settings("highway-cut-in", "b", (trigger("fusion", "version"), trigger("ttc"),
+                                             trigger("m2", "version")))
+    s = summarise_supervision(both, two, budgets=(5.0,), resamples=200)
+    pairs = [(d["a"], d["b"]) for d in s["differences"]]
+    assert pairs == [("fusion", "ttc"), ("fusion", "m2"), ("m2", "ttc")]  # not m2 − fusion
+    at = {r["trigger"]: r["prevented_share"] for r in s["at_budget"]}
+    d = s["differences"][2]
+    assert d["difference"] == pytest.approx(at["m2"] - at["ttc"]) and d["rule_based"]
+    # the headline's sentence and table stay the headline's; the other pair has its own table
+    md = markdown_report([s])
+    assert "trained − rule-based trigger" in md and "m2 − ttc" in md
