@@ -3,8 +3,10 @@ demo-monitors`).
 
 Per logical scenario: simulate `--runs` uniformly sampled runs with seed `--seed` (batch
 `pretrain`; the demo simulates with other seeds, so it never tests on these), ingest them, train
-a FusionMonitor (L = 5, all module inputs, training seed 0; at most EPOCHS epochs, early
-stopping after PATIENCE without a better validation loss) on 80 % of them, calibrate its
+a FusionMonitor (all module inputs, training seed 0) by `--recipe` — by default the one `evoeye
+train` trains (`recipes.COMMAND_RECIPE`), as its recipe has it; the legacy recipe v1 at most
+EPOCHS epochs, early-stopped after PATIENCE without a better validation loss — on 80 % of them,
+calibrate its
 thresholds on the other 20 %, and copy the version into `evoeye/monitor/pretrained/` in place of
 the scenario's previous one, its card saying which runs trained it (`shipped`: batch,
 simulation seed, runs per scenario). Version ids hash the weights and what produced them, so the
@@ -22,13 +24,14 @@ from pathlib import Path
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.monitor.families import DEFAULT_FAMILY, FAMILIES
 from evoeye.monitor.pretrained import PACKAGED, packaged_versions
+from evoeye.monitor.recipes import COMMAND_RECIPE, LEGACY_RECIPE, RECIPES
 from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
 from evoeye.store import SplitSpec, ingest
 
 RUNS = 500
 SEED = 1000
-EPOCHS, PATIENCE = 20, 4  # hundreds of runs: the validation loss settles within a few epochs
+EPOCHS, PATIENCE = 20, 4  # v1: hundreds of runs: the validation loss settles within a few epochs
 BATCH = "pretrain"
 SPLITS = SplitSpec(seed=0, train_frac=0.8, val_frac=0.2)  # no test split: the demo tests
 
@@ -46,7 +49,8 @@ def stamp(version_dir: Path, runs: int, seed: int) -> None:
 
 def build(root: DataRoot, runs: int = RUNS, seed: int = SEED, workers: int = 2,
           out: Path = PACKAGED, say: Callable[[str], None] = print,
-          scenarios: Sequence[str] = tuple(SCENARIOS)) -> dict[str, str]:
+          scenarios: Sequence[str] = tuple(SCENARIOS), recipe: str = COMMAND_RECIPE
+          ) -> dict[str, str]:
     """Simulate, ingest, train and package one monitor per logical scenario; their versions
     (runs already simulated or ingested are skipped, so an interrupted build resumes)."""
     from evoeye.monitor.train import train_monitor
@@ -60,8 +64,9 @@ def build(root: DataRoot, runs: int = RUNS, seed: int = SEED, workers: int = 2,
     versions = {}
     for scenario in scenarios:
         say(f"{scenario}: training")
+        legacy = {"epochs": EPOCHS, "patience": PATIENCE} if recipe == LEGACY_RECIPE else {}
         version = train_monitor(
-            root, scenario, seed=0, splits=SPLITS, epochs=EPOCHS, patience=PATIENCE,
+            root, scenario, seed=0, splits=SPLITS, recipe=recipe, **legacy,
             progress=lambda row: say(f"  epoch {row['epoch']}: val loss {row['val_loss']:.4f}"))
         if shipped.get(scenario) not in (None, version):
             shutil.rmtree(out / shipped[scenario])
@@ -81,11 +86,13 @@ def main() -> None:
     ap.add_argument("--runs", type=int, default=RUNS, help="runs per logical scenario")
     ap.add_argument("--seed", type=int, default=SEED)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--recipe", default=COMMAND_RECIPE, choices=sorted(RECIPES),
+                    help="training recipe (default: what `evoeye train` trains)")
     ap.add_argument("--scenario", action="append", choices=sorted(SCENARIOS),
                     help="only this logical scenario (repeatable; default: all)")
     args = ap.parse_args()
     build(DataRoot.resolve(args.root), args.runs, args.seed, args.workers,
-          scenarios=args.scenario or tuple(SCENARIOS))
+          scenarios=args.scenario or tuple(SCENARIOS), recipe=args.recipe)
 
 
 if __name__ == "__main__":

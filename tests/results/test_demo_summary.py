@@ -74,8 +74,12 @@ def test_too_few_collisions_are_said_so_in_the_summary(tmp_path) -> None:
     assert f"Fewer than {demo.MIN_COLLISIONS} test collisions in a scenario" in text
 
 
+TRIGGER_CONFIRMED = ("highway-cut-in", "unprotected-intersection")
+
+
 def test_a_monitor_is_shipped_per_scenario_and_installs_into_a_root(tmp_path) -> None:
     from evoeye.monitor.families import load_version
+    from evoeye.monitor.recipes import COMMAND_RECIPE
     from evoeye.results import demo_monitors
     from evoeye.scenarios import SCENARIO_SPECS
 
@@ -93,6 +97,9 @@ def test_a_monitor_is_shipped_per_scenario_and_installs_into_a_root(tmp_path) ->
         assert (shipped["batch"], shipped["simulation_seed"]) == (demo_monitors.BATCH,
                                                                  demo_monitors.SEED)
         assert card["hyperparameters"]["seed"] == shipped["training_seed"] == 0
+        if scenario in TRIGGER_CONFIRMED:  # the monitor `evoeye train` makes, where the
+            # closed loop confirmed it (docs/lookahead.md)
+            assert card["hyperparameters"]["recipe"] == COMMAND_RECIPE
         assert sum(p.stat().st_size for p in (PACKAGED / version).iterdir()) < 400_000
         assert install(root, version) == version == install(root, version)
         monitor = load_version(root, version)  # the weights match the card's sha256
