@@ -5,10 +5,11 @@ the context the study's recipe fixes, `fusion_context_len`) trained with seed s,
 each trained baseline (AEM, the context-only control) fitted with seed s, and the rules (TTC,
 TTC-2D, RSS, RSS-2s), which have no seed and so the same figures for every s. The ablation
 trains every variant (L ∈ context_lens with every input; the input subsets at L = 5) with the
-same seeds; its "L=5" row is the RQ1 FusionMonitor (the same units), its reference rows are the
-RQ1 baselines that `ablation.REFERENCES` names. Methods and variants trained with the same seed
-on the same data are compared pair by pair (`evoeye.results.tables`). A recipe's seeds the
-ledger lacks train together (`units.trained_versions`): the same versions.
+same seeds; its "L=5" row is the RQ1 FusionMonitor (the same units, where the recipe fixes no
+context), its reference rows are the RQ1 baselines that `ablation.REFERENCES` names. Methods
+and variants trained with the same seed on the same data are compared pair by pair
+(`evoeye.results.tables`). A recipe's seeds the ledger lacks train together
+(`units.trained_versions`): the same versions.
 """
 
 from __future__ import annotations
