@@ -85,6 +85,14 @@ class MonitorFamily:
     fit: Fitter | None = None  # an RQ1 baseline trained on a scenario's train split
     recipes: bool = False  # its train and fit take a training recipe by name (`recipe=`)
     train_seeds: SeedsTrainer | None = None  # several seeds at once: the ids `train` gives
+    # the `train` options that rebuild a version's network from scratch (None: its context)
+    network: Callable[[SavedMonitor], dict[str, Any]] | None = None
+
+    def network_of(self, monitor: SavedMonitor) -> dict[str, Any]:
+        """What `train` needs to train `monitor`'s network again from scratch (a campaign's
+        retraining keeps G_0's)."""
+        return (self.network(monitor) if self.network is not None
+                else {"context_len": monitor.context_len})
 
     @property
     def evolvable(self) -> bool:
@@ -244,6 +252,13 @@ def _train_fusion(root: DataRoot, scenario: str | None = None, **kwargs: Any) ->
     return train_monitor(root, scenario, **kwargs)
 
 
+def _fusion_network(monitor: SavedMonitor) -> dict[str, Any]:
+    """A FusionMonitor's network options: context, module inputs, dropout, derived kinematics."""
+    c = monitor.net.config  # type: ignore[attr-defined]
+    return {"context_len": c.context_len, "modules": list(c.modules), "dropout": c.dropout,
+            "kinematics": c.kinematics}
+
+
 def _train_fusion_seeds(root: DataRoot, scenario: str | None = None, **kwargs: Any
                         ) -> list[str]:
     from evoeye.monitor.train import train_monitors
@@ -254,6 +269,6 @@ def _train_fusion_seeds(root: DataRoot, scenario: str | None = None, **kwargs: A
 register_family(MonitorFamily(
     DEFAULT_FAMILY, "FusionMonitor", "fusion-", "monitors", "model.pt", "card.json",
     decode=_decode_fusion, train=_train_fusion, initial=initial_monitor, recipes=True,
-    train_seeds=_train_fusion_seeds,
+    train_seeds=_train_fusion_seeds, network=_fusion_network,
 ))
 

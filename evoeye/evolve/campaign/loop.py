@@ -308,15 +308,13 @@ class Campaign:
     def train_monitor_version(self, ids: list[str], *, seed: int, init_from: str | None,
                               state: CampaignState | None = None) -> str:
         """A version of the family trained on runs `ids` (fine-tuned from `init_from`, or from
-        scratch with G_0's network: its context length, and a FusionMonitor's derived
-        kinematics) and the fixed val split, as the update trains; with `importance_weights`,
-        each run weighted by its p/q in `state`'s records."""
+        scratch with G_0's network, `MonitorFamily.network_of`) and the fixed val split, as the
+        update trains; with `importance_weights`, each run weighted by its p/q in `state`'s
+        records."""
         cfg = self.config
         weights = ({"run_weights": state.records.ratio_by_run()}
                    if cfg.importance_weights and state is not None else {})
-        g0 = self.monitor(self.g0)
-        network = {"context_len": None} if init_from else {"context_len": g0.context_len} | (
-            {"kinematics": True} if g0.card.get("config", {}).get("kinematics") else {})
+        network = {} if init_from else self.family.network_of(self.monitor(self.g0))
         return self._train(self.root, cfg.scenario, train_runs=ids, val_runs=self.val_runs,
                            horizon_s=cfg.horizon_s, seed=seed, splits=cfg.splits,
                            init_from=init_from, **network, **self._recipe,

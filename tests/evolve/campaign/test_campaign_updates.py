@@ -142,24 +142,28 @@ def test_disagreement_campaign_keeps_a_committee_and_each_runs_spread(root_copy,
         == Campaign(root, config(seeded[1])).campaign_id
 
 
-def test_retraining_keeps_the_network_of_g0_kinematics_included(root_copy, seeded) -> None:
+def test_retraining_keeps_g0s_network_kinematics_and_inputs_included(root_copy, seeded) -> None:
     from evoeye.monitor import train_monitor
     from evoeye.monitor.registry import load_monitor
 
     root = root_copy("kinematics")
-    g0 = train_monitor(root, SCENARIO, seed=0, splits=SPLITS, epochs=1, kinematics=True)
+    g0 = train_monitor(root, SCENARIO, seed=0, splits=SPLITS, epochs=1, kinematics=True,
+                       modules=("perception", "planning"))
     asked: list[dict] = []
 
     def train(*args, **kwargs) -> str:
-        asked.append({k: kwargs.get(k) for k in ("context_len", "kinematics", "init_from")})
+        asked.append({k: kwargs.get(k) for k in ("context_len", "kinematics", "modules",
+                                                 "init_from")})
         return FAMILIES["fusion"].train(*args, **kwargs)
 
     state = Campaign(root, config(g0, strategy="uniform"), train=train).run(max_rounds=1)
-    assert asked == [{"context_len": 5, "kinematics": True, "init_from": None}]
-    assert load_monitor(root, state.monitor).net.config.kinematics  # G_1 derives them too
+    assert asked == [{"context_len": 5, "kinematics": True,
+                      "modules": ["perception", "planning"], "init_from": None}]
+    g1 = load_monitor(root, state.monitor).net.config  # G_1 derives them too, on G_0's inputs
+    assert g1.kinematics and g1.modules == ("perception", "planning")
     # a G_0 without them is retrained without them, as before
     plain: list[dict] = []
     Campaign(root_copy("plain"), config(seeded[1], strategy="uniform"),
              train=lambda *a, **k: plain.append(k) or FAMILIES["fusion"].train(*a, **k)
              ).run(max_rounds=1)
-    assert "kinematics" not in plain[0] and plain[0]["context_len"] == 5
+    assert plain[0]["kinematics"] is False and plain[0]["context_len"] == 5
