@@ -18,7 +18,13 @@ from evoeye.results.config import (
     ResultsConfig,
     parse_initial_runs,
 )
-from evoeye.results.efficiency.config import MODES, REFERENCE, UPDATES, EfficiencyConfig
+from evoeye.results.efficiency.config import (
+    MAX_MEMBERS,
+    MODES,
+    REFERENCE,
+    UPDATES,
+    EfficiencyConfig,
+)
 
 D = ResultsConfig()  # the defaults --help shows (config.py imports nothing heavy)
 E = EfficiencyConfig()
@@ -138,6 +144,15 @@ def results_command(
     pool_runs: Annotated[int, typer.Option(
         min=1, help="Sample-efficiency study: uniform runs per regime to pick from.")] =
         E.pool_runs,
+    members: Annotated[int, typer.Option(
+        min=1, max=MAX_MEMBERS,
+        help="Sample-efficiency study: each checkpoint's monitor is an ensemble of this many "
+             "members trained from scratch (1: one monitor), scored by their mean risk.")] =
+        E.members,
+    val_collisions: Annotated[int, typer.Option(
+        min=0, help="Sample-efficiency study: the validation set holds at least this many "
+                    "colliding runs (further runs of its seed stream; 0: the uniform batch "
+                    "alone).")] = E.val_collisions,
     recipe: Annotated[str, typer.Option(
         help=f"Training recipe of every monitor trained from scratch, one of "
              f"{', '.join(RECIPES)} (campaign updates keep theirs).")] = D.recipe,
@@ -180,7 +195,7 @@ def results_command(
                 mode=mode, update=study_update,
                 seeds=tuple(range(first_study_seed, first_study_seed + study_seeds)),
                 oracle=oracle, pool_runs=pool_runs, recipe=recipe, epochs=epochs,
-                patience=patience
+                patience=patience, members=members, val_collisions=val_collisions
             ).changed())
         config.check_names()
     except ValueError as exc:

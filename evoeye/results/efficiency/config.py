@@ -28,6 +28,18 @@ Plain data (the command line reads it at start-up). Sizes, and why:
   the checkpoint's from-scratch one).
   At a checkpoint the monitor is trained from scratch on everything acquired, with the training
   seed of that seed and checkpoint shared by every strategy (the pairing absorbs it).
+* `members`: the checkpoint's monitor is an ensemble of that many from-scratch members (member
+  0 with the checkpoint's training seed, the others with seeds derived from it:
+  `evoeye.monitor.ensemble.member_seeds`), scored by their mean risk and calibrated on the
+  validation set like one monitor. A single monitor's Test AUPRC varies from training seed to
+  training seed more than the strategies differ; k members vary less, at k times the cost.
+  The per-round monitor the strategies' feedback comes from (and `disagreement`'s committee)
+  stays one network.
+* `val_collisions`: the validation set holds at least that many colliding runs. The uniform
+  validation batch stays as it is; its seed stream is drawn on (`data.extend_validation`)
+  until enough further runs collided, and their unsafe windows (only those) join it. The
+  validation negatives are then exactly the uniform batch's, so the thresholds calibrated for a
+  target FPR (a share of negative frames) do not move; early stopping sees more positives.
 """
 
 from __future__ import annotations
@@ -47,6 +59,10 @@ CEILINGS = (ORACLE, ORACLE_UNIFORM)  # curves that know outcomes: no strategy, n
 DEFAULT_PROFILE = "default"  # evoeye.ads.profiles.DEFAULT_PROFILE
 # evoeye.monitor.recipes (importing it loads torch)
 RECIPES, DEFAULT_RECIPE = ("v1", "v2", "v3", "lookahead-v1"), "v3"
+MAX_MEMBERS = 8  # evoeye.monitor.ensemble.MAX_MEMBERS (importing it loads torch)
+# fields added since studies were recorded: left out of `to_dict` at their defaults, so a
+# study that does not use them stores the config it always did
+LATER_FIELDS = ("members", "val_collisions")
 
 
 def parse_regime(regime: str) -> tuple[str, str]:
@@ -94,6 +110,8 @@ class EfficiencyConfig:
     patience: int | None = None
     # every monitor trained with its runs' p/q (exact for ce-is's runs, 1 for the others)
     importance_weights: bool = False
+    members: int = 1  # from-scratch members of each checkpoint's monitor (module doc)
+    val_collisions: int = 0  # colliding runs the validation set holds at least (module doc)
 
     @property
     def train_overrides(self) -> dict[str, int | bool]:
@@ -130,6 +148,10 @@ class EfficiencyConfig:
                      "boundary_steps", "oracle_candidates", "n_round"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if not 1 <= self.members <= MAX_MEMBERS:
+            raise ValueError(f"members must be 1 to {MAX_MEMBERS}, got {self.members}")
+        if self.val_collisions < 0:
+            raise ValueError(f"val_collisions must be >= 0, got {self.val_collisions}")
         if self.pool_runs < self.initial_runs + points[-1]:
             raise ValueError(f"the pool ({self.pool_runs}) must hold the initial runs and the "
                              f"largest budget ({points[-1]})")
@@ -158,7 +180,10 @@ class EfficiencyConfig:
         return self.budgets if strategy == REFERENCE else self.checkpoints
 
     def to_dict(self) -> dict:
-        return {f.name: getattr(self, f.name) for f in fields(self)}
+        """Every field, but the LATER_FIELDS only where they differ from their defaults."""
+        default = EfficiencyConfig()
+        return {f.name: v for f in fields(self) if (v := getattr(self, f.name)) !=
+                getattr(default, f.name) or f.name not in LATER_FIELDS}
 
     def changed(self) -> dict:
         """The fields that differ from the defaults, as JSON values (lists for tuples)."""

@@ -39,6 +39,7 @@ from evoeye.evolve.search.registry import (
     make_strategy,
     strategy_options,
 )
+from evoeye.monitor.ensemble import EnsembleMonitor
 from evoeye.monitor.fusion import FusionMonitor
 from evoeye.results.efficiency.acquire import Acquirer, Bank
 from evoeye.results.efficiency.config import EfficiencyConfig
@@ -76,6 +77,12 @@ def training_seed(seed: int, budget: int) -> int:
     return seed * 100_003 + budget
 
 
+def members_key(members: int) -> dict[str, int]:
+    """What a ledger key adds for the checkpoint monitors' ensemble size: nothing for one
+    monitor (the keys of single-monitor units are as they always were)."""
+    return {} if members == 1 else {"members": members}
+
+
 def ids_digest(ids) -> str:
     return hashlib.sha256("\n".join(sorted(map(str, ids))).encode()).hexdigest()
 
@@ -94,20 +101,24 @@ class Context:
     say: Say = field(default=lambda msg: None)
 
     def scratch_figures(self, ids, budget: int, seed: int,
-                        monitor: FusionMonitor | None = None,
-                        weights: dict[str, float] | None = None) -> dict:
-        """{set: metrics} of the monitor trained from scratch on `ids` with the checkpoint's
-        seed (a ledger unit; `monitor`: that very monitor, if trained already; `weights`: the
-        runs' p/q, which train it if the recipe says so, and key it then)."""
+                        monitor: FusionMonitor | EnsembleMonitor | None = None,
+                        weights: dict[str, float] | None = None,
+                        first: FusionMonitor | None = None) -> dict:
+        """{set: metrics} of the checkpoint's monitor trained from scratch on `ids` with the
+        checkpoint's seed (`Learner.checkpoint`; a ledger unit; `monitor`: that very monitor,
+        if built already; `first`: its member 0, if trained already; `weights`: the runs' p/q,
+        which train it if the recipe says so, and key it then)."""
         tseed = training_seed(seed, budget)
         inputs = {"regime": self.regime, "sets": self.fingerprint, "runs": ids_digest(ids),
                   "n": len(ids), "seed": tseed, "recipe": self.learner.recipe}
         if self.learner.params.importance_weights:
             inputs["weights"] = ids_digest(f"{s}={(weights or {}).get(s, 1.0)!r}" for s in ids)
+        inputs.update(members_key(self.learner.members))
 
         def train() -> dict:
             self.say(f"{self.regime}: from scratch on {len(ids)} runs, seed {tseed}")
-            trained = monitor or self.learner.scratch(self.bank.windows(ids), tseed, weights)
+            trained = monitor or self.learner.checkpoint(self.bank.windows(ids), tseed, weights,
+                                                         first)
             return self.learner.judge(trained)
 
         return self.ledger.remember("efficiency-scratch", inputs, train)
@@ -163,6 +174,7 @@ def run_curve(ctx: Context, strategy: str, seed: int, acquirer: Acquirer) -> dic
               "recipe": ctx.learner.recipe}
     if cfg.update != "replay":  # replay curves keep the keys they were ledgered under
         inputs["update"] = cfg.update
+    inputs.update(members_key(cfg.members))
     return ctx.ledger.remember("efficiency-curve", inputs,
                                lambda: _curve(ctx, strategy, seed, acquirer))
 
@@ -236,8 +248,10 @@ def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> d
     strategy = make_strategy(strategy_name, ctx.space, seed, pool=acquirer.pool_params,
                              **strategy_options(strategy_name, batch=cfg.n_round))
     budgets = cfg.checkpoints_of(strategy_name)
-    g0 = ctx.scratch_figures(t.records.scenario_id, cfg.initial_runs, seed, t.monitor)
-    out: dict = {"budgets": {str(cfg.initial_runs): {"scratch": g0, "update": g0}}}
+    g0 = ctx.scratch_figures(t.records.scenario_id, cfg.initial_runs, seed, first=t.monitor)
+    # the per-round monitor starts as member 0 of G_0 (G_0 itself when it has one member)
+    u0 = g0 if cfg.members == 1 or retrain else ctx.learner.judge(t.monitor)
+    out: dict = {"budgets": {str(cfg.initial_runs): {"scratch": g0, "update": u0}}}
     round_ = 0
     while t.records.n < budgets[-1]:
         round_ += 1
@@ -258,8 +272,8 @@ def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> d
             ids = list(t.records.scenario_id)
             ctx.say(f"{ctx.regime}: {strategy_name} seed {seed} at {len(ids)} runs")
             scratch = ctx.scratch_figures(ids, len(ids), seed,
-                                          t.monitor if retrains else None,
-                                          t.records.ratio_by_run())
+                                          weights=t.records.ratio_by_run(),
+                                          first=t.monitor if retrains else None)
             out["budgets"][str(len(ids))] = {
                 "scratch": scratch,
                 "update": scratch if retrain else ctx.learner.judge(t.monitor),

@@ -4,7 +4,8 @@ scored for the strategies' feedback, and judged on the sets no strategy shaped.
 Nothing is saved: a monitor lives as long as its curve (the ledger keeps its figures). Every
 monitor is early-stopped and calibrated on the regime's validation set, trained with one
 intra-op thread (`evoeye.monitor.threads`), and seeded, so the same runs and seed give the same
-monitor.
+monitor. A checkpoint's monitor (`Learner.checkpoint`) is one such monitor, or with
+`members` > 1 an ensemble of that many (`evoeye.monitor.ensemble`), calibrated as one.
 """
 
 from __future__ import annotations
@@ -17,6 +18,7 @@ import numpy as np
 from evoeye.evolve.campaign.assess import metrics_dict
 from evoeye.evolve.campaign.config import REPLAY_EPOCHS, REPLAY_PATIENCE, REPLAY_RATIO
 from evoeye.evolve.search.feedback import scenario_disagreement, scenario_feedback
+from evoeye.monitor.ensemble import EnsembleMonitor, member_seeds
 from evoeye.monitor.fusion import FusionMonitor
 from evoeye.monitor.recipes import TrainParams, recipe_key, recipe_params
 from evoeye.monitor.train import fit_windows
@@ -30,6 +32,7 @@ class Learner:
     val: Windows
     judging: dict[str, Windows]  # set name → windows (the Test Set, the boundary set)
     params: TrainParams = field(default_factory=recipe_params)  # the seed is given per call
+    members: int = 1  # of every checkpoint's monitor (`checkpoint`)
 
     @property
     def recipe(self) -> dict:
@@ -43,6 +46,20 @@ class Learner:
         return self._monitor(fit_windows(train, self.val, replace(self.params, seed=seed),
                                          run_weights=self._weights(weights)),
                              f"scratch-{seed}")
+
+    def checkpoint(self, train: Windows, seed: int,
+                   weights: Mapping[str, float] | None = None,
+                   first: FusionMonitor | None = None) -> FusionMonitor | EnsembleMonitor:
+        """A checkpoint's monitor on `train`: `scratch` with `seed` (`first`, if that monitor
+        was trained already), or with `members` > 1 the ensemble of it and `members` − 1 more
+        from scratch with the seeds `member_seeds` derives from `seed`."""
+        seeds = member_seeds(seed, self.members)
+        one = first or self.scratch(train, seed, weights)
+        if self.members == 1:
+            return one
+        rest = [self.scratch(train, s, weights) for s in seeds[1:]]
+        return EnsembleMonitor.calibrated([one, *rest], self.val,
+                                          f"ensemble-{seed}x{self.members}")
 
     def update(self, parent: FusionMonitor, train: Windows, seed: int,
                weights: Mapping[str, float] | None = None) -> FusionMonitor:
@@ -60,7 +77,7 @@ class Learner:
         card = {"hyperparameters": {"pos_weight": trained.result.pos_weight}}
         return FusionMonitor(trained.result.net, version, trained.thresholds, card)
 
-    def judge(self, monitor: FusionMonitor) -> dict[str, dict]:
+    def judge(self, monitor: FusionMonitor | EnsembleMonitor) -> dict[str, dict]:
         """{set: metrics} of the monitor on every judging set, at its calibrated thresholds."""
         return {name: metrics_dict(monitor.score(w), w.label, monitor.thresholds)
                 for name, w in self.judging.items()}

@@ -11,7 +11,8 @@ AUPRC on the oracle set (uniform runs of their own, neither the Test Set nor the
   that passed closest, half and half);
 * half of each of the last two with uniform draws.
 The kept monitor is the checkpoint's: trained with the seed every strategy's checkpoint
-monitor gets, so it is judged on the Test and boundary sets like theirs. The oracle's choices
+monitor gets (an ensemble as theirs are, with `members` > 1), so it is judged on the Test and
+boundary sets like theirs. The oracle's choices
 use the outcomes and errors of runs before they are acquired, which no strategy can know: it
 is a bound, not a strategy. It is greedy (one step at a time, one step per checkpoint) and tries
 a handful of increments, so it is a lower bound of the best choice, never a ceiling: an oracle
@@ -31,7 +32,13 @@ import numpy as np
 
 from evoeye.evolve.campaign.assess import metrics_dict
 from evoeye.results.efficiency.config import ORACLE, ORACLE_UNIFORM
-from evoeye.results.efficiency.curves import Context, acquired_summary, initial_rows, training_seed
+from evoeye.results.efficiency.curves import (
+    Context,
+    acquired_summary,
+    initial_rows,
+    members_key,
+    training_seed,
+)
 from evoeye.results.efficiency.learner import run_feedback
 
 SAMPLE = 1000  # unused pool runs the error and margin candidates are chosen from
@@ -72,7 +79,8 @@ def run_oracle(ctx: Context, seed: int, control: bool = False) -> dict:
     name = ORACLE_UNIFORM if control else ORACLE
     inputs = {"regime": ctx.regime, "sets": ctx.fingerprint, "strategy": name, "seed": seed,
               "initial": cfg.initial_runs, "budgets": list(cfg.checkpoints),
-              "candidates": cfg.oracle_candidates, "recipe": ctx.learner.recipe}
+              "candidates": cfg.oracle_candidates, "recipe": ctx.learner.recipe,
+              **members_key(cfg.members)}
     return ctx.ledger.remember("efficiency-curve", inputs, lambda: _oracle(ctx, seed, name))
 
 
@@ -82,8 +90,8 @@ def _oracle(ctx: Context, seed: int, name: str) -> dict:
     init = np.zeros(len(pool), bool)
     init[initial_rows(pool.collided, cfg.initial_runs, seed)] = True
     used = init.copy()
-    monitor = learner.scratch(ctx.bank.windows(pool.scenario_id[used]),
-                              training_seed(seed, cfg.initial_runs))
+    monitor = learner.checkpoint(ctx.bank.windows(pool.scenario_id[used]),
+                                 training_seed(seed, cfg.initial_runs))
     g0 = ctx.scratch_figures(pool.scenario_id[used], cfg.initial_runs, seed, monitor)
     out: dict = {"budgets": {str(cfg.initial_runs): {"scratch": g0}}, "kinds": []}
     for step, budget in enumerate(cfg.checkpoints):
@@ -92,7 +100,7 @@ def _oracle(ctx: Context, seed: int, name: str) -> dict:
         best = None
         for kind, rows in _candidates(ctx, monitor, used, size, rng, name == ORACLE_UNIFORM):
             ids = [*pool.scenario_id[used], *pool.scenario_id[rows]]
-            candidate = learner.scratch(ctx.bank.windows(ids), training_seed(seed, budget))
+            candidate = learner.checkpoint(ctx.bank.windows(ids), training_seed(seed, budget))
             auprc = metrics_dict(candidate.score(oracle_set), oracle_set.label,
                                  candidate.thresholds)["auprc"]
             ctx.say(f"{ctx.regime}: {name} seed {seed} at {budget}: {kind} {auprc:.3f}")

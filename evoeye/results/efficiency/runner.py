@@ -104,7 +104,7 @@ def run_regime(root: DataRoot, regime: str, config: EfficiencyConfig, *, workers
     say(f"{regime}: loading its sets")
     data = RegimeData.load(data_root, config)
     learner = Learner(data.sets["val"], {k: data.sets[k] for k in JUDGING_SETS},
-                      recipe_params(config.recipe, **config.train_overrides))
+                      recipe_params(config.recipe, **config.train_overrides), config.members)
     _CONTEXT = ctx = Context(regime, get_scenario(parse_regime(regime)[0]), config, learner,
                              Bank(data), ledger or Ledger(root), sets_fingerprint(data), say)
     curves: dict[str, dict[str, dict]] = {}

@@ -30,6 +30,9 @@ def test_regimes_name_a_scenario_and_a_profile() -> None:
     ({"checkpoints": (80, 70)}, "must increase"),
     ({"checkpoints": (70, 160)}, "whole rounds of 20"),
     ({"pool_runs": 100}, "must hold the initial runs and the largest budget"),
+    ({"members": 0}, "members must be 1 to 8, got 0"),
+    ({"members": 9}, "members must be 1 to 8, got 9"),
+    ({"val_collisions": -1}, "val_collisions must be >= 0"),
 ])
 def test_a_bad_config_names_the_problem(change, message) -> None:
     with pytest.raises(ValueError, match=message):
@@ -80,7 +83,30 @@ def test_the_command_refuses_a_bad_study_before_anything_runs(tmp_path) -> None:
     base = ["results", "--part", "efficiency", "--root", str(tmp_path / "r")]
     for extra, message in ((["--regime", "highway-cut-in:reckless"], "ADS profiles"),
                            (["--strategy", "annealing"], "unknown strategy"),
-                           (["--mode", "live"], "mode must be one of")):
+                           (["--mode", "live"], "mode must be one of"),
+                           (["--members", "9"], "--members"),
+                           (["--val-collisions", "-1"], "--val-collisions")):
         result = CliRunner().invoke(app, [*base, *extra])
         assert result.exit_code == 2 and message in result.output, result.output
     assert not (tmp_path / "r").exists()
+
+
+def test_the_later_fields_are_recorded_only_where_set() -> None:
+    """A study with one member and the uniform validation batch stores the config it always
+    did; one that sets either field records it, and reads back the same."""
+    from evoeye.results.efficiency.config import LATER_FIELDS
+
+    assert not set(LATER_FIELDS) & set(EfficiencyConfig().to_dict())
+    changed = EfficiencyConfig(members=3, val_collisions=40)
+    assert {k: changed.to_dict()[k] for k in LATER_FIELDS} == {"members": 3,
+                                                               "val_collisions": 40}
+    assert EfficiencyConfig.from_dict(json.loads(json.dumps(changed.to_dict()))) == changed
+    assert ResultsConfig(efficiency=changed.changed()).efficiency == {"members": 3,
+                                                                      "val_collisions": 40}
+
+
+def test_the_configs_member_limit_is_the_ensembles() -> None:
+    from evoeye.monitor.ensemble import MAX_MEMBERS
+    from evoeye.results.efficiency.config import MAX_MEMBERS as SHOWN
+
+    assert SHOWN == MAX_MEMBERS
