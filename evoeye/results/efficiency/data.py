@@ -12,6 +12,18 @@ outcome flipped with the seed), and the segment between them is bisected `bounda
 times under that seed, keeping the half whose ends differ. The set is the last safe and the last
 colliding run of every pair: two runs of one seed, 1/2^steps of the pair's distance apart
 across the failure boundary. Its ids are kept in `boundary.json` under the regime's root.
+
+With `val_collisions` the validation set is enriched with collisions (`extend_validation`): the
+validation batch's own stream (`plan_uniform` with its seed; a longer plan begins with the
+shorter one) is drawn on past its `val_runs`, in chunks of `val_runs` runs (batch
+`val-more-seed<its seed>`), until the further runs hold enough collisions; the first ones in
+stream order are kept, so the set is the same whatever was simulated before. Only the unsafe
+windows of those runs join the validation set (`sets.RegimeData.load`): its negatives stay the
+uniform batch's, so a threshold calibrated for a target false-positive rate is calibrated on the
+same frames, while early stopping gets more positives, drawn from the same distribution (uniform
+runs that collided). Whole colliding runs would not do: their frames before the horizon are
+negatives too, and over-representing them would move the calibration. The kept ids are in
+`val-collisions.json`.
 """
 
 from __future__ import annotations
@@ -34,6 +46,8 @@ from evoeye.store import Warehouse, ingest
 SETS = ("pool", "test", "val", "oracle")  # uniform batches, seeds data_seed + their index
 BOUNDARY_BATCH = "boundary"
 BOUNDARY_FILE = "boundary.json"
+VAL_FILE = "val-collisions.json"
+VAL_MAX_CHUNKS = 50  # further validation runs drawn at most, in units of val_runs
 Say = Callable[[str], None]
 
 
@@ -65,6 +79,8 @@ def prepare_regime(root: DataRoot, regime: str, config: EfficiencyConfig, *, wor
         say(f"{regime}: {name} set, {n} runs (seed {seed})")
         run_batch(plan_uniform(scenario, n, seed, batch=batch_name(name, config), ads=profile),
                   data, workers=workers)
+    if config.val_collisions:
+        extend_validation(data, regime, config, workers=workers, say=say)
     say(f"{regime}: ingesting")
     ingest(data)
     if not (data.path / BOUNDARY_FILE).is_file():
@@ -156,3 +172,51 @@ def build_boundary_set(data: DataRoot, regime: str, config: EfficiencyConfig, *,
 def boundary_ids(data: DataRoot) -> list[str]:
     """The boundary set's run ids (`build_boundary_set`)."""
     return json.loads((data.path / BOUNDARY_FILE).read_bytes())["scenario_ids"]
+
+
+def extend_validation(data: DataRoot, regime: str, config: EfficiencyConfig, *,
+                      workers: int = 1, say: Say | None = None) -> list[str]:
+    """Draw the validation batch's stream on until it holds `config.val_collisions` colliding
+    runs (module doc); the ids of the further colliding runs kept, in stream order (none when
+    the batch holds enough), also written to `val-collisions.json`. ValueError, with nothing
+    written, if VAL_MAX_CHUNKS × val_runs further runs do not hold enough."""
+    say = say or (lambda msg: None)
+    scenario, profile = parse_regime(regime)
+    seed, n = config.data_seed + SETS.index("val"), config.val_runs
+    base = run_batch(plan_uniform(scenario, n, seed, batch=batch_name("val", config),
+                                  ads=profile), data, workers=workers).collisions
+    need, drawn, kept = config.val_collisions - base, 0, []
+    while len(kept) < need:
+        if drawn >= VAL_MAX_CHUNKS * n:
+            raise ValueError(f"{regime}: {drawn} further validation runs held {len(kept)} "
+                             f"collisions, {need} short of val_collisions = "
+                             f"{config.val_collisions} with the batch's {base}: ask fewer")
+        specs = plan_uniform(scenario, n + drawn + n, seed, batch=f"val-more-seed{seed}",
+                             ads=profile)[n + drawn:]
+        say(f"{regime}: validation stream, runs {n + drawn}–{n + drawn + n - 1} "
+            f"({len(kept)} of {need} further collisions)")
+        outcome = {r.scenario_id: r.status == "ok" and r.collided
+                   for r in run_batch(specs, data, workers=workers).results}
+        kept += [s.scenario_id for s in specs if outcome[s.scenario_id]]
+        drawn += n
+    kept = kept[:max(need, 0)]
+    with atomic_file(data.path / VAL_FILE) as f:
+        f.write(json.dumps({"regime": regime, "val_runs": n, "seed": seed,
+                            "val_collisions": config.val_collisions, "batch_collisions": base,
+                            "drawn": drawn, "scenario_ids": kept}, indent=1).encode())
+    return kept
+
+
+def val_extra_ids(data: DataRoot, config: EfficiencyConfig) -> list[str]:
+    """The further colliding validation runs `extend_validation` kept for this config; [] for
+    val_collisions = 0. ValueError if they were kept for another config."""
+    if not config.val_collisions:
+        return []
+    path = data.path / VAL_FILE
+    found = json.loads(path.read_bytes()) if path.is_file() else {}
+    asked = {"val_runs": config.val_runs, "seed": config.data_seed + SETS.index("val"),
+             "val_collisions": config.val_collisions}
+    if {k: found.get(k) for k in asked} != asked:
+        raise ValueError(f"{path} does not hold the validation runs of {asked}: prepare the "
+                         "regime's data again")
+    return found["scenario_ids"]

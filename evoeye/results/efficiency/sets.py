@@ -16,7 +16,7 @@ import numpy as np
 from evoeye.evolve.search.fitness import criticality
 from evoeye.paths import DataRoot
 from evoeye.results.efficiency.config import EfficiencyConfig
-from evoeye.results.efficiency.data import batch_name, boundary_ids
+from evoeye.results.efficiency.data import batch_name, boundary_ids, val_extra_ids
 from evoeye.store import Warehouse, load_windows
 from evoeye.store.features import FrameFeatures
 from evoeye.store.windows import DEFAULT_CONTEXT_LEN, Windows
@@ -83,6 +83,8 @@ class RegimeData:
                            f"'{batch_name(name, config)}' AND status = 'ok'")
 
         sets = {name: of_batch(name) for name in ("val", "oracle", "test")}
+        if extra := val_extra_ids(data, config):  # their unsafe windows only (data.py)
+            sets["val"] = with_unsafe_windows(sets["val"], windows(extra))
         sets["boundary"] = windows(boundary_ids(data))
         return cls(data, _run_table(data, batch_name("pool", config)), of_batch("pool"), sets)
 
@@ -115,3 +117,8 @@ def concat_windows(parts: Sequence[Windows]) -> Windows:
     return Windows(features, np.concatenate(contexts), cat("context_mask"), cat("label"),
                    cat("scenario_id"), cat("frame"), cat("t_s"), parts[0].horizon_s,
                    parts[0].spec, xy)
+
+
+def with_unsafe_windows(windows: Windows, more: Windows) -> Windows:
+    """`windows` and the unsafe windows of `more` (label 1): its negatives are `windows`'."""
+    return concat_windows([windows, more.subset(np.flatnonzero(more.label == 1))])
