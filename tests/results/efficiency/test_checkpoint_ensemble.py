@@ -15,6 +15,7 @@ from evoeye.paths import DataRoot
 from evoeye.results.efficiency.acquire import PoolAcquirer
 from evoeye.results.efficiency.curves import run_curve
 from evoeye.results.efficiency.learner import Learner
+from evoeye.results.efficiency.oracle import run_oracle
 from evoeye.results.efficiency.report import learner_words
 from evoeye.results.ledger import Ledger
 
@@ -101,4 +102,25 @@ def test_an_ensemble_curve_is_keyed_apart_and_judged_as_an_ensemble(context, tmp
     single = run_curve(context, "uniform", 0, PoolAcquirer(context.bank))
     assert curve["acquired_ids"] == single["acquired_ids"]  # the same runs (uniform is blind)
     assert curve["budgets"]["10"]["scratch"] != single["budgets"]["10"]["scratch"]
+    # the per-round monitor starts from G_0's member 0: the single monitor's G_0
+    assert curve["budgets"]["6"]["update"] == single["budgets"]["6"]["scratch"]
+    assert curve["budgets"]["6"]["scratch"] != single["budgets"]["6"]["scratch"]
     assert "2 members" in " ".join(learner_words(ctx.config.to_dict()).split())
+
+
+def test_the_oracles_candidates_are_ensembles_and_keyed_apart(context, tmp_path,
+                                                              monkeypatch) -> None:
+    ctx = replace(context, config=replace(context.config, members=2, checkpoints=(10,),
+                                          oracle_candidates=2),
+                  learner=_learner(context, 2),
+                  ledger=Ledger(DataRoot.resolve(tmp_path / "oracle")))
+    built = []
+    real = Learner.checkpoint
+    monkeypatch.setattr(Learner, "checkpoint", lambda self, *a, **k:
+                        built.append(m := real(self, *a, **k)) or m)
+    asked = _keys(ctx, monkeypatch)
+    curve = run_oracle(ctx, 0, control=True)  # its control: exactly oracle_candidates
+    assert all(isinstance(m, EnsembleMonitor) and len(m.members) == 2 for m in built)
+    assert len(built) == 1 + 2  # G_0, and each candidate of the one step
+    assert asked and all(inputs.get("members") == 2 for _, inputs in asked)
+    assert curve["budgets"]["10"]["scratch"] in [ctx.learner.judge(m) for m in built[1:]]
