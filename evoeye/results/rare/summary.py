@@ -1,0 +1,205 @@
+"""A regime's testing-efficiency figures, from its curves: found, estimated, told apart.
+
+* **Failures found** per 100 simulated runs: Σ collisions / Σ runs over the seeds with a
+  bootstrap interval resampling whole seeds (`rate_ci`); beside Uniform, the ratio of the two
+  with a paired bootstrap interval over seeds (seeds resampled jointly), and the paired
+  difference of per-seed rates (`compare_paired`) with its minimum detectable effect.
+* **The failure rate under p.** Each seed's estimate from its own runs: Uniform's share that
+  collided (plain Monte Carlo), an importance-sampling strategy's mean of w·y with its runs'
+  exact w = p/q (`evoeye.evaluation.failure_rate`). Strategies whose runs carry no exact p/q
+  (e.g. AV-Fuzzer) estimate nothing. The *reference* is the inverse-variance mean of every
+  estimating strategy's pooled estimate (Uniform: all its runs; the others: the mean over seeds).
+  Per strategy: the mean of the seeds' estimates against Uniform's pooled one (an unbiased
+  strategy's difference has a CI around 0), and the **relative error at equal budget**, the
+  root mean square of (estimate − reference) / reference over seeds, with a bootstrap interval;
+  beside Uniform the ratio of Uniform's to the strategy's, seeds resampled jointly, and Uniform's
+  exact figure √((1 − P) / (n·P)) at the reference P.
+* **Distinct failure mechanisms**: a mechanism is a (class, root cause) pair of a collision
+  (`runner.py`); per strategy the distinct ones per seed (mean, paired against Uniform) and
+  over all seeds.
+"""
+
+from __future__ import annotations
+
+import math
+from collections import Counter
+
+import numpy as np
+
+from evoeye.evaluation.failure_rate import failure_rate
+from evoeye.evaluation.stats import (
+    CONFIDENCE,
+    compare_paired,
+    mean_ci,
+    minimum_detectable_effect,
+    rate_ci,
+)
+from evoeye.results.rare.config import ESTIMATING, REFERENCE, RareConfig
+
+PER = 100  # failures per PER simulated runs
+N_RESAMPLES = 10_000
+
+
+def weights(curve: dict) -> np.ndarray:
+    """(n,) p/q of each run: exp(log p − log q), 1 where the run was drawn from p."""
+    q = np.array([np.nan if v is None else v for v in curve["log_q"]], float)
+    p = np.array([np.nan if v is None else v for v in curve["log_p"]], float)
+    known = np.isfinite(q) & np.isfinite(p)
+    return np.where(known, np.exp(np.where(known, p - q, 0.0)), 1.0)
+
+
+def mechanisms(curve: dict) -> Counter[str]:
+    """Collisions per mechanism "class / cause" of one curve."""
+    return Counter(f"{r['mechanism']} / {r['cause'] or 'unexplained'}"
+                   for r in curve["runs"] if r["collided"])
+
+
+def _seeds(curves: dict[str, dict]) -> list[str]:
+    return sorted(curves, key=int)
+
+
+def _hits(curve: dict) -> np.ndarray:
+    return np.array([r["collided"] for r in curve["runs"]], bool)
+
+
+def _boot(seeds: int, statistic, seed: int = 0) -> tuple[float | None, float | None]:
+    """Percentile interval of statistic(idx) over joint resamples of the seeds. A resample
+    where it is undefined (a zero denominator: non-finite) counts as +inf, so the upper end is
+    None when more than the tail share of resamples leave it undefined."""
+    rng = np.random.default_rng(seed)
+    values = np.array([statistic(rng.integers(0, seeds, seeds)) for _ in range(N_RESAMPLES)])
+    values = np.sort(np.where(np.isfinite(values), values, np.inf))
+    tail = (1.0 - CONFIDENCE) / 2
+    low = values[int(math.floor(tail * N_RESAMPLES))]
+    high = values[int(math.ceil((1.0 - tail) * N_RESAMPLES)) - 1]
+    return (float(low) if math.isfinite(low) else None), \
+        (float(high) if math.isfinite(high) else None)
+
+
+def found(curves: dict[str, dict[str, dict]]) -> dict[str, dict]:
+    """Failures found per PER runs, per strategy, and against Uniform (module doc)."""
+    out = {}
+    counts = {name: {s: (int(_hits(c).sum()), len(c["runs"])) for s, c in seeds.items()}
+              for name, seeds in curves.items()}
+    for name, rows in counts.items():
+        events, runs = zip(*rows.values(), strict=True)
+        ci = rate_ci(list(events), list(runs)).to_dict()
+        out[name] = {"seeds": len(rows), "runs": int(sum(runs)), "collisions": int(sum(events)),
+                     "per_100": {k: (v * PER if isinstance(v, float) and k in
+                                     ("value", "low", "high") else v) for k, v in ci.items()}}
+    ref = counts.get(REFERENCE)
+    for name, rows in counts.items():
+        common = [s for s in rows if ref and s in ref]
+        if name == REFERENCE or len(common) < 2:
+            continue
+        a = np.array([rows[s] for s in common], float)  # (S, 2): hits, runs
+        b = np.array([ref[s] for s in common], float)
+
+        def ratio(idx: np.ndarray, a=a, b=b) -> float:
+            mine, theirs = a[idx, 0].sum() / a[idx, 1].sum(), b[idx, 0].sum() / b[idx, 1].sum()
+            return mine / theirs if theirs else math.inf
+
+        paired = compare_paired(PER * a[:, 0] / a[:, 1], PER * b[:, 0] / b[:, 1]).to_dict()
+        low, high = _boot(len(common), ratio)
+        point = ratio(np.arange(len(common)))
+        out[name]["vs_reference"] = {
+            "ratio": point if math.isfinite(point) else None, "ratio_low": low,
+            "ratio_high": high, "paired": paired,
+            "mde_per_100": minimum_detectable_effect(len(common), paired["sd_diff"])
+            if paired["sd_diff"] else None}
+    return out
+
+
+def estimates(curves: dict[str, dict[str, dict]], runs: int) -> dict[str, dict]:
+    """Per estimating strategy: its seeds' estimates, bias against Uniform's pooled estimate
+    and relative error at equal budget about the reference; beside Uniform, the ratio of the
+    relative errors (module doc)."""
+    per = {name: {s: failure_rate(_hits(c), weights(c)).value or 0.0
+                  for s, c in seeds.items()}
+           for name, seeds in curves.items() if name in ESTIMATING}
+    if REFERENCE not in per:
+        return {}
+    uniform_hits = sum(int(_hits(c).sum()) for c in curves[REFERENCE].values())
+    uniform_runs = sum(len(c["runs"]) for c in curves[REFERENCE].values())
+    pooled = {}  # name → (estimate, variance)
+    for name, values in per.items():
+        v = np.array(list(values.values()))
+        if name == REFERENCE:
+            p = uniform_hits / uniform_runs
+            pooled[name] = (p, p * (1 - p) / uniform_runs)
+        else:
+            pooled[name] = (float(v.mean()), float(v.var(ddof=1) / len(v)))
+    usable = {k: e for k, e in pooled.items() if e[1] > 0}
+    if not usable:
+        return {"reference": None}
+    w = {k: 1.0 / var for k, (_, var) in usable.items()}
+    ref = sum(w[k] * usable[k][0] for k in usable) / sum(w.values())
+    ref_se = math.sqrt(1.0 / sum(w.values()))
+    out: dict = {"reference": {"value": ref, "se": ref_se,
+                               "uniform_pooled": pooled[REFERENCE][0],
+                               "uniform_runs": uniform_runs, "uniform_collisions": uniform_hits,
+                               "uniform_exact_relative_error":
+                                   math.sqrt((1 - ref) / (runs * ref)) if ref else None}}
+    u_p, u_var = pooled[REFERENCE]
+    seeds_u = per[REFERENCE]
+    for name, values in per.items():
+        v = np.array([values[s] for s in _seeds(values)])
+        rel = (v - ref) / ref if ref else np.full(len(v), np.nan)
+
+        def rmse(idx: np.ndarray, rel=rel) -> float:
+            return float(np.sqrt(np.mean(rel[idx] ** 2)))
+
+        m = mean_ci(v)
+        low, high = _boot(len(v), rmse)
+        row = {"seeds": len(v), "mean": m.mean, "mean_low": m.low, "mean_high": m.high,
+               "pooled": pooled[name][0], "relative_error": rmse(np.arange(len(v))),
+               "relative_error_low": low, "relative_error_high": high,
+               "spread": float(v.std(ddof=1) / v.mean()) if len(v) > 1 and v.mean() else None}
+        if name != REFERENCE:
+            half = 1.959964 * math.sqrt(pooled[name][1] + u_var)
+            diff = pooled[name][0] - u_p
+            row["bias_vs_uniform"] = {"diff": diff, "low": diff - half, "high": diff + half}
+            common = [s for s in _seeds(values) if s in seeds_u]
+            a = np.array([values[s] for s in common])
+            b = np.array([seeds_u[s] for s in common])
+
+            def ratio(idx: np.ndarray, a=a, b=b) -> float:
+                mine = np.sqrt(np.mean(((a[idx] - ref) / ref) ** 2))
+                theirs = np.sqrt(np.mean(((b[idx] - ref) / ref) ** 2))
+                return float(theirs / mine) if mine else math.inf
+
+            low, high = _boot(len(common), ratio)
+            point = ratio(np.arange(len(common)))
+            row["error_ratio"] = {"value": point if math.isfinite(point) else None,
+                                  "low": low, "high": high}
+        out[name] = row
+    return out
+
+
+def distinct(curves: dict[str, dict[str, dict]]) -> dict[str, dict]:
+    """Distinct mechanisms per strategy: per seed (mean, paired against Uniform) and over all
+    seeds, with each mechanism's collisions."""
+    per = {name: {s: mechanisms(c) for s, c in seeds.items()} for name, seeds in curves.items()}
+    out = {}
+    for name, rows in per.items():
+        total: Counter[str] = Counter()
+        for c in rows.values():
+            total.update(c)
+        m = mean_ci([len(c) for c in rows.values()])
+        out[name] = {"per_seed": m.mean, "per_seed_low": m.low, "per_seed_high": m.high,
+                     "total": len(total), "by_mechanism": dict(total.most_common()),
+                     "classes": len({k.split(" / ")[0] for k in total})}
+        if name != REFERENCE and REFERENCE in per:
+            common = [s for s in _seeds(rows) if s in per[REFERENCE]]
+            out[name]["vs_reference"] = compare_paired(
+                [len(rows[s]) for s in common], [len(per[REFERENCE][s]) for s in common]
+            ).to_dict()
+    return out
+
+
+def summarise(curves: dict[str, dict[str, dict]], config: RareConfig) -> dict:
+    """Every figure of one regime (module doc)."""
+    if not curves:
+        return {"found": {}, "estimates": {}, "distinct": {}}
+    return {"found": found(curves), "estimates": estimates(curves, config.runs),
+            "distinct": distinct(curves)}
