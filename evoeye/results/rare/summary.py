@@ -12,8 +12,9 @@
   Per strategy: the mean of the seeds' estimates against Uniform's pooled one (an unbiased
   strategy's difference has a CI around 0), and the **relative error at equal budget**, the
   root mean square of (estimate − reference) / reference over seeds, with a bootstrap interval;
-  beside Uniform the ratio of Uniform's to the strategy's, seeds resampled jointly, and Uniform's
-  exact figure √((1 − P) / (n·P)) at the reference P.
+  beside Uniform the ratio of Uniform's to the strategy's, seeds resampled jointly, the paired
+  difference of the seeds' absolute relative errors (Uniform's − the strategy's: > 0 where the
+  strategy is closer), and Uniform's exact figure √((1 − P) / (n·P)) at the reference P.
 * **Distinct failure mechanisms**: a mechanism is a (class, root cause) pair of a collision
   (`runner.py`); per strategy the distinct ones per seed (mean, paired against Uniform) and
   over all seeds.
@@ -151,7 +152,8 @@ def estimates(curves: dict[str, dict[str, dict]], runs: int) -> dict[str, dict]:
 
         m = mean_ci(v)
         low, high = _boot(len(v), rmse)
-        row = {"seeds": len(v), "mean": m.mean, "mean_low": m.low, "mean_high": m.high,
+        row = {"seeds": len(v), "per_seed": {s: values[s] for s in _seeds(values)},
+               "mean": m.mean, "mean_low": m.low, "mean_high": m.high,
                "pooled": pooled[name][0], "relative_error": rmse(np.arange(len(v))),
                "relative_error_low": low, "relative_error_high": high,
                "spread": float(v.std(ddof=1) / v.mean()) if len(v) > 1 and v.mean() else None}
@@ -172,6 +174,9 @@ def estimates(curves: dict[str, dict[str, dict]], runs: int) -> dict[str, dict]:
             point = ratio(np.arange(len(common)))
             row["error_ratio"] = {"value": point if math.isfinite(point) else None,
                                   "low": low, "high": high}
+            # per seed: how much closer to the reference than Uniform's at the same seed
+            row["paired_abs_error"] = compare_paired(np.abs(b - ref) / ref,
+                                                     np.abs(a - ref) / ref).to_dict()
         out[name] = row
     return out
 

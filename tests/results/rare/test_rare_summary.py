@@ -66,6 +66,9 @@ def test_importance_estimates_are_reweighted_and_compared_at_equal_budget():
     assert out["uniform"]["relative_error"] > 0.4  # binomial noise at 2 per seed
     assert out["ce-is"]["relative_error"] == pytest.approx(0.0, abs=1e-9)
     assert out["ce-is"]["error_ratio"]["value"] is None  # infinitely better: undefined
+    closer = out["ce-is"]["paired_abs_error"]
+    assert closer["n"] == 30 and closer["mean_diff"] > 0 and closer["ci_low"] > 0
+    assert out["ce-is"]["per_seed"]["7"] == pytest.approx(0.02)
     bias = out["ce-is"]["bias_vs_uniform"]
     assert bias["low"] <= bias["diff"] <= bias["high"]
 
