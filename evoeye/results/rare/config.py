@@ -3,8 +3,8 @@
 Plain data (the command line reads it at start-up). The protocol (`runner.py`):
 
 * Regimes: a logical scenario and the ADS profile that drives it (`scenario:profile`), chosen
-  where failures are rare — `highway-cut-in:cautious` (≈ 1 % of uniform runs) and
-  `occluded-crossing:cautious` (a few per mille).
+  where failures are rare — `highway-cut-in:cautious` (≈ 1 % of uniform runs: 11 of 1 000 on
+  the screening seed) and `highway-cut-in:defensive` (≈ 0.1 %: 1 of 2 000).
 * Generative mode only: every strategy simulates its own runs, `runs` per seed, in batches of
   `batch` (a strategy adapts between batches). No initial set: ce-is's first batch is drawn
   from p itself, and a curve that finds no failure is part of the result.
@@ -28,7 +28,7 @@ STRATEGIES = (REFERENCE, "ce-is")
 USABLE = (REFERENCE, "ce-is", "sobol", "avfuzzer")
 # whose runs carry their exact p/q, so they estimate the failure rate under p without bias
 ESTIMATING = (REFERENCE, "ce-is")
-REGIMES = ("highway-cut-in:cautious", "occluded-crossing:cautious")
+REGIMES = ("highway-cut-in:cautious", "highway-cut-in:defensive")
 
 
 @dataclass(frozen=True)
@@ -39,7 +39,7 @@ class RareConfig:
     strategies: tuple[str, ...] = STRATEGIES
     seeds: tuple[int, ...] = tuple(range(40))  # paired across strategies
     runs: int = 200  # simulated per seed and strategy
-    batch: int = 20  # runs between two adaptations of a strategy
+    batch: int = 10  # runs between two adaptations of a strategy
     data_seed: int = 9_100  # the run seeds' stream (fresh: no earlier study drew from it)
     explain: bool = True  # attribute every collision found to a module (counterfactuals)
     # ce-is's elite share and screening z, chosen on screening seeds of data_seed 9_000
