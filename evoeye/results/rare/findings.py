@@ -28,15 +28,15 @@ their regimes; a regime in two runs of one protocol is refused by name.
 
 from __future__ import annotations
 
-import json
+import math
 
 from evoeye.results.findings import AGAINST, NOT_RUN, NOT_SHOWN, PARTLY, REPRODUCES
+from evoeye.results.merge import merge_runs
 from evoeye.results.rare.config import ESTIMATING, REFERENCE, RareConfig
 
 RARE_BELOW = 0.003  # a regime whose reference failure rate is below this is the ≈ 0.1 % one
 FOUND_TARGETS = (10.0, 3.0)  # × Uniform's failures per run: below RARE_BELOW, else
 ERROR_TARGET = 3.0  # × smaller relative error at equal budget
-FREE = ("regimes", "seeds", "strategies")  # what the runs of one protocol may differ in
 
 
 class RareMergeError(ValueError):
@@ -71,6 +71,8 @@ def found_verdict(vs: dict, target: float) -> str:
 def estimate_verdict(row: dict) -> str:
     """The verdict of one strategy's failure-rate estimate (module doc)."""
     bias, ratio = row["bias_vs_uniform"], row["error_ratio"]
+    if not all(isinstance(v, float) and math.isfinite(v) for v in (bias["low"], bias["high"])):
+        return NOT_SHOWN  # no interval (a strategy left with one seed has no variance)
     if bias["low"] > 0 or bias["high"] < 0:
         return AGAINST
     if ratio["high"] is not None and ratio["high"] < ERROR_TARGET:
@@ -141,34 +143,6 @@ def rare_findings(results: dict) -> list[dict]:
 def merge_rare(runs: list[dict]) -> list[dict]:
     """Runs ({"path", "config", "findings", "regimes"}: a results JSON's `rare` part and its
     file) as protocols ({"paths", "config", "findings"}): runs of one protocol merged, their
-    claims checked over every regime (module doc). A merged one's config lists each regime's
-    seeds (`{regime: seeds}`)."""
-    default = RareConfig().to_dict()
-    groups: dict[str, list[dict]] = {}
-    for run in runs:
-        protocol = {k: v for k, v in {**default, **run["config"]}.items() if k not in FREE}
-        groups.setdefault(json.dumps(protocol, sort_keys=True), []).append(run)
-    out = []
-    for group in groups.values():
-        if len(group) == 1:
-            out.append({"paths": [group[0]["path"]], "config": group[0]["config"],
-                        "findings": group[0]["findings"]})
-            continue
-        regimes, owner, seeds, strategies = {}, {}, {}, []
-        for run in group:
-            if not run.get("regimes"):
-                raise RareMergeError(f"{run['path']}: the rare-failure regimes are missing (it "
-                                     "cannot be checked with the protocol's other runs)")
-            for regime, summary in run["regimes"].items():
-                if regime in owner:
-                    raise RareMergeError(f"{run['path']}: rare-failure regime {regime} is also "
-                                         f"in {owner[regime]}; give each regime of a protocol "
-                                         "from one run only")
-                owner[regime], regimes[regime] = run["path"], summary
-                seeds[regime] = run["config"]["seeds"]
-            strategies += [s for s in run["config"]["strategies"] if s not in strategies]
-        config = {**group[0]["config"], "regimes": list(regimes), "strategies": strategies,
-                  "seeds": seeds}
-        out.append({"paths": [run["path"] for run in group], "config": config,
-                    "findings": rare_findings({"regimes": regimes})})
-    return out
+    claims checked over every regime (module doc, `evoeye.results.merge`)."""
+    return merge_runs(runs, RareConfig().to_dict(), rare_findings, RareMergeError,
+                      noun="protocol", label="rare-failure ")

@@ -4,7 +4,7 @@ and runs of one protocol merged regime by regime."""
 from __future__ import annotations
 
 import pytest
-from conftest import COMMON, RARE, rare_part
+from rare_curves import COMMON, RARE, rare_part
 
 from evoeye.results.findings import AGAINST, NOT_RUN, NOT_SHOWN, PARTLY, REPRODUCES
 from evoeye.results.rare.findings import (
@@ -40,6 +40,7 @@ def test_a_ratio_reproduces_only_when_its_whole_interval_reaches_the_target(low,
     ((-1e-4, 1e-4), (1.5, 2.9), AGAINST),  # unbiased, not 3x better
     ((-1e-4, 1e-4), (2.0, 9.0), NOT_SHOWN),
     ((-1e-4, 1e-4), (None, None), NOT_SHOWN),
+    ((float("nan"), float("nan")), (3.0, 9.0), NOT_SHOWN),  # one seed left: no variance
 ])
 def test_an_estimate_must_be_unbiased_and_three_times_closer(bias, ratio, verdict):
     row = {"bias_vs_uniform": {"diff": 0.0, "low": bias[0], "high": bias[1]},

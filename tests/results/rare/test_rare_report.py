@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from conftest import COMMON, RARE, rare_part
+from rare_curves import COMMON, RARE, rare_part
 
 from evoeye.results.rare.report import (
     HEADING,
