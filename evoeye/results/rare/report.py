@@ -8,6 +8,8 @@ runs, relative error, mechanisms) rather than in points.
 
 from __future__ import annotations
 
+from evoeye.evaluation.plots import interval_chart
+from evoeye.evaluation.report import Table
 from evoeye.results.efficiency.config import parse_regime
 from evoeye.results.findings import ALPHA
 from evoeye.results.markdown import DASH, FLOOR_MARK, FLOOR_NOTE, MINUS, md_table, p_text
@@ -233,6 +235,21 @@ def rare_findings_markdown(findings: list[dict]) -> str:
             out += [f"**{f['claim']}** — {f['verdict']}", "",
                     *md_table(header, rows(f["checks"]), numbers=False), ""]
     return "\n".join(out)
+
+
+def rare_html(rare: dict) -> list[str]:
+    """The protocol's part of results.html: its claims, then per regime each strategy's
+    failures per 100 runs with its 95 % CI."""
+    out = ["<h2>Rare failures</h2>", Table(["claim", "verdict"], [
+        [f["claim"], f["verdict"]] for f in rare["findings"]]).html()]
+    for regime, summary in rare["regimes"].items():
+        scenario, profile = parse_regime(regime)
+        rows = [(_label(name), f["per_100"]["value"], f["per_100"]["low"], f["per_100"]["high"])
+                for name, f in summary["found"].items()]
+        if rows:
+            out.append(interval_chart(rows, title=f"{scenario}, {profile} ADS: failures found, "
+                                                  "95 % CI", xlabel="collisions per 100 runs"))
+    return out
 
 
 def rare_words(cfg: dict) -> str:

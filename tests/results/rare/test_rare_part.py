@@ -78,6 +78,7 @@ def test_the_part_writes_its_files_names_a_failed_curve_and_resumes(tmp_path,
     text = (folder / "rare.md").read_text()
     assert "## highway-cut-in, cautious ADS" in text and "### Failures found" in text
     assert "Does testing find and measure rare failures" in (folder / "findings.md").read_text()
+    assert "<h2>Rare failures</h2>" in (folder / "results.html").read_text()
     before = (folder / "results.json").read_bytes()
     assert CliRunner().invoke(app, args).exit_code == 0
     assert (folder / "results.json").read_bytes() == before  # a re-run writes the same bytes

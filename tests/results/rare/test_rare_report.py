@@ -10,6 +10,7 @@ from evoeye.results.rare.report import (
     interval,
     num,
     rare_findings_markdown,
+    rare_html,
     rare_markdown,
     rare_words,
     regime_markdown,
@@ -76,3 +77,9 @@ def test_a_protocol_is_named_by_its_runs_seeds_and_regimes(two_regimes):
     assert rare_words(merged).endswith(f"regimes {RARE} (2 seeds (0–1)), {COMMON} (3 seeds "
                                        "(5–7))")
     assert rare_part({RARE: "rare"})["config"]["regimes"] == [RARE]
+
+
+def test_the_html_part_shows_the_claims_and_a_chart_per_regime(two_regimes):
+    html = "".join(rare_html(two_regimes))
+    assert html.count("<svg") == 2 and "<h2>Rare failures</h2>" in html
+    assert "highway-cut-in, cautious ADS: failures found" in html and "partly" in html
