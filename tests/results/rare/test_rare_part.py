@@ -114,3 +114,19 @@ def test_findings_carries_the_claims_merged_over_the_protocols_runs(tmp_path) ->
     with pytest.raises(ResultsFileError, match=f"rare-failure regime {RARE} is also in"):
         combine([a, b, _write(tmp_path / "c.json", rare_part({RARE: "common"}))])
     assert combine_module.RESULTS_FILE == "results.json"
+
+
+def test_a_rare_run_reproduces_its_own_markdown_and_copies_rare_md_to_docs(tmp_path) -> None:
+    from evoeye.paths import DataRoot
+    from evoeye.results.reproduce import run_markdown
+    from evoeye.results.run import assemble, write_results
+    from evoeye.results.study import Study
+
+    root = DataRoot.resolve(tmp_path / "r")
+    config = ResultsConfig(parts=("rare",), rare=RareConfig(regimes=(RARE,)).changed())
+    results = assemble(Study(root, config), {}, rare=rare_part({RARE: "rare"}))
+    text = run_markdown(results)
+    assert text.startswith("# Rare failures") and "Monitoring effectiveness" not in text
+    write_results(root, results, "rare", docs=tmp_path / "docs")
+    assert (tmp_path / "docs" / "rare.md").read_text() == (
+        root.reports / "rare" / "rare.md").read_text()
