@@ -8,6 +8,8 @@ runs, relative error, mechanisms) rather than in points.
 
 from __future__ import annotations
 
+import math
+
 from evoeye.evaluation.plots import interval_chart
 from evoeye.evaluation.report import Table
 from evoeye.results.efficiency.config import parse_regime
@@ -41,8 +43,8 @@ INTRO = (
 
 
 def num(x: float | None, digits: int = 2, signed: bool = False) -> str:
-    """A number in its own unit (`−` for minus, `–` for none)."""
-    if x is None:
+    """A number in its own unit (`−` for minus, `–` for none or NaN)."""
+    if x is None or math.isnan(x):
         return DASH
     value = round(x, digits) + 0.0  # + 0.0: nothing rounds to "−0.00"
     return (f"{value:+.{digits}f}" if signed else f"{value:.{digits}f}").replace("-", MINUS)

@@ -23,6 +23,7 @@ def _row(text: str, first: str) -> str:
 
 def test_numbers_use_a_true_minus_and_open_ends_read_infinite():
     assert num(-0.004, 2) == "0.00" and num(-1.5, 1, signed=True) == "−1.5"
+    assert num(float("nan")) == "–"  # a figure one seed cannot define
     assert interval(2.5, 1.0, None, open_ends=True, prefix="×") == f"×2.50 [1.00, {OPEN}]"
     assert interval(None, None, None, open_ends=True) == f"– [{OPEN}, {OPEN}]"
     assert interval(None, 1.0, 2.0) == "–" and interval(3.0, None, None) == "3.00"
