@@ -13,7 +13,8 @@ paired per-seed cell it rests on (`compare_paired`'s fields: n, mean_diff, ci_lo
   smaller relative error at equal budget: it **reproduces** when the bias CI against Uniform's
   pooled estimate contains 0 and the error ratio's (Uniform's / the strategy's) CI lies at or
   above 3; it **does not reproduce** when the bias CI excludes 0 or the ratio's upper end lies
-  below 3; otherwise not shown. Cell: the paired difference of the seeds' absolute relative
+  below 3; otherwise not shown (so where Uniform saw no failure: its pooled 0 has no
+  variance to judge a bias by). Cell: the paired difference of the seeds' absolute relative
   errors (Uniform's − the strategy's).
 
 A claim reproduces when one strategy reproduces in every regime run; does not reproduce when
@@ -68,17 +69,19 @@ def found_verdict(vs: dict, target: float) -> str:
     return NOT_SHOWN
 
 
-def estimate_verdict(row: dict) -> str:
-    """The verdict of one strategy's failure-rate estimate (module doc)."""
+def estimate_verdict(row: dict, uniform_failures: int) -> str:
+    """The verdict of one strategy's failure-rate estimate (module doc); the bias is judged
+    only where Uniform saw a failure (with none its pooled estimate 0 has no variance, and the
+    bias interval would ignore Uniform's uncertainty)."""
     bias, ratio = row["bias_vs_uniform"], row["error_ratio"]
     if not all(isinstance(v, float) and math.isfinite(v) for v in (bias["low"], bias["high"])):
         return NOT_SHOWN  # no interval (a strategy left with one seed has no variance)
-    if bias["low"] > 0 or bias["high"] < 0:
+    if uniform_failures and (bias["low"] > 0 or bias["high"] < 0):
         return AGAINST
     if ratio["high"] is not None and ratio["high"] < ERROR_TARGET:
         return AGAINST
-    return REPRODUCES if ratio["low"] is not None and ratio["low"] >= ERROR_TARGET \
-        else NOT_SHOWN
+    return REPRODUCES if uniform_failures and ratio["low"] is not None and \
+        ratio["low"] >= ERROR_TARGET else NOT_SHOWN
 
 
 def found_checks(regimes: dict[str, dict]) -> list[dict]:
@@ -100,6 +103,7 @@ def found_checks(regimes: dict[str, dict]) -> list[dict]:
 def estimate_checks(regimes: dict[str, dict]) -> list[dict]:
     out = []
     for regime, summary in regimes.items():
+        seen = (summary["estimates"].get("reference") or {}).get("uniform_collisions", 0)
         for name, row in summary["estimates"].items():
             if name in (REFERENCE, "reference") or "bias_vs_uniform" not in row:
                 continue
@@ -107,7 +111,7 @@ def estimate_checks(regimes: dict[str, dict]) -> list[dict]:
                         "metric": "relative error at equal budget",
                         "cell": row["paired_abs_error"], "bias": row["bias_vs_uniform"],
                         "error_ratio": row["error_ratio"], "target": ERROR_TARGET,
-                        "verdict": estimate_verdict(row)})
+                        "verdict": estimate_verdict(row, seen)})
     return out
 
 

@@ -110,7 +110,7 @@ def found_table(found: dict[str, dict]) -> list[str]:
 
 def reference_line(ref: dict, runs: int) -> str:
     return (f"Reference P = {rate(ref['value'])} (SE {rate(ref['se'])}). Uniform pooled: "
-            f"{ref['uniform_collisions']} collisions in {ref['uniform_runs']} runs = "
+            f"{ref['uniform_collisions']} of {ref['uniform_runs']} runs collided, "
             f"{rate(ref['uniform_pooled'])}; Uniform's exact relative error at {runs} runs, "
             f"√((1 − P) / (n·P)): {num(ref['uniform_exact_relative_error'])}.")
 
@@ -135,7 +135,7 @@ def estimates_table(estimates: dict[str, dict]) -> list[str]:
     return md_table(["strategy", "seeds", "mean estimate [95 % CI]",
                      "bias against Uniform's pooled, points [95 % CI]",
                      "relative error [95 % CI]", "Uniform's error / its [95 % CI]",
-                     f"|error| Uniform {MINUS} strategy, per seed"], rows)
+                     f"absolute error, Uniform {MINUS} strategy, per seed"], rows)
 
 
 def distinct_table(distinct: dict[str, dict]) -> list[str]:
@@ -221,7 +221,8 @@ CHECK_TABLES = {
     "rare-found": (["regime", "strategy", "reference P", "target", "× Uniform [95 % CI]",
                     "Δ per 100 runs [95 % CI] p", "verdict"], _found_rows),
     "rare-estimate": (["regime", "strategy", "bias, points [95 % CI]",
-                       "Uniform's error / its [95 % CI]", "|error| Δ per seed [95 % CI] p",
+                       "Uniform's error / its [95 % CI]",
+                       "absolute error Δ per seed [95 % CI] p",
                        "verdict"], _estimate_rows),
 }
 

@@ -45,7 +45,9 @@ def test_a_ratio_reproduces_only_when_its_whole_interval_reaches_the_target(low,
 def test_an_estimate_must_be_unbiased_and_three_times_closer(bias, ratio, verdict):
     row = {"bias_vs_uniform": {"diff": 0.0, "low": bias[0], "high": bias[1]},
            "error_ratio": {"value": None, "low": ratio[0], "high": ratio[1]}}
-    assert estimate_verdict(row) == verdict
+    assert estimate_verdict(row, uniform_failures=8) == verdict
+    if verdict != AGAINST or ratio[1] >= 3.0:  # with no failure Uniform's 0 judges no bias
+        assert estimate_verdict(row, uniform_failures=0) == NOT_SHOWN
 
 
 def test_checks_carry_their_paired_cell_target_and_verdict(two_regimes):

@@ -17,6 +17,17 @@ from evoeye.results.rare.report import (
 )
 
 
+def assert_tables_aligned(text: str) -> None:
+    """Every line of a Markdown table has its header's columns (no stray "|" in a cell)."""
+    widths: list[int] = []
+    for line in [*text.splitlines(), ""]:
+        if line.startswith("|"):
+            widths.append(line.count("|"))
+            continue
+        assert len(set(widths)) <= 1, widths
+        widths = []
+
+
 def _row(text: str, first: str) -> str:
     return next(line for line in text.splitlines() if line.startswith(f"| {first} |"))
 
@@ -32,6 +43,7 @@ def test_numbers_use_a_true_minus_and_open_ends_read_infinite():
 def test_rare_md_has_every_table_per_regime(two_regimes):
     text = rare_markdown(two_regimes)
     assert text.startswith("# Rare failures")
+    assert_tables_aligned(text)
     assert "20 seeds (0–19)" in text and "data seed 9100" in text
     assert "unbiased by construction only where a strategy's runs carry their exact p/q" in text
     assert "## highway-cut-in, cautious ADS" in text
@@ -40,7 +52,7 @@ def test_rare_md_has_every_table_per_regime(two_regimes):
     found = _row(rare, "ce-is")  # the first ce-is row: failures found
     assert "| 20 | 4000 | 200 | 5.00 [" in found and "| ×25.00 [" in found
     assert "+4.80 [" in found  # 5 per 100 against 0.2, paired per seed
-    assert "Reference P = 0.200 % (SE" in rare and "8 collisions in 4000 runs = 0.200 %" in rare
+    assert "Reference P = 0.200 % (SE" in rare and "8 of 4000 runs collided, 0.200 %" in rare
     estimate = [line for line in rare.splitlines() if line.startswith("| ce-is |")][1]
     assert "0.200 % [" in estimate and "| ×8.66 [" in estimate
     assert "| uniform (reference) | 20 | 4000 | 8 | 0.20 [" in rare
@@ -68,6 +80,7 @@ def test_the_claims_section_lists_each_check(two_regimes):
     assert _row(text, COMMON).endswith("| ×3 | ×1.00 [1.00, 1.00] | +0.00 [+0.00, +0.00] p=1 "
                                        "| does not reproduce |")
     assert "| bias, points [95 % CI] |" in text
+    assert_tables_aligned(text)
 
 
 def test_a_protocol_is_named_by_its_runs_seeds_and_regimes(two_regimes):
