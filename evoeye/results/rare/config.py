@@ -42,6 +42,9 @@ class RareConfig:
     batch: int = 20  # runs between two adaptations of a strategy
     data_seed: int = 9_100  # the run seeds' stream (fresh: no earlier study drew from it)
     explain: bool = True  # attribute every collision found to a module (counterfactuals)
+    # ce-is's elite share and screening z, chosen on screening seeds of data_seed 9_000
+    ce_rho: float = 0.2
+    ce_screen_z: float = 2.0
 
     def __post_init__(self) -> None:
         for name in ("regimes", "strategies", "seeds"):
@@ -60,6 +63,9 @@ class RareConfig:
             raise ValueError(f"need at least 2 distinct seeds >= 0, got {self.seeds}")
         if self.batch < 1 or self.runs < self.batch or self.runs % self.batch:
             raise ValueError(f"runs must be whole batches (runs {self.runs}, batch {self.batch})")
+        if not (0.0 < self.ce_rho < 1.0 and self.ce_screen_z >= 0.0):
+            raise ValueError(f"ce-is needs 0 < ce_rho < 1 and ce_screen_z >= 0, got "
+                             f"{self.ce_rho}, {self.ce_screen_z}")
         if self.data_seed < 0:
             raise ValueError(f"data_seed must be >= 0, got {self.data_seed}")
 
@@ -74,10 +80,18 @@ class RareConfig:
                 raise ValueError(f"regime {regime!r}: scenarios are {sorted(SCENARIOS)}, ADS "
                                  f"profiles {sorted(ADS_PROFILES)}")
 
+    def options(self, strategy: str) -> dict:
+        """The options strategy `strategy`'s factory takes from this config (loads it)."""
+        from evoeye.evolve.search.registry import strategy_options
+
+        return strategy_options(strategy, batch=self.batch, rho=self.ce_rho,
+                                screen_z=self.ce_screen_z)
+
     def unit(self, regime: str, strategy: str, seed: int) -> dict:
         """The inputs that fix one curve's runs (its ledger key)."""
         return {"regime": regime, "strategy": strategy, "seed": seed, "runs": self.runs,
-                "batch": self.batch, "data_seed": self.data_seed, "explain": self.explain}
+                "options": self.options(strategy), "data_seed": self.data_seed,
+                "explain": self.explain}
 
     def to_dict(self) -> dict:
         return {f.name: list(v) if isinstance(v, tuple) else v

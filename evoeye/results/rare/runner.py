@@ -25,7 +25,7 @@ from evoeye.criticality import peak_risk
 from evoeye.evaluation.mechanism import mechanism
 from evoeye.evolve.search.fitness import risk_fitness
 from evoeye.evolve.search.records import Records
-from evoeye.evolve.search.registry import make_strategy, strategy_options
+from evoeye.evolve.search.registry import make_strategy
 from evoeye.results.efficiency.config import parse_regime
 from evoeye.results.rare.config import RareConfig
 from evoeye.scenarios import get_scenario
@@ -85,8 +85,8 @@ def run_curve(config: RareConfig, regime: str, strategy: str, seed: int,
               on_run: Callable[[int], None] | None = None) -> dict:
     """Every run of one curve (module doc): {"x", "runs": [row], "log_q", "log_p"}."""
     space = get_scenario(parse_regime(regime)[0])
-    options = strategy_options(strategy, batch=config.batch)
-    strat = make_strategy(strategy, space, strategy_seed(config, seed), **options)
+    strat = make_strategy(strategy, space, strategy_seed(config, seed),
+                          **config.options(strategy))
     records = Records.empty(space.dim)
     rows = []
     for k in range(config.runs):
