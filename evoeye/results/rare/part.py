@@ -74,3 +74,21 @@ def run_rare(root: DataRoot, config: RareConfig, *, workers: int = 1,
     return {"config": config.to_dict(), "software_version": __version__,
             "regimes": {r: summarise(curves[r], config) for r in config.regimes},
             "failed": failed, "computed": computed}
+
+
+def rare_results(root: DataRoot, config: RareConfig, *, workers: int = 1,
+                 say: Say | None = None) -> tuple[dict, int]:
+    """`run_rare`'s results with the claims checked over its regimes (`findings.py`), and
+    the curves computed now (kept out of the results: a re-run writes the same ones)."""
+    from evoeye.results.rare.findings import rare_findings
+
+    out = run_rare(root, config, workers=workers, say=say)
+    computed = out.pop("computed")
+    out["findings"] = rare_findings(out)
+    return out, computed
+
+
+def failed_curves(rare: dict) -> list[str]:
+    """"regime: strategy seed k: error" of every curve that failed."""
+    return [f"{f['regime']}: {f['strategy']} seed {f['seed']}: {f['error']}"
+            for f in rare.get("failed", [])]
