@@ -10,7 +10,7 @@
   (e.g. AV-Fuzzer) estimate nothing. The *reference* is the inverse-variance mean of every
   estimating strategy's pooled estimate (Uniform: all its runs; the others: the mean over seeds).
   Per strategy: the mean of the seeds' estimates against Uniform's pooled one (an unbiased
-  strategy's difference has a CI around 0), and the **relative error at equal budget**, the
+  strategy's difference has a CI around 0; `bias`), and the **relative error at equal budget**, the
   root mean square of (estimate − reference) / reference over seeds, with a bootstrap interval;
   beside Uniform the ratio of Uniform's to the strategy's, seeds resampled jointly, the paired
   difference of the seeds' absolute relative errors (Uniform's − the strategy's: > 0 where the
@@ -30,9 +30,11 @@ import numpy as np
 from evoeye.evaluation.failure_rate import failure_rate
 from evoeye.evaluation.stats import (
     CONFIDENCE,
+    MeanCI,
     compare_paired,
     mean_ci,
     minimum_detectable_effect,
+    proportion_ci,
     rate_ci,
 )
 from evoeye.results.rare.config import ESTIMATING, REFERENCE, RareConfig
@@ -111,6 +113,20 @@ def found(curves: dict[str, dict[str, dict]]) -> dict[str, dict]:
     return out
 
 
+def bias(mine: MeanCI, hits: int, runs: int) -> dict:
+    """The strategy's mean estimate − Uniform's pooled share, with the MOVER interval (Zou &
+    Donner 2008): each side's own interval combined — the strategy's t interval over seeds and
+    Uniform's Wilson interval, which stays honest at a handful of collisions or none (a normal
+    interval for Uniform's share has no width at 0 and too little at 1 or 2)."""
+    u = proportion_ci(hits, runs)
+    if mine.mean is None or mine.low is None or u.value is None:
+        return {"diff": None, "low": None, "high": None}
+    diff = mine.mean - u.value
+    low = diff - math.hypot(mine.mean - mine.low, u.high - u.value)
+    high = diff + math.hypot(mine.high - mine.mean, u.value - u.low)
+    return {"diff": diff, "low": low, "high": high}
+
+
 def estimates(curves: dict[str, dict[str, dict]], runs: int) -> dict[str, dict]:
     """Per estimating strategy: its seeds' estimates, bias against Uniform's pooled estimate
     and relative error at equal budget about the reference; beside Uniform, the ratio of the
@@ -129,7 +145,9 @@ def estimates(curves: dict[str, dict[str, dict]], runs: int) -> dict[str, dict]:
             p = uniform_hits / uniform_runs
             pooled[name] = (p, p * (1 - p) / uniform_runs)
         else:
-            pooled[name] = (float(v.mean()), float(v.var(ddof=1) / len(v)))
+            # one seed has no spread to weigh it by: it enters the reference with none
+            pooled[name] = (float(v.mean()),
+                            float(v.var(ddof=1) / len(v)) if len(v) > 1 else 0.0)
     usable = {k: e for k, e in pooled.items() if e[1] > 0}
     if not usable:
         return {"reference": None}
@@ -141,7 +159,6 @@ def estimates(curves: dict[str, dict[str, dict]], runs: int) -> dict[str, dict]:
                                "uniform_runs": uniform_runs, "uniform_collisions": uniform_hits,
                                "uniform_exact_relative_error":
                                    math.sqrt((1 - ref) / (runs * ref)) if ref else None}}
-    u_p, u_var = pooled[REFERENCE]
     seeds_u = per[REFERENCE]
     for name, values in per.items():
         v = np.array([values[s] for s in _seeds(values)])
@@ -158,9 +175,7 @@ def estimates(curves: dict[str, dict[str, dict]], runs: int) -> dict[str, dict]:
                "relative_error_low": low, "relative_error_high": high,
                "spread": float(v.std(ddof=1) / v.mean()) if len(v) > 1 and v.mean() else None}
         if name != REFERENCE:
-            half = 1.959964 * math.sqrt(pooled[name][1] + u_var)
-            diff = pooled[name][0] - u_p
-            row["bias_vs_uniform"] = {"diff": diff, "low": diff - half, "high": diff + half}
+            row["bias_vs_uniform"] = bias(m, uniform_hits, uniform_runs)
             common = [s for s in _seeds(values) if s in seeds_u]
             a = np.array([values[s] for s in common])
             b = np.array([seeds_u[s] for s in common])

@@ -86,3 +86,14 @@ def test_distinct_mechanisms_per_seed_and_overall():
 
 def test_summarise_without_curves_is_empty_not_an_error():
     assert summarise({}, RareConfig()) == {"found": {}, "estimates": {}, "distinct": {}}
+
+
+def test_bias_interval_stays_open_where_uniform_saw_no_failure():
+    from evoeye.evaluation.stats import mean_ci
+    from evoeye.results.rare.summary import bias
+
+    b = bias(mean_ci([0.001, 0.002, 0.0015, 0.0005]), hits=0, runs=800)
+    # a normal interval for Uniform's 0 / 800 has no width and would call 0.00125 a bias;
+    # Wilson's reaches 0.48 %, so the difference's interval holds 0
+    assert b["diff"] == pytest.approx(0.00125)
+    assert b["low"] < 0 < b["high"]
