@@ -25,7 +25,7 @@ def readme_section(findings: list[dict], source: str, *, command: str = "evoeye 
     `efficiency` part of a results JSON) and per rare-failure protocol (its `rare` part) one
     row per claim."""
     from evoeye.results.efficiency.report import study_words
-    from evoeye.results.rare.report import HEADING, rare_words
+    from evoeye.results.rare.report import HEADING, advice_lines, rare_words
 
     header, rows = findings_summary(findings)
     more = f" Every comparison behind a verdict: [{details}]({details})." if details else ""
@@ -47,7 +47,7 @@ def readme_section(findings: list[dict], source: str, *, command: str = "evoeye 
         which = (f"Protocol run {i} of {len(rare)}" if len(rare) > 1
                  else "The rare-failure protocol")
         lines += [f"{which}: {rare_words(protocol['config'])}.", "",
-                  *claim_rows(protocol["findings"]), ""]
+                  *claim_rows(protocol["findings"]), "", *advice_lines(protocol["findings"])]
     return "\n".join(lines)
 
 

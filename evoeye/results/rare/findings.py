@@ -144,6 +144,29 @@ def rare_findings(results: dict) -> list[dict]:
     ]
 
 
+def advice(findings: list[dict]) -> dict[str, dict[str, str]]:
+    """Per regime, which strategy to use to find failures and which to estimate the failure
+    rate with, from the claims' checks alone: the strategy whose ratio to Uniform has a CI above
+    1 (the largest, to find; the smallest error with a bias CI holding 0, to estimate), else
+    Uniform — a strategy no check showed better is no reason to leave p."""
+    out: dict[str, dict[str, str]] = {}
+    by_id = {f["id"]: f["checks"] for f in findings}
+    for c in by_id.get("rare-found", []):
+        row = out.setdefault(c["regime"], {"find": REFERENCE, "estimate": REFERENCE})
+        best = row.get("_find_ratio", 1.0)
+        if c["ratio_low"] is not None and c["ratio_low"] > 1.0 and (c["ratio"] or 0) > best:
+            row["find"], row["_find_ratio"] = c["strategy"], c["ratio"]
+    for c in by_id.get("rare-estimate", []):
+        row = out.setdefault(c["regime"], {"find": REFERENCE, "estimate": REFERENCE})
+        ratio, bias = c["error_ratio"], c["bias"]
+        unbiased = bias["low"] is not None and bias["low"] <= 0 <= bias["high"]
+        best = row.get("_estimate_ratio", 1.0)
+        if unbiased and ratio["low"] is not None and ratio["low"] > 1.0 and \
+                (ratio["value"] or math.inf) > best:
+            row["estimate"], row["_estimate_ratio"] = c["strategy"], ratio["value"] or math.inf
+    return {r: {k: v for k, v in row.items() if not k.startswith("_")} for r, row in out.items()}
+
+
 def merge_rare(runs: list[dict]) -> list[dict]:
     """Runs ({"path", "config", "findings", "regimes"}: a results JSON's `rare` part and its
     file) as protocols ({"paths", "config", "findings"}): runs of one protocol merged, their

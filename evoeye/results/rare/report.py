@@ -16,6 +16,7 @@ from evoeye.results.efficiency.config import parse_regime
 from evoeye.results.findings import ALPHA
 from evoeye.results.markdown import DASH, FLOOR_MARK, FLOOR_NOTE, MINUS, md_table, p_text
 from evoeye.results.rare.config import REFERENCE
+from evoeye.results.rare.findings import advice
 
 HEADING = "### Does testing find and measure rare failures faster than Uniform?"
 OPEN = "∞"  # an interval end no resample bounds (module doc of summary.py: `_boot`)
@@ -227,11 +228,24 @@ CHECK_TABLES = {
 }
 
 
+def advice_lines(findings: list[dict]) -> list[str]:
+    """Which strategy to use, per regime (`findings.advice`), as Markdown bullets."""
+    rows = advice(findings)
+    if not rows:
+        return []
+    return ["Which strategy, when (from the checks below: a strategy only where its ratio to "
+            "Uniform has a 95 % CI above 1, else Uniform):", "",
+            *(f"* `{regime}`: to find failures, **{row['find']}**; to estimate how often "
+              f"they happen, **{row['estimate']}**." for regime, row in rows.items()), ""]
+
+
 def rare_findings_markdown(findings: list[dict]) -> str:
-    """The protocol's claims, their verdicts and their checks (for findings.md)."""
+    """The protocol's claims, their verdicts, which strategy to use when, and the checks (for
+    findings.md)."""
     out = [HEADING, "",
            *md_table(["claim", "verdict"], [[f["claim"], f"**{f['verdict']}**"]
-                                            for f in findings], numbers=False), ""]
+                                            for f in findings], numbers=False), "",
+           *advice_lines(findings)]
     for f in findings:
         if f["checks"]:
             header, rows = CHECK_TABLES[f["id"]]

@@ -108,3 +108,15 @@ def test_runs_of_one_protocol_are_checked_over_all_their_regimes():
     with pytest.raises(RareMergeError, match=f"d.json: rare-failure regime {RARE} is also in "
                                              "a.json"):
         merge_rare([a, b, _run("d.json", {RARE: "rare"})])
+
+
+def test_advice_names_a_strategy_only_where_it_was_shown_better(two_regimes):
+    from evoeye.results.rare.findings import advice
+    from evoeye.results.rare.report import rare_findings_markdown
+
+    rows = advice(two_regimes["findings"])
+    assert rows[RARE] == {"find": "ce-is", "estimate": "ce-is"}
+    # Sobol's ratio to Uniform reaches at most 1: keep Uniform there, for both
+    assert rows[COMMON] == {"find": "uniform", "estimate": "uniform"}
+    text = rare_findings_markdown(two_regimes["findings"])
+    assert f"* `{RARE}`: to find failures, **ce-is**" in text
