@@ -45,13 +45,10 @@ class RareMergeError(ValueError):
 
 
 def reference_rate(summary: dict) -> float | None:
-    """A regime's failure rate under p: the inverse-variance reference, else Uniform's share
-    of runs that collided (no estimate had a variance), else None."""
+    """A regime's failure rate under p: Uniform's pooled share (the protocol's reference), None
+    where Uniform saw no failure (the rate is then unknown, and the stricter target applies)."""
     ref = (summary.get("estimates") or {}).get("reference")
-    if ref:
-        return ref["value"]
-    uniform = summary.get("found", {}).get(REFERENCE)
-    return uniform["collisions"] / uniform["runs"] if uniform and uniform["runs"] else None
+    return ref["value"] if ref else None
 
 
 def found_target(rate: float | None) -> float:

@@ -110,9 +110,9 @@ def found_table(found: dict[str, dict]) -> list[str]:
 
 
 def reference_line(ref: dict, runs: int) -> str:
-    return (f"Reference P = {rate(ref['value'])} (SE {rate(ref['se'])}). Uniform pooled: "
-            f"{ref['uniform_collisions']} of {ref['uniform_runs']} runs collided, "
-            f"{rate(ref['uniform_pooled'])}; Uniform's exact relative error at {runs} runs, "
+    return (f"Reference P = Uniform's pooled share, {ref['uniform_collisions']} of "
+            f"{ref['uniform_runs']} runs collided: {rate(ref['value'])} [{rate(ref['low'])}, "
+            f"{rate(ref['high'])}] (Wilson 95 %); Uniform's exact relative error at {runs} runs, "
             f"√((1 − P) / (n·P)): {num(ref['uniform_exact_relative_error'])}.")
 
 

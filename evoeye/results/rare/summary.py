@@ -7,8 +7,10 @@
 * **The failure rate under p.** Each seed's estimate from its own runs: Uniform's share that
   collided (plain Monte Carlo), an importance-sampling strategy's mean of w·y with its runs'
   exact w = p/q (`evoeye.evaluation.failure_rate`). Strategies whose runs carry no exact p/q
-  (e.g. AV-Fuzzer) estimate nothing. The *reference* is the inverse-variance mean of every
-  estimating strategy's pooled estimate (Uniform: all its runs; the others: the mean over seeds).
+  (e.g. AV-Fuzzer) estimate nothing. The *reference* P is Uniform's pooled share over all its
+  runs (with its Wilson interval): independent of the strategies it judges. Uniform's own
+  relative error is then measured about its own mean, which flatters it slightly (hence also
+  its exact figure below); a strategy's is measured about an independent P.
   Per strategy: the mean of the seeds' estimates against Uniform's pooled one (an unbiased
   strategy's difference has a CI around 0; `bias`), and the **relative error at equal budget**, the
   root mean square of (estimate − reference) / reference over seeds, with a bootstrap interval;
@@ -30,7 +32,6 @@ import numpy as np
 from evoeye.evaluation.failure_rate import failure_rate
 from evoeye.evaluation.stats import (
     CONFIDENCE,
-    MeanCI,
     compare_paired,
     mean_ci,
     minimum_detectable_effect,
@@ -113,18 +114,21 @@ def found(curves: dict[str, dict[str, dict]]) -> dict[str, dict]:
     return out
 
 
-def bias(mine: MeanCI, hits: int, runs: int) -> dict:
-    """The strategy's mean estimate − Uniform's pooled share, with the MOVER interval (Zou &
-    Donner 2008): each side's own interval combined — the strategy's t interval over seeds and
-    Uniform's Wilson interval, which stays honest at a handful of collisions or none (a normal
-    interval for Uniform's share has no width at 0 and too little at 1 or 2)."""
+def bias(values: np.ndarray, hits: int, runs: int) -> dict:
+    """The strategy's mean estimate over seeds − Uniform's pooled share, with the MOVER
+    interval (Zou & Donner 2008): each side's own interval combined — the strategy's percentile
+    bootstrap over seeds (its estimates are skewed: most seeds of a rare regime see no failure)
+    and Uniform's Wilson interval, which stays honest at a handful of collisions or none (a
+    normal interval for Uniform's share has no width at 0 and too little at 1 or 2)."""
     u = proportion_ci(hits, runs)
-    if mine.mean is None or mine.low is None or u.value is None:
+    v = np.asarray(values, float)
+    if len(v) < 2 or u.value is None:
         return {"diff": None, "low": None, "high": None}
-    diff = mine.mean - u.value
-    low = diff - math.hypot(mine.mean - mine.low, u.high - u.value)
-    high = diff + math.hypot(mine.high - mine.mean, u.value - u.low)
-    return {"diff": diff, "low": low, "high": high}
+    mean = float(v.mean())
+    low, high = _boot(len(v), lambda idx: float(v[idx].mean()))
+    diff = mean - u.value
+    return {"diff": diff, "low": diff - math.hypot(mean - low, u.high - u.value),
+            "high": diff + math.hypot(high - mean, u.value - u.low)}
 
 
 def estimates(curves: dict[str, dict[str, dict]], runs: int) -> dict[str, dict]:
@@ -138,27 +142,21 @@ def estimates(curves: dict[str, dict[str, dict]], runs: int) -> dict[str, dict]:
         return {}
     uniform_hits = sum(int(_hits(c).sum()) for c in curves[REFERENCE].values())
     uniform_runs = sum(len(c["runs"]) for c in curves[REFERENCE].values())
-    pooled = {}  # name → (estimate, variance)
-    for name, values in per.items():
-        v = np.array(list(values.values()))
-        if name == REFERENCE:
-            p = uniform_hits / uniform_runs
-            pooled[name] = (p, p * (1 - p) / uniform_runs)
-        else:
-            # one seed has no spread to weigh it by: it enters the reference with none
-            pooled[name] = (float(v.mean()),
-                            float(v.var(ddof=1) / len(v)) if len(v) > 1 else 0.0)
-    usable = {k: e for k, e in pooled.items() if e[1] > 0}
-    if not usable:
+    pooled = {name: float(np.mean(list(values.values()))) for name, values in per.items()}
+    if not uniform_hits:
         return {"reference": None}
-    w = {k: 1.0 / var for k, (_, var) in usable.items()}
-    ref = sum(w[k] * usable[k][0] for k in usable) / sum(w.values())
-    ref_se = math.sqrt(1.0 / sum(w.values()))
-    out: dict = {"reference": {"value": ref, "se": ref_se,
-                               "uniform_pooled": pooled[REFERENCE][0],
+    # the reference is Uniform's pooled share: plain Monte Carlo over all its runs, independent
+    # of every other strategy (an inverse-variance mean with an importance-sampling estimator
+    # whose seeds mostly saw no failure would trust its near-zero sample variance, and collapse
+    # onto it)
+    ref = uniform_hits / uniform_runs
+    wilson = proportion_ci(uniform_hits, uniform_runs)
+    out: dict = {"reference": {"value": ref, "low": wilson.low, "high": wilson.high,
+                               "se": math.sqrt(ref * (1 - ref) / uniform_runs),
+                               "uniform_pooled": ref,
                                "uniform_runs": uniform_runs, "uniform_collisions": uniform_hits,
                                "uniform_exact_relative_error":
-                                   math.sqrt((1 - ref) / (runs * ref)) if ref else None}}
+                                   math.sqrt((1 - ref) / (runs * ref))}}
     seeds_u = per[REFERENCE]
     for name, values in per.items():
         v = np.array([values[s] for s in _seeds(values)])
@@ -171,11 +169,11 @@ def estimates(curves: dict[str, dict[str, dict]], runs: int) -> dict[str, dict]:
         low, high = _boot(len(v), rmse)
         row = {"seeds": len(v), "per_seed": {s: values[s] for s in _seeds(values)},
                "mean": m.mean, "mean_low": m.low, "mean_high": m.high,
-               "pooled": pooled[name][0], "relative_error": rmse(np.arange(len(v))),
+               "pooled": pooled[name], "relative_error": rmse(np.arange(len(v))),
                "relative_error_low": low, "relative_error_high": high,
                "spread": float(v.std(ddof=1) / v.mean()) if len(v) > 1 and v.mean() else None}
         if name != REFERENCE:
-            row["bias_vs_uniform"] = bias(m, uniform_hits, uniform_runs)
+            row["bias_vs_uniform"] = bias(v, uniform_hits, uniform_runs)
             common = [s for s in _seeds(values) if s in seeds_u]
             a = np.array([values[s] for s in common])
             b = np.array([seeds_u[s] for s in common])

@@ -52,7 +52,7 @@ def test_rare_md_has_every_table_per_regime(two_regimes):
     found = _row(rare, "ce-is")  # the first ce-is row: failures found
     assert "| 20 | 4000 | 200 | 5.00 [" in found and "| ×25.00 [" in found
     assert "+4.80 [" in found  # 5 per 100 against 0.2, paired per seed
-    assert "Reference P = 0.200 % (SE" in rare and "8 of 4000 runs collided, 0.200 %" in rare
+    assert "Reference P = Uniform's pooled share, 8 of 4000 runs collided: 0.200 % [" in rare
     estimate = [line for line in rare.splitlines() if line.startswith("| ce-is |")][1]
     assert "0.200 % [" in estimate and "| ×8.66 [" in estimate
     assert "| uniform (reference) | 20 | 4000 | 8 | 0.20 [" in rare
