@@ -69,6 +69,13 @@ class FrameRisk:
     def conflict(self, c: Criticality) -> np.ndarray:  # (F,) bool
         return (self.ttc_s < c.conflict_ttc_s) | (self.decel_mps2 > c.conflict_decel_mps2)
 
+    def ratio(self, c: Criticality) -> np.ndarray:  # (F,) ≥ 0
+        """How close each frame is to critical: the larger of critical TTC / TTC and required
+        deceleration / critical deceleration (1 at the bounds, > 1 where `critical` holds)."""
+        with np.errstate(divide="ignore"):
+            ttc = np.where(self.ttc_s > 0, c.critical_ttc_s / self.ttc_s, np.inf)
+        return np.maximum(ttc, self.decel_mps2 / c.critical_decel_mps2)
+
 
 def scene_risk(scene: SceneState) -> tuple[float, float]:
     """(TTC-2D in s, required deceleration in m/s²) of the ego (row 0) against every other
@@ -101,6 +108,15 @@ def frame_risk(scenes: list[SceneState]) -> FrameRisk:
     """`scene_risk` of every frame of a run."""
     pairs = np.array([scene_risk(s) for s in scenes], dtype=np.float64).reshape(-1, 2)
     return FrameRisk(pairs[:, 0], pairs[:, 1])
+
+
+def peak_risk(scenes: list[SceneState], c: Criticality | None = None) -> float:
+    """A run's peak `FrameRisk.ratio` over its scenes (0 for none): a continuous level of how
+    near it came to a collision (> 1: it turned critical). Pass the frames before a collision
+    only; the collision itself is the top level."""
+    if not scenes:
+        return 0.0
+    return float(frame_risk(scenes).ratio(c or Criticality()).max())
 
 
 def justified_frames(label: np.ndarray, critical: np.ndarray, horizon_frames: int) -> np.ndarray:

@@ -1,7 +1,8 @@
 """Defaults shown in `--help`, kept here so that help never imports the heavy modules they come
 from; tests/cli/test_defaults.py checks each against its source."""
 
-ADS_PROFILE_NAMES = ("default", "cautious", "firm-yield")  # evoeye.ads.profiles.ADS_PROFILES
+# evoeye.ads.profiles.ADS_PROFILES
+ADS_PROFILE_NAMES = ("default", "cautious", "firm-yield", "defensive")
 WORLD_NAMES = ("default", "follower")  # evoeye.sim.worlds.WORLD_NAMES
 SPLIT_SEED, TRAIN_FRAC, VAL_FRAC = 0, 0.5, 0.125  # evoeye.store.SplitSpec()
 # evoeye.monitor.recipes

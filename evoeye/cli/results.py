@@ -25,9 +25,11 @@ from evoeye.results.efficiency.config import (
     UPDATES,
     EfficiencyConfig,
 )
+from evoeye.results.rare.config import USABLE, RareConfig
 
 D = ResultsConfig()  # the defaults --help shows (config.py imports nothing heavy)
 E = EfficiencyConfig()
+R = RareConfig()
 
 
 def _csv(text: str) -> tuple[str, ...]:
@@ -41,6 +43,11 @@ def study_scenarios(scenario: list[str] | None, initial_runs: list[str] | None
     if scenario:
         return tuple(scenario)
     return tuple(PAPER_INITIAL_RUNS) if initial_runs == ["paper"] else tuple(D.scenarios)
+
+
+def with_reference(given: list[str] | None, default: tuple[str, ...]) -> tuple[str, ...]:
+    """The strategies given, Uniform (the reference) first and always; else the default."""
+    return tuple(dict.fromkeys((REFERENCE, *given))) if given else default
 
 
 @app.command("results")
@@ -153,6 +160,27 @@ def results_command(
         min=0, help="Sample-efficiency study: the validation set holds at least this many "
                     "colliding runs (further runs of its seed stream; 0: the uniform batch "
                     "alone).")] = E.val_collisions,
+    rare_regime: Annotated[list[str] | None, typer.Option(
+        "--rare-regime", help="Rare-failure protocol (--part rare): a regime, "
+                              "SCENARIO:ADS_PROFILE (repeatable; default "
+                              f"{', '.join(R.regimes)}).")] = None,
+    rare_strategy: Annotated[list[str] | None, typer.Option(
+        "--rare-strategy", help="Rare-failure protocol: the strategies that simulate their own "
+                                f"runs beside Uniform's, the reference, from {', '.join(USABLE)} "
+                                f"(repeatable; default {', '.join(R.strategies)}).")] = None,
+    rare_seeds: Annotated[int, typer.Option(
+        min=2, help="Rare-failure protocol: seeds, paired across strategies.")] = len(R.seeds),
+    first_rare_seed: Annotated[int, typer.Option(
+        min=0, help="Rare-failure protocol: its first seed (seeds K … K+N−1).")] = 0,
+    rare_runs: Annotated[int, typer.Option(
+        min=1, help="Rare-failure protocol: runs simulated per seed and strategy.")] = R.runs,
+    rare_batch: Annotated[int, typer.Option(
+        min=1, help="Rare-failure protocol: runs between two adaptations of a strategy "
+                    "(--rare-runs must be whole batches).")] = R.batch,
+    rare_explain: Annotated[bool, typer.Option(
+        help="Rare-failure protocol: attribute every collision found to a module by "
+             "`evoeye explain`'s counterfactuals (4 more simulations per collision).")] =
+        R.explain,
     recipe: Annotated[str, typer.Option(
         help=f"Training recipe of every monitor trained from scratch, one of "
              f"{', '.join(RECIPES)} (campaign updates keep theirs).")] = D.recipe,
@@ -169,9 +197,12 @@ def results_command(
 ) -> None:
     """Regenerate RQ1, the monitor ablation, RQ2, the evolution ablations and AEM-Evo — and,
     with --part efficiency, the sample-efficiency study (learning curves of acquisition
-    strategies against Uniform and a greedy oracle) — each comparison with its mean, 95 % CI
-    and p; re-running reuses every finished unit."""
+    strategies against Uniform and a greedy oracle); with --part rare, the rare-failure
+    protocol (failures found, failure-rate estimates and distinct mechanisms per simulated run,
+    against Uniform's) — each comparison with its mean, 95 % CI and p; re-running reuses every
+    finished unit."""
     from evoeye.results.efficiency.part import failed_units
+    from evoeye.results.rare.part import failed_curves
     from evoeye.results.run import run_results, write_results
 
     try:
@@ -190,18 +221,22 @@ def results_command(
             epochs=epochs, patience=patience, recipe=recipe, workers=workers,
             efficiency=EfficiencyConfig(
                 regimes=tuple(regime or E.regimes),
-                strategies=tuple(dict.fromkeys((REFERENCE, *strategy))) if strategy
-                else E.strategies,
+                strategies=with_reference(strategy, E.strategies),
                 mode=mode, update=study_update,
                 seeds=tuple(range(first_study_seed, first_study_seed + study_seeds)),
                 oracle=oracle, pool_runs=pool_runs, recipe=recipe, epochs=epochs,
                 patience=patience, members=members, val_collisions=val_collisions
-            ).changed())
+            ).changed(),
+            rare=RareConfig(
+                regimes=tuple(rare_regime or R.regimes),
+                strategies=with_reference(rare_strategy, R.strategies),
+                seeds=tuple(range(first_rare_seed, first_rare_seed + rare_seeds)),
+                runs=rare_runs, batch=rare_batch, explain=rare_explain).changed())
         config.check_names()
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from None
     simulates = (any(map(config.runs_of, config.scenarios)) or test_runs
-                 or "efficiency" in config.parts)
+                 or {"efficiency", "rare"} & set(config.parts))
     data = DataRoot.resolve(root) if simulates else DataRoot.existing(root)
     with StepBar("results") as bar:
         run = run_results(data, config, progress=bar)
@@ -211,6 +246,7 @@ def results_command(
     typer.echo(f"units: {found} found done, {done} done now ({run.computed or 'nothing new'})")
     typer.echo(f"report: {folder / 'results.html'} (tables: rq1.md, rq2.md, results.json)")
     failed = failed_units(run.results["efficiency"]) if "efficiency" in run.results else []
+    failed += failed_curves(run.results["rare"]) if "rare" in run.results else []
     if failed:  # every other curve is in the report; the command still fails
         typer.echo(f"{len(failed)} curve(s) failed and are left out (re-run to retry them):",
                    err=True)

@@ -7,6 +7,10 @@ the findings over all of them, exactly as one run over everything would (`check_
 A table (part and scenario) present in two runs is refused by name: which of the two counts
 would be a choice, and a choice is what the findings must not depend on.
 
+The sample-efficiency study's and the rare-failure protocol's claims are carried over under
+"efficiency" and "rare": runs of one protocol are checked together over all their regimes, and
+a regime in two of them is refused by name, for the same reason.
+
 The combined JSON keeps, for each run, its path, its config and the tables it gave, so every
 verdict can be traced to the run (seeds, sizes, Test Set) that produced it.
 """
@@ -19,6 +23,7 @@ from pathlib import Path
 
 from evoeye.results.efficiency.findings import StudyMergeError, merge_studies
 from evoeye.results.findings import check_findings
+from evoeye.results.rare.findings import RareMergeError, merge_rare
 
 RESULTS_FILE = "results.json"
 
@@ -59,7 +64,7 @@ def combine(paths: Sequence[Path]) -> dict:
     """{"sources": [{"path", "config", "tables"}], "tables", "findings"} over the runs."""
     if not paths:
         raise ResultsFileError("give at least one results file")
-    sources, tables, owner, studies = [], [], {}, []
+    sources, tables, owner, studies, rare = [], [], {}, [], []
     for path in paths:
         file = file_in(path)
         results = load_results(file)
@@ -77,22 +82,34 @@ def combine(paths: Sequence[Path]) -> dict:
                         "tables": names})
         if "efficiency" in results:
             studies.append({"path": str(file), **results["efficiency"]})
+        if "rare" in results:
+            rare.append({"path": str(file), **results["rare"]})
     combined = {"sources": sources, "tables": tables, "findings": check_findings(tables)}
     if studies:
         try:  # a study run regime by regime is checked over all of them
             combined["efficiency"] = merge_studies(studies)
         except StudyMergeError as exc:
             raise ResultsFileError(str(exc)) from None
+    if rare:
+        try:
+            combined["rare"] = merge_rare(rare)
+        except RareMergeError as exc:
+            raise ResultsFileError(str(exc)) from None
     return combined
 
 
-def source_lines(sources: list[dict], studies: frozenset[str] = frozenset()) -> list[str]:
+def source_lines(sources: list[dict], studies: frozenset[str] = frozenset(),
+                 rare: frozenset[str] = frozenset()) -> list[str]:
     """One Markdown bullet per run: its file, the tables it gave and the sizes they rest on
-    (`studies`: the paths of sample-efficiency study runs, whose paper settings mean nothing)."""
+    (`studies`, `rare`: the paths of sample-efficiency study and rare-failure protocol runs,
+    whose paper settings mean nothing)."""
     out = []
     for s in sources:
-        if not s["tables"] and s["path"] in studies:
-            out.append(f"* `{s['path']}`: the sample-efficiency study — its claims are below")
+        if not s["tables"] and (s["path"] in studies or s["path"] in rare):
+            what = " and ".join(w for w, paths in (("the sample-efficiency study", studies),
+                                                   ("the rare-failure protocol", rare))
+                                if s["path"] in paths)
+            out.append(f"* `{s['path']}`: {what} — its claims are below")
             continue
         cfg = s["config"]
         campaigns = "rq2" in cfg.get("parts", ("rq2",))  # RQ1-only runs have none
@@ -110,16 +127,21 @@ def combined_markdown(combined: dict, source: str) -> str:
     """findings.md of combined runs: the runs, then the findings as `evoeye results` shows them."""
     from evoeye.results.efficiency.report import efficiency_findings_markdown, study_words
     from evoeye.results.markdown import findings_markdown
+    from evoeye.results.rare.report import rare_findings_markdown, rare_words
+
+    def paths_of(key: str) -> frozenset[str]:
+        return frozenset(p for s in combined.get(key, []) for p in s["paths"])
 
     text = findings_markdown(combined["findings"], source, command="evoeye findings",
                              runs=["Each table comes from one `evoeye results` run:", "",
-                                   *source_lines(combined["sources"], frozenset(
-                                       p for s in combined.get("efficiency", [])
-                                       for p in s["paths"]))])
-    for study in combined.get("efficiency", []):
-        paths = ", ".join(f"`{p}`" for p in study["paths"])
-        text += (f"\n{efficiency_findings_markdown(study['findings'])}\n"
-                 f"From {paths}: {study_words(study['config'])}.\n")
+                                   *source_lines(combined["sources"], paths_of("efficiency"),
+                                                 paths_of("rare"))])
+    for key, claims, words in (("efficiency", efficiency_findings_markdown, study_words),
+                               ("rare", rare_findings_markdown, rare_words)):
+        for study in combined.get(key, []):
+            paths = ", ".join(f"`{p}`" for p in study["paths"])
+            text += (f"\n{claims(study['findings'])}\n"
+                     f"From {paths}: {words(study['config'])}.\n")
     return text
 
 
@@ -139,5 +161,6 @@ def write_combined(combined: dict, out: Path | None = None, readme: Path | None 
     if readme is not None:
         write_readme_section(readme, combined["findings"], source,
                              None if out is None else out / "findings.md",
-                             command="evoeye findings", studies=combined.get("efficiency", []))
+                             command="evoeye findings", studies=combined.get("efficiency", []),
+                             rare=combined.get("rare", []))
     return text

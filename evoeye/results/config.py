@@ -34,6 +34,7 @@ from typing import Any
 
 from evoeye.evaluation.baselines import BASELINE_SPECS
 from evoeye.results.efficiency.config import EfficiencyConfig
+from evoeye.results.rare.config import RareConfig
 from evoeye.scenarios import SCENARIO_SPECS, SCENARIOS
 
 BASELINES = BASELINE_SPECS  # the registered baselines' names (evoeye.evaluation.baselines)
@@ -43,7 +44,9 @@ INPUTS = ("perception", "perception+prediction", "perception+prediction+planning
 METHODS = ("uniform", "avfuzzer", "evoeye", "no-feedback", "no-density",
            "aem-evo")  # evoeye.evolve.campaign.experiment MAIN + ABLATION
 PAPER_PARTS = ("rq1", "ablation", "rq2")  # what `evoeye results` runs by default
-PARTS = (*PAPER_PARTS, "efficiency")  # + the sample-efficiency study (evoeye.results.efficiency)
+# + the sample-efficiency study (evoeye.results.efficiency) and the rare-failure protocol
+# (evoeye.results.rare): each on data of its own per regime, neither run by default
+PARTS = (*PAPER_PARTS, "efficiency", "rare")
 # how a campaign's k final monitors are made (evoeye.results.rq2): its last update again with
 # k seeds (what a user of the method deploys), or G_0's recipe trained from scratch on its D_R
 # with the k seeds of "G_0 (k seeds)" (what the data it acquired is worth, whatever the update)
@@ -128,12 +131,15 @@ class ResultsConfig:
     workers: int = 1  # processes simulating the data batches, then running campaigns
     # the sample-efficiency study: EfficiencyConfig's fields that differ from its defaults
     efficiency: Mapping[str, Any] = field(default_factory=dict)
+    # the rare-failure protocol: RareConfig's fields that differ from its defaults
+    rare: Mapping[str, Any] = field(default_factory=dict)
 
     def __post_init__(self) -> None:
         for name in ("scenarios", "training_seeds", "campaign_seeds", "parts", "baselines",
                      "context_lens", "inputs", "methods"):
             object.__setattr__(self, name, tuple(getattr(self, name)))
         object.__setattr__(self, "efficiency", self.efficiency_config.changed())
+        object.__setattr__(self, "rare", self.rare_config.changed())
         if not self.scenarios:
             raise ValueError("give at least one logical scenario")
         if isinstance(self.initial_runs, Mapping):
@@ -195,6 +201,8 @@ class ResultsConfig:
         SplitSpec(self.split_seed, *self.shares, self.held_out_batch)  # shares and batch name
         if "efficiency" in self.parts:
             self.efficiency_config.check_names()
+        if "rare" in self.parts:
+            self.rare_config.check_names()
 
     @property
     def efficiency_config(self) -> EfficiencyConfig:
@@ -202,9 +210,15 @@ class ResultsConfig:
         return EfficiencyConfig.from_dict(self.efficiency)
 
     @property
+    def rare_config(self) -> RareConfig:
+        """The rare-failure protocol's config (ValueError naming a bad field)."""
+        return RareConfig.from_dict(self.rare)
+
+    @property
     def paper_parts(self) -> tuple[str, ...]:
         """The parts run per logical scenario on the study's initial data (all but the
-        sample-efficiency study, which has data of its own per regime)."""
+        sample-efficiency study and the rare-failure protocol, which have data of their own
+        per regime)."""
         return tuple(p for p in self.parts if p in PAPER_PARTS)
 
     @property

@@ -25,6 +25,7 @@ from evoeye.results.markdown import (
     row_cells,
     table_intro,
 )
+from evoeye.results.rare.report import rare_html
 from evoeye.results.tables import SET_NAMES, cell_key
 
 CHART_METRICS = ("f1@0.05", "auprc")
@@ -86,6 +87,8 @@ def results_html(results: dict, title: str = "evoeye results") -> str:
             body += [_table_html(t) for t in tables]
     if "efficiency" in results:
         body += efficiency_html(results["efficiency"])
+    if "rare" in results:
+        body += rare_html(results["rare"])
     return ("<!DOCTYPE html><html lang=\"en\"><head><meta charset=\"utf-8\">"
             f"<title>{escape(title)}</title><style>{CSS}</style></head><body>"
             + "".join(body) + "</body></html>\n")

@@ -1,7 +1,7 @@
 """The README's findings section — each of the paper's findings and its verdict, then each
-sample-efficiency study's claims and verdicts, with a link to findings.md, where every
-comparison behind a verdict is shown with its CI and p — and its figure, RQ1's Test F1@0.05
-per method with its CI (FIGURE, written beside findings.md)."""
+sample-efficiency study's and rare-failure protocol's claims and verdicts, with a link to
+findings.md, where every comparison behind a verdict is shown with its CI and p — and its
+figure, RQ1's Test F1@0.05 per method with its CI (FIGURE, written beside findings.md)."""
 
 from __future__ import annotations
 
@@ -18,11 +18,14 @@ FIGURE_KEY = cell_key("test", "f1@0.05")
 
 
 def readme_section(findings: list[dict], source: str, *, command: str = "evoeye results",
-                   details: str | None = None, studies: Sequence[dict] = ()) -> str:
+                   details: str | None = None, studies: Sequence[dict] = (),
+                   rare: Sequence[dict] = ()) -> str:
     """The section: where it comes from, the rule, one row per finding (`details`: the link to
     the findings.md that shows their checks), then per study ({"config", "findings"}: the
-    `efficiency` part of a results JSON) one row per claim."""
+    `efficiency` part of a results JSON) and per rare-failure protocol (its `rare` part) one
+    row per claim."""
     from evoeye.results.efficiency.report import study_words
+    from evoeye.results.rare.report import HEADING, advice_lines, rare_words
 
     header, rows = findings_summary(findings)
     more = f" Every comparison behind a verdict: [{details}]({details})." if details else ""
@@ -37,19 +40,32 @@ def readme_section(findings: list[dict], source: str, *, command: str = "evoeye 
         which = (f"Study {i} of {len(studies)}" if len(studies) > 1
                  else "The sample-efficiency study")
         lines += [f"{which}: {study_words(study['config'])}.", "",
-                  "| claim | verdict |", "|---|---|",
-                  *(f"| {f['claim']} | **{f['verdict']}** |" for f in study["findings"]), ""]
+                  *claim_rows(study["findings"]), ""]
+    if rare:
+        lines += [HEADING, ""]
+    for i, protocol in enumerate(rare, 1):
+        which = (f"Protocol run {i} of {len(rare)}" if len(rare) > 1
+                 else "The rare-failure protocol")
+        lines += [f"{which}: {rare_words(protocol['config'])}.", "",
+                  *claim_rows(protocol["findings"]), "", *advice_lines(protocol["findings"])]
     return "\n".join(lines)
+
+
+def claim_rows(findings: Sequence[dict]) -> list[str]:
+    """A claim | verdict table."""
+    return ["| claim | verdict |", "|---|---|",
+            *(f"| {f['claim']} | **{f['verdict']}** |" for f in findings)]
 
 
 def write_readme_section(readme: Path, findings: list[dict], source: str,
                          findings_md: Path | None = None, *,
-                         command: str = "evoeye results", studies: Sequence[dict] = ()) -> None:
+                         command: str = "evoeye results", studies: Sequence[dict] = (),
+                         rare: Sequence[dict] = ()) -> None:
     """Splice the section into `readme`, linking to `findings_md` (if written) relative to it."""
     details = (None if findings_md is None else
                Path(os.path.relpath(findings_md, readme.resolve().parent)).as_posix())
     section = readme_section(findings, source, command=command, details=details,
-                             studies=studies)
+                             studies=studies, rare=rare)
     readme.write_text(splice_readme(readme.read_text(encoding="utf-8"), section),
                       encoding="utf-8")
 

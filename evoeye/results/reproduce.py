@@ -72,13 +72,14 @@ def read_plan(path: Path) -> list[PlannedRun]:
 
 def run_markdown(results: dict) -> str:
     """The Markdown of a run's parts: RQ1's and the monitor ablation's, RQ2's, the
-    sample-efficiency study's, or several."""
+    sample-efficiency study's, the rare-failure protocol's, or several."""
     from evoeye.results.run import markdown_files
 
     files = markdown_files(results)
     parts = set(results["config"]["parts"])
     chosen = [f for f, own in (("rq1.md", parts & set(MONITOR_PARTS)), ("rq2.md", "rq2" in parts),
-                               ("efficiency.md", "efficiency" in parts)) if own]
+                               ("efficiency.md", "efficiency" in parts),
+                               ("rare.md", "rare" in parts)) if own]
     return "\n\n".join(files[f].rstrip("\n") for f in chosen) + "\n"
 
 

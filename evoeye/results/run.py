@@ -28,6 +28,7 @@ from evoeye.results.efficiency.report import efficiency_findings_markdown, effic
 from evoeye.results.findings import check_findings
 from evoeye.results.html import results_html
 from evoeye.results.markdown import findings_markdown, part_markdown
+from evoeye.results.rare.report import rare_findings_markdown, rare_markdown
 from evoeye.results.readme import write_figure, write_readme_section
 from evoeye.results.rq1 import ablation, rq1
 from evoeye.results.rq2 import rq2
@@ -36,7 +37,7 @@ from evoeye.results.tables import build_tables
 from evoeye.store import Warehouse
 
 PARTS: dict[str, Callable[[Study, str], dict]] = {"rq1": rq1, "ablation": ablation, "rq2": rq2}
-DOCS_FILES = ("rq1.md", "rq2.md", "efficiency.md", "findings.md", "results.json")
+DOCS_FILES = ("rq1.md", "rq2.md", "efficiency.md", "rare.md", "findings.md", "results.json")
 FINAL_WORDS = {"update": "of its last update",
                "retrain": "of G_0's recipe trained from scratch on its D_R (`--final retrain`: "
                           "what the acquired data is worth, whatever the update rule)"}
@@ -108,20 +109,33 @@ def run_results(root: DataRoot, config: ResultsConfig,
         efficiency = run_efficiency(root, config.efficiency_config, workers=config.workers,
                                     say=progress, ledger=study.ledger)
     ledgers = {id(s.ledger): s.ledger for s in (study, monitors)}.values()
-    return ResultsRun(assemble(study, scenarios, efficiency),
-                      dict(sum((lg.found for lg in ledgers), Counter())),
-                      dict(sum((lg.computed for lg in ledgers), Counter())))
+    found = sum((lg.found for lg in ledgers), Counter())
+    computed = sum((lg.computed for lg in ledgers), Counter())
+    rare = None
+    if "rare" in config.parts:  # its curves run in workers, each with a ledger of its own
+        from evoeye.results.rare.part import KIND, rare_results
+
+        c = config.rare_config
+        rare, now = rare_results(root, c, workers=config.workers, say=progress)
+        computed[KIND] += now
+        found[KIND] += len(c.regimes) * len(c.seeds) * len(c.strategies) - now - len(
+            rare["failed"])
+    return ResultsRun(assemble(study, scenarios, efficiency, rare), dict(found),
+                      dict(computed))
 
 
-def assemble(study: Study, scenarios: dict[str, dict], efficiency: dict | None = None) -> dict:
-    """The results JSON of a study's parts ({scenario: {"data", part: figures}}, and the
-    sample-efficiency study's): the config, the splits, the per-seed figures, every table and
-    the findings (plain JSON types)."""
+def assemble(study: Study, scenarios: dict[str, dict], efficiency: dict | None = None,
+             rare: dict | None = None) -> dict:
+    """The results JSON of a study's parts ({scenario: {"data", part: figures}}, the
+    sample-efficiency study's and the rare-failure protocol's): the config, the splits, the
+    per-seed figures, every table and the findings (plain JSON types)."""
     tables = build_tables(scenarios)
     results = {"config": study.config.to_dict(), "splits": asdict(study.splits),
                "scenarios": scenarios, "tables": tables, "findings": check_findings(tables)}
     if efficiency is not None:
         results["efficiency"] = efficiency
+    if rare is not None:
+        results["rare"] = rare
     return json.loads(json.dumps(results, default=float))
 
 
@@ -183,6 +197,9 @@ def markdown_files(results: dict, source: str = "results.json") -> dict[str, str
         files["efficiency.md"] = efficiency_markdown(results["efficiency"])
         files["findings.md"] += "\n" + efficiency_findings_markdown(
             results["efficiency"]["findings"])
+    if "rare" in results:
+        files["rare.md"] = rare_markdown(results["rare"])
+        files["findings.md"] += "\n" + rare_findings_markdown(results["rare"]["findings"])
     return files
 
 
@@ -210,5 +227,6 @@ def write_results(root: DataRoot, results: dict, name: str = "results", *,
     if readme is not None:
         write_readme_section(readme, results["findings"], source,
                              (docs if docs is not None else folder) / "findings.md",
-                             studies=[results["efficiency"]] if "efficiency" in results else [])
+                             studies=[results["efficiency"]] if "efficiency" in results else [],
+                             rare=[results["rare"]] if "rare" in results else [])
     return folder

@@ -82,7 +82,8 @@ def test_ads_names_a_profile_and_its_runs_go_to_a_batch_of_their_own(tmp_path) -
     logs = list((tmp_path / "runs" / "highway-cut-in").glob("*/*.mcap"))
     assert [p.parent.name for p in logs] == ["uniform-firm-yield-seed0"]
     refused = runner.invoke(app, [*SIM, "--ads", "reckless", "--root", str(tmp_path / "x")])
-    assert refused.exit_code == 2 and "known: default, cautious, firm-yield" in refused.output
+    assert refused.exit_code == 2
+    assert "known: default, cautious, firm-yield, defensive" in refused.output
     assert not (tmp_path / "x").exists()  # refused before anything ran
 
 

@@ -24,7 +24,8 @@ def _section() -> str:
         combined = json.loads(COMBINED.read_text())
         return readme_section(combined["findings"], "docs/results/findings.json",
                               command="evoeye findings", details="docs/results/findings.md",
-                              studies=combined.get("efficiency", []))
+                              studies=combined.get("efficiency", []),
+                              rare=combined.get("rare", []))
     findings = (json.loads(RESULTS.read_text())["findings"] if RESULTS.exists()
                 else check_findings([]))  # before the first run: every finding "not run yet"
     return readme_section(findings, "docs/results/results.json",

@@ -156,7 +156,7 @@ def effective_size(w: np.ndarray) -> float:
 
 def ce_update(previous: DefensiveMixture, u: np.ndarray, log_w: np.ndarray,
               fitness: np.ndarray, collided: np.ndarray, *, rho: float = RHO,
-              smoothing: float = SMOOTHING) -> DefensiveMixture:
+              smoothing: float = SMOOTHING, screen_z: float = SCREEN_Z) -> DefensiveMixture:
     """The next mixture from runs u (n, dim) with log p/q (n,) and outcomes (module doc); the
     previous one while fewer than MIN_RECORDS outcomes or MIN_ELITE elite runs are known."""
     top = elite(fitness, collided, rho)
@@ -168,8 +168,8 @@ def ce_update(previous: DefensiveMixture, u: np.ndarray, log_w: np.ndarray,
     var = w @ (u[top] - mean) ** 2
     # keep p's marginal where the elite's does not depart from it beyond sampling noise
     n_eff = effective_size(w)
-    moved = (np.abs(mean - 0.5) > SCREEN_Z * UNIFORM_SD / math.sqrt(n_eff)) | (
-        UNIFORM_SD**2 - var > SCREEN_Z * UNIFORM_VAR_SD / math.sqrt(n_eff))
+    moved = (np.abs(mean - 0.5) > screen_z * UNIFORM_SD / math.sqrt(n_eff)) | (
+        UNIFORM_SD**2 - var > screen_z * UNIFORM_VAR_SD / math.sqrt(n_eff))
     mean = np.where(moved, mean, 0.5)
     sd = np.where(moved, np.sqrt(var), UNIFORM_SD)
     old_mean, old_sd = previous.moments(u.shape[1])
@@ -184,13 +184,15 @@ class CrossEntropyIS(BatchedStrategy):
     name = "ce-is"
 
     def __init__(self, space: LogicalScenario, seed: int, batch: int = 20,
-                 alpha: float = ALPHA, rho: float = RHO) -> None:
+                 alpha: float = ALPHA, rho: float = RHO, screen_z: float = SCREEN_Z) -> None:
         if not 0.0 < alpha <= 1.0:
             raise StrategyError(f"{self.name}: alpha must be in (0, 1], got {alpha}")
         if not 0.0 < rho < 1.0:
             raise StrategyError(f"{self.name}: rho must be in (0, 1), got {rho}")
+        if not screen_z >= 0.0:
+            raise StrategyError(f"{self.name}: screen_z must be >= 0, got {screen_z}")
         super().__init__(space, seed, batch)
-        self.alpha, self.rho = alpha, rho
+        self.alpha, self.rho, self.screen_z = alpha, rho, screen_z
         self.log_span = float(np.log(space.high - space.low).sum())  # u → θ: density / Π span
         self._mixtures: list[DefensiveMixture] = []  # per batch, rebuilt from the records
 
@@ -210,7 +212,8 @@ class CrossEntropyIS(BatchedStrategy):
             u = self.space.normalise(basis.params)
             log_w = -self._log_q_unit(u, n_init)
             self._mixtures.append(ce_update(self._mixtures[-1], u, log_w, basis.fitness,
-                                            basis.collided, rho=self.rho))
+                                            basis.collided, rho=self.rho,
+                                            screen_z=self.screen_z))
         return self._mixtures[b]
 
     def _log_q_unit(self, u: np.ndarray, n_init: int) -> np.ndarray:

@@ -27,8 +27,6 @@ name (which of the two counts would be a choice).
 
 from __future__ import annotations
 
-import json
-
 from evoeye.results.efficiency.config import (
     ORACLE,
     ORACLE_UNIFORM,
@@ -43,11 +41,11 @@ from evoeye.results.findings import (
     REVERSED,
     check_verdict,
 )
+from evoeye.results.merge import merge_runs
 
 MEASURE = "test/scratch"
 EFFICIENCY = 1.5
 BASELINES = (REFERENCE, "sobol", "evoeye", ORACLE, ORACLE_UNIFORM)  # not "beyond the paper"
-FREE = ("regimes", "seeds", "strategies")  # what the runs of one study may differ in
 
 
 class StudyMergeError(ValueError):
@@ -134,35 +132,6 @@ def efficiency_findings(results: dict) -> list[dict]:
 def merge_studies(runs: list[dict]) -> list[dict]:
     """Runs ({"path", "config", "findings", "regimes"}: a results JSON's `efficiency` part and
     its file) as studies ({"paths", "config", "findings"}): runs of one protocol merged, their
-    claims checked over every regime (module doc). A study of one run keeps its own findings;
-    a merged one's config lists each regime's seeds (`{regime: seeds}`)."""
-    # a field added since a run was recorded reads as its default: the behaviour that run had
-    default = EfficiencyConfig().to_dict()
-    groups: dict[str, list[dict]] = {}
-    for run in runs:
-        protocol = {k: v for k, v in {**default, **run["config"]}.items() if k not in FREE}
-        groups.setdefault(json.dumps(protocol, sort_keys=True), []).append(run)
-    out = []
-    for group in groups.values():
-        if len(group) == 1:
-            out.append({"paths": [group[0]["path"]], "config": group[0]["config"],
-                        "findings": group[0]["findings"]})
-            continue
-        regimes, owner, seeds, strategies = {}, {}, {}, []
-        for run in group:
-            if not run.get("regimes"):
-                raise StudyMergeError(f"{run['path']}: the study's regimes are missing (it "
-                                      "cannot be checked with the study's other runs)")
-            for regime, result in run["regimes"].items():
-                if regime in owner:
-                    raise StudyMergeError(f"{run['path']}: regime {regime} is also in "
-                                          f"{owner[regime]}; give each regime of a study from "
-                                          "one run only")
-                owner[regime], regimes[regime] = run["path"], result
-                seeds[regime] = run["config"]["seeds"]
-            strategies += [s for s in run["config"].get("strategies", []) if s not in strategies]
-        config = {**group[0]["config"], "regimes": list(regimes), "strategies": strategies,
-                  "seeds": seeds}
-        out.append({"paths": [run["path"] for run in group], "config": config,
-                    "findings": efficiency_findings({"regimes": regimes})})
-    return out
+    claims checked over every regime (module doc, `evoeye.results.merge`)."""
+    return merge_runs(runs, EfficiencyConfig().to_dict(), efficiency_findings,
+                      StudyMergeError, noun="study")

@@ -128,7 +128,21 @@ def test_pool_mode_draws_unused_rows_with_their_densities():
     assert np.isfinite(records.log_q[40:]).all()
 
 
-@pytest.mark.parametrize("option", [{"alpha": 0.0}, {"rho": 1.0}, {"batch": 0}])
+def test_a_lower_screening_z_lets_a_weaker_departure_adapt():
+    rng = np.random.default_rng(5)
+    u = rng.uniform(size=(200, 2))
+    u[:20, 0] = 0.25 + 0.75 * (np.arange(20) + 0.5) / 20  # the elite leans high, mean 0.625
+    f = np.where(np.arange(200) < 20, 0.1, 0.9)  # the elite: the 20 most critical runs
+    strict = ce_update(DefensiveMixture(ALPHA), u, np.zeros(200), f, f == 0, smoothing=1.0,
+                       screen_z=3.0, rho=0.1)
+    loose = ce_update(DefensiveMixture(ALPHA), u, np.zeros(200), f, f == 0, smoothing=1.0,
+                      screen_z=1.0, rho=0.1)
+    assert strict.proposal.moments()[0][0] == pytest.approx(0.5)  # screened out at z = 3
+    assert loose.proposal.moments()[0][0] > 0.6  # adapts at z = 1
+
+
+@pytest.mark.parametrize("option", [{"alpha": 0.0}, {"rho": 1.0}, {"batch": 0},
+                                    {"screen_z": -1.0}])
 def test_bad_options_are_named(option):
     with pytest.raises(StrategyError, match=next(iter(option))):
         make_strategy("ce-is", HIGHWAY, seed=0, **option)

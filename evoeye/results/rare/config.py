@@ -1,0 +1,111 @@
+"""What the testing-efficiency protocol runs, at what size: declared once and validated.
+
+Plain data (the command line reads it at start-up). The protocol (`runner.py`):
+
+* Regimes: a logical scenario and the ADS profile that drives it (`scenario:profile`), chosen
+  where failures are rare — `highway-cut-in:cautious` (≈ 1 % of uniform runs: 11 of 1 000 on
+  the screening seed) and `highway-cut-in:defensive` (≈ 0.1 %: 1 of 2 000).
+* Generative mode only: every strategy simulates its own runs, `runs` per seed, in batches of
+  `batch` (a strategy adapts between batches). No initial set: ce-is's first batch is drawn
+  from p itself, and a curve that finds no failure is part of the result.
+* Seeds are paired across strategies (the same seed, a different run-seed stream per strategy),
+  and every run seed derives from `data_seed`, which no earlier study used.
+* Every collision found is classified (`evoeye.evaluation.mechanism`: the partner's motion) and,
+  with `explain`, attributed (`evoeye explain`'s counterfactuals: the module whose oracle
+  prevents it); a distinct mechanism is one (class, root cause) pair.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass, fields
+
+from evoeye.results.efficiency.config import parse_regime
+
+REFERENCE = "uniform"
+STRATEGIES = (REFERENCE, "ce-is")
+# the strategies that need no monitor (the protocol trains none): the others read feedback
+USABLE = (REFERENCE, "ce-is", "sobol", "avfuzzer")
+# whose runs carry their exact p/q, so they estimate the failure rate under p without bias
+ESTIMATING = (REFERENCE, "ce-is")
+REGIMES = ("highway-cut-in:cautious", "highway-cut-in:defensive")
+
+
+@dataclass(frozen=True)
+class RareConfig:
+    """Everything the protocol regenerates, and at what size (module doc)."""
+
+    regimes: tuple[str, ...] = REGIMES
+    strategies: tuple[str, ...] = STRATEGIES
+    seeds: tuple[int, ...] = tuple(range(40))  # paired across strategies
+    runs: int = 200  # simulated per seed and strategy
+    batch: int = 10  # runs between two adaptations of a strategy
+    data_seed: int = 9_100  # the run seeds' stream (fresh: no earlier study drew from it)
+    explain: bool = True  # attribute every collision found to a module (counterfactuals)
+    # ce-is's elite share and screening z, chosen on screening seeds of data_seed 9_000
+    ce_rho: float = 0.2
+    ce_screen_z: float = 2.0
+
+    def __post_init__(self) -> None:
+        for name in ("regimes", "strategies", "seeds"):
+            object.__setattr__(self, name, tuple(getattr(self, name)))
+        for regime in self.regimes:
+            parse_regime(regime)
+        if not self.regimes:
+            raise ValueError("need at least one regime")
+        if REFERENCE not in self.strategies or len(set(self.strategies)) != len(self.strategies):
+            raise ValueError(f"the strategies must be distinct and include {REFERENCE!r}, "
+                             f"got {self.strategies}")
+        if unusable := [s for s in self.strategies if s not in USABLE]:
+            raise ValueError(f"strategies {unusable} need a monitor; the rare-failure protocol "
+                             f"runs {', '.join(USABLE)}")
+        if len(self.seeds) < 2 or len(set(self.seeds)) != len(self.seeds) or min(self.seeds) < 0:
+            raise ValueError(f"need at least 2 distinct seeds >= 0, got {self.seeds}")
+        if self.batch < 1 or self.runs < self.batch or self.runs % self.batch:
+            raise ValueError(f"runs must be whole batches (runs {self.runs}, batch {self.batch})")
+        if not (0.0 < self.ce_rho < 1.0 and self.ce_screen_z >= 0.0):
+            raise ValueError(f"ce-is needs 0 < ce_rho < 1 and ce_screen_z >= 0, got "
+                             f"{self.ce_rho}, {self.ce_screen_z}")
+        if self.data_seed < 0:
+            raise ValueError(f"data_seed must be >= 0, got {self.data_seed}")
+
+    def check_names(self) -> None:
+        """ValueError naming a scenario or ADS profile no registry knows (loads them)."""
+        from evoeye.ads.profiles import ADS_PROFILES
+        from evoeye.scenarios import SCENARIOS
+
+        for regime in self.regimes:
+            scenario, profile = parse_regime(regime)
+            if scenario not in SCENARIOS or profile not in ADS_PROFILES:
+                raise ValueError(f"regime {regime!r}: scenarios are {sorted(SCENARIOS)}, ADS "
+                                 f"profiles {sorted(ADS_PROFILES)}")
+
+    def options(self, strategy: str) -> dict:
+        """The options strategy `strategy`'s factory takes from this config (loads it)."""
+        from evoeye.evolve.search.registry import strategy_options
+
+        return strategy_options(strategy, batch=self.batch, rho=self.ce_rho,
+                                screen_z=self.ce_screen_z)
+
+    def unit(self, regime: str, strategy: str, seed: int) -> dict:
+        """The inputs that fix one curve's runs (its ledger key)."""
+        return {"regime": regime, "strategy": strategy, "seed": seed, "runs": self.runs,
+                "options": self.options(strategy), "data_seed": self.data_seed,
+                "explain": self.explain}
+
+    def to_dict(self) -> dict:
+        return {f.name: list(v) if isinstance(v, tuple) else v
+                for f in fields(self) if (v := getattr(self, f.name)) is not None}
+
+    def changed(self) -> dict:
+        """The fields that differ from the defaults, as JSON values."""
+        default = RareConfig()
+        return {k: v for k, v in self.to_dict().items() if v != default.to_dict()[k]}
+
+    @classmethod
+    def from_dict(cls, data: Mapping) -> RareConfig:
+        if not isinstance(data, Mapping):
+            raise ValueError(f"the rare-failure config must be a mapping, got {data!r}")
+        if unknown := sorted(set(data) - {f.name for f in fields(cls)}):
+            raise ValueError(f"unknown rare-failure config key(s) {unknown}")
+        return cls(**data)

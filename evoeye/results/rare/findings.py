@@ -1,0 +1,172 @@
+"""What the rare-failure protocol shows, claim by claim, over its regimes.
+
+Each check is one strategy against Uniform on one regime (`summary.py`'s figures), with the
+paired per-seed cell it rests on (`compare_paired`'s fields: n, mean_diff, ci_low, ci_high, p):
+
+* **rare-found** — failures found per run: the target is 10× Uniform's where the regime's
+  reference failure rate is below 0.3 % (the ≈ 0.1 % regime), else 3× (≈ 1 %). It
+  **reproduces** when the ratio's bootstrap CI lies at or above the target, **does not
+  reproduce** when its upper end exists and lies below it, and is **not shown** otherwise (an
+  open interval: Uniform found too few to bound the ratio). Cell: the paired difference of the
+  seeds' failures per 100 runs.
+* **rare-estimate** — the strategy's failure-rate estimate (exact p/q) is unbiased and has ≥ 3×
+  smaller relative error at equal budget: it **reproduces** when the bias CI against Uniform's
+  pooled estimate contains 0 and the error ratio's (Uniform's / the strategy's) CI lies at or
+  above 3; it **does not reproduce** when the bias CI excludes 0 or the ratio's upper end lies
+  below 3; otherwise not shown (so where Uniform saw no failure: its pooled 0 has no
+  variance to judge a bias by). Cell: the paired difference of the seeds' absolute relative
+  errors (Uniform's − the strategy's).
+
+A claim reproduces when one strategy reproduces in every regime run; does not reproduce when
+every check goes against it; is partly shown when some check reproduces; not shown otherwise,
+or when a strategy it is about ran but no check could be made (e.g. no failure seen, so no
+estimate); not run yet when none ran.
+
+A protocol too big for one session runs regime by regime: runs whose config agrees but for
+regimes, seeds and strategies are one protocol, and `merge_rare` checks its claims over all
+their regimes; a regime in two runs of one protocol is refused by name.
+"""
+
+from __future__ import annotations
+
+import math
+
+from evoeye.results.findings import AGAINST, NOT_RUN, NOT_SHOWN, PARTLY, REPRODUCES
+from evoeye.results.merge import merge_runs
+from evoeye.results.rare.config import ESTIMATING, REFERENCE, RareConfig
+
+RARE_BELOW = 0.003  # a regime whose reference failure rate is below this is the ≈ 0.1 % one
+FOUND_TARGETS = (10.0, 3.0)  # × Uniform's failures per run: below RARE_BELOW, else
+ERROR_TARGET = 3.0  # × smaller relative error at equal budget
+
+
+class RareMergeError(ValueError):
+    """Runs of one protocol that cannot be checked together (module doc)."""
+
+
+def reference_rate(summary: dict) -> float | None:
+    """A regime's failure rate under p: Uniform's pooled share (the protocol's reference), None
+    where Uniform saw no failure (the rate is then unknown, and the stricter target applies)."""
+    ref = (summary.get("estimates") or {}).get("reference")
+    return ref["value"] if ref else None
+
+
+def found_target(rate: float | None) -> float:
+    """The multiple of Uniform's failures per run a strategy must reach (module doc); the
+    stricter one where the rate is unknown (no failure seen at all)."""
+    return FOUND_TARGETS[0] if rate is None or rate < RARE_BELOW else FOUND_TARGETS[1]
+
+
+def found_verdict(vs: dict, target: float) -> str:
+    """The verdict of one ratio of failures per run (module doc)."""
+    if vs["ratio_low"] is not None and vs["ratio_low"] >= target:
+        return REPRODUCES
+    if vs["ratio_high"] is not None and vs["ratio_high"] < target:
+        return AGAINST
+    return NOT_SHOWN
+
+
+def estimate_verdict(row: dict, uniform_failures: int) -> str:
+    """The verdict of one strategy's failure-rate estimate (module doc); the bias is judged
+    only where Uniform saw a failure (with none its pooled estimate 0 has no variance, and the
+    bias interval would ignore Uniform's uncertainty)."""
+    bias, ratio = row["bias_vs_uniform"], row["error_ratio"]
+    if not all(isinstance(v, float) and math.isfinite(v) for v in (bias["low"], bias["high"])):
+        return NOT_SHOWN  # no interval (a strategy left with one seed has no variance)
+    if uniform_failures and (bias["low"] > 0 or bias["high"] < 0):
+        return AGAINST
+    if ratio["high"] is not None and ratio["high"] < ERROR_TARGET:
+        return AGAINST
+    return REPRODUCES if uniform_failures and ratio["low"] is not None and \
+        ratio["low"] >= ERROR_TARGET else NOT_SHOWN
+
+
+def found_checks(regimes: dict[str, dict]) -> list[dict]:
+    out = []
+    for regime, summary in regimes.items():
+        rate = reference_rate(summary)
+        target = found_target(rate)
+        for name, f in summary["found"].items():
+            if name == REFERENCE or "vs_reference" not in f:
+                continue
+            vs = f["vs_reference"]
+            out.append({"regime": regime, "strategy": name, "metric": "failures per 100 runs",
+                        "cell": vs["paired"], "ratio": vs["ratio"], "ratio_low": vs["ratio_low"],
+                        "ratio_high": vs["ratio_high"], "target": target,
+                        "reference_rate": rate, "verdict": found_verdict(vs, target)})
+    return out
+
+
+def estimate_checks(regimes: dict[str, dict]) -> list[dict]:
+    out = []
+    for regime, summary in regimes.items():
+        seen = (summary["estimates"].get("reference") or {}).get("uniform_collisions", 0)
+        for name, row in summary["estimates"].items():
+            if name in (REFERENCE, "reference") or "bias_vs_uniform" not in row:
+                continue
+            out.append({"regime": regime, "strategy": name,
+                        "metric": "relative error at equal budget",
+                        "cell": row["paired_abs_error"], "bias": row["bias_vs_uniform"],
+                        "error_ratio": row["error_ratio"], "target": ERROR_TARGET,
+                        "verdict": estimate_verdict(row, seen)})
+    return out
+
+
+def _claim(id_: str, claim: str, checks: list[dict], regimes: int, ran: bool) -> dict:
+    """A claim over the regimes (module doc; `ran`: a strategy it is about has curves)."""
+    if not checks:
+        return {"id": id_, "claim": claim, "checks": [], "verdict": NOT_SHOWN if ran else NOT_RUN}
+    wins: dict[str, int] = {}
+    for c in checks:
+        wins[c["strategy"]] = wins.get(c["strategy"], 0) + (c["verdict"] == REPRODUCES)
+    if max(wins.values()) >= regimes:
+        verdict = REPRODUCES
+    elif all(c["verdict"] == AGAINST for c in checks):
+        verdict = AGAINST
+    else:
+        verdict = PARTLY if any(wins.values()) else NOT_SHOWN
+    return {"id": id_, "claim": claim, "checks": checks, "verdict": verdict}
+
+
+def rare_findings(results: dict) -> list[dict]:
+    """The protocol's claims with their checks and verdicts, over `results["regimes"]`."""
+    regimes = results["regimes"]
+    ran = {name for summary in regimes.values() for name in summary["found"]} - {REFERENCE}
+    return [
+        _claim("rare-found", "A strategy finds ≥ 10× Uniform's failures per run where failures "
+               "are ≈ 0.1 % (≥ 3× at ≈ 1 %)", found_checks(regimes), len(regimes), bool(ran)),
+        _claim("rare-estimate", "Its failure-rate estimate is unbiased and has ≥ 3× smaller "
+               "relative error at equal budget", estimate_checks(regimes), len(regimes),
+               bool(ran & set(ESTIMATING))),
+    ]
+
+
+def advice(findings: list[dict]) -> dict[str, dict[str, str]]:
+    """Per regime, which strategy to use to find failures and which to estimate the failure
+    rate with, from the claims' checks alone: the strategy whose ratio to Uniform has a CI above
+    1 (the largest, to find; the smallest error with a bias CI holding 0, to estimate), else
+    Uniform — a strategy no check showed better is no reason to leave p."""
+    out: dict[str, dict[str, str]] = {}
+    by_id = {f["id"]: f["checks"] for f in findings}
+    for c in by_id.get("rare-found", []):
+        row = out.setdefault(c["regime"], {"find": REFERENCE, "estimate": REFERENCE})
+        best = row.get("_find_ratio", 1.0)
+        if c["ratio_low"] is not None and c["ratio_low"] > 1.0 and (c["ratio"] or 0) > best:
+            row["find"], row["_find_ratio"] = c["strategy"], c["ratio"]
+    for c in by_id.get("rare-estimate", []):
+        row = out.setdefault(c["regime"], {"find": REFERENCE, "estimate": REFERENCE})
+        ratio, bias = c["error_ratio"], c["bias"]
+        unbiased = bias["low"] is not None and bias["low"] <= 0 <= bias["high"]
+        best = row.get("_estimate_ratio", 1.0)
+        if unbiased and ratio["low"] is not None and ratio["low"] > 1.0 and \
+                (ratio["value"] or math.inf) > best:
+            row["estimate"], row["_estimate_ratio"] = c["strategy"], ratio["value"] or math.inf
+    return {r: {k: v for k, v in row.items() if not k.startswith("_")} for r, row in out.items()}
+
+
+def merge_rare(runs: list[dict]) -> list[dict]:
+    """Runs ({"path", "config", "findings", "regimes"}: a results JSON's `rare` part and its
+    file) as protocols ({"paths", "config", "findings"}): runs of one protocol merged, their
+    claims checked over every regime (module doc, `evoeye.results.merge`)."""
+    return merge_runs(runs, RareConfig().to_dict(), rare_findings, RareMergeError,
+                      noun="protocol", label="rare-failure ")

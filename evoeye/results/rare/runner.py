@@ -1,0 +1,107 @@
+"""One curve of the testing-efficiency protocol: a strategy's runs at one seed of one regime.
+
+A curve is a strategy simulating `runs` runs in memory (no log: the protocol keeps only what it
+reports), proposal by proposal, told each outcome before its next batch. Every run keeps its θ,
+outcome, level (`risk_fitness`: what `ce-is` adapts on), proposal densities (log q, log p: its
+exact weight p/q; NaN for a run drawn from p), and, for a collision, its mechanism and root
+cause: the modules whose oracle alone avoids it (`evoeye.sim.counterfactual`, the variants
+`evoeye explain` runs, re-simulated from the factual episode already in memory).
+
+Run seeds: run k of a curve has the seed SeedSequence([data_seed, crc(regime), crc(strategy),
+seed, k]), so strategies share no run seed, and adding a regime or a strategy moves no other
+curve's runs. The strategy itself is seeded with SeedSequence([data_seed, seed]): the pairing
+is by seed. The same config gives the same runs, bit for bit.
+"""
+
+from __future__ import annotations
+
+import zlib
+from collections.abc import Callable
+
+import numpy as np
+
+from evoeye.ads.profiles import ads_profile
+from evoeye.criticality import peak_risk
+from evoeye.evaluation.mechanism import mechanism
+from evoeye.evolve.search.fitness import risk_fitness
+from evoeye.evolve.search.records import Records
+from evoeye.evolve.search.registry import make_strategy
+from evoeye.results.efficiency.config import parse_regime
+from evoeye.results.rare.config import RareConfig
+from evoeye.scenarios import get_scenario
+from evoeye.sim.counterfactual import VARIANTS
+from evoeye.sim.episode import STATUS_OK, Episode
+from evoeye.sim.runner import SimConfig, run_episode, run_spec
+
+ORACLES = ("oracle_perception", "oracle_prediction", "oracle_planning", "oracle_control")
+UNATTRIBUTED = "none"  # no single module's oracle avoids the collision
+
+
+def _key(text: str) -> int:
+    return zlib.crc32(text.encode())
+
+
+def run_seed(config: RareConfig, regime: str, strategy: str, seed: int, k: int) -> int:
+    """The run seed of run k of a curve (module doc)."""
+    ss = np.random.SeedSequence([config.data_seed, _key(regime), _key(strategy), seed, k])
+    return int(ss.generate_state(1)[0])
+
+
+def strategy_seed(config: RareConfig, seed: int) -> int:
+    return int(np.random.SeedSequence([config.data_seed, seed]).generate_state(1)[0])
+
+
+def root_cause(factual: Episode) -> str:
+    """The modules (in pipeline order, "+"-joined) whose oracle alone avoids the factual
+    collision, or UNATTRIBUTED."""
+    sim, ads = SimConfig(), ads_profile(factual.spec.ads)  # run_episode sets the cruise
+    avoided = [v.removeprefix("oracle_") for v in ORACLES
+               if not VARIANTS[v](factual, sim, ads).collided]
+    return "+".join(avoided) or UNATTRIBUTED
+
+
+def simulate(regime: str, x: np.ndarray, seed: int, explain: bool) -> dict:
+    """One run, in memory: its outcome, level and, for a collision, mechanism and root cause."""
+    scenario, profile = parse_regime(regime)
+    ep = run_episode(run_spec(scenario, x, seed, ads=profile))
+    o = ep.outcome
+    ok = o.status == STATUS_OK
+    collided = bool(o.collided) and ok
+    scenes = [f.scene for f in ep.frames]
+    if collided:  # the level of the approach, not of the contact
+        scenes = scenes[:max(int(round(o.collision_time_s * ep.rate_hz)), 1)]
+    risk = peak_risk(scenes) if ok else float("nan")
+    row = {"collided": collided, "ok": ok, "reason": o.reason, "risk": risk,
+           "fitness": float(risk_fitness(collided, risk)), "min_gap_m": o.min_distance_m,
+           "mechanism": None, "cause": None}
+    if collided:
+        m = mechanism(ep)
+        row["mechanism"] = m.kind if m else None
+        row["cause"] = root_cause(ep) if explain else None
+    return row
+
+
+def run_curve(config: RareConfig, regime: str, strategy: str, seed: int,
+              on_run: Callable[[int], None] | None = None) -> dict:
+    """Every run of one curve (module doc): {"x", "runs": [row], "log_q", "log_p"}."""
+    space = get_scenario(parse_regime(regime)[0])
+    strat = make_strategy(strategy, space, strategy_seed(config, seed),
+                          **config.options(strategy))
+    records = Records.empty(space.dim)
+    rows = []
+    for k in range(config.runs):
+        prop = strat.propose(records)
+        row = simulate(regime, prop.x, run_seed(config, regime, strategy, seed, k),
+                       config.explain)
+        strat.tell(prop.x, row["fitness"])
+        records = records.append(prop.x, fitness=row["fitness"], collided=row["collided"],
+                                 log_q=prop.log_q, log_p=prop.log_p)
+        rows.append(row)
+        if on_run:
+            on_run(k)
+    return {"x": records.params.tolist(), "runs": rows,
+            "log_q": _json_floats(records.log_q), "log_p": _json_floats(records.log_p)}
+
+
+def _json_floats(a: np.ndarray) -> list[float | None]:
+    return [None if not np.isfinite(v) else float(v) for v in a]

@@ -1,0 +1,99 @@
+"""rare.md and the claims' section of findings.md, rendered from the `rare` part alone."""
+
+from __future__ import annotations
+
+from rare_curves import COMMON, RARE, rare_part
+
+from evoeye.results.rare.report import (
+    HEADING,
+    OPEN,
+    interval,
+    num,
+    rare_findings_markdown,
+    rare_html,
+    rare_markdown,
+    rare_words,
+    regime_markdown,
+)
+
+
+def assert_tables_aligned(text: str) -> None:
+    """Every line of a Markdown table has its header's columns (no stray "|" in a cell)."""
+    widths: list[int] = []
+    for line in [*text.splitlines(), ""]:
+        if line.startswith("|"):
+            widths.append(line.count("|"))
+            continue
+        assert len(set(widths)) <= 1, widths
+        widths = []
+
+
+def _row(text: str, first: str) -> str:
+    return next(line for line in text.splitlines() if line.startswith(f"| {first} |"))
+
+
+def test_numbers_use_a_true_minus_and_open_ends_read_infinite():
+    assert num(-0.004, 2) == "0.00" and num(-1.5, 1, signed=True) == "−1.5"
+    assert num(float("nan")) == "–"  # a figure one seed cannot define
+    assert interval(2.5, 1.0, None, open_ends=True, prefix="×") == f"×2.50 [1.00, {OPEN}]"
+    assert interval(None, None, None, open_ends=True) == f"– [{OPEN}, {OPEN}]"
+    assert interval(None, 1.0, 2.0) == "–" and interval(3.0, None, None) == "3.00"
+
+
+def test_rare_md_has_every_table_per_regime(two_regimes):
+    text = rare_markdown(two_regimes)
+    assert text.startswith("# Rare failures")
+    assert_tables_aligned(text)
+    assert "20 seeds (0–19)" in text and "data seed 9100" in text
+    assert "unbiased by construction only where a strategy's runs carry their exact p/q" in text
+    assert "## highway-cut-in, cautious ADS" in text
+    assert "## occluded-crossing, cautious ADS" in text
+    rare = text.split("## occluded-crossing")[0]
+    found = _row(rare, "ce-is")  # the first ce-is row: failures found
+    assert "| 20 | 4000 | 200 | 5.00 [" in found and "| ×25.00 [" in found
+    assert "+4.80 [" in found  # 5 per 100 against 0.2, paired per seed
+    assert "Reference P = Uniform's pooled share, 8 of 4000 runs collided: 0.200 % [" in rare
+    estimate = [line for line in rare.splitlines() if line.startswith("| ce-is |")][1]
+    assert "0.200 % [" in estimate and "| ×8.66 [" in estimate
+    assert "| uniform (reference) | 20 | 4000 | 8 | 0.20 [" in rare
+    assert "* ce-is: cut-in / perception (200)" in rare
+    common = text.split("## occluded-crossing")[1]
+    assert "No estimate" not in common and "| sobol |" in common
+    assert "* sobol: crossing / perception (40)" in common
+
+
+def test_a_regime_with_no_curve_and_failed_curves_are_said_so():
+    empty = {"found": {}, "estimates": {}, "distinct": {}}
+    text = regime_markdown(RARE, empty, 200, [{"regime": RARE, "strategy": "ce-is", "seed": 3,
+                                              "error": "RuntimeError: planted"}])
+    assert "No curve of this regime finished." in text
+    assert "* ce-is, seed 3: RuntimeError: planted" in text
+
+
+def test_the_claims_section_lists_each_check(two_regimes):
+    text = rare_findings_markdown(two_regimes["findings"])
+    assert text.startswith(HEADING)
+    assert "| A strategy finds ≥ 10× Uniform's failures per run where failures are ≈ 0.1 % " \
+           "(≥ 3× at ≈ 1 %) | **partly** |" in text
+    found = _row(text, RARE)
+    assert "| ce-is | 0.200 % | ×10 | ×25.00 [" in found and found.endswith("| reproduces |")
+    assert _row(text, COMMON).endswith("| ×3 | ×1.00 [1.00, 1.00] | +0.00 [+0.00, +0.00] p=1 "
+                                       "| does not reproduce |")
+    assert "| bias, points [95 % CI] |" in text
+    assert_tables_aligned(text)
+
+
+def test_a_protocol_is_named_by_its_runs_seeds_and_regimes(two_regimes):
+    assert rare_words(two_regimes["config"]) == (
+        f"200 runs per seed and strategy (data seed 9100), 20 seeds (0–19), regimes {RARE}, "
+        f"{COMMON}")
+    merged = {**two_regimes["config"], "seeds": {RARE: [0, 1], COMMON: [5, 6, 7]}}
+    assert rare_words(merged).endswith(f"regimes {RARE} (2 seeds (0–1)), {COMMON} (3 seeds "
+                                       "(5–7))")
+    assert rare_part({RARE: "rare"})["config"]["regimes"] == [RARE]
+
+
+def test_the_html_part_shows_the_claims_and_a_chart_per_regime(two_regimes):
+    html = "".join(rare_html(two_regimes))
+    assert html.count("<svg") == 2 and "<h2>Rare failures</h2>" in html
+    assert "highway-cut-in, cautious ADS: failures found" in html and "partly" in html
