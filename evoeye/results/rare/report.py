@@ -235,7 +235,7 @@ def advice_lines(findings: list[dict]) -> list[str]:
     rows = advice(findings)
     if not rows:
         return []
-    return ["Which strategy, when (from the checks below: a strategy only where its ratio to "
+    return ["Which strategy, when (a strategy is named only where its ratio to "
             "Uniform has a 95 % CI above 1, else Uniform):", "",
             *(f"* `{regime}`: to find failures, **{row['find']}**; to estimate how often "
               f"they happen, **{row['estimate']}**." for regime, row in rows.items()), ""]
