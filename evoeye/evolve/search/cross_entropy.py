@@ -156,7 +156,7 @@ def effective_size(w: np.ndarray) -> float:
 
 def ce_update(previous: DefensiveMixture, u: np.ndarray, log_w: np.ndarray,
               fitness: np.ndarray, collided: np.ndarray, *, rho: float = RHO,
-              smoothing: float = SMOOTHING, screen_z: float = SCREEN_Z) -> DefensiveMixture:
+              smoothing: float = SMOOTHING, screen_z: float | None = None) -> DefensiveMixture:
     """The next mixture from runs u (n, dim) with log p/q (n,) and outcomes (module doc); the
     previous one while fewer than MIN_RECORDS outcomes or MIN_ELITE elite runs are known."""
     top = elite(fitness, collided, rho)
@@ -168,6 +168,7 @@ def ce_update(previous: DefensiveMixture, u: np.ndarray, log_w: np.ndarray,
     var = w @ (u[top] - mean) ** 2
     # keep p's marginal where the elite's does not depart from it beyond sampling noise
     n_eff = effective_size(w)
+    screen_z = SCREEN_Z if screen_z is None else screen_z  # read when called (tests patch it)
     moved = (np.abs(mean - 0.5) > screen_z * UNIFORM_SD / math.sqrt(n_eff)) | (
         UNIFORM_SD**2 - var > screen_z * UNIFORM_VAR_SD / math.sqrt(n_eff))
     mean = np.where(moved, mean, 0.5)
@@ -184,12 +185,12 @@ class CrossEntropyIS(BatchedStrategy):
     name = "ce-is"
 
     def __init__(self, space: LogicalScenario, seed: int, batch: int = 20,
-                 alpha: float = ALPHA, rho: float = RHO, screen_z: float = SCREEN_Z) -> None:
+                 alpha: float = ALPHA, rho: float = RHO, screen_z: float | None = None) -> None:
         if not 0.0 < alpha <= 1.0:
             raise StrategyError(f"{self.name}: alpha must be in (0, 1], got {alpha}")
         if not 0.0 < rho < 1.0:
             raise StrategyError(f"{self.name}: rho must be in (0, 1), got {rho}")
-        if not screen_z >= 0.0:
+        if screen_z is not None and not screen_z >= 0.0:
             raise StrategyError(f"{self.name}: screen_z must be >= 0, got {screen_z}")
         super().__init__(space, seed, batch)
         self.alpha, self.rho, self.screen_z = alpha, rho, screen_z
