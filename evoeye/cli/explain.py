@@ -21,7 +21,6 @@ if TYPE_CHECKING:
 
     from evoeye.evaluation.explain import Explained
 
-ORACLES = ("oracle_perception", "oracle_prediction", "oracle_planning", "oracle_control")
 
 
 def _verdict(collided: bool) -> str:
@@ -31,6 +30,8 @@ def _verdict(collided: bool) -> str:
 
 def runs_table(done: list[Explained]) -> Table:
     """One row per run: each oracle's verdict, the careful driver's, and the cause shares."""
+    from evoeye.sim.counterfactual import ORACLES, avoided_by  # loaded by the explaining
+
     t = table("explain (✓ avoids the collision, ✗ still collides)",
               ["run", "t_col s", *(o.removeprefix("oracle_") for o in ORACLES),
                "careful (brakes at)", "cause share %"], left=("run", "cause share %"))
@@ -41,7 +42,7 @@ def runs_table(done: list[Explained]) -> Table:
             continue
         ex = e.explanation
         by = {v.variant: v for v in ex.variants}
-        avoiding = [o.removeprefix("oracle_") for o in ORACLES if not by[o].collided]
+        avoiding = avoided_by(ex.variants)
         careful = by["careful_driver"]
         react = f" @{careful.react_s:.2f} s" if careful.react_s is not None else ""
         behind = " (struck from behind)" if careful.struck_from_behind else ""

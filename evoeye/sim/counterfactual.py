@@ -16,7 +16,7 @@ counts as not avoided (conservative), and is recorded in `struck_from_behind`.
 from __future__ import annotations
 
 import math
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 
 import numpy as np
@@ -218,6 +218,15 @@ VARIANTS: dict[str, Variant] = {
         "oracle_control", "controller",
         lambda ads: IdealController(ads.config.control, ads.config.frame_dt_s)),
 }
+# the variants that replace one module by its oracle, in pipeline order
+ORACLES = tuple(v for v in VARIANTS if v.startswith("oracle_"))
+
+
+def avoided_by(results: Sequence[VariantResult]) -> list[str]:
+    """The modules (pipeline order, without the "oracle_" prefix) whose oracle variant among
+    `results` ended without a collision: the collision's root causes."""
+    by = {r.variant: r for r in results}
+    return [o.removeprefix("oracle_") for o in ORACLES if o in by and not by[o].collided]
 
 
 class NotACollisionError(ValueError):

@@ -166,3 +166,15 @@ def test_a_run_that_does_not_collide_is_refused():
                 if not run_episode(s, sim).outcome.collided)
     with pytest.raises(ValueError, match="does not collide"):
         explain_run(spec, sim)
+
+
+def test_root_causes_are_the_modules_whose_oracle_avoids_it_in_pipeline_order():
+    from evoeye.sim.counterfactual import ORACLES, VariantResult, avoided_by
+
+    assert ORACLES == ("oracle_perception", "oracle_prediction", "oracle_planning",
+                       "oracle_control")
+    results = [VariantResult(v, collided, None, None, False) for v, collided in (
+        ("oracle_control", False), ("careful_driver", False), ("oracle_perception", False),
+        ("oracle_planning", True))]
+    assert avoided_by(results) == ["perception", "control"]  # not the careful driver
+    assert avoided_by([]) == []

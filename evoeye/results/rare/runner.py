@@ -29,11 +29,10 @@ from evoeye.evolve.search.registry import make_strategy
 from evoeye.results.efficiency.config import parse_regime
 from evoeye.results.rare.config import RareConfig
 from evoeye.scenarios import get_scenario
-from evoeye.sim.counterfactual import VARIANTS
+from evoeye.sim.counterfactual import ORACLES, VARIANTS, avoided_by
 from evoeye.sim.episode import STATUS_OK, Episode
 from evoeye.sim.runner import SimConfig, run_episode, run_spec
 
-ORACLES = ("oracle_perception", "oracle_prediction", "oracle_planning", "oracle_control")
 UNATTRIBUTED = "none"  # no single module's oracle avoids the collision
 
 
@@ -55,9 +54,8 @@ def root_cause(factual: Episode) -> str:
     """The modules (in pipeline order, "+"-joined) whose oracle alone avoids the factual
     collision, or UNATTRIBUTED."""
     sim, ads = SimConfig(), ads_profile(factual.spec.ads)  # run_episode sets the cruise
-    avoided = [v.removeprefix("oracle_") for v in ORACLES
-               if not VARIANTS[v](factual, sim, ads).collided]
-    return "+".join(avoided) or UNATTRIBUTED
+    return "+".join(avoided_by([VARIANTS[v](factual, sim, ads) for v in ORACLES])) \
+        or UNATTRIBUTED
 
 
 def simulate(regime: str, x: np.ndarray, seed: int, explain: bool) -> dict:
