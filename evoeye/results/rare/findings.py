@@ -146,22 +146,26 @@ def advice(findings: list[dict]) -> dict[str, dict[str, str]]:
     rate with, from the claims' checks alone: the strategy whose ratio to Uniform has a CI above
     1 (the largest, to find; the smallest error with a bias CI holding 0, to estimate), else
     Uniform — a strategy no check showed better is no reason to leave p."""
-    out: dict[str, dict[str, str]] = {}
     by_id = {f["id"]: f["checks"] for f in findings}
-    for c in by_id.get("rare-found", []):
-        row = out.setdefault(c["regime"], {"find": REFERENCE, "estimate": REFERENCE})
-        best = row.get("_find_ratio", 1.0)
-        if c["ratio_low"] is not None and c["ratio_low"] > 1.0 and (c["ratio"] or 0) > best:
-            row["find"], row["_find_ratio"] = c["strategy"], c["ratio"]
-    for c in by_id.get("rare-estimate", []):
-        row = out.setdefault(c["regime"], {"find": REFERENCE, "estimate": REFERENCE})
+
+    def finds(c: dict) -> float | None:
+        return c["ratio"] or math.inf if c["ratio_low"] is not None and c["ratio_low"] > 1 \
+            else None
+
+    def estimates(c: dict) -> float | None:
         ratio, bias = c["error_ratio"], c["bias"]
         unbiased = bias["low"] is not None and bias["low"] <= 0 <= bias["high"]
-        best = row.get("_estimate_ratio", 1.0)
-        if unbiased and ratio["low"] is not None and ratio["low"] > 1.0 and \
-                (ratio["value"] or math.inf) > best:
-            row["estimate"], row["_estimate_ratio"] = c["strategy"], ratio["value"] or math.inf
-    return {r: {k: v for k, v in row.items() if not k.startswith("_")} for r, row in out.items()}
+        return ratio["value"] or math.inf if unbiased and ratio["low"] is not None and \
+            ratio["low"] > 1 else None
+
+    regimes = {c["regime"]: {} for checks in by_id.values() for c in checks}
+    for use, claim, score in (("find", "rare-found", finds),
+                              ("estimate", "rare-estimate", estimates)):
+        for regime, row in regimes.items():
+            shown = [(v, c["strategy"]) for c in by_id.get(claim, [])
+                     if c["regime"] == regime and (v := score(c)) is not None]
+            row[use] = max(shown)[1] if shown else REFERENCE
+    return regimes
 
 
 def merge_rare(runs: list[dict]) -> list[dict]:

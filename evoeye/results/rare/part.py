@@ -41,7 +41,7 @@ def _unit(args: tuple[str, RareConfig, str, str, int]) -> tuple[str, str, int, d
 
 
 def run_rare(root: DataRoot, config: RareConfig, *, workers: int = 1,
-                say: Say | None = None) -> dict:
+             say: Say | None = None) -> dict:
     """Every curve of every regime and their summaries: {"config", "regimes": {regime:
     summary}, "failed": [{"regime", "strategy", "seed", "error"}], "computed": n}."""
     say = say or (lambda msg: None)

@@ -38,6 +38,7 @@ from evoeye.evaluation.stats import (
     proportion_ci,
     rate_ci,
 )
+from evoeye.evolve.search.records import Records
 from evoeye.results.rare.config import ESTIMATING, REFERENCE, RareConfig
 
 PER = 100  # failures per PER simulated runs
@@ -45,11 +46,13 @@ N_RESAMPLES = 10_000
 
 
 def weights(curve: dict) -> np.ndarray:
-    """(n,) p/q of each run: exp(log p − log q), 1 where the run was drawn from p."""
-    q = np.array([np.nan if v is None else v for v in curve["log_q"]], float)
-    p = np.array([np.nan if v is None else v for v in curve["log_p"]], float)
-    known = np.isfinite(q) & np.isfinite(p)
-    return np.where(known, np.exp(np.where(known, p - q, 0.0)), 1.0)
+    """(n,) p/q of each run (`Records.importance_ratio`: 1 where the run was drawn from p)."""
+    def column(values: list) -> np.ndarray:
+        return np.array([np.nan if v is None else v for v in values], float)
+
+    n = len(curve["log_q"])
+    return Records(np.zeros((n, 0)), np.full(n, np.nan), log_q=column(curve["log_q"]),
+                   log_p=column(curve["log_p"])).importance_ratio()
 
 
 def mechanisms(curve: dict) -> Counter[str]:
