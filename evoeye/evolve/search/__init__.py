@@ -28,6 +28,7 @@ from evoeye.evolve.search.protocol import Proposal, Strategy, StrategyError
 from evoeye.evolve.search.records import Records
 from evoeye.evolve.search.registry import (
     FEEDBACK_BLIND,
+    GENERATIVE_ONLY,
     READS_DISAGREEMENT,
     STRATEGIES,
     make_strategy,
@@ -38,6 +39,7 @@ from evoeye.evolve.search.strategies import DensityStrategy, UniformStrategy
 __all__ = [
     "CRITICALITY_SCALE_M",
     "FEEDBACK_BLIND",
+    "GENERATIVE_ONLY",
     "STRATEGIES",
     "AVFuzzer",
     "AVFuzzerConfig",

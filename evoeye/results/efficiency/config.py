@@ -160,6 +160,7 @@ class EfficiencyConfig:
         """ValueError naming a scenario, ADS profile or strategy no registry knows (loads the
         registries)."""
         from evoeye.ads.profiles import ADS_PROFILES
+        from evoeye.evolve.search import GENERATIVE_ONLY
         from evoeye.evolve.search import STRATEGIES as KNOWN
         from evoeye.scenarios import SCENARIOS
 
@@ -170,6 +171,9 @@ class EfficiencyConfig:
                                  f"profiles {sorted(ADS_PROFILES)}")
         if unknown := [s for s in self.strategies if s not in KNOWN]:
             raise ValueError(f"unknown strategy {unknown}; known: {sorted(KNOWN)}")
+        if self.mode == "pool" and (only := sorted(GENERATIVE_ONLY & set(self.strategies))):
+            raise ValueError(f"strategies {only} propose new points only: run them with "
+                             "--mode generative")
 
     @property
     def budgets(self) -> tuple[int, ...]:

@@ -25,9 +25,10 @@ from evoeye.results.efficiency.config import parse_regime
 REFERENCE = "uniform"
 STRATEGIES = (REFERENCE, "ce-is")
 # the strategies that need no monitor (the protocol trains none): the others read feedback
-USABLE = (REFERENCE, "ce-is", "sobol", "avfuzzer")
-# whose runs carry their exact p/q, so they estimate the failure rate under p without bias
-ESTIMATING = (REFERENCE, "ce-is")
+USABLE = (REFERENCE, "ce-is", "subset", "sobol", "avfuzzer")
+# the strategies that estimate the failure rate under p: from their runs' exact p/q (Uniform:
+# 1; ce-is), or, for subset simulation, from its levels (`evoeye.evolve.search.subset`)
+ESTIMATING = (REFERENCE, "ce-is", "subset")
 REGIMES = ("highway-cut-in:cautious", "highway-cut-in:defensive")
 
 

@@ -6,8 +6,9 @@
   difference of per-seed rates (`compare_paired`) with its minimum detectable effect.
 * **The failure rate under p.** Each seed's estimate from its own runs: Uniform's share that
   collided (plain Monte Carlo), an importance-sampling strategy's mean of w·y with its runs'
-  exact w = p/q (`evoeye.evaluation.failure_rate`). Strategies whose runs carry no exact p/q
-  (e.g. AV-Fuzzer) estimate nothing. The *reference* P is Uniform's pooled share over all its
+  exact w = p/q (`evoeye.evaluation.failure_rate`), subset simulation's product of its levels'
+  conditional probabilities (`subset_estimate`). Other strategies (e.g. AV-Fuzzer) estimate
+  nothing. The *reference* P is Uniform's pooled share over all its
   runs (with its Wilson interval): independent of the strategies it judges. Uniform's own
   relative error is then measured about its own mean, which flatters it slightly (hence also
   its exact figure below); a strategy's is measured about an independent P.
@@ -39,9 +40,11 @@ from evoeye.evaluation.stats import (
     rate_ci,
 )
 from evoeye.evolve.search.records import Records
+from evoeye.evolve.search.subset import subset_estimate
 from evoeye.results.rare.config import ESTIMATING, REFERENCE, RareConfig
 
 PER = 100  # failures per PER simulated runs
+SUBSET = "subset"  # estimates from its levels, not from weights
 N_RESAMPLES = 10_000
 
 
@@ -134,12 +137,19 @@ def bias(values: np.ndarray, hits: int, runs: int) -> dict:
             "high": diff + math.hypot(high - mean, u.value - u.low)}
 
 
-def estimates(curves: dict[str, dict[str, dict]], runs: int) -> dict[str, dict]:
+def estimate(name: str, curve: dict, batch: int) -> float:
+    """One curve's estimate of the failure rate under p (module doc); `batch`: the runs
+    between two adaptations (subset simulation's chains)."""
+    if name == SUBSET:
+        return subset_estimate([r["fitness"] for r in curve["runs"]], _hits(curve), batch)
+    return failure_rate(_hits(curve), weights(curve)).value or 0.0
+
+
+def estimates(curves: dict[str, dict[str, dict]], runs: int, batch: int) -> dict[str, dict]:
     """Per estimating strategy: its seeds' estimates, bias against Uniform's pooled estimate
     and relative error at equal budget about the reference; beside Uniform, the ratio of the
     relative errors (module doc)."""
-    per = {name: {s: failure_rate(_hits(c), weights(c)).value or 0.0
-                  for s, c in seeds.items()}
+    per = {name: {s: estimate(name, c, batch) for s, c in seeds.items()}
            for name, seeds in curves.items() if name in ESTIMATING}
     if REFERENCE not in per:
         return {}
@@ -222,5 +232,5 @@ def summarise(curves: dict[str, dict[str, dict]], config: RareConfig) -> dict:
     """Every figure of one regime (module doc)."""
     if not curves:
         return {"found": {}, "estimates": {}, "distinct": {}}
-    return {"found": found(curves), "estimates": estimates(curves, config.runs),
+    return {"found": found(curves), "estimates": estimates(curves, config.runs, config.batch),
             "distinct": distinct(curves)}

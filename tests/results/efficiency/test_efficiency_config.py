@@ -44,6 +44,9 @@ def test_unknown_names_are_refused_with_the_known_ones() -> None:
         EfficiencyConfig(regimes=("highway-cut-in:reckless",)).check_names()
     with pytest.raises(ValueError, match="unknown strategy \\['annealing'\\]"):
         EfficiencyConfig(strategies=("uniform", "annealing")).check_names()
+    with pytest.raises(ValueError, match="\\['subset'\\] propose new points only"):
+        EfficiencyConfig(strategies=("uniform", "subset")).check_names()
+    EfficiencyConfig(strategies=("uniform", "subset"), mode="generative").check_names()
     EfficiencyConfig().check_names()
 
 

@@ -45,7 +45,7 @@ def test_rare_md_has_every_table_per_regime(two_regimes):
     assert text.startswith("# Rare failures")
     assert_tables_aligned(text)
     assert "20 seeds (0–19)" in text and "data seed 9100" in text
-    assert "unbiased by construction only where a strategy's runs carry their exact p/q" in text
+    assert "unbiased by construction where a strategy's runs carry their exact p/q" in text
     assert "## highway-cut-in, cautious ADS" in text
     assert "## occluded-crossing, cautious ADS" in text
     rare = text.split("## occluded-crossing")[0]

@@ -56,7 +56,7 @@ def test_importance_estimates_are_reweighted_and_compared_at_equal_budget():
     is_curves = {str(s): curve([i < 20 for i in range(100)],
                                log_q=[math.log(10.0)] * 20 + [math.log(0.8 / 0.98)] * 80)
                  for s in range(30)}
-    out = estimates({"uniform": uniform, "ce-is": is_curves}, runs=100)
+    out = estimates({"uniform": uniform, "ce-is": is_curves}, runs=100, batch=10)
     assert out["ce-is"]["mean"] == pytest.approx(0.02)
     assert out["ce-is"]["spread"] == pytest.approx(0.0, abs=1e-12)
     # the reference is Uniform's own pooled share, whatever the other strategies estimate

@@ -1,0 +1,98 @@
+"""`subset`: levels conditioned towards the failures, an estimate near P, resume, refusals."""
+
+import numpy as np
+import pytest
+
+from evoeye.evolve.search import Records, StrategyError, make_strategy
+from evoeye.evolve.search.subset import Walk, subset_estimate
+from evoeye.scenarios import get_scenario
+
+HIGHWAY = get_scenario("highway-cut-in")
+CHAINS = 10
+
+
+def level(space, x, p):
+    """Synthetic: a failure (0) in the corner u0 > 1 − √p, u1 < √p (p-mass p), rising linearly
+    away from it; the other dimensions do not matter."""
+    u = space.normalise(x)
+    a = np.sqrt(p)
+    gap = np.maximum(1.0 - a - u[..., 0], 0.0) + np.maximum(u[..., 1] - a, 0.0)
+    return np.where(gap <= 0.0, 0.0, 0.05 + gap)
+
+
+def acquire(seed, n, p, records=None, strategy=None):
+    strategy = strategy or make_strategy("subset", HIGHWAY, seed, batch=CHAINS)
+    records = records or Records.empty(HIGHWAY.dim)
+    props = []
+    for _ in range(n):
+        prop = strategy.propose(records)
+        f = float(level(HIGHWAY, prop.x, p))
+        strategy.tell(prop.x, f)
+        records = records.append(prop.x, fitness=f, collided=f == 0.0, log_q=prop.log_q,
+                                 log_p=prop.log_p)
+        props.append(prop)
+    return strategy, records, props
+
+
+@pytest.mark.parametrize("p", [0.0016, 0.014])
+def test_it_finds_far_more_failures_than_p_and_estimates_p(p):
+    found, estimates = [], []
+    for seed in range(30):
+        _, records, _ = acquire(seed, 200, p)
+        found.append(records.collided.sum())
+        estimates.append(subset_estimate(records.fitness, records.collided, CHAINS))
+    assert np.mean(found) >= 10 * 200 * p  # Uniform would find 200·p per seed
+    # the estimate is near P: its mean within a third of it over 30 seeds (its bias is O(1/N))
+    assert np.mean(estimates) == pytest.approx(p, rel=0.35)
+
+
+def test_the_first_level_is_uniform_and_later_ones_are_chains_from_the_best():
+    _, records, props = acquire(0, 90, 0.0016)
+    n0 = Walk(CHAINS, 0.2).per_level
+    assert n0 == 50  # c / p0 samples per level
+    assert {p.kind for p in props[:n0]} == {"uniform"} and props[0].parent is None
+    assert {p.kind for p in props[n0:]} == {"subset"}
+    # the chains start at the c lowest levels of level 0
+    best = set(np.argsort(records.fitness[:n0], kind="stable")[:CHAINS].tolist())
+    assert {p.parent for p in props[n0:n0 + CHAINS]} == best
+    # no proposal carries a density: subset runs have no importance weight
+    assert all(p.log_q is None for p in props)
+
+
+def test_the_walk_moves_only_inside_the_current_level():
+    fitness = np.r_[np.linspace(0.9, 0.4, 50), [0.3] * 5 + [0.95] * 5]  # level 0 + one step
+    collided = np.zeros(60, bool)
+    w = Walk.replay(fitness, collided, CHAINS, 0.2)
+    assert w.level == 1 and w.steps == 1
+    assert w.threshold == pytest.approx(fitness[40])  # the 10th lowest of level 0
+    # the five candidates under the threshold were accepted, the others left their chain put
+    # (chain j starts at the j-th lowest: rows 49, 48, … 40)
+    assert w.states[:5] == [50, 51, 52, 53, 54] and w.states[5:] == [44, 43, 42, 41, 40]
+    assert w.accepted == 5
+
+
+def test_the_estimate_freezes_once_a_level_holds_enough_failures():
+    fitness = np.r_[np.zeros(12), np.full(38, 0.5)]  # 12 collisions in level 0's 50
+    collided = fitness == 0.0
+    assert subset_estimate(fitness, collided, CHAINS) == pytest.approx(12 / 50)
+    more = np.r_[fitness, np.zeros(40)]  # the chains then walk inside F: every step a failure
+    assert subset_estimate(more, more == 0.0, CHAINS) == pytest.approx(12 / 50)
+
+
+def test_a_resumed_strategy_proposes_the_same_runs():
+    _, records, props = acquire(3, 130, 0.014)
+    head = records.head(125)  # resumed in the middle of a batch: the batch is rebuilt
+    fresh = make_strategy("subset", HIGHWAY, 3, batch=CHAINS)
+    fresh.replay(head.params, head.fitness)
+    _, _, again = acquire(3, 5, 0.014, records=head, strategy=fresh)
+    assert [p.x.tolist() for p in again] == [p.x.tolist() for p in props[125:130]]
+    assert [p.parent for p in again] == [p.parent for p in props[125:130]]
+
+
+def test_it_refuses_a_pool_and_a_bad_p0():
+    pool = HIGHWAY.sample(np.random.default_rng(0), 50)
+    s = make_strategy("subset", HIGHWAY, 0, batch=CHAINS, pool=pool)
+    with pytest.raises(StrategyError, match="generative mode only"):
+        s.propose(Records.empty(HIGHWAY.dim))
+    with pytest.raises(StrategyError, match="p0 must be in"):
+        make_strategy("subset", HIGHWAY, 0, p0=0.9)
