@@ -40,6 +40,12 @@ Plain data (the command line reads it at start-up). Sizes, and why:
   until enough further runs collided, and their unsafe windows (only those) join it. The
   validation negatives are then exactly the uniform batch's, so the thresholds calibrated for a
   target FPR (a share of negative frames) do not move; early stopping sees more positives.
+* The oracle (a lower bound, `oracle.py`) tries `oracle_candidates` increments per step, a step
+  from one checkpoint to the next (`oracle_step="checkpoint"`, as every recorded study ran it)
+  or every round (`"round"`); its controls choose among uniform draws (`oracle-uniform`) or
+  among training seeds on Uniform's runs (`oracle-seeds`).
+* `qbc` (`qbc.py`) is a study-only diagnostic, in pool mode only: query-by-committee on the
+  unused pool runs' own windows, which generative mode does not have.
 """
 
 from __future__ import annotations
