@@ -181,7 +181,9 @@ def regime_markdown(regime: str, result: dict) -> str:
         lines += ["### Failures found", "", "Collisions per 100 runs acquired beyond the initial "
                   "set [95 % CI, bootstrap over seeds] and the multiple of Uniform's (in "
                   "generative mode a run acquired is a run simulated; the oracle and its "
-                  "control trained on several increments per step and kept one).", "",
+                  "control trained on several increments per step and kept one"
+                  + ("; oracle-seeds's runs are Uniform's" if ORACLE_SEEDS in result["where"]
+                     else "") + ").", "",
                   *found_table(result["found"]), ""]
     if result.get("rates"):
         lines += ["### The failure rate under p", "", "The unbiased estimate of P(collision) "

@@ -37,6 +37,7 @@ def test_the_study_runs_in_workers_resumes_and_writes_its_files(tiny_regime, tin
     update = regime["summaries"]["test/update"]["strategies"]
     assert not {"oracle", "oracle-uniform", "oracle-seeds", "qbc"} & set(update)  # none
     assert regime["where"]["boundary"]["runs"] == 14 - 6
+    assert regime["where"]["oracle-seeds"] == regime["where"]["uniform"]  # Uniform's runs
     assert [f["id"] for f in first["findings"]] == ["efficiency-area", "efficiency-factor",
                                                     "efficiency-ceiling", "efficiency-choice",
                                                     "efficiency-seeds", "efficiency-paper"]
@@ -63,6 +64,7 @@ def test_the_study_runs_in_workers_resumes_and_writes_its_files(tiny_regime, tin
     assert "Oracle − its best-of-k-training-seeds control: area" in text
     assert "qbc (pool-mode diagnostic)" in text and "(oracle-seeds) chooses no runs" in text
     assert "### Failures found" in text and "Minimum detectable effect" in text
+    assert "oracle-seeds's runs are Uniform's" in text
     assert regime["found"]["14"]["boundary"]["runs"] == 2 * (14 - 6)  # two seeds, initial apart
     assert "Does acquisition earn its budget?" in (folder / "findings.md").read_text()
     assert (folder / "results.html").read_text().count("<svg") == 3  # one chart per summary
