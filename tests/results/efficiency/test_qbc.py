@@ -2,12 +2,16 @@
 
 from __future__ import annotations
 
+from dataclasses import replace
+
 import numpy as np
 
+from evoeye.paths import DataRoot
 from evoeye.results.efficiency.acquire import PoolAcquirer
 from evoeye.results.efficiency.curves import initial_rows, run_curve, training_seed
 from evoeye.results.efficiency.oracle import SAMPLE
 from evoeye.results.efficiency.qbc import committee_size, most_disagreed, run_qbc
+from evoeye.results.ledger import Ledger
 
 
 class _Member:
@@ -65,3 +69,17 @@ def test_a_qbc_curve_takes_what_its_committee_disagrees_on_most(context) -> None
 
 def test_the_committee_is_the_study_ensemble_or_three() -> None:
     assert committee_size(1) == 3 and committee_size(2) == 2 and committee_size(5) == 5
+
+
+def test_with_an_ensemble_the_committee_is_the_checkpoints_ensemble(context, tmp_path) -> None:
+    """members = 2: the committee has two members, and its checkpoint monitor is the very
+    ensemble every strategy's checkpoint gets (the same G_0 figures as Uniform's)."""
+    ctx = replace(context, config=replace(context.config, members=2, checkpoints=(10,)),
+                  learner=replace(context.learner, members=2),
+                  ledger=Ledger(DataRoot.resolve(tmp_path / "k2")))
+    curve = run_qbc(ctx, 0)
+    single = run_qbc(replace(context, config=replace(context.config, checkpoints=(10,))), 0)
+    assert curve["budgets"]["6"] != single["budgets"]["6"]  # an ensemble, not one monitor
+    apart = replace(ctx, ledger=Ledger(DataRoot.resolve(tmp_path / "apart")))  # trained again
+    uniform = run_curve(apart, "uniform", 0, PoolAcquirer(ctx.bank))
+    assert curve["budgets"]["6"]["scratch"] == uniform["budgets"]["6"]["scratch"]
