@@ -21,6 +21,7 @@ from evoeye.results.config import (
 from evoeye.results.efficiency.config import (
     MAX_MEMBERS,
     MODES,
+    ORACLE_STEPS,
     REFERENCE,
     UPDATES,
     EfficiencyConfig,
@@ -143,7 +144,16 @@ def results_command(
         min=0, help="Sample-efficiency study: its first seed (seeds K … K+N−1).")] = 0,
     oracle: Annotated[bool, typer.Option(
         help="Sample-efficiency study: draw the greedy oracle's curves (a lower bound on what "
-             "choosing runs can gain) and its control's (pool mode).")] = E.oracle,
+             "choosing runs can gain) and its two controls' (pool mode).")] = E.oracle,
+    oracle_candidates: Annotated[int, typer.Option(
+        min=1, help="Sample-efficiency study: increments the oracle tries per step (its "
+                    "best-of-k-seeds control: training seeds per checkpoint).")] =
+        E.oracle_candidates,
+    oracle_step: Annotated[str, typer.Option(
+        help=f"Sample-efficiency study: the oracle chooses once per "
+             f"{' or per '.join(ORACLE_STEPS)} (a round: the study's {E.n_round} runs; more "
+             "steps adapt more, at more trainings).")] =
+        E.oracle_step,
     study_update: Annotated[str, typer.Option(
         help=f"Sample-efficiency study: how the per-round monitor the strategies' feedback "
              f"comes from is updated, {' or '.join(UPDATES)} (fine-tuned, or trained again "
@@ -224,7 +234,8 @@ def results_command(
                 strategies=with_reference(strategy, E.strategies),
                 mode=mode, update=study_update,
                 seeds=tuple(range(first_study_seed, first_study_seed + study_seeds)),
-                oracle=oracle, pool_runs=pool_runs, recipe=recipe, epochs=epochs,
+                oracle=oracle, oracle_candidates=oracle_candidates, oracle_step=oracle_step,
+                pool_runs=pool_runs, recipe=recipe, epochs=epochs,
                 patience=patience, members=members, val_collisions=val_collisions
             ).changed(),
             rare=RareConfig(

@@ -40,6 +40,12 @@ Plain data (the command line reads it at start-up). Sizes, and why:
   until enough further runs collided, and their unsafe windows (only those) join it. The
   validation negatives are then exactly the uniform batch's, so the thresholds calibrated for a
   target FPR (a share of negative frames) do not move; early stopping sees more positives.
+* The oracle (a lower bound, `oracle.py`) tries `oracle_candidates` increments per step, a step
+  from one checkpoint to the next (`oracle_step="checkpoint"`, as every recorded study ran it)
+  or every round (`"round"`); its controls choose among uniform draws (`oracle-uniform`) or
+  among training seeds on Uniform's runs (`oracle-seeds`).
+* `qbc` (`qbc.py`) is a study-only diagnostic, in pool mode only: query-by-committee on the
+  unused pool runs' own windows, which generative mode does not have.
 """
 
 from __future__ import annotations
@@ -55,14 +61,20 @@ STRATEGIES = ("uniform", "sobol", "boundary", "disagreement", "evoeye-knn", "evo
 REFERENCE = "uniform"
 ORACLE = "oracle"
 ORACLE_UNIFORM = "oracle-uniform"  # the oracle's control: it chooses among uniform draws only
-CEILINGS = (ORACLE, ORACLE_UNIFORM)  # curves that know outcomes: no strategy, no update rule
+ORACLE_SEEDS = "oracle-seeds"  # its other control: Uniform's runs, the best of k training seeds
+CONTROLS = (ORACLE_UNIFORM, ORACLE_SEEDS)
+CEILINGS = (ORACLE, *CONTROLS)  # curves that know outcomes: no strategy, no update rule
+ORACLE_STEPS = ("checkpoint", "round")  # the oracle chooses once per checkpoint, or per round
+QBC = "qbc"  # query-by-committee on the unused pool runs' own windows (pool mode only)
+DIAGNOSTICS = (QBC,)  # study-only strategies: no registry entry, no per-round monitor
+NO_UPDATE = (*CEILINGS, *DIAGNOSTICS)  # curves without the per-round (update) monitor
 DEFAULT_PROFILE = "default"  # evoeye.ads.profiles.DEFAULT_PROFILE
 # evoeye.monitor.recipes (importing it loads torch)
 RECIPES, DEFAULT_RECIPE = ("v1", "v2", "v3", "lookahead-v1"), "v3"
 MAX_MEMBERS = 8  # evoeye.monitor.ensemble.MAX_MEMBERS (importing it loads torch)
 # fields added since studies were recorded: left out of `to_dict` at their defaults, so a
 # study that does not use them stores the config it always did
-LATER_FIELDS = ("members", "val_collisions")
+LATER_FIELDS = ("members", "val_collisions", "oracle_step")
 
 
 def parse_regime(regime: str) -> tuple[str, str]:
@@ -92,7 +104,7 @@ class EfficiencyConfig:
     strategies: tuple[str, ...] = STRATEGIES
     seeds: tuple[int, ...] = tuple(range(10))  # campaign seeds, paired across strategies
     oracle: bool = True  # the greedy oracle (a lower bound), its uniform-only control (pool)
-    oracle_candidates: int = 6  # increments tried at each step of the oracle
+    oracle_candidates: int = 6  # increments (the seeds control: training seeds) per step
     initial_runs: int = 40
     checkpoints: tuple[int, ...] = (80, 160, 320)  # total runs, initial runs included
     reference_checkpoints: tuple[int, ...] = (640,)  # Uniform's further ones
@@ -112,6 +124,7 @@ class EfficiencyConfig:
     importance_weights: bool = False
     members: int = 1  # from-scratch members of each checkpoint's monitor (module doc)
     val_collisions: int = 0  # colliding runs the validation set holds at least (module doc)
+    oracle_step: str = "checkpoint"  # the oracle steps from checkpoint to checkpoint, or rounds
 
     @property
     def train_overrides(self) -> dict[str, int | bool]:
@@ -132,6 +145,13 @@ class EfficiencyConfig:
             raise ValueError(f"mode must be one of {MODES}, got {self.mode!r}")
         if self.update not in UPDATES:
             raise ValueError(f"update must be one of {UPDATES}, got {self.update!r}")
+        if self.oracle_step not in ORACLE_STEPS:
+            raise ValueError(f"oracle_step must be one of {ORACLE_STEPS}, got "
+                             f"{self.oracle_step!r}")
+        if self.mode != "pool" and (pool_only := [s for s in self.strategies
+                                                  if s in DIAGNOSTICS]):
+            raise ValueError(f"{', '.join(pool_only)} is a pool-mode diagnostic (it scores the "
+                             f"unused pool runs' own windows): drop it or use mode 'pool'")
         if self.recipe not in RECIPES:
             raise ValueError(f"unknown training recipe {self.recipe!r}; known: {list(RECIPES)}")
         if REFERENCE not in self.strategies:
@@ -169,8 +189,9 @@ class EfficiencyConfig:
             if scenario not in SCENARIOS or profile not in ADS_PROFILES:
                 raise ValueError(f"regime {regime!r}: scenarios are {sorted(SCENARIOS)}, ADS "
                                  f"profiles {sorted(ADS_PROFILES)}")
-        if unknown := [s for s in self.strategies if s not in KNOWN]:
-            raise ValueError(f"unknown strategy {unknown}; known: {sorted(KNOWN)}")
+        if unknown := [s for s in self.strategies if s not in KNOWN and s not in DIAGNOSTICS]:
+            raise ValueError(f"unknown strategy {unknown}; known: "
+                             f"{sorted([*KNOWN, *DIAGNOSTICS])}")
         if self.mode == "pool" and (only := sorted(GENERATIVE_ONLY & set(self.strategies))):
             raise ValueError(f"strategies {only} propose new points only: run them with "
                              "--mode generative")

@@ -41,7 +41,7 @@ from evoeye.evolve.search.registry import (
 )
 from evoeye.monitor.ensemble import EnsembleMonitor
 from evoeye.monitor.fusion import FusionMonitor
-from evoeye.results.efficiency.acquire import Acquirer, Bank
+from evoeye.results.efficiency.acquire import Acquirer, Bank, PoolAcquirer
 from evoeye.results.efficiency.config import EfficiencyConfig
 from evoeye.results.efficiency.learner import (
     Learner,
@@ -129,7 +129,7 @@ class Trajectory:
     """A curve in progress: the records, the monitor (and committee) and what was picked."""
 
     records: Records
-    monitor: FusionMonitor
+    monitor: FusionMonitor | None  # None while only the picks are replayed (`blind_picks`)
     committee: list[FusionMonitor]
     kinds: list[str]  # how each acquired run was chosen (the proposal's kind)
 
@@ -179,18 +179,54 @@ def run_curve(ctx: Context, strategy: str, seed: int, acquirer: Acquirer) -> dic
                                lambda: _curve(ctx, strategy, seed, acquirer))
 
 
+def initial_records(ctx: Context, seed: int) -> Records:
+    """The records of a seed's D_init (`initial_rows`), unscored."""
+    pool = ctx.bank.pool
+    rows = initial_rows(pool.collided, ctx.config.initial_runs, seed)
+    return Records(params=pool.params[rows], feedback=np.full(len(rows), np.nan),
+                   fitness=pool.fitness[rows], collided=pool.collided[rows],
+                   duration_s=pool.duration_s[rows], scenario_id=pool.scenario_id[rows])
+
+
 def _start(ctx: Context, seed: int, reads_disagreement: bool) -> Trajectory:
-    bank, learner = ctx.bank, ctx.learner
-    rows = initial_rows(bank.pool.collided, ctx.config.initial_runs, seed)
-    ids = bank.pool.scenario_id[rows]
-    records = Records(params=bank.pool.params[rows], feedback=np.full(len(rows), np.nan),
-                      fitness=bank.pool.fitness[rows], collided=bank.pool.collided[rows],
-                      duration_s=bank.pool.duration_s[rows], scenario_id=ids)
-    train = bank.windows(ids)
+    learner, records = ctx.learner, initial_records(ctx, seed)
+    train = ctx.bank.windows(records.scenario_id)
     monitor = learner.scratch(train, training_seed(seed, ctx.config.initial_runs))
     committee = [monitor, *(learner.scratch(train, training_seed(seed, 50_000 + j))
                             for j in range(1, COMMITTEE))] if reads_disagreement else []
     return _refreshed(ctx, Trajectory(records, monitor, committee, []))
+
+
+def _acquire_round(ctx: Context, strategy, acquirer: Acquirer, t: Trajectory,
+                   seed: int) -> None:
+    """One round: n_round proposals, each acquired, appended to the records and told."""
+    for _ in range(ctx.config.n_round):
+        prop = strategy.propose(t.records)
+        run = acquirer.acquire(prop, seed, t.records.n - ctx.config.initial_runs)
+        t.records = t.records.append(run.x, feedback=np.nan, fitness=run.fitness,
+                                     collided=run.collided, duration_s=run.duration_s,
+                                     scenario_id=run.scenario_id, log_q=prop.log_q,
+                                     log_p=prop.log_p)
+        t.kinds.append(prop.kind)
+        strategy.tell(run.x, run.fitness)
+
+
+def _make(ctx: Context, name: str, seed: int, acquirer: Acquirer):
+    return make_strategy(name, ctx.space, seed, pool=acquirer.pool_params,
+                         **strategy_options(name, batch=ctx.config.n_round))
+
+
+def blind_picks(ctx: Context, name: str, seed: int, budget: int) -> np.ndarray:
+    """The scenario ids (D_init first) of a feedback-blind strategy's pool-mode curve at
+    `budget` runs: its picks read no monitor, so they are replayed without training any."""
+    if name not in FEEDBACK_BLIND:
+        raise ValueError(f"{name!r} reads feedback: its picks need its monitors")
+    acquirer = PoolAcquirer(ctx.bank)
+    strategy = _make(ctx, name, seed, acquirer)
+    t = Trajectory(initial_records(ctx, seed), None, [], [])
+    while t.records.n < budget:
+        _acquire_round(ctx, strategy, acquirer, t, seed)
+    return t.records.scenario_id[:budget]
 
 
 def _refreshed(ctx: Context, t: Trajectory) -> Trajectory:
@@ -245,8 +281,7 @@ def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> d
     retrain = cfg.update == "retrain"
     retrains = retrain and strategy_name not in FEEDBACK_BLIND  # someone reads its monitor
     t = _start(ctx, seed, reads)
-    strategy = make_strategy(strategy_name, ctx.space, seed, pool=acquirer.pool_params,
-                             **strategy_options(strategy_name, batch=cfg.n_round))
+    strategy = _make(ctx, strategy_name, seed, acquirer)
     budgets = cfg.checkpoints_of(strategy_name)
     g0 = ctx.scratch_figures(t.records.scenario_id, cfg.initial_runs, seed, first=t.monitor)
     # the per-round monitor starts as member 0 of G_0 (G_0 itself when it has one member)
@@ -255,15 +290,7 @@ def _curve(ctx: Context, strategy_name: str, seed: int, acquirer: Acquirer) -> d
     round_ = 0
     while t.records.n < budgets[-1]:
         round_ += 1
-        for _ in range(cfg.n_round):
-            prop = strategy.propose(t.records)
-            run = acquirer.acquire(prop, seed, t.records.n - cfg.initial_runs)
-            t.records = t.records.append(run.x, feedback=np.nan, fitness=run.fitness,
-                                         collided=run.collided, duration_s=run.duration_s,
-                                         scenario_id=run.scenario_id, log_q=prop.log_q,
-                                         log_p=prop.log_p)
-            t.kinds.append(prop.kind)
-            strategy.tell(run.x, run.fitness)
+        _acquire_round(ctx, strategy, acquirer, t, seed)
         if retrains:
             _retrain(ctx, t, seed)
         elif not retrain:

@@ -53,12 +53,26 @@ class Learner:
         """A checkpoint's monitor on `train`: `scratch` with `seed` (`first`, if that monitor
         was trained already), or with `members` > 1 the ensemble of it and `members` − 1 more
         from scratch with the seeds `member_seeds` derives from `seed`."""
-        seeds = member_seeds(seed, self.members)
-        one = first or self.scratch(train, seed, weights)
+        return self.as_checkpoint(self.committee(train, seed, self.members, weights, first), seed)
+
+    def committee(self, train: Windows, seed: int, k: int,
+                  weights: Mapping[str, float] | None = None,
+                  first: FusionMonitor | None = None) -> list[FusionMonitor]:
+        """k monitors from scratch on `train` with the seeds `member_seeds(seed, k)` (member 0:
+        `first`, if trained already); its first `members` are the checkpoint's members."""
+        seeds = member_seeds(seed, k)
+        return [first or self.scratch(train, seed, weights),
+                *(self.scratch(train, s, weights) for s in seeds[1:])]
+
+    def as_checkpoint(self, committee: list[FusionMonitor],
+                      seed: int) -> FusionMonitor | EnsembleMonitor:
+        """The checkpoint's monitor of a `committee` trained with `seed` (`committee`): its
+        member 0 alone, or its first `members` as an ensemble calibrated as one monitor."""
+        if len(committee) < self.members:
+            raise ValueError(f"a checkpoint needs {self.members} members, got {len(committee)}")
         if self.members == 1:
-            return one
-        rest = [self.scratch(train, s, weights) for s in seeds[1:]]
-        return EnsembleMonitor.calibrated([one, *rest], self.val,
+            return committee[0]
+        return EnsembleMonitor.calibrated(committee[: self.members], self.val,
                                           f"ensemble-{seed}x{self.members}")
 
     def update(self, parent: FusionMonitor, train: Windows, seed: int,

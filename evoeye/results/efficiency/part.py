@@ -16,7 +16,7 @@ from collections.abc import Callable
 import numpy as np
 
 from evoeye.paths import DataRoot
-from evoeye.results.efficiency.config import CEILINGS, EfficiencyConfig
+from evoeye.results.efficiency.config import NO_UPDATE, EfficiencyConfig
 from evoeye.results.efficiency.findings import efficiency_findings
 from evoeye.results.efficiency.found import failure_rates, failures_found
 from evoeye.results.efficiency.runner import run_regime
@@ -53,7 +53,7 @@ def regime_results(result: dict, config: EfficiencyConfig) -> dict:
     for set_name, kind in SUMMARIES:
         if kind == "update" and config.update == "retrain":
             continue  # the per-round monitor at a checkpoint is the from-scratch one
-        chosen = {k: v for k, v in curves.items() if kind == "scratch" or k not in CEILINGS}
+        chosen = {k: v for k, v in curves.items() if kind == "scratch" or k not in NO_UPDATE}
         summaries[f"{set_name}/{kind}"] = summarise(
             chosen, config.seeds, config.initial_runs, config.checkpoints,
             config.reference_checkpoints, kind, (set_name, "auprc"))

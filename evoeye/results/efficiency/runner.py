@@ -27,14 +27,17 @@ from evoeye.paths import DataRoot
 from evoeye.results.efficiency.acquire import Bank, PoolAcquirer, SimAcquirer
 from evoeye.results.efficiency.config import (
     CEILINGS,
+    ORACLE_SEEDS,
     ORACLE_UNIFORM,
+    QBC,
     EfficiencyConfig,
     parse_regime,
 )
 from evoeye.results.efficiency.curves import Context, run_curve
 from evoeye.results.efficiency.data import prepare_regime
 from evoeye.results.efficiency.learner import Learner
-from evoeye.results.efficiency.oracle import run_oracle
+from evoeye.results.efficiency.oracle import run_oracle, run_seeds_control
+from evoeye.results.efficiency.qbc import run_qbc
 from evoeye.results.efficiency.sets import JUDGING_SETS, RegimeData
 from evoeye.results.ledger import Ledger
 from evoeye.scenarios import get_scenario
@@ -79,8 +82,12 @@ def _unit(unit: tuple[str, int]) -> tuple[str, int, dict, Counter, Counter]:
 
 def _curve(ctx: Context, strategy: str, seed: int) -> dict:
     with intra_op_threads():
+        if strategy == ORACLE_SEEDS:
+            return run_seeds_control(ctx, seed)
         if strategy in CEILINGS:
             return run_oracle(ctx, seed, control=strategy == ORACLE_UNIFORM)
+        if strategy == QBC:  # pool mode only (the config refuses it in generative mode)
+            return run_qbc(ctx, seed)
         if ctx.config.mode == "pool":
             acquirer = PoolAcquirer(ctx.bank)
         else:
@@ -89,7 +96,7 @@ def _curve(ctx: Context, strategy: str, seed: int) -> dict:
 
 
 def units(config: EfficiencyConfig) -> list[tuple[str, int]]:
-    """Every curve of a regime, seed-major; the oracle's and its control's in pool mode only."""
+    """Every curve of a regime, seed-major; the oracle's and its controls' in pool mode only."""
     extra = CEILINGS if config.oracle and config.mode == "pool" else ()
     return [(s, seed) for seed in config.seeds for s in (*config.strategies, *extra)]
 

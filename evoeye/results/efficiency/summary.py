@@ -16,8 +16,10 @@ efficiency), and each as a paired difference with Uniform over the seeds.
   seeds), 2.5 and 97.5 percentiles.
 * What the seeds could detect (`power.py`): per strategy, the paired minimum detectable effect
   against Uniform on the area and at each checkpoint.
-* The oracle against its uniform-only control (`oracle.py`): the paired difference of their
-  areas and final figures, what choosing the kind of run adds to a best-of-k choice.
+* The oracle against each of its controls (`oracle.py`): the paired difference of their
+  areas and final figures — against its uniform-only control (`*_vs_control`) what choosing
+  the kind of run adds to a best-of-k choice of runs, against its best-of-k-training-seeds
+  control (`*_vs_seeds`) what choosing runs adds to picking the luckiest training seed.
 """
 
 from __future__ import annotations
@@ -28,10 +30,11 @@ from collections.abc import Sequence
 import numpy as np
 
 from evoeye.evaluation.stats import compare_paired, mean_ci
-from evoeye.results.efficiency.config import ORACLE, ORACLE_UNIFORM, REFERENCE
+from evoeye.results.efficiency.config import ORACLE, ORACLE_SEEDS, ORACLE_UNIFORM, REFERENCE
 from evoeye.results.efficiency.power import detectable
 
 N_BOOT = 2000
+VERSUS = {ORACLE_UNIFORM: "control", ORACLE_SEEDS: "seeds"}  # the oracle's controls' key suffix
 CURVE_METRIC = ("test", "auprc")
 
 
@@ -126,10 +129,11 @@ def summarise(curves: dict[str, dict[str, dict]], seeds: Sequence[int], initial_
                                    **{str(b): detectable(common[:, j], ref[:, j])
                                       for j, b in enumerate(budgets) if j > 0}}
         out["strategies"][name] = entry
-    if ORACLE in rows and ORACLE_UNIFORM in rows:
-        oracle, control = rows[ORACLE], rows[ORACLE_UNIFORM]
-        out["strategies"][ORACLE]["area_vs_control"] = compare_paired(
-            area(oracle, budgets), area(control, budgets)).to_dict()
-        out["strategies"][ORACLE]["final_vs_control"] = compare_paired(
-            oracle[:, -1], control[:, -1]).to_dict()
+    for name, suffix in VERSUS.items():
+        if ORACLE in rows and name in rows:
+            oracle, control = rows[ORACLE], rows[name]
+            out["strategies"][ORACLE][f"area_vs_{suffix}"] = compare_paired(
+                area(oracle, budgets), area(control, budgets)).to_dict()
+            out["strategies"][ORACLE][f"final_vs_{suffix}"] = compare_paired(
+                oracle[:, -1], control[:, -1]).to_dict()
     return out

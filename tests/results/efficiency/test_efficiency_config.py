@@ -33,6 +33,10 @@ def test_regimes_name_a_scenario_and_a_profile() -> None:
     ({"members": 0}, "members must be 1 to 8, got 0"),
     ({"members": 9}, "members must be 1 to 8, got 9"),
     ({"val_collisions": -1}, "val_collisions must be >= 0"),
+    ({"oracle_step": "run"}, "oracle_step must be one of"),
+    ({"oracle_candidates": 0}, "oracle_candidates must be >= 1"),
+    ({"mode": "generative", "strategies": ("uniform", "qbc")},
+     "^qbc is a pool-mode diagnostic .*: drop it or use mode 'pool'$"),
 ])
 def test_a_bad_config_names_the_problem(change, message) -> None:
     with pytest.raises(ValueError, match=message):
@@ -48,6 +52,7 @@ def test_unknown_names_are_refused_with_the_known_ones() -> None:
         EfficiencyConfig(strategies=("uniform", "subset")).check_names()
     EfficiencyConfig(strategies=("uniform", "subset"), mode="generative").check_names()
     EfficiencyConfig().check_names()
+    EfficiencyConfig(strategies=("uniform", "qbc")).check_names()  # a study-only diagnostic
 
 
 def test_a_results_config_records_only_what_differs_and_reads_back_the_same() -> None:
@@ -88,6 +93,10 @@ def test_the_command_refuses_a_bad_study_before_anything_runs(tmp_path) -> None:
                            (["--strategy", "annealing"], "unknown strategy"),
                            (["--mode", "live"], "mode must be one of"),
                            (["--members", "9"], "--members"),
+                           (["--oracle-step", "run"], "oracle_step must be one of"),
+                           (["--oracle-candidates", "0"], "--oracle-candidates"),
+                           (["--mode", "generative", "--strategy", "qbc"],
+                            "qbc is a pool-mode diagnostic"),
                            (["--val-collisions", "-1"], "--val-collisions")):
         result = CliRunner().invoke(app, [*base, *extra])
         assert result.exit_code == 2 and message in result.output, result.output
@@ -100,12 +109,11 @@ def test_the_later_fields_are_recorded_only_where_set() -> None:
     from evoeye.results.efficiency.config import LATER_FIELDS
 
     assert not set(LATER_FIELDS) & set(EfficiencyConfig().to_dict())
-    changed = EfficiencyConfig(members=3, val_collisions=40)
-    assert {k: changed.to_dict()[k] for k in LATER_FIELDS} == {"members": 3,
-                                                               "val_collisions": 40}
+    changed = EfficiencyConfig(members=3, val_collisions=40, oracle_step="round")
+    later = {"members": 3, "val_collisions": 40, "oracle_step": "round"}
+    assert {k: changed.to_dict()[k] for k in LATER_FIELDS} == later
     assert EfficiencyConfig.from_dict(json.loads(json.dumps(changed.to_dict()))) == changed
-    assert ResultsConfig(efficiency=changed.changed()).efficiency == {"members": 3,
-                                                                      "val_collisions": 40}
+    assert ResultsConfig(efficiency=changed.changed()).efficiency == later
 
 
 def test_the_configs_member_limit_is_the_ensembles() -> None:

@@ -20,30 +20,38 @@ def test_the_study_runs_in_workers_resumes_and_writes_its_files(tiny_regime, tin
                                                                  monkeypatch) -> None:
     root, data = tiny_regime
     monkeypatch.setattr(runner, "prepare_regime", lambda *a, **k: data)  # no simulation
-    config = replace(tiny_config, strategies=("uniform", "boundary"))
+    config = replace(tiny_config, strategies=("uniform", "boundary", "qbc"))
     ledger = Ledger(root)
     first = run_efficiency(root, config, workers=2, ledger=ledger)
     regime = first["regimes"][config.regimes[0]]
     measure = regime["summaries"]["test/scratch"]["strategies"]
-    assert set(measure) == {"uniform", "boundary", "oracle", "oracle-uniform"}
+    assert set(measure) == {"uniform", "boundary", "qbc", "oracle", "oracle-uniform",
+                            "oracle-seeds"}
+    assert measure["qbc"]["area_vs_reference"]["n"] == 2  # paired with Uniform like any
+    assert measure["oracle-seeds"]["area_vs_reference"]["n"] == 2
+    assert measure["oracle"]["area_vs_seeds"]["n"] == 2
     assert [m["n"] for m in measure["uniform"]["mean"]] == [2, 2, 2, 2]  # 6, 10, 14, 18 runs
     assert measure["boundary"]["area_vs_reference"]["n"] == 2
     assert measure["oracle"]["area_vs_control"]["n"] == 2  # paired with its control
     assert "area_vs_control" not in measure["boundary"]
     update = regime["summaries"]["test/update"]["strategies"]
-    assert not {"oracle", "oracle-uniform"} & set(update)  # no update rule
+    assert not {"oracle", "oracle-uniform", "oracle-seeds", "qbc"} & set(update)  # none
     assert regime["where"]["boundary"]["runs"] == 14 - 6
+    assert regime["where"]["oracle-seeds"] == regime["where"]["uniform"]  # Uniform's runs
     assert [f["id"] for f in first["findings"]] == ["efficiency-area", "efficiency-factor",
                                                     "efficiency-ceiling", "efficiency-choice",
-                                                    "efficiency-paper"]
+                                                    "efficiency-seeds", "efficiency-paper"]
     choice = first["findings"][3]["checks"]
     assert [(c["strategy"], c["against"]) for c in choice] == [("oracle", "oracle-uniform")]
+    seeds = first["findings"][4]["checks"]
+    assert [(c["strategy"], c["against"]) for c in seeds] == [("oracle", "oracle-seeds")]
+    assert all(c["strategy"] != "qbc" for c in first["findings"][0]["checks"])  # a diagnostic
 
-    assert ledger.computed["efficiency-curve"] + ledger.found["efficiency-curve"] == 8  # workers'
+    assert ledger.computed["efficiency-curve"] + ledger.found["efficiency-curve"] == 12
     found = Ledger(root)
     again = run_efficiency(root, config, workers=1, ledger=found)  # every curve found
     assert again == first and found.computed["efficiency-curve"] == 0
-    assert found.found["efficiency-curve"] == 8  # 2 strategies, the oracle, its control; 2 seeds
+    assert found.found["efficiency-curve"] == 12  # 3 strategies, the oracle, 2 controls; 2 seeds
     raw = runner.run_regime(root, config.regimes[0], config, ledger=found)
     retrained = regime_results(raw, replace(config, update="retrain"))["summaries"]
     assert set(retrained) == {"test/scratch", "boundary/scratch"}  # the update one is scratch
@@ -53,12 +61,15 @@ def test_the_study_runs_in_workers_resumes_and_writes_its_files(tiny_regime, tin
     text = (folder / "efficiency.md").read_text()
     assert "## highway-cut-in, default ADS" in text and "uniform (reference)" in text
     assert "Oracle − its uniform-only control: area" in text
+    assert "Oracle − its best-of-k-training-seeds control: area" in text
+    assert "qbc (pool-mode diagnostic)" in text and "(oracle-seeds) chooses no runs" in text
     assert "### Failures found" in text and "Minimum detectable effect" in text
+    assert "oracle-seeds's runs are Uniform's" in text
     assert regime["found"]["14"]["boundary"]["runs"] == 2 * (14 - 6)  # two seeds, initial apart
     assert "Does acquisition earn its budget?" in (folder / "findings.md").read_text()
     assert (folder / "results.html").read_text().count("<svg") == 3  # one chart per summary
     stored = json.loads((folder / "results.json").read_text())["efficiency"]
-    assert stored["config"]["strategies"] == ["uniform", "boundary"]
+    assert stored["config"]["strategies"] == ["uniform", "boundary", "qbc"]
     assert restate(stored).strip() == text.strip()  # the stored curves give the same page
 
 
