@@ -170,6 +170,11 @@ def results_command(
         min=0, help="Sample-efficiency study: the validation set holds at least this many "
                     "colliding runs (further runs of its seed stream; 0: the uniform batch "
                     "alone).")] = E.val_collisions,
+    data_seed: Annotated[int | None, typer.Option(
+        min=0, help="Seed of every run the sample-efficiency study (its pool, Test, validation, "
+                    "oracle and boundary sets) and the rare-failure protocol simulate: a fresh "
+                    "one for a confirmation no screening drew from (default: each its own, "
+                    f"{E.data_seed} and {R.data_seed}).")] = None,
     rare_regime: Annotated[list[str] | None, typer.Option(
         "--rare-regime", help="Rare-failure protocol (--part rare): a regime, "
                               "SCENARIO:ADS_PROFILE (repeatable; default "
@@ -215,6 +220,7 @@ def results_command(
     from evoeye.results.rare.part import failed_curves
     from evoeye.results.run import run_results, write_results
 
+    fresh = {} if data_seed is None else {"data_seed": data_seed}
     try:
         runs = parse_initial_runs(initial_runs or [])
         config = ResultsConfig(
@@ -236,13 +242,14 @@ def results_command(
                 seeds=tuple(range(first_study_seed, first_study_seed + study_seeds)),
                 oracle=oracle, oracle_candidates=oracle_candidates, oracle_step=oracle_step,
                 pool_runs=pool_runs, recipe=recipe, epochs=epochs,
-                patience=patience, members=members, val_collisions=val_collisions
+                patience=patience, members=members, val_collisions=val_collisions,
+                **fresh
             ).changed(),
             rare=RareConfig(
                 regimes=tuple(rare_regime or R.regimes),
                 strategies=with_reference(rare_strategy, R.strategies),
                 seeds=tuple(range(first_rare_seed, first_rare_seed + rare_seeds)),
-                runs=rare_runs, batch=rare_batch, explain=rare_explain).changed())
+                runs=rare_runs, batch=rare_batch, explain=rare_explain, **fresh).changed())
         config.check_names()
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from None

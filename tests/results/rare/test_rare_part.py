@@ -130,3 +130,20 @@ def test_a_rare_run_reproduces_its_own_markdown_and_copies_rare_md_to_docs(tmp_p
     write_results(root, results, "rare", docs=tmp_path / "docs")
     assert (tmp_path / "docs" / "rare.md").read_text() == (
         root.reports / "rare" / "rare.md").read_text()
+
+
+def test_a_fresh_data_seed_moves_every_run_and_is_recorded(tmp_path) -> None:
+    """--data-seed reaches both studies' configs; the protocol's runs are those of that seed."""
+    args = ["results", "--root", str(tmp_path / "r"), *TINY, "--data-seed", "4242"]
+    result = CliRunner().invoke(app, args)
+    assert result.exit_code == 0, result.output
+    results = json.loads((tmp_path / "r" / "reports" / "results" / "results.json").read_text())
+    assert results["config"]["rare"]["data_seed"] == 4242
+    assert results["config"]["efficiency"] == {"data_seed": 4242}
+    config = RareConfig(regimes=(RARE,), seeds=(0, 1), runs=2, batch=2, explain=False,
+                        data_seed=4242)
+    curve = rare_part_module.run_curve(config, RARE, "uniform", 0)
+    stored = results["rare"]["regimes"][RARE]["found"]["uniform"]
+    assert stored["runs"] == 4 and curve["x"] != rare_part_module.run_curve(
+        RareConfig(regimes=(RARE,), seeds=(0, 1), runs=2, batch=2, explain=False), RARE,
+        "uniform", 0)["x"]
