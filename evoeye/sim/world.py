@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from highway_env.road.road import Road
 
-from evoeye.boxes import box_corners, box_gaps
+from evoeye.boxes import box_corners, box_gap_bound, box_gaps
 from evoeye.scene import EGO_ID, RoadMap, SceneState
 from evoeye.sim.npc import EgoVehicle, Npc
 from evoeye.sim.path import Path
@@ -31,6 +31,8 @@ from evoeye.sim.traffic import (
 )
 
 NPC_REACTION_S = 1.0  # an NPC driver brakes for a car crossing its way after this long
+# a pair whose footprint gap bound exceeds this cannot touch: far above the rounding of the bound
+CONTACT_SLACK_M = 1e-6
 
 
 class World:
@@ -159,7 +161,14 @@ class World:
         if not np.count_nonzero(close):
             return
         i, j = i[close], j[close]
-        corners = box_corners(x, y, heading, self.length_m, self.width_m)
+        length, width = self.length_m, self.width_m
+        bound = box_gap_bound(x[i], y[i], heading[i], length[i], width[i], x[j], y[j],
+                              heading[j], length[j], width[j])
+        near = bound <= CONTACT_SLACK_M  # usually none: most close pairs are lanes apart
+        if not np.count_nonzero(near):
+            return
+        i, j = i[near], j[near]
+        corners = box_corners(x, y, heading, length, width)
         touching = box_gaps(corners[i], corners[j]) <= 0.0
         if not np.count_nonzero(touching):
             return
