@@ -91,6 +91,12 @@ def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray
 CURVE_AHEAD_RAD = 0.1  # a path turning more than this within BLOCKING_M is checked along its arc
 
 
+def may_curve(path) -> bool:
+    """Whether `path_block` can find anything on `path` at all: its heading turns by
+    CURVE_AHEAD_RAD somewhere (a straight lane never does, so its NPCs need no arc check)."""
+    return float(path.h.max() - path.h.min()) >= CURVE_AHEAD_RAD
+
+
 def path_block(path, s_m: float, half_len_m: float, half_wid_m: float, x: np.ndarray,
                y: np.ndarray, heading: np.ndarray, half_l: np.ndarray, half_w: np.ndarray,
                others: np.ndarray) -> float:
@@ -101,7 +107,7 @@ def path_block(path, s_m: float, half_len_m: float, half_wid_m: float, x: np.nda
     from every path sample to each box, against the NPC's half-width plus the corridor margin."""
     k0 = path.index(s_m)
     k1 = path.index(s_m + half_len_m + BLOCKING_M)
-    if k1 <= k0 or abs(path.h[k1] - path.h[k0]) < CURVE_AHEAD_RAD or not len(others):
+    if k1 <= k0 or path.turn(k0, k1) < CURVE_AHEAD_RAD or not len(others):
         return np.inf
     px, py, ph = path.x[k0:k1 + 1], path.y[k0:k1 + 1], path.h[k0:k1 + 1]  # (K,)
     c, s = np.cos(heading[others])[:, None], np.sin(heading[others])[:, None]  # (m, 1)

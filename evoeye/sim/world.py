@@ -27,6 +27,7 @@ from evoeye.sim.traffic import (
     clear_to_change,
     half_sums,
     leaders,
+    may_curve,
     path_block,
 )
 
@@ -67,6 +68,8 @@ class World:
         rows = np.arange(len(self.vehicles))
         self._others = [rows[rows != i] for i in rows]  # every row but i, per row
         self._half_sums = half_sums(self.length_m, self.width_m)
+        # the NPCs whose path turns somewhere: only they can be blocked along an arc
+        self._on_curves = [(i, npc) for i, npc in enumerate(npcs, start=1) if may_curve(npc.path)]
         assert EGO_ID == 0
 
     # -- reading -------------------------------------------------------------------------------
@@ -109,7 +112,8 @@ class World:
                 rel, i, npc.lane_change.offset_m
             ):
                 npc.start_lane_change()
-        accels = [npc.longitudinal(gap[i], v_lead[i], dt)
+        gaps, v_leads = gap.tolist(), v_lead.tolist()  # floats for the scalar driver models
+        accels = [npc.longitudinal(gaps[i], v_leads[i], dt)
                   for i, npc in enumerate(self.npcs, start=1)]
 
         ego = self.ego
@@ -128,7 +132,7 @@ class World:
         """Where an NPC's path curves ahead (a turn), what blocks it is looked for along the
         arc rather than straight ahead: a car standing in the turn is seen as a driver sees it."""
         half_l, half_w = 0.5 * self.length_m, 0.5 * self.width_m
-        for i, npc in enumerate(self.npcs, start=1):
+        for i, npc in self._on_curves:
             if npc.crashed or npc.changing_lanes:
                 continue
             g = path_block(npc.path, npc.s_m, half_l[i], half_w[i], x, y, heading, half_l,
