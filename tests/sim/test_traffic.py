@@ -13,6 +13,7 @@ from evoeye.sim.traffic import (
     PASSED_M,
     Conflict,
     YieldToEgo,
+    may_curve,
     path_block,
 )
 
@@ -115,6 +116,10 @@ def test_a_car_standing_in_a_turn_blocks_it_though_it_is_not_straight_ahead():
 def test_a_straight_path_is_left_to_the_straight_corridor():
     p = Path(np.stack((np.linspace(0.0, 200.0, 201), np.zeros(201)), axis=1))
     assert blocking(p, 20.0, [(35.0, 0.0, math.pi / 2)]) == math.inf
+    assert not may_curve(p)  # so the world never asks: nothing can block it along an arc
+    assert may_curve(arc_path())
+    gentle = Path(np.stack((np.linspace(0.0, 200.0, 201), np.linspace(0.0, 10.0, 201)), axis=1))
+    assert not may_curve(gentle)  # a slanted straight line turns nowhere either
 
 
 def test_only_the_west_approach_lane_that_ends_at_the_box_gives_way() -> None:
