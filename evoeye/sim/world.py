@@ -65,11 +65,12 @@ class World:
         self._pair_i, self._pair_j = np.triu_indices(len(self.vehicles), k=1)
         reach = 0.5 * np.hypot(self.length_m, self.width_m)  # (n,) circumscribed radius
         self._pair_reach_m = reach[self._pair_i] + reach[self._pair_j]
-        rows = np.arange(len(self.vehicles))
-        self._others = [rows[rows != i] for i in rows]  # every row but i, per row
         self._half_sums = half_sums(self.length_m, self.width_m)
         # the NPCs whose path turns somewhere: only they can be blocked along an arc
         self._on_curves = [(i, npc) for i, npc in enumerate(npcs, start=1) if may_curve(npc.path)]
+        # the NPCs with a scripted lane change: only they have a trigger to update
+        self._scripted = [(i, npc) for i, npc in enumerate(npcs, start=1)
+                          if npc.lane_change is not None]
         assert EGO_ID == 0
 
     # -- reading -------------------------------------------------------------------------------
@@ -104,14 +105,14 @@ class World:
         gap, v_lead = np.where(seen & (block < gap), block, gap), np.where(
             seen & (block < gap), 0.0, v_lead)
         self._wait_at_crossings(gap, v_lead)
-        for i, npc in enumerate(self.npcs, start=1):
-            if npc.lane_change is None:  # nothing scripted: no trigger to update
-                continue
-            closing = speed[0] - speed[i] * rel.cos_dh[0, i]
-            if npc.wants_lane_change(rel.gap_ahead_of(i, 0), closing) and clear_to_change(
-                rel, i, npc.lane_change.offset_m
-            ):
-                npc.start_lane_change()
+        if self._scripted:  # lane-change triggers to update, on floats
+            v, cos_dh = speed.tolist(), rel.cos_dh[0].tolist()
+            for i, npc in self._scripted:
+                closing = v[0] - v[i] * cos_dh[i]
+                if npc.wants_lane_change(rel.gap_ahead_of(i, 0), closing) and clear_to_change(
+                    rel, i, npc.lane_change.offset_m
+                ):
+                    npc.start_lane_change()
         gaps, v_leads = gap.tolist(), v_lead.tolist()  # floats for the scalar driver models
         accels = [npc.longitudinal(gaps[i], v_leads[i], dt)
                   for i, npc in enumerate(self.npcs, start=1)]
@@ -136,7 +137,7 @@ class World:
             if npc.crashed or npc.changing_lanes:
                 continue
             g = path_block(npc.path, npc.s_m, half_l[i], half_w[i], x, y, heading, half_l,
-                           half_w, self._others[i])
+                           half_w, i)
             if g < block[i]:
                 block[i] = g
 

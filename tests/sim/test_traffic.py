@@ -96,8 +96,7 @@ def blocking(path, s_m, others):
     rows = [(0.0, 0.0, 0.0)] + list(others)  # row 0 stands for the NPC itself
     x, y, h = (np.array(c, dtype=float) for c in zip(*rows, strict=True))
     n = len(rows)
-    return path_block(path, s_m, 2.5, 1.0, x, y, h, np.full(n, 2.5), np.full(n, 1.0),
-                      np.arange(1, n))
+    return path_block(path, s_m, 2.5, 1.0, x, y, h, np.full(n, 2.5), np.full(n, 1.0), 0)
 
 
 def test_a_car_standing_in_a_turn_blocks_it_though_it_is_not_straight_ahead():
