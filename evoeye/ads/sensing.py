@@ -39,7 +39,6 @@ from evoeye.zero_d import zero_d, zero_d_fields
 
 N_NORMALS = 8  # standard normals per actor and frame: lidar x, y, vx, vy, heading; radar r, az, rr
 _J, _ZERO, _ONE = np.array(1j), zero_d(0.0), zero_d(1.0)  # 0-d constants (`evoeye.zero_d`)
-_J.flags.writeable = False
 
 
 def line_of_sight_blocked(x0: float, y0: float, x: np.ndarray, y: np.ndarray,
