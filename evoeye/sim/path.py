@@ -110,9 +110,9 @@ class Path:
         px, py = self.x[k0:k1], self.y[k0:k1]
         dx, dy, seg2 = self._dx[k0:k1], self._dy[k0:k1], self._seg2[k0:k1]
         x_, y_ = np.array(x, dtype=float), np.array(y, dtype=float)  # 0-d: `evoeye.zero_d`
-        t = np.minimum(np.maximum(((x_ - px) * dx + (y_ - py) * dy) / seg2, _ZERO), _ONE)
+        t = (((x_ - px) * dx + (y_ - py) * dy) / seg2).clip(_ZERO, _ONE)
         cx, cy = px + t * dx, py + t * dy
-        k = int(((cx - x_) ** 2 + (cy - y_) ** 2).argmin())
+        k = int(np.argmin((cx - x_) ** 2 + (cy - y_) ** 2))
         s = float(self.s[k0 + k] + t[k] * math.sqrt(seg2[k]))
         h = math.atan2(dy[k], dx[k])
         return s, float(-(x - cx[k]) * math.sin(h) + (y - cy[k]) * math.cos(h))

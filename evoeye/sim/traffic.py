@@ -12,11 +12,8 @@ from __future__ import annotations
 
 import functools
 from dataclasses import dataclass, field
-from types import SimpleNamespace
 
 import numpy as np
-
-from evoeye.zero_d import zero_d
 
 CORRIDOR_MARGIN_M = 0.5  # lateral slack added to the two half-widths
 ALIGNED_COS = 0.5  # a vehicle within ±60° of one's heading drives one's way …
@@ -62,12 +59,6 @@ def half_sums(length: np.ndarray, width: np.ndarray) -> tuple[np.ndarray, np.nda
     return 0.5 * (length[:, None] + length[None, :]), 0.5 * (width[:, None] + width[None, :])
 
 
-# the constants `leaders` combines with (n, n) arrays, as 0-d arrays (`evoeye.zero_d`)
-_K = SimpleNamespace(corridor_margin=zero_d(CORRIDOR_MARGIN_M), zero=zero_d(0.0),
-                     aligned_cos=zero_d(ALIGNED_COS), lookahead=zero_d(LOOKAHEAD_M),
-                     blocking=zero_d(BLOCKING_M), inf=zero_d(np.inf))
-
-
 @functools.cache
 def _not_self(n: int) -> np.ndarray:
     """(n, n) True off the diagonal (read-only: shared by every call)."""
@@ -83,19 +74,18 @@ def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray
     `BLOCKING_M` (a crossing car, which a driver answers only after a reaction time). Gaps are
     inf without one. (n,) each."""
     n = len(rel.speed)
-    reach = rel.half_w + _K.corridor_margin
+    reach = rel.half_w + CORRIDOR_MARGIN_M
     in_lane = np.abs(rel.eta) < reach
     if np.count_nonzero(shift_m):  # someone changes lanes: its target lane counts too
         in_lane |= (shift_m != 0.0)[:, None] & (np.abs(rel.eta - shift_m[:, None]) < reach)
-    ahead = (rel.xi > _K.zero) & _not_self(n) & in_lane
-    aligned = rel.cos_dh > _K.aligned_cos
-    gap = np.where(ahead & aligned & (rel.xi < _K.lookahead), rel.bumper, _K.inf)
-    block = np.minimum.reduce(
-        np.where(ahead & ~aligned & (rel.xi < _K.blocking), rel.bumper, _K.inf), axis=1)
+    ahead = (rel.xi > 0.0) & _not_self(n) & in_lane
+    aligned = rel.cos_dh > ALIGNED_COS
+    gap = np.where(ahead & aligned & (rel.xi < LOOKAHEAD_M), rel.bumper, np.inf)
+    block = np.where(ahead & ~aligned & (rel.xi < BLOCKING_M), rel.bumper, np.inf).min(axis=1)
     j = gap.argmin(axis=1)
     rows = np.arange(n)
     best = gap[rows, j]
-    return best, np.where(np.isfinite(best), rel.speed[j] * rel.cos_dh[rows, j], _K.zero), block
+    return best, np.where(np.isfinite(best), rel.speed[j] * rel.cos_dh[rows, j], 0.0), block
 
 
 CURVE_AHEAD_RAD = 0.1  # a path turning more than this within BLOCKING_M is checked along its arc
