@@ -16,10 +16,7 @@ import numpy as np
 from highway_env.road.lane import StraightLane
 from scipy.spatial import cKDTree
 
-from evoeye.zero_d import zero_d
-
 SAMPLE_STEP_M = 0.5
-_ZERO, _ONE = zero_d(0.0), zero_d(1.0)
 
 
 class Path:
@@ -109,10 +106,9 @@ class Path:
             k1 = min(self.index(near_s + window_m) + 1, len(self.s) - 1)
         px, py = self.x[k0:k1], self.y[k0:k1]
         dx, dy, seg2 = self._dx[k0:k1], self._dy[k0:k1], self._seg2[k0:k1]
-        x_, y_ = np.array(x, dtype=float), np.array(y, dtype=float)  # 0-d: `evoeye.zero_d`
-        t = (((x_ - px) * dx + (y_ - py) * dy) / seg2).clip(_ZERO, _ONE)
+        t = (((x - px) * dx + (y - py) * dy) / seg2).clip(0.0, 1.0)
         cx, cy = px + t * dx, py + t * dy
-        k = int(np.argmin((cx - x_) ** 2 + (cy - y_) ** 2))
+        k = int(np.argmin((cx - x) ** 2 + (cy - y) ** 2))
         s = float(self.s[k0 + k] + t[k] * math.sqrt(seg2[k]))
         h = math.atan2(dy[k], dx[k])
         return s, float(-(x - cx[k]) * math.sin(h) + (y - cy[k]) * math.cos(h))
