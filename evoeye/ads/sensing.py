@@ -35,10 +35,8 @@ from evoeye.ads.detections import (
 )
 from evoeye.ads.messages import Localization
 from evoeye.scene import SceneState
-from evoeye.zero_d import zero_d, zero_d_fields
 
 N_NORMALS = 8  # standard normals per actor and frame: lidar x, y, vx, vy, heading; radar r, az, rr
-_J, _ZERO, _ONE = np.array(1j), zero_d(0.0), zero_d(1.0)  # 0-d constants (`evoeye.zero_d`)
 
 
 def line_of_sight_blocked(x0: float, y0: float, x: np.ndarray, y: np.ndarray,
@@ -70,8 +68,8 @@ def occluded_fraction(
     lo = bearing_rad - half_width_rad
     hi = bearing_rad + half_width_rad
     overlap = np.minimum.outer(hi, hi) - np.maximum.outer(lo, lo)  # (n, n) target i, actor j
-    overlap = np.where(np.greater.outer(range_m, range_m), overlap, _ZERO)  # nearer actors only
-    return np.minimum(np.add.reduce(np.maximum(overlap, _ZERO), axis=1) / (hi - lo), _ONE)
+    overlap = np.where(np.greater.outer(range_m, range_m), overlap, 0.0)  # nearer actors only
+    return np.minimum(np.add.reduce(np.maximum(overlap, 0.0), axis=1) / (hi - lo), 1.0)
 
 
 def merge_segments(
@@ -108,16 +106,14 @@ def merge_segments(
 def to_world(z: np.ndarray, pose: tuple[float, float, float, float]) -> np.ndarray:
     """Sensor-frame detections (DET_FIELDS, m) → world frame, in place, for the ego pose
     (x, y, h, v); velocities are relative to the ego in the sensor frame."""
-    x0, y0, h0, v0 = np.array(pose[0]), np.array(pose[1]), np.array(pose[2]), np.array(pose[3])
-    c, s = np.array(math.cos(pose[2])), np.array(math.sin(pose[2]))  # 0-d: `evoeye.zero_d`
-    px, py = z[DET_X], z[DET_Y]
-    world_x = x0 + c * px - s * py
+    x0, y0, h0, v0 = pose
+    c, s = math.cos(h0), math.sin(h0)
+    px, py = z[DET_X].copy(), z[DET_Y].copy()
+    z[DET_X] = x0 + c * px - s * py
     z[DET_Y] = y0 + s * px + c * py
-    z[DET_X] = world_x
-    vx, vy = z[DET_VX] + v0, z[DET_VY]  # relative to the ego → absolute, ego-aligned
-    world_vx = c * vx - s * vy
+    vx, vy = z[DET_VX] + v0, z[DET_VY].copy()  # relative to the ego → absolute, ego-aligned
+    z[DET_VX] = c * vx - s * vy
     z[DET_VY] = s * vx + c * vy
-    z[DET_VX] = world_vx
     z[DET_HEADING] += h0
     return z
 
@@ -138,13 +134,6 @@ class SensorModel:
         self._radar_var_vel = c.radar_vel_sigma_mps**2 + VAR_FLOOR
         self._var_range = c.radar_range_sigma_m**2 + VAR_FLOOR  # radar variances, for the fusion
         self._var_range_rate = c.radar_range_rate_sigma_mps**2 + VAR_FLOOR
-        # the same constants as 0-d arrays, for the per-frame arithmetic (`evoeye.zero_d`)
-        self.k = k = zero_d_fields(c)
-        k.lidar_drop, k.radar_drop = zero_d(self._lidar_drop), zero_d(self._radar_drop)
-        k.inv_occ_lidar, k.inv_occ_radar = zero_d(self._inv_occ_lidar), zero_d(self._inv_occ_radar)
-        k.var_range, k.var_range_rate = zero_d(self._var_range), zero_d(self._var_range_rate)
-        k.unseen_frac = zero_d(1.0 - c.lidar_depth_seen_frac)
-        k.half, k.var_floor = zero_d(0.5), zero_d(VAR_FLOOR)
 
     def _may_merge(self, pos: np.ndarray, length_m: np.ndarray, width_m: np.ndarray) -> bool:
         """Whether any two lidar detections at pos (m,) complex may be close enough to merge:
@@ -157,7 +146,7 @@ class SensorModel:
     def detect(self, scene: SceneState, ego: Localization | None = None) -> Detections:
         """Detections of every actor but the ego (row 0) at scene.t_s, in the world frame placed
         with `ego` (the localisation estimate at capture; None: the true pose)."""
-        c, k = self.c, self.k
+        c = self.c
         n = len(scene.actor_id) - 1
         fp = self.false_positives
         # a fixed number of draws per frame, whatever is detected: the stream stays aligned
@@ -172,9 +161,9 @@ class SensorModel:
         if n == 0:
             return Detections(fp_ids, to_world(fp_z, pose))
         # ground truth in the sensor frame (x forward, y left)
-        rel = ((x[1:] - x0) + _J * (y[1:] - y0)) * cmath.exp(-1j * h0)  # (n,)
+        rel = ((x[1:] - x0) + 1j * (y[1:] - y0)) * cmath.exp(-1j * h0)  # (n,)
         h_rel = h[1:] - h0
-        e_h = np.exp(_J * h_rel)
+        e_h = np.exp(1j * h_rel)
         vrel = v[1:] * e_h - v0  # velocity relative to the ego
         r = np.abs(rel)
         bearing = np.arctan2(rel.imag, rel.real)  # (−π, π]: the seam is straight behind
@@ -186,25 +175,25 @@ class SensorModel:
         if scene.occluders is not None:  # a building between: nothing to see
             occ = np.where(line_of_sight_blocked(x0, y0, x[1:], y[1:], scene.occluders), 1.0, occ)
         r2 = r * r
-        p_lidar = (k.lidar_detect_prob_near - k.lidar_drop * r2) * (
-            _ONE - occ * k.inv_occ_lidar)
-        p_radar = (k.radar_detect_prob_near - k.radar_drop * r2) * (
-            _ONE - occ * k.inv_occ_radar)
-        lidar = (u[:n] < p_lidar) & (r <= k.lidar_range_m)
-        radar = (u[n:2 * n] < p_radar) & (r <= k.radar_range_m) & (
-            np.abs(bearing) <= k.radar_half_fov_rad)
+        p_lidar = (c.lidar_detect_prob_near - self._lidar_drop * r2) * (
+            1.0 - occ * self._inv_occ_lidar)
+        p_radar = (c.radar_detect_prob_near - self._radar_drop * r2) * (
+            1.0 - occ * self._inv_occ_radar)
+        lidar = (u[:n] < p_lidar) & (r <= c.lidar_range_m)
+        radar = (u[n:2 * n] < p_radar) & (r <= c.radar_range_m) & (
+            np.abs(bearing) <= c.radar_half_fov_rad)
 
         # lidar boxes from the visible points: shorter end-on, centred on the visible part
-        f = k.lidar_depth_seen_frac
-        len_l = length * (f + k.unseen_frac * sin_phi)
-        wid_l = width * (f + k.unseen_frac * cos_phi)
-        shift = k.half * ((length - len_l) * cos_phi + (width - wid_l) * sin_phi)
-        sig_p = k.pos_sigma_m + k.pos_sigma_per_m * r
-        sig_v = k.vel_sigma_mps + k.vel_sigma_per_m * r
+        f = c.lidar_depth_seen_frac
+        len_l = length * (f + (1.0 - f) * sin_phi)
+        wid_l = width * (f + (1.0 - f) * cos_phi)
+        shift = 0.5 * ((length - len_l) * cos_phi + (width - wid_l) * sin_phi)
+        sig_p = c.pos_sigma_m + c.pos_sigma_per_m * r
+        sig_v = c.vel_sigma_mps + c.vel_sigma_per_m * r
         pos_l = rel - shift * los + sig_p * gc[:n]
         vel_l = vrel + sig_v * gc[n:]
-        head_l = h_rel + (k.heading_sigma_rad + k.heading_sigma_per_m * r) * g[4 * n:5 * n]
-        var_pl, var_vl = sig_p * sig_p + k.var_floor, sig_v * sig_v + k.var_floor
+        head_l = h_rel + (c.heading_sigma_rad + c.heading_sigma_per_m * r) * g[4 * n:5 * n]
+        var_pl, var_vl = sig_p * sig_p + VAR_FLOOR, sig_v * sig_v + VAR_FLOOR
         if np.count_nonzero(lidar) > 1 and self._may_merge(pos_l[lidar], length, width):
             i = lidar.nonzero()[0]
             keep, pos_l[i], vel_l[i], len_l[i], wid_l[i] = merge_segments(
@@ -212,17 +201,17 @@ class SensorModel:
             lidar[i[~keep]] = False
 
         # radar: range and azimuth → position; range rate → the radial velocity only
-        rm = r + k.radar_range_sigma_m * g[5 * n:6 * n]
-        los_r = np.exp(_J * (bearing + k.radar_azimuth_sigma_rad * g[6 * n:7 * n]))
-        rr = (vrel * los.conj()).real + k.radar_range_rate_sigma_mps * g[7 * n:]
+        rm = r + c.radar_range_sigma_m * g[5 * n:6 * n]
+        los_r = np.exp(1j * (bearing + c.radar_azimuth_sigma_rad * g[6 * n:7 * n]))
+        rr = (vrel * los.conj()).real + c.radar_range_rate_sigma_mps * g[7 * n:]
 
         # fusion where both see the actor: the radar measures range and range rate only, so it
         # corrects the lidar along its line of sight (a Kalman update with a radial measurement)
         both = lidar & radar
         if np.count_nonzero(both):
             back = los_r.conj()
-            d_pos = (var_pl / (var_pl + k.var_range)) * (rm - (pos_l * back).real)
-            d_vel = (var_vl / (var_vl + k.var_range_rate)) * (rr - (vel_l * back).real)
+            d_pos = (var_pl / (var_pl + self._var_range)) * (rm - (pos_l * back).real)
+            d_vel = (var_vl / (var_vl + self._var_range_rate)) * (rr - (vel_l * back).real)
             pos_l = np.where(both, pos_l + d_pos * los_r, pos_l)
             vel_l = np.where(both, vel_l + d_vel * los_r, vel_l)
         z = pack(pos_l, vel_l, head_l, len_l, wid_l, r, var_pl, var_vl)  # (DET_FIELDS, n)
@@ -237,7 +226,7 @@ class SensorModel:
             z[:, j] = pack(pos_r, vel_r, head_r, c.radar_length_m, c.radar_width_m, r[j], var_pr,
                            self._radar_var_vel)
         ids = scene.actor_id[1:]
-        multipath = radar & (u[2 * n:3 * n] < k.ghost_prob) & (r > k.ghost_min_range_m)
+        multipath = radar & (u[2 * n:3 * n] < c.ghost_prob) & (r > c.ghost_min_range_m)
         seen = lidar | radar
         if np.count_nonzero(seen) < n:
             ids, z, multipath = ids[seen], z[:, seen], multipath[seen]
