@@ -26,6 +26,21 @@ def box_corners(x: np.ndarray, y: np.ndarray, heading: np.ndarray, length: np.nd
                      y[:, None] + s * local[..., 0] + c * local[..., 1]], axis=-1)
 
 
+def box_gap_bound(x: np.ndarray, y: np.ndarray, h: np.ndarray, length: np.ndarray,
+                  width: np.ndarray, ox: np.ndarray, oy: np.ndarray, oh: np.ndarray,
+                  olength: np.ndarray, owidth: np.ndarray) -> np.ndarray:
+    """Distance from box (x, y, h, length, width) to the bounding box, in its own frame, of the
+    box o: a lower bound of their `box_gaps`, exact unless the closest points of the two are
+    corner to corner (the bounding box along an axis reaches exactly o's extreme corner), for a
+    dozen elementwise operations instead of the exact gap's corner-to-edge pairs."""
+    c, s = np.cos(h), np.sin(h)
+    dx, dy = ox - x, oy - y
+    ca, sa = np.abs(np.cos(oh - h)), np.abs(np.sin(oh - h))
+    gap_x = np.abs(c * dx + s * dy) - 0.5 * (length + olength * ca + owidth * sa)
+    gap_y = np.abs(c * dy - s * dx) - 0.5 * (width + olength * sa + owidth * ca)
+    return np.hypot(np.maximum(gap_x, 0.0), np.maximum(gap_y, 0.0))
+
+
 def _axes(a: np.ndarray, b: np.ndarray) -> np.ndarray:
     """(..., 4, 2) the separating-axis candidates of rectangles a and b: two edges of each."""
     return np.concatenate([a[..., 1:3, :] - a[..., 0:2, :], b[..., 1:3, :] - b[..., 0:2, :]],

@@ -6,7 +6,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from evoeye.boxes import box_corners, box_gaps, first_contact_s
+from evoeye.boxes import box_corners, box_gap_bound, box_gaps, first_contact_s
 
 DT_S = 0.05  # the brute force's time step (the ADS's 20 Hz)
 HORIZON_S = 8.0
@@ -89,3 +89,17 @@ def test_broadcasts_over_leading_dimensions() -> None:
     t = first_contact_s(ego, others, np.broadcast_to([-10.0, 0.0], (2, 3, 2)))
     assert t.shape == (2, 3)
     np.testing.assert_allclose(t.ravel(), (np.arange(6.0) * 10 + 10 - 4.8) / 10)
+
+
+def test_gap_bound_never_exceeds_the_exact_gap_and_is_exact_for_aligned_boxes() -> None:
+    s = _random_states(np.random.default_rng(3), 4000)
+    zero, n = np.zeros(4000), 4000
+    ego = (zero, zero, zero, np.full(n, 4.8), np.full(n, 2.0))
+    other = (s["x"], s["y"], s["h"], s["length"], s["width"])
+    exact = box_gaps(np.broadcast_to(_box(0.0, 0.0), (n, 4, 2)), box_corners(*other))
+    bound = box_gap_bound(*ego, *other)
+    assert (bound <= exact + 1e-9).all() and (bound == 0.0).any() and (bound > 0.0).any()
+    aligned = box_gap_bound(*ego, s["x"], s["y"], zero, s["length"], s["width"])
+    exact_aligned = box_gaps(np.broadcast_to(_box(0.0, 0.0), (n, 4, 2)),
+                             box_corners(s["x"], s["y"], zero, s["length"], s["width"]))
+    np.testing.assert_allclose(aligned, exact_aligned, atol=1e-9)

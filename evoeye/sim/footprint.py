@@ -15,24 +15,10 @@ from collections.abc import Sequence
 
 import numpy as np
 
-from evoeye.boxes import box_corners, box_gaps
+from evoeye.boxes import box_corners, box_gap_bound, box_gaps
 from evoeye.scene import SceneState
 
 __all__ = ["ego_gaps", "min_ego_gap"]
-
-
-def _bbox_gap(x: np.ndarray, y: np.ndarray, h: np.ndarray, length: np.ndarray,
-              width: np.ndarray, ox: np.ndarray, oy: np.ndarray, oh: np.ndarray,
-              olength: np.ndarray, owidth: np.ndarray) -> np.ndarray:
-    """Distance from box (x, y, h, length, width) to the bounding box, in its own frame, of the
-    box o: a lower bound of the footprint distance, exact unless the closest points of the two
-    are corner to corner (the bounding box along an axis reaches exactly o's extreme corner)."""
-    c, s = np.cos(h), np.sin(h)
-    dx, dy = ox - x, oy - y
-    ca, sa = np.abs(np.cos(oh - h)), np.abs(np.sin(oh - h))
-    gap_x = np.abs(c * dx + s * dy) - 0.5 * (length + olength * ca + owidth * sa)
-    gap_y = np.abs(c * dy - s * dx) - 0.5 * (width + olength * sa + owidth * ca)
-    return np.hypot(np.maximum(gap_x, 0.0), np.maximum(gap_y, 0.0))
 
 
 def ego_gaps(scene: SceneState) -> np.ndarray:
@@ -62,7 +48,7 @@ def min_ego_gap(scenes: Sequence[SceneState], batch: int = 16) -> float:
     is_other[start] = False
     ego = rows[:, np.repeat(start, n - 1)]  # (5, pairs): x, y, heading, length, width
     other = rows[:, is_other]
-    bound = np.maximum(_bbox_gap(*ego, *other), _bbox_gap(*other, *ego))
+    bound = np.maximum(box_gap_bound(*ego, *other), box_gap_bound(*other, *ego))
     order = np.argsort(bound, kind="stable")
     best = np.inf
     for start in range(0, len(order), batch):

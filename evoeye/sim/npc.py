@@ -114,7 +114,8 @@ class Npc(Vehicle):
         self._trigger_side: float | None = None  # sign of (gap − trigger) when last seen
         self._armed = False  # the trigger gap was crossed; waiting for a clear target lane
         dm = self.driver
-        self._curve_speed = curve_speed(path, dm)
+        self._curve_speed = curve_speed(path, dm).tolist()  # floats: one lookup per step
+        self._idm_root = 2.0 * math.sqrt(dm.accel_mps2 * dm.comfort_decel_mps2)  # IDM's 2·√(ab)
         self._reacting: deque[float] | None = None  # the decisions not acted on yet (reaction_s)
 
     # -- the script ------------------------------------------------------------------------------
@@ -170,8 +171,7 @@ class Npc(Vehicle):
         v = self.speed
         if self.crashed:
             return -dm.crash_decel_mps2 if v > 0.0 else 0.0
-        v0 = max(min(self.desired_speed_mps, float(self._curve_speed[self.path.index(self.s_m)])),
-                 0.1)
+        v0 = max(min(self.desired_speed_mps, self._curve_speed[self.path.index(self.s_m)]), 0.1)
         if v <= v0:
             a = dm.accel_mps2 * (1.0 - (v / v0) ** dm.delta)
         else:  # above the desired speed (a curve ahead, a slower set speed): comfortable braking
@@ -180,7 +180,7 @@ class Npc(Vehicle):
             closing = v - leader_speed_mps
             s_star = dm.min_gap_m + max(
                 0.0, v * dm.time_headway_s
-                + v * closing / (2.0 * math.sqrt(dm.accel_mps2 * dm.comfort_decel_mps2)))
+                + v * closing / self._idm_root)
             interaction = (s_star / max(gap_m, 0.1)) ** 2
             a = min(a, dm.accel_mps2 * (1.0 - (v / v0) ** dm.delta - interaction))
         b = self.brake

@@ -48,6 +48,11 @@ class Path:
         """The sample at or before arc length s_m."""
         return min(max(int(s_m / self.step_m), 0), len(self.s) - 1)
 
+    def turn(self, k0: int, k1: int) -> float:
+        """|heading at sample k1 − heading at sample k0| (rad)."""
+        h = self._samples[3]
+        return abs(h[k1] - h[k0])
+
     @classmethod
     def from_lanes(cls, lanes: Sequence) -> Path:
         """The path through highway-env lanes `lanes`, in order."""

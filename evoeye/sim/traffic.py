@@ -91,28 +91,36 @@ def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray
 CURVE_AHEAD_RAD = 0.1  # a path turning more than this within BLOCKING_M is checked along its arc
 
 
+def may_curve(path) -> bool:
+    """Whether `path_block` can find anything on `path` at all: its heading turns by
+    CURVE_AHEAD_RAD somewhere (a straight lane never does, so its NPCs need no arc check)."""
+    return float(path.h.max() - path.h.min()) >= CURVE_AHEAD_RAD
+
+
 def path_block(path, s_m: float, half_len_m: float, half_wid_m: float, x: np.ndarray,
                y: np.ndarray, heading: np.ndarray, half_l: np.ndarray, half_w: np.ndarray,
-               others: np.ndarray) -> float:
-    """Bumper gap along a *curved* path to the first vehicle (rows `others`) whose footprint
-    lies on it within `BLOCKING_M` and that does not drive its way there (a car standing in a
-    turn, the ego's nose in the crossing); inf if none, or if the path ahead is straight (the
-    straight corridor of `leaders` already covers it). Footprints are exact boxes: the distance
-    from every path sample to each box, against the NPC's half-width plus the corridor margin."""
+               me: int) -> float:
+    """Bumper gap along a *curved* path to the first vehicle (any row but `me`, the NPC's own)
+    whose footprint lies on it within `BLOCKING_M` and that does not drive its way there (a car
+    standing in a turn, the ego's nose in the crossing); inf if none, or if the path ahead is
+    straight (the straight corridor of `leaders` already covers it). Footprints are exact boxes:
+    the distance from every path sample to each box, against the NPC's half-width plus the
+    corridor margin."""
     k0 = path.index(s_m)
     k1 = path.index(s_m + half_len_m + BLOCKING_M)
-    if k1 <= k0 or abs(path.h[k1] - path.h[k0]) < CURVE_AHEAD_RAD or not len(others):
+    if k1 <= k0 or path.turn(k0, k1) < CURVE_AHEAD_RAD or len(x) < 2:
         return np.inf
     px, py, ph = path.x[k0:k1 + 1], path.y[k0:k1 + 1], path.h[k0:k1 + 1]  # (K,)
-    c, s = np.cos(heading[others])[:, None], np.sin(heading[others])[:, None]  # (m, 1)
-    dx, dy = px[None, :] - x[others, None], py[None, :] - y[others, None]  # (m, K)
-    ex = np.maximum(np.abs(c * dx + s * dy) - half_l[others, None], 0.0)
-    ey = np.maximum(np.abs(c * dy - s * dx) - half_w[others, None], 0.0)
-    on_path = ex * ex + ey * ey < (half_wid_m + CORRIDOR_MARGIN_M) ** 2  # (m, K)
+    c, s = np.cos(heading)[:, None], np.sin(heading)[:, None]  # (n, 1)
+    dx, dy = px[None, :] - x[:, None], py[None, :] - y[:, None]  # (n, K)
+    ex = np.maximum(np.abs(c * dx + s * dy) - half_l[:, None], 0.0)
+    ey = np.maximum(np.abs(c * dy - s * dx) - half_w[:, None], 0.0)
+    on_path = ex * ex + ey * ey < (half_wid_m + CORRIDOR_MARGIN_M) ** 2  # (n, K)
+    on_path[me] = False  # its own box
     on_path[:, : int(half_len_m / path.step_m) + 1] = False  # behind its own front bumper
     if not np.count_nonzero(on_path):  # usually: then the headings need not be compared
         return np.inf
-    on_path &= np.cos(heading[others, None] - ph[None, :]) <= ALIGNED_COS  # not a leader
+    on_path &= np.cos(heading[:, None] - ph[None, :]) <= ALIGNED_COS  # not a leader
     hit = np.logical_or.reduce(on_path, axis=0)
     if not np.count_nonzero(hit):
         return np.inf

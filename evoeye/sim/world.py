@@ -16,7 +16,7 @@ from __future__ import annotations
 import numpy as np
 from highway_env.road.road import Road
 
-from evoeye.boxes import box_corners, box_gaps
+from evoeye.boxes import box_corners, box_gap_bound, box_gaps
 from evoeye.scene import EGO_ID, RoadMap, SceneState
 from evoeye.sim.npc import EgoVehicle, Npc
 from evoeye.sim.path import Path
@@ -27,10 +27,13 @@ from evoeye.sim.traffic import (
     clear_to_change,
     half_sums,
     leaders,
+    may_curve,
     path_block,
 )
 
 NPC_REACTION_S = 1.0  # an NPC driver brakes for a car crossing its way after this long
+# a pair whose footprint gap bound exceeds this cannot touch: far above the rounding of the bound
+CONTACT_SLACK_M = 1e-6
 
 
 class World:
@@ -62,9 +65,12 @@ class World:
         self._pair_i, self._pair_j = np.triu_indices(len(self.vehicles), k=1)
         reach = 0.5 * np.hypot(self.length_m, self.width_m)  # (n,) circumscribed radius
         self._pair_reach_m = reach[self._pair_i] + reach[self._pair_j]
-        rows = np.arange(len(self.vehicles))
-        self._others = [rows[rows != i] for i in rows]  # every row but i, per row
         self._half_sums = half_sums(self.length_m, self.width_m)
+        # the NPCs whose path turns somewhere: only they can be blocked along an arc
+        self._on_curves = [(i, npc) for i, npc in enumerate(npcs, start=1) if may_curve(npc.path)]
+        # the NPCs with a scripted lane change: only they have a trigger to update
+        self._scripted = [(i, npc) for i, npc in enumerate(npcs, start=1)
+                          if npc.lane_change is not None]
         assert EGO_ID == 0
 
     # -- reading -------------------------------------------------------------------------------
@@ -99,15 +105,16 @@ class World:
         gap, v_lead = np.where(seen & (block < gap), block, gap), np.where(
             seen & (block < gap), 0.0, v_lead)
         self._wait_at_crossings(gap, v_lead)
-        for i, npc in enumerate(self.npcs, start=1):
-            if npc.lane_change is None:  # nothing scripted: no trigger to update
-                continue
-            closing = speed[0] - speed[i] * rel.cos_dh[0, i]
-            if npc.wants_lane_change(rel.gap_ahead_of(i, 0), closing) and clear_to_change(
-                rel, i, npc.lane_change.offset_m
-            ):
-                npc.start_lane_change()
-        accels = [npc.longitudinal(gap[i], v_lead[i], dt)
+        if self._scripted:  # lane-change triggers to update, on floats
+            v, cos_dh = speed.tolist(), rel.cos_dh[0].tolist()
+            for i, npc in self._scripted:
+                closing = v[0] - v[i] * cos_dh[i]
+                if npc.wants_lane_change(rel.gap_ahead_of(i, 0), closing) and clear_to_change(
+                    rel, i, npc.lane_change.offset_m
+                ):
+                    npc.start_lane_change()
+        gaps, v_leads = gap.tolist(), v_lead.tolist()  # floats for the scalar driver models
+        accels = [npc.longitudinal(gaps[i], v_leads[i], dt)
                   for i, npc in enumerate(self.npcs, start=1)]
 
         ego = self.ego
@@ -126,11 +133,11 @@ class World:
         """Where an NPC's path curves ahead (a turn), what blocks it is looked for along the
         arc rather than straight ahead: a car standing in the turn is seen as a driver sees it."""
         half_l, half_w = 0.5 * self.length_m, 0.5 * self.width_m
-        for i, npc in enumerate(self.npcs, start=1):
+        for i, npc in self._on_curves:
             if npc.crashed or npc.changing_lanes:
                 continue
             g = path_block(npc.path, npc.s_m, half_l[i], half_w[i], x, y, heading, half_l,
-                           half_w, self._others[i])
+                           half_w, i)
             if g < block[i]:
                 block[i] = g
 
@@ -159,7 +166,14 @@ class World:
         if not np.count_nonzero(close):
             return
         i, j = i[close], j[close]
-        corners = box_corners(x, y, heading, self.length_m, self.width_m)
+        length, width = self.length_m, self.width_m
+        bound = box_gap_bound(x[i], y[i], heading[i], length[i], width[i], x[j], y[j],
+                              heading[j], length[j], width[j])
+        near = bound <= CONTACT_SLACK_M  # usually none: most close pairs are lanes apart
+        if not np.count_nonzero(near):
+            return
+        i, j = i[near], j[near]
+        corners = box_corners(x, y, heading, length, width)
         touching = box_gaps(corners[i], corners[j]) <= 0.0
         if not np.count_nonzero(touching):
             return

@@ -13,6 +13,7 @@ from evoeye.sim.traffic import (
     PASSED_M,
     Conflict,
     YieldToEgo,
+    may_curve,
     path_block,
 )
 
@@ -95,8 +96,7 @@ def blocking(path, s_m, others):
     rows = [(0.0, 0.0, 0.0)] + list(others)  # row 0 stands for the NPC itself
     x, y, h = (np.array(c, dtype=float) for c in zip(*rows, strict=True))
     n = len(rows)
-    return path_block(path, s_m, 2.5, 1.0, x, y, h, np.full(n, 2.5), np.full(n, 1.0),
-                      np.arange(1, n))
+    return path_block(path, s_m, 2.5, 1.0, x, y, h, np.full(n, 2.5), np.full(n, 1.0), 0)
 
 
 def test_a_car_standing_in_a_turn_blocks_it_though_it_is_not_straight_ahead():
@@ -115,6 +115,10 @@ def test_a_car_standing_in_a_turn_blocks_it_though_it_is_not_straight_ahead():
 def test_a_straight_path_is_left_to_the_straight_corridor():
     p = Path(np.stack((np.linspace(0.0, 200.0, 201), np.zeros(201)), axis=1))
     assert blocking(p, 20.0, [(35.0, 0.0, math.pi / 2)]) == math.inf
+    assert not may_curve(p)  # so the world never asks: nothing can block it along an arc
+    assert may_curve(arc_path())
+    gentle = Path(np.stack((np.linspace(0.0, 200.0, 201), np.linspace(0.0, 10.0, 201)), axis=1))
+    assert not may_curve(gentle)  # a slanted straight line turns nowhere either
 
 
 def test_only_the_west_approach_lane_that_ends_at_the_box_gives_way() -> None:
