@@ -9,13 +9,13 @@ paired per-seed cell it rests on (`compare_paired`'s fields: n, mean_diff, ci_lo
   reproduce** when its upper end exists and lies below it, and is **not shown** otherwise (an
   open interval: Uniform found too few to bound the ratio). Cell: the paired difference of the
   seeds' failures per 100 runs.
-* **rare-estimate** — the strategy's failure-rate estimate (exact p/q) is unbiased and has ≥ 3×
-  smaller relative error at equal budget: it **reproduces** when the bias CI against Uniform's
-  pooled estimate contains 0 and the error ratio's (Uniform's / the strategy's) CI lies at or
-  above 3; it **does not reproduce** when the bias CI excludes 0 or the ratio's upper end lies
-  below 3; otherwise not shown (so where Uniform saw no failure: its pooled 0 has no
-  variance to judge a bias by). Cell: the paired difference of the seeds' absolute relative
-  errors (Uniform's − the strategy's).
+* **rare-estimate** — the strategy's failure-rate estimate (exact p/q, or subset simulation's
+  product of its levels) is unbiased and has ≥ 3× smaller relative error at equal budget: it
+  **reproduces** when the bias CI against Uniform's pooled estimate contains 0 and the error
+  ratio's (Uniform's / the strategy's) CI lies at or above 3; it **does not reproduce** when
+  the bias CI excludes 0 or the ratio's upper end lies below 3; otherwise not shown (so where
+  Uniform saw no failure: its pooled 0 has no variance to judge a bias by). Cell: the paired
+  difference of the seeds' absolute relative errors (Uniform's − the strategy's).
 
 A claim reproduces when one strategy reproduces in every regime run; does not reproduce when
 every check goes against it; is partly shown when some check reproduces; not shown otherwise,
