@@ -48,7 +48,7 @@ from evoeye.evolve.campaign.committee import Committee
 from evoeye.evolve.campaign.config import CampaignConfig, campaign_id
 from evoeye.evolve.campaign.guard import CampaignCancelled, campaign_lease
 from evoeye.evolve.campaign.phases import PhaseClock
-from evoeye.evolve.campaign.scoring import fresh_run_feedback, warehouse_feedback
+from evoeye.evolve.campaign.scoring import fresh_run_feedback
 from evoeye.evolve.campaign.state import (
     CampaignState,
     acquired_runs,
@@ -59,7 +59,7 @@ from evoeye.evolve.campaign.state import (
     records_of,
     run_outcome,
 )
-from evoeye.evolve.search.records import Records
+from evoeye.evolve.campaign.stored import StoredFeedback
 from evoeye.evolve.search.registry import (
     FEEDBACK_BLIND,
     READS_DISAGREEMENT,
@@ -81,12 +81,9 @@ from evoeye.seeds import search_seed
 from evoeye.store import RunFilter
 from evoeye.store.connections import shared_connections
 from evoeye.store.feedback import (
-    FeedbackRows,
     RoundMetrics,
     RoundRow,
-    feedback_of,
     read_rounds,
-    write_feedback,
 )
 from evoeye.store.feedback import write_round as store_round
 from evoeye.store.ingest import IngestReport, ingest_batch, refresh_catalog
@@ -97,7 +94,7 @@ Trainer = Callable[..., str]  # train_monitor's signature
 Assessor = Callable[[str], RoundMetrics]  # monitor version → metrics, stored with the round
 
 
-class Campaign:
+class Campaign(StoredFeedback):
     """One campaign over a data root: `start()` (or resume), then `run_round` until `done`."""
 
     def __init__(self, root: DataRoot, config: CampaignConfig, *,
@@ -158,11 +155,6 @@ class Campaign:
     def committee(self) -> Committee | None:
         """The monitors whose disagreement the strategy reads (None if it reads none)."""
         return Committee(self) if self.config.strategy in READS_DISAGREEMENT else None
-
-    def stored_feedback(self, version: str) -> dict[str, float]:
-        """scenario_id → f stored under `version` in this campaign's feedback mode (G_0's is
-        shared by every campaign of the mode)."""
-        return feedback_of(self.root, version, self.config.feedback)
 
     def log_path(self, scenario_id: str) -> Path:
         return self.root.run_log(self.config.scenario, self.campaign_id, scenario_id)
@@ -379,34 +371,6 @@ class Campaign:
     def check_stop(self) -> None:
         if self.should_stop is not None and self.should_stop():
             raise CampaignCancelled(f"campaign {self.campaign_id} stopped on request")
-
-    def _store_feedback(self, version: str, scenario_ids) -> None:
-        """Score ingested runs with `version` and store f (runs already stored are skipped)."""
-        have = self.stored_feedback(version)
-        todo = [str(s) for s in scenario_ids if s not in have]
-        if not todo:
-            return
-        with self.clock("refresh"):
-            fb = warehouse_feedback(self.root, self.monitor(version), todo,
-                                    self.config.horizon_s, self.config.feedback)
-        self.write_feedback(version, fb.scenario_id, fb.feedback, fb.n_contexts)
-
-    def write_feedback(self, version: str, ids, values, n_contexts=None,
-                       mode: str | None = None) -> None:
-        """Store per-run values (the finite ones) under `version` in `mode` (default: ours)."""
-        write_feedback(self.root, FeedbackRows.finite(self.config.scenario, version,
-                                                      mode or self.config.feedback, ids, values,
-                                                      n_contexts))
-
-    def with_stored(self, records: Records, version: str) -> Records:
-        """`records` with the feedback (and the committee's disagreement) stored under G_r =
-        `version`; NaN where none is."""
-        def aligned(stored: dict[str, float]) -> np.ndarray:
-            return np.array([stored.get(s, np.nan) for s in records.scenario_id], dtype=float)
-
-        records = records.with_feedback(aligned(self.stored_feedback(version)))
-        return records if self.committee is None else records.with_disagreement(
-            aligned(self.committee.stored(version)))
 
     def _metrics(self, version: str) -> RoundMetrics | None:
         with self.clock("assess"):
