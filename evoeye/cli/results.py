@@ -21,6 +21,7 @@ from evoeye.results.config import (
 from evoeye.results.efficiency.config import (
     MAX_MEMBERS,
     MODES,
+    ORACLE_MIN_CANDIDATES,
     ORACLE_STEPS,
     REFERENCE,
     UPDATES,
@@ -146,8 +147,9 @@ def results_command(
         help="Sample-efficiency study: draw the greedy oracle's curves (a lower bound on what "
              "choosing runs can gain) and its two controls' (pool mode).")] = E.oracle,
     oracle_candidates: Annotated[int, typer.Option(
-        min=1, help="Sample-efficiency study: increments the oracle tries per step (its "
-                    "best-of-k-seeds control: training seeds per checkpoint).")] =
+        min=ORACLE_MIN_CANDIDATES,
+        help="Sample-efficiency study: increments the oracle tries per step (its "
+             "best-of-k-seeds control: training seeds per checkpoint).")] =
         E.oracle_candidates,
     oracle_step: Annotated[str, typer.Option(
         help=f"Sample-efficiency study: the oracle chooses once per "

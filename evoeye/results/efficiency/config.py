@@ -71,6 +71,7 @@ NO_UPDATE = (*CEILINGS, *DIAGNOSTICS)  # curves without the per-round (update) m
 DEFAULT_PROFILE = "default"  # evoeye.ads.profiles.DEFAULT_PROFILE
 # evoeye.monitor.recipes (importing it loads torch)
 RECIPES, DEFAULT_RECIPE = ("v1", "v2", "v3", "lookahead-v1"), "v3"
+ORACLE_MIN_CANDIDATES = 4  # oracle.py: the error, margin and mixed increments, and a uniform one
 MAX_MEMBERS = 8  # evoeye.monitor.ensemble.MAX_MEMBERS (importing it loads torch)
 # fields added since studies were recorded: left out of `to_dict` at their defaults, so a
 # study that does not use them stores the config it always did
@@ -165,9 +166,13 @@ class EfficiencyConfig:
             raise ValueError(f"every checkpoint must be the initial runs plus whole rounds of "
                              f"{self.n_round}, got {points}")
         for name in ("pool_runs", "test_runs", "val_runs", "oracle_runs", "boundary_pairs",
-                     "boundary_steps", "oracle_candidates", "n_round"):
+                     "boundary_steps", "n_round"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if self.oracle_candidates < ORACLE_MIN_CANDIDATES:  # else the oracle tries more than
+            raise ValueError(  # its controls, which try exactly this many
+                f"oracle_candidates must be >= {ORACLE_MIN_CANDIDATES} (the oracle's three "
+                f"targeted increments and a uniform one), got {self.oracle_candidates}")
         if not 1 <= self.members <= MAX_MEMBERS:
             raise ValueError(f"members must be 1 to {MAX_MEMBERS}, got {self.members}")
         if self.val_collisions < 0:

@@ -75,7 +75,7 @@ def _candidates(ctx: Context, monitor, used: np.ndarray, size: int,
         return rng.choice(left, size=k, replace=False)
 
     half = size // 2
-    out = [("uniform", uniform(size)) for _ in range(max(1, ctx.config.oracle_candidates - 3))]
+    out = [("uniform", uniform(size)) for _ in range(ctx.config.oracle_candidates - 3)]
     out += [("error", by_error[:size]), ("margin", by_margin[:size])]
     mixed = np.concatenate([by_error[: half - half // 2], by_margin[: half // 2]])
     mixed = np.unique(mixed)

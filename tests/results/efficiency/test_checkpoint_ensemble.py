@@ -111,7 +111,7 @@ def test_an_ensemble_curve_is_keyed_apart_and_judged_as_an_ensemble(context, tmp
 def test_the_oracles_candidates_are_ensembles_and_keyed_apart(context, tmp_path,
                                                               monkeypatch) -> None:
     ctx = replace(context, config=replace(context.config, members=2, checkpoints=(10,),
-                                          oracle_candidates=2),
+                                          oracle_candidates=4),
                   learner=_learner(context, 2),
                   ledger=Ledger(DataRoot.resolve(tmp_path / "oracle")))
     built = []
@@ -121,6 +121,6 @@ def test_the_oracles_candidates_are_ensembles_and_keyed_apart(context, tmp_path,
     asked = _keys(ctx, monkeypatch)
     curve = run_oracle(ctx, 0, control=True)  # its control: exactly oracle_candidates
     assert all(isinstance(m, EnsembleMonitor) and len(m.members) == 2 for m in built)
-    assert len(built) == 1 + 2  # G_0, and each candidate of the one step
+    assert len(built) == 1 + 4  # G_0, and each candidate of the one step
     assert asked and all(inputs.get("members") == 2 for _, inputs in asked)
     assert curve["budgets"]["10"]["scratch"] in [ctx.learner.judge(m) for m in built[1:]]

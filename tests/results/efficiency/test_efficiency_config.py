@@ -34,7 +34,7 @@ def test_regimes_name_a_scenario_and_a_profile() -> None:
     ({"members": 9}, "members must be 1 to 8, got 9"),
     ({"val_collisions": -1}, "val_collisions must be >= 0"),
     ({"oracle_step": "run"}, "oracle_step must be one of"),
-    ({"oracle_candidates": 0}, "oracle_candidates must be >= 1"),
+    ({"oracle_candidates": 3}, "oracle_candidates must be >= 4"),
     ({"mode": "generative", "strategies": ("uniform", "qbc")},
      "^qbc is a pool-mode diagnostic .*: drop it or use mode 'pool'$"),
 ])

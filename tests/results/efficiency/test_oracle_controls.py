@@ -58,7 +58,7 @@ def test_the_seeds_control_keeps_its_best_training_seed_on_uniforms_runs(context
 
 
 def test_the_seeds_control_is_a_unit_of_its_own(context, tmp_path) -> None:
-    ctx = _fresh(context, tmp_path, "seeds", checkpoints=(10,), oracle_candidates=2)
+    ctx = _fresh(context, tmp_path, "seeds", checkpoints=(10,), oracle_candidates=4)
     first = run_seeds_control(ctx, 0)
     assert ctx.ledger.computed["efficiency-curve"] == 1
     assert run_seeds_control(ctx, 0) == first and ctx.ledger.found["efficiency-curve"] == 1
@@ -81,7 +81,7 @@ def _keys(ctx, monkeypatch) -> list[dict]:
 
 def test_checkpoint_steps_keep_the_oracles_keys_and_round_steps_are_keyed_apart(
         context, tmp_path, monkeypatch) -> None:
-    ctx = _fresh(context, tmp_path, "steps", checkpoints=(10, 14), oracle_candidates=2)
+    ctx = _fresh(context, tmp_path, "steps", checkpoints=(10, 14), oracle_candidates=4)
     asked = _keys(ctx, monkeypatch)
     by_checkpoint = run_oracle(ctx, 0)
     assert set(asked[-1]) == {"regime", "sets", "strategy", "seed", "initial", "budgets",
