@@ -75,8 +75,6 @@ class Walk:
     previous: list[int] = field(default_factory=list)  # the level before's, complete
     steps: int = 0  # chain steps taken on this level
     accepted: int = 0
-    scale: float = 1.0  # P(F_level): the product of the levels' conditional shares so far
-    previous_scale: float = 1.0  # the level before's
     estimate: float | None = None  # frozen once `final`
 
     @property
@@ -87,6 +85,15 @@ class Walk:
     def per_level(self) -> int:
         """N: samples per level, the seeds included."""
         return self.chains * (self.steps_per_level + 1)
+
+    def reach(self, level: int) -> float:
+        """P(F_level) as the estimator takes it: p0 per level (by construction; counting the
+        ties a chain that stayed put adds at a threshold overestimated P by a third on the
+        synthetic outcome of the tests)."""
+        out = 1.0
+        for _ in range(level):
+            out *= self.p0
+        return out
 
     @classmethod
     def replay(cls, fitness: np.ndarray, collided: np.ndarray, chains: int, p0: float) -> Walk:
@@ -119,7 +126,6 @@ class Walk:
         """The next level from the current one's samples (complete): its seeds and threshold,
         or, once c of them collided, the walk inside F; σ from this level's acceptance."""
         rows = np.array(self.samples, dtype=np.int64)
-        self.previous_scale = self.scale
         if self.steps:
             rate = self.accepted / (self.chains * self.steps)
             self.sigma = float(np.clip(self.sigma * math.exp(rate - TARGET_ACCEPT), SIGMA_MIN,
@@ -127,7 +133,7 @@ class Walk:
         if not self.final:
             hits = collided[rows]
             if np.count_nonzero(hits) >= self.chains:
-                self.estimate = self.scale * float(hits.mean())
+                self.estimate = self.reach(self.level) * float(hits.mean())
                 self.final = True
                 self.states = [int(r) for r in rows[hits][: self.chains]]
             else:
@@ -135,9 +141,6 @@ class Walk:
                 order = np.lexsort((np.arange(len(rows)), f))[: self.chains]
                 self.states = [int(r) for r in rows[order]]
                 self.threshold = float(f[order].max())
-                self.scale *= self.p0  # by construction (the standard estimator: counting
-                # the ties a chain that stayed put adds at the threshold overestimated P by a
-                # third on the synthetic outcome of the tests)
         self.level += 1
         self.previous, self.samples = self.samples, list(self.states)
         self.steps = self.accepted = 0
@@ -146,10 +149,10 @@ class Walk:
         """P(F) from the runs replayed (module doc)."""
         if self.estimate is not None:
             return self.estimate
-        scale, rows = self.scale, self.samples
-        if self.level > 0 and not self.steps:  # a level of seeds only: the one before is
-            scale, rows = self.previous_scale, self.previous  # complete
-        return scale * float(collided[np.array(rows, dtype=np.int64)].mean())
+        level, rows = self.level, self.samples
+        if level > 0 and not self.steps:  # a level of seeds only: the one before is complete
+            level, rows = level - 1, self.previous
+        return self.reach(level) * float(collided[np.array(rows, dtype=np.int64)].mean())
 
 
 def subset_estimate(fitness: np.ndarray, collided: np.ndarray, chains: int,
