@@ -27,11 +27,12 @@ from evoeye.results.efficiency.config import (
     UPDATES,
     EfficiencyConfig,
 )
-from evoeye.results.rare.config import USABLE, RareConfig
+from evoeye.results.rare.config import USABLE, LearnConfig, RareConfig
 
 D = ResultsConfig()  # the defaults --help shows (config.py imports nothing heavy)
 E = EfficiencyConfig()
 R = RareConfig()
+L = LearnConfig()
 
 
 def _csv(text: str) -> tuple[str, ...]:
@@ -198,6 +199,16 @@ def results_command(
         help="Rare-failure protocol: attribute every collision found to a module by "
              "`evoeye explain`'s counterfactuals (4 more simulations per collision).")] =
         R.explain,
+    rare_learn: Annotated[bool, typer.Option(
+        help="Rare-failure protocol: also train a monitor from scratch on each curve's first "
+             f"{', '.join(map(str, L.budgets))} runs (importance-weighted by their p/q) and "
+             "judge it on a uniform Test Set of its own (the learning side).")] = False,
+    rare_test_runs: Annotated[int, typer.Option(
+        min=1, help="Rare-failure protocol, learning side: uniform Test Set runs per regime "
+                    "(enough to hold ≥ 50 failures).")] = L.test_runs,
+    rare_members: Annotated[int, typer.Option(
+        min=1, max=8, help="Rare-failure protocol, learning side: from-scratch members of "
+                           "each monitor.")] = L.members,
     recipe: Annotated[str, typer.Option(
         help=f"Training recipe of every monitor trained from scratch, one of "
              f"{', '.join(RECIPES)} (campaign updates keep theirs).")] = D.recipe,
@@ -251,7 +262,9 @@ def results_command(
                 regimes=tuple(rare_regime or R.regimes),
                 strategies=with_reference(rare_strategy, R.strategies),
                 seeds=tuple(range(first_rare_seed, first_rare_seed + rare_seeds)),
-                runs=rare_runs, batch=rare_batch, explain=rare_explain, **fresh).changed())
+                runs=rare_runs, batch=rare_batch, explain=rare_explain,
+                learn={"test_runs": rare_test_runs, "members": rare_members,
+                       "recipe": recipe} if rare_learn else None, **fresh).changed())
         config.check_names()
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from None

@@ -17,15 +17,17 @@ FREE = ("regimes", "seeds", "strategies")  # what the runs of one protocol may d
 
 
 def merge_runs(runs: list[dict], default: dict, check: Callable[[dict], list[dict]],
-               error: type[ValueError], *, noun: str, label: str = "") -> list[dict]:
+               error: type[ValueError], *, noun: str, label: str = "",
+               free: tuple[str, ...] = ()) -> list[dict]:
     """Runs ({"path", "config", "findings", "regimes"}) as protocols ({"paths", "config",
     "findings"}): a protocol of one run keeps its own findings; a merged one's are
     `check({"regimes": ...})` over every regime, and its config lists each regime's seeds
     (`{regime: seeds}`). `error` names a regime in two runs (`label` + "regime", `noun`: what
-    a protocol is called in the message)."""
+    a protocol is called in the message; `free`: further fields its runs may differ in)."""
     groups: dict[str, list[dict]] = {}
+    free = (*FREE, *free)
     for run in runs:
-        protocol = {k: v for k, v in {**default, **run["config"]}.items() if k not in FREE}
+        protocol = {k: v for k, v in {**default, **run["config"]}.items() if k not in free}
         groups.setdefault(json.dumps(protocol, sort_keys=True), []).append(run)
     out = []
     for group in groups.values():

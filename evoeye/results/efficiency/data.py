@@ -176,21 +176,28 @@ def boundary_ids(data: DataRoot) -> list[str]:
 
 def extend_validation(data: DataRoot, regime: str, config: EfficiencyConfig, *,
                       workers: int = 1, say: Say | None = None) -> list[str]:
-    """Draw the validation batch's stream on until it holds `config.val_collisions` colliding
-    runs (module doc); the ids of the further colliding runs kept, in stream order (none when
-    the batch holds enough), also written to `val-collisions.json`. ValueError, with nothing
-    written, if VAL_MAX_CHUNKS × val_runs further runs do not hold enough."""
+    """`draw_collisions` for the study's validation batch and `config.val_collisions`."""
+    return draw_collisions(data, regime, config.data_seed + SETS.index("val"), config.val_runs,
+                           config.val_collisions, batch_name("val", config), workers=workers,
+                           say=say)
+
+
+def draw_collisions(data: DataRoot, regime: str, seed: int, n: int, want: int, batch: str, *,
+                    workers: int = 1, say: Say | None = None) -> list[str]:
+    """Draw the stream of the uniform batch `batch` (`n` runs of `seed`) on until it holds
+    `want` colliding runs (module doc); the ids of the further colliding runs kept, in stream
+    order (none when the batch holds enough), also written to `val-collisions.json`.
+    ValueError, with nothing written, if VAL_MAX_CHUNKS × n further runs do not hold enough."""
     say = say or (lambda msg: None)
     scenario, profile = parse_regime(regime)
-    seed, n = config.data_seed + SETS.index("val"), config.val_runs
-    base = run_batch(plan_uniform(scenario, n, seed, batch=batch_name("val", config),
-                                  ads=profile), data, workers=workers).collisions
-    need, drawn, kept = config.val_collisions - base, 0, []
+    base = run_batch(plan_uniform(scenario, n, seed, batch=batch, ads=profile), data,
+                     workers=workers).collisions
+    need, drawn, kept = want - base, 0, []
     while len(kept) < need:
         if drawn >= VAL_MAX_CHUNKS * n:
             raise ValueError(f"{regime}: {drawn} further validation runs held {len(kept)} "
                              f"collisions, {need} short of val_collisions = "
-                             f"{config.val_collisions} with the batch's {base}: ask fewer")
+                             f"{want} with the batch's {base}: ask fewer")
         specs = plan_uniform(scenario, n + drawn + n, seed, batch=f"val-more-seed{seed}",
                              ads=profile)[n + drawn:]
         say(f"{regime}: validation stream, runs {n + drawn}–{n + drawn + n - 1} "
@@ -202,7 +209,7 @@ def extend_validation(data: DataRoot, regime: str, config: EfficiencyConfig, *,
     kept = kept[:max(need, 0)]
     with atomic_file(data.path / VAL_FILE) as f:
         f.write(json.dumps({"regime": regime, "val_runs": n, "seed": seed,
-                            "val_collisions": config.val_collisions, "batch_collisions": base,
+                            "val_collisions": want, "batch_collisions": base,
                             "drawn": drawn, "scenario_ids": kept}, indent=1).encode())
     return kept
 
@@ -210,12 +217,18 @@ def extend_validation(data: DataRoot, regime: str, config: EfficiencyConfig, *,
 def val_extra_ids(data: DataRoot, config: EfficiencyConfig) -> list[str]:
     """The further colliding validation runs `extend_validation` kept for this config; [] for
     val_collisions = 0. ValueError if they were kept for another config."""
-    if not config.val_collisions:
+    return kept_collisions(data, config.data_seed + SETS.index("val"), config.val_runs,
+                           config.val_collisions)
+
+
+def kept_collisions(data: DataRoot, seed: int, n: int, want: int) -> list[str]:
+    """The further colliding runs `draw_collisions` kept for a batch of `n` runs of `seed` and
+    `want` collisions; [] for want = 0. ValueError if they were kept for other settings."""
+    if not want:
         return []
     path = data.path / VAL_FILE
     found = json.loads(path.read_bytes()) if path.is_file() else {}
-    asked = {"val_runs": config.val_runs, "seed": config.data_seed + SETS.index("val"),
-             "val_collisions": config.val_collisions}
+    asked = {"val_runs": n, "seed": seed, "val_collisions": want}
     if {k: found.get(k) for k in asked} != asked:
         raise ValueError(f"{path} does not hold the validation runs of {asked}: prepare the "
                          "regime's data again")

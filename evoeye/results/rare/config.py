@@ -13,6 +13,9 @@ Plain data (the command line reads it at start-up). The protocol (`runner.py`):
 * Every collision found is classified (`evoeye.evaluation.mechanism`: the partner's motion) and,
   with `explain`, attributed (`evoeye explain`'s counterfactuals: the module whose oracle
   prevents it); a distinct mechanism is one (class, root cause) pair.
+* With `learn` (`LearnConfig`), the learning side: a monitor trained from scratch on each
+  curve's first n runs (importance-weighted by their p/q), judged on a uniform Test Set of its
+  own seed sized to hold ≥ 50 failures (`learn.py`). 4 000 runs at ≈ 1.4 % hold ≈ 56.
 """
 
 from __future__ import annotations
@@ -20,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
 
-from evoeye.results.efficiency.config import parse_regime
+from evoeye.results.efficiency.config import MAX_MEMBERS, RECIPES, parse_regime
 
 REFERENCE = "uniform"
 STRATEGIES = (REFERENCE, "ce-is")
@@ -30,6 +33,56 @@ USABLE = (REFERENCE, "ce-is", "subset", "sobol", "avfuzzer")
 # 1; ce-is), or, for subset simulation, from its levels (`evoeye.evolve.search.subset`)
 ESTIMATING = (REFERENCE, "ce-is", "subset")
 REGIMES = ("highway-cut-in:cautious", "highway-cut-in:defensive")
+
+
+@dataclass(frozen=True)
+class LearnConfig:
+    """What the learning side trains and judges on (`learn.py`; module doc)."""
+
+    budgets: tuple[int, ...] = (50, 100, 200)  # a curve's first n runs, log-spaced
+    test_runs: int = 4000  # ≈ 56 collisions at the ≈ 1.4 % regime
+    val_runs: int = 200
+    val_collisions: int = 20
+    members: int = 1  # 3 did not narrow Uniform's spread at 80 runs (efficiency.md), at 3×
+    recipe: str = "v3"
+    horizon_s: float = 3.0
+    context_len: int = 5
+    min_test_failures: int = 50  # a Test Set with fewer cannot judge the regime (issue 38)
+
+    def __post_init__(self) -> None:
+        object.__setattr__(self, "budgets", tuple(self.budgets))
+        b = self.budgets
+        if len(b) < 2 or list(b) != sorted(set(b)) or b[0] < 1:
+            raise ValueError(f"budgets must be at least two increasing run counts, got {b}")
+        for name in ("test_runs", "val_runs", "context_len", "min_test_failures"):
+            if getattr(self, name) < 1:
+                raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if self.val_collisions < 0:
+            raise ValueError(f"val_collisions must be >= 0, got {self.val_collisions}")
+        if not 1 <= self.members <= MAX_MEMBERS:
+            raise ValueError(f"members must be 1 to {MAX_MEMBERS}, got {self.members}")
+        if self.recipe not in RECIPES:
+            raise ValueError(f"unknown training recipe {self.recipe!r}; known: {list(RECIPES)}")
+        if not self.horizon_s > 0:
+            raise ValueError(f"horizon_s must be > 0, got {self.horizon_s}")
+
+    def check_runs(self, runs: int) -> None:
+        """ValueError if a budget exceeds the curves' `runs`."""
+        if self.budgets[-1] > runs:
+            raise ValueError(f"the largest budget ({self.budgets[-1]}) exceeds the runs a "
+                             f"curve holds ({runs})")
+
+    def to_dict(self) -> dict:
+        return {f.name: list(v) if isinstance(v, tuple) else v
+                for f in fields(self) if (v := getattr(self, f.name)) is not None}
+
+    @classmethod
+    def from_dict(cls, data: Mapping) -> LearnConfig:
+        if not isinstance(data, Mapping):
+            raise ValueError(f"the learning config must be a mapping, got {data!r}")
+        if unknown := sorted(set(data) - {f.name for f in fields(cls)}):
+            raise ValueError(f"unknown learning config key(s) {unknown}")
+        return cls(**data)
 
 
 @dataclass(frozen=True)
@@ -46,6 +99,10 @@ class RareConfig:
     # ce-is's elite share and screening z, chosen on screening seeds of data_seed 9_000
     ce_rho: float = 0.2
     ce_screen_z: float = 2.0
+    # the learning side (`learn.py`): its LearnConfig as a mapping (stored whole, defaults
+    # filled in), or None where it is not run (every recorded protocol); its curves are the
+    # ones above
+    learn: Mapping | None = None
 
     def __post_init__(self) -> None:
         for name in ("regimes", "strategies", "seeds"):
@@ -69,6 +126,15 @@ class RareConfig:
                              f"{self.ce_rho}, {self.ce_screen_z}")
         if self.data_seed < 0:
             raise ValueError(f"data_seed must be >= 0, got {self.data_seed}")
+        if self.learn is not None:
+            learning = LearnConfig.from_dict(self.learn)
+            learning.check_runs(self.runs)
+            object.__setattr__(self, "learn", learning.to_dict())
+
+    @property
+    def learning(self) -> LearnConfig | None:
+        """The learning side's config, or None where it is not run."""
+        return None if self.learn is None else LearnConfig.from_dict(self.learn)
 
     def check_names(self) -> None:
         """ValueError naming a scenario or ADS profile no registry knows (loads them)."""
@@ -101,7 +167,7 @@ class RareConfig:
     def changed(self) -> dict:
         """The fields that differ from the defaults, as JSON values."""
         default = RareConfig()
-        return {k: v for k, v in self.to_dict().items() if v != default.to_dict()[k]}
+        return {k: v for k, v in self.to_dict().items() if v != default.to_dict().get(k)}
 
     @classmethod
     def from_dict(cls, data: Mapping) -> RareConfig:

@@ -16,6 +16,14 @@ paired per-seed cell it rests on (`compare_paired`'s fields: n, mean_diff, ci_lo
   the bias CI excludes 0 or the ratio's upper end lies below 3; otherwise not shown (so where
   Uniform saw no failure: its pooled 0 has no variance to judge a bias by). Cell: the paired
   difference of the seeds' absolute relative errors (Uniform's − the strategy's).
+* **rare-learn** — with the learning side (`learn.py`): the monitor trained on the strategy's
+  runs (importance-weighted by their p/q) beats Uniform's on the area under the Test AUPRC
+  curve. It **reproduces** when the paired difference of the areas has a 95 % CI above 0 and
+  p ≤ 0.05 (`evoeye.results.findings.check_verdict`), **does not reproduce** when it is
+  reversed; otherwise it is not shown, with the minimum detectable effect the seeds had (80 %
+  power): a null at an MDE ≤ NULL_MDE points is the issue's stated null, a larger one is not.
+  A regime whose Test Set holds fewer than its `min_test_failures` collisions is not shown
+  (too few failures to judge a monitor by). Cell: the paired difference of the areas.
 
 A claim reproduces when one strategy reproduces in every regime run; does not reproduce when
 every check goes against it; is partly shown when some check reproduces; not shown otherwise,
@@ -23,21 +31,31 @@ or when a strategy it is about ran but no check could be made (e.g. no failure s
 estimate); not run yet when none ran.
 
 A protocol too big for one session runs regime by regime: runs whose config agrees but for
-regimes, seeds and strategies are one protocol, and `merge_rare` checks its claims over all
-their regimes; a regime in two runs of one protocol is refused by name.
+regimes, seeds, strategies and the learning side's settings are one protocol (each regime's
+learning figures carry their own config), and `merge_rare` checks its claims over all their
+regimes; a regime in two runs of one protocol is refused by name.
 """
 
 from __future__ import annotations
 
 import math
 
-from evoeye.results.findings import AGAINST, NOT_RUN, NOT_SHOWN, PARTLY, REPRODUCES
+from evoeye.results.findings import (
+    AGAINST,
+    NOT_RUN,
+    NOT_SHOWN,
+    PARTLY,
+    REPRODUCES,
+    REVERSED,
+    check_verdict,
+)
 from evoeye.results.merge import merge_runs
 from evoeye.results.rare.config import ESTIMATING, REFERENCE, RareConfig
 
 RARE_BELOW = 0.003  # a regime whose reference failure rate is below this is the ≈ 0.1 % one
 FOUND_TARGETS = (10.0, 3.0)  # × Uniform's failures per run: below RARE_BELOW, else
 ERROR_TARGET = 3.0  # × smaller relative error at equal budget
+NULL_MDE = 2.0  # AUPRC points: a null on the learning side is stated at an MDE at most this
 
 
 class RareMergeError(ValueError):
@@ -112,6 +130,28 @@ def estimate_checks(regimes: dict[str, dict]) -> list[dict]:
     return out
 
 
+def learn_checks(regimes: dict[str, dict]) -> list[dict]:
+    """One check per regime with a learning side and strategy beside Uniform (module doc)."""
+    out = []
+    for regime, summary in regimes.items():
+        if not (learning := summary.get("learning")):
+            continue
+        failures = learning["sets"]["test"]["failures"]
+        enough = failures >= learning["config"]["min_test_failures"]
+        for name, row in learning["strategies"].items():
+            if "vs_reference" not in row:
+                continue
+            vs = row["vs_reference"]
+            verdict = check_verdict(vs["area"], "better") if enough else NOT_SHOWN
+            mde = vs["detectable"]["mde"]
+            out.append({"regime": regime, "strategy": name, "metric": "area under Test AUPRC",
+                        "cell": vs["area"], "mde": mde, "test_failures": failures,
+                        "null_at_mde": bool(enough and verdict == NOT_SHOWN and mde is not None
+                                            and mde <= NULL_MDE),
+                        "verdict": AGAINST if verdict == REVERSED else verdict})
+    return out
+
+
 def _claim(id_: str, claim: str, checks: list[dict], regimes: int, ran: bool) -> dict:
     """A claim over the regimes (module doc; `ran`: a strategy it is about has curves)."""
     if not checks:
@@ -138,6 +178,10 @@ def rare_findings(results: dict) -> list[dict]:
         _claim("rare-estimate", "Its failure-rate estimate is unbiased and has ≥ 3× smaller "
                "relative error at equal budget", estimate_checks(regimes), len(regimes),
                bool(ran & set(ESTIMATING))),
+        _claim("rare-learn", "The importance-weighted monitor trained on its runs beats "
+               "Uniform's on the area under the Test AUPRC curve", learn_checks(regimes),
+               sum(bool(s.get("learning")) for s in regimes.values()),
+               any(s.get("learning") for s in regimes.values())),
     ]
 
 
@@ -173,4 +217,4 @@ def merge_rare(runs: list[dict]) -> list[dict]:
     file) as protocols ({"paths", "config", "findings"}): runs of one protocol merged, their
     claims checked over every regime (module doc, `evoeye.results.merge`)."""
     return merge_runs(runs, RareConfig().to_dict(), rare_findings, RareMergeError,
-                      noun="protocol", label="rare-failure ")
+                      noun="protocol", label="rare-failure ", free=("learn",))

@@ -5,6 +5,10 @@ Every curve is a ledger unit (`RareConfig.unit` and the software version): a kil
 protocol resumes with the curves it had not finished, and a re-run computes nothing. Curves run
 seed-major in worker processes, so a protocol stopped early has whole seeds. A curve that raises
 is named with its error and left out; the others go on, and a re-run retries it alone.
+
+With the learning side (`RareConfig.learn`), each regime's recorded curves are then learned
+from (`learn.py`; each learned curve a ledger unit too) and the regime's summary gains
+`learning` (`learn.summarise_learning`, with the sets' sizes and the config).
 """
 
 from __future__ import annotations
@@ -71,9 +75,19 @@ def run_rare(root: DataRoot, config: RareConfig, *, workers: int = 1,
                                  initargs=(os.getpid(),)) as pool:
             for done in pool.map(_unit, todo):
                 keep(*done)
+    regimes = {r: summarise(curves[r], config) for r in config.regimes}
+    if (learning := config.learning) is not None:
+        from evoeye.results.rare.learn import learn_regime, summarise_learning  # loads torch
+
+        for regime in config.regimes:
+            learned = learn_regime(root, regime, curves[regime], learning, config,
+                                   workers=workers, say=say)
+            failed += [{**f, "regime": regime, "strategy": f"{f['strategy']} (learning)"}
+                       for f in learned["failed"]]
+            regimes[regime]["learning"] = {**summarise_learning(learned),
+                                           "sets": learned["sets"], "config": learned["config"]}
     return {"config": config.to_dict(), "software_version": __version__,
-            "regimes": {r: summarise(curves[r], config) for r in config.regimes},
-            "failed": failed, "computed": computed}
+            "regimes": regimes, "failed": failed, "computed": computed}
 
 
 def rare_results(root: DataRoot, config: RareConfig, *, workers: int = 1,

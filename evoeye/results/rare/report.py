@@ -16,7 +16,7 @@ from evoeye.results.efficiency.config import parse_regime
 from evoeye.results.findings import ALPHA
 from evoeye.results.markdown import DASH, FLOOR_MARK, FLOOR_NOTE, MINUS, md_table, p_text
 from evoeye.results.rare.config import REFERENCE
-from evoeye.results.rare.findings import advice
+from evoeye.results.rare.findings import NULL_MDE, advice
 
 HEADING = "### Does testing find and measure rare failures faster than Uniform?"
 OPEN = "∞"  # an interval end no resample bounds (module doc of summary.py: `_boot`)
@@ -165,6 +165,40 @@ def mechanism_lines(distinct: dict[str, dict]) -> list[str]:
     return out
 
 
+def learning_lines(learning: dict) -> list[str]:
+    """The learning side of a regime (`learn.summarise_learning`): the sets, then per strategy
+    the Test AUPRC at each budget, the area and its paired difference from Uniform's."""
+    cfg, sets, budgets = learning["config"], learning["sets"], learning["budgets"]
+    test, val = sets["test"], sets["val"]
+    few = test["failures"] < cfg["min_test_failures"]
+    lines = [f"Each curve's first {', '.join(map(str, budgets))} runs train a monitor from "
+             f"scratch (recipe {cfg['recipe']}, {cfg['members']} member(s); every run "
+             "weighted by its p/q: exact for ce-is, 1 for Uniform; subset simulation's runs "
+             "carry none and train unweighted); a budget whose runs hold no collision to learn "
+             "from scores every frame alike (the no-skill AUPRC, the Test Set's unsafe share). "
+             f"Test Set: {test['runs']} uniform runs of their own seed, **{test['failures']} "
+             f"collided** ({test['unsafe']} unsafe of {test['windows']} windows)"
+             + (f", fewer than the {cfg['min_test_failures']} a check needs: not shown" if few
+                else "")
+             + f"; validation: {val['runs']} runs, {val['failures']} of them colliding. Test "
+             "Set AUPRC in points; the area is the mean height over log2(budget); MDE: the "
+             "paired difference the seeds detect with 80 % power.", ""]
+    rows = []
+    for name, row in learning["strategies"].items():
+        vs = row.get("vs_reference")
+        rows.append([_label(name), str(row["seeds"]),
+                     " / ".join(num(c, 1) for c in row["collisions"]),
+                     " / ".join(f"{100 * x:.0f} %" for x in row["no_skill"]),
+                     " / ".join(num(a["mean"], 1) for a in row["auprc"]),
+                     interval(row["area"]["mean"], row["area"]["low"], row["area"]["high"]),
+                     paired(vs["area"]) if vs else DASH,
+                     num(vs["detectable"]["mde"]) if vs else DASH])
+    header = ["strategy", "seeds", "collisions trained on", "no-skill share",
+              "Test AUPRC at " + " / ".join(map(str, budgets)), "area [95 % CI]",
+              "area − Uniform's [95 % CI] p", "MDE"]
+    return lines + md_table(header, rows, numbers=False) + [""]
+
+
 def regime_markdown(regime: str, summary: dict, runs: int,
                     failed: list[dict] = ()) -> str:
     """One regime's section: failures found, the failure rate, distinct mechanisms."""
@@ -183,6 +217,9 @@ def regime_markdown(regime: str, summary: dict, runs: int,
         lines += ["### Distinct failure mechanisms", "", *distinct_table(summary["distinct"]),
                   "", "Mechanisms (class / root cause) and their collisions:", "",
                   *mechanism_lines(summary["distinct"]), ""]
+    if summary.get("learning"):
+        lines += ["### What a monitor learns from these runs", "",
+                  *learning_lines(summary["learning"])]
     if failed:
         lines += ["### Curves that failed", "", "Left out of every table above; a re-run of the "
                   "same command retries them alone.", "",
@@ -222,6 +259,12 @@ def _estimate_rows(checks: list[dict]) -> list[list[str]]:
              paired(c["cell"]), c["verdict"]] for c in checks]
 
 
+def _learn_rows(checks: list[dict]) -> list[list[str]]:
+    return [[c["regime"], c["strategy"], str(c["test_failures"]), paired(c["cell"]),
+             num(c["mde"]), c["verdict"] + (f" (a null at MDE ≤ {NULL_MDE:g})"
+                                            if c["null_at_mde"] else "")] for c in checks]
+
+
 CHECK_TABLES = {
     "rare-found": (["regime", "strategy", "reference P", "target", "× Uniform [95 % CI]",
                     "Δ per 100 runs [95 % CI] p", "verdict"], _found_rows),
@@ -229,6 +272,8 @@ CHECK_TABLES = {
                        "Uniform's error / its [95 % CI]",
                        "absolute error Δ per seed [95 % CI] p",
                        "verdict"], _estimate_rows),
+    "rare-learn": (["regime", "strategy", "Test Set failures",
+                    "area − Uniform's, points [95 % CI] p", "MDE", "verdict"], _learn_rows),
 }
 
 

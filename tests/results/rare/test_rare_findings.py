@@ -73,7 +73,7 @@ def test_checks_carry_their_paired_cell_target_and_verdict(two_regimes):
 
 def test_a_claim_reproduces_when_one_strategy_does_in_every_regime():
     part = rare_part({RARE: "rare", COMMON: "rare"})
-    assert [f["verdict"] for f in part["findings"]] == [REPRODUCES, REPRODUCES]
+    assert [f["verdict"] for f in part["findings"]] == [REPRODUCES, REPRODUCES, NOT_RUN]
     flat = rare_part({COMMON: "common"}, strategies=("uniform", "sobol"))
     f = _by_id(flat["findings"])
     assert f["rare-found"]["verdict"] == AGAINST  # every check against
@@ -101,7 +101,7 @@ def test_runs_of_one_protocol_are_checked_over_all_their_regimes():
     (merged,) = merge_rare([a, b])
     assert merged["paths"] == ["a.json", "b.json"]
     assert merged["config"]["seeds"] == {RARE: list(range(20)), COMMON: list(range(20))}
-    assert [f["verdict"] for f in merged["findings"]] == [REPRODUCES, REPRODUCES]
+    assert [f["verdict"] for f in merged["findings"]] == [REPRODUCES, REPRODUCES, NOT_RUN]
     other = _run("c.json", {RARE: "rare"}, runs=400)  # another protocol
     assert [m["paths"] for m in merge_rare([a, b, other])] == [["a.json", "b.json"],
                                                                ["c.json"]]

@@ -73,7 +73,7 @@ def test_the_part_writes_its_files_names_a_failed_curve_and_resumes(tmp_path,
                                          "batch": 2, "explain": False}
     assert rare["failed"] == [] and "computed" not in rare
     assert rare["regimes"][RARE]["found"]["ce-is"]["runs"] == 4
-    assert [f["id"] for f in rare["findings"]] == ["rare-found", "rare-estimate"]
+    assert [f["id"] for f in rare["findings"]] == ["rare-found", "rare-estimate", "rare-learn"]
     assert rare["findings"][0]["checks"][0]["cell"]["n"] == 2
     text = (folder / "rare.md").read_text()
     assert "## highway-cut-in, cautious ADS" in text and "### Failures found" in text
@@ -96,7 +96,8 @@ def test_findings_carries_the_claims_merged_over_the_protocols_runs(tmp_path) ->
     combined = combine([a, b])
     (protocol,) = combined["rare"]
     assert protocol["paths"] == [str(a), str(b)]
-    assert [f["verdict"] for f in protocol["findings"]] == ["reproduces", "reproduces"]
+    assert [f["verdict"] for f in protocol["findings"]] == ["reproduces", "reproduces",
+                                                            "not run yet"]
     checks = protocol["findings"][0]["checks"]
     assert {c["regime"] for c in checks} == {RARE, COMMON}
     assert all({"regime", "strategy", "metric", "cell", "verdict"} <= c.keys() for c in checks)
