@@ -119,7 +119,7 @@ def run_results(root: DataRoot, config: ResultsConfig,
         rare, now = rare_results(root, c, workers=config.workers, say=progress)
         computed[KIND] += now
         found[KIND] += len(c.regimes) * len(c.seeds) * len(c.strategies) - now - len(
-            rare["failed"])
+            [f for f in rare["failed"] if not f.get("learning")])
     return ResultsRun(assemble(study, scenarios, efficiency, rare), dict(found),
                       dict(computed))
 

@@ -34,7 +34,9 @@ INTRO = (
     "{seeds}, paired across strategies. *Area*: the curve's mean height on a log-budget axis. "
     "*Uniform's budget ×*: the budget Uniform's mean curve needs to reach the strategy's final "
     "mean, over the strategy's budget (≥ 1.5: Uniform needs 1.5× the runs; censored \">\" "
-    "past Uniform's last point), with its bootstrap 95 % CI. The oracle picks by true benefit "
+    "past Uniform's last point), with its bootstrap 95 % CI.")
+ORACLE_WORDS = (
+    " The oracle picks by true benefit "
     "(outcomes and errors it could not know), greedily among a few increments per step: a "
     "lower bound on what choosing runs can gain, not a ceiling. Its "
     "control chooses the same way among uniform draws only: what a best-of-k choice gains "
@@ -207,9 +209,9 @@ def efficiency_markdown(efficiency: dict) -> str:
                          mode=MODE_WORDS[cfg["mode"]],
                          budgets=", ".join(map(str, cfg["checkpoints"])),
                          seeds=f"{cfg['seeds'][0]}–{cfg['seeds'][-1]}")
-    intro += learner_words(cfg)
     shown = {n for r in efficiency["regimes"].values()
              for n in r["summaries"]["test/scratch"]["strategies"]}
+    intro += (ORACLE_WORDS if ORACLE in shown else "") + learner_words(cfg)
     intro += curve_words(cfg, shown)
     body = [regime_markdown(r, result) for r, result in efficiency["regimes"].items()]
     return "\n".join(["# Sample efficiency: does choosing runs teach the monitor faster?", "",
@@ -235,7 +237,7 @@ def learner_words(cfg: dict) -> str:
 
 def curve_words(cfg: dict, shown: set[str]) -> str:
     """What the curves beyond the strategies' are, where a study has them (nothing for a study
-    without them: its pages read as they did)."""
+    without them, e.g. run with --no-oracle)."""
     out = ""
     if cfg.get("oracle_step", "checkpoint") == "round" and ORACLE in shown:
         out += (f" The oracle chooses an increment every round of {cfg['n_round']} runs, each "

@@ -82,8 +82,8 @@ def run_rare(root: DataRoot, config: RareConfig, *, workers: int = 1,
         for regime in config.regimes:
             learned = learn_regime(root, regime, curves[regime], learning, config,
                                    workers=workers, say=say)
-            failed += [{**f, "regime": regime, "strategy": f"{f['strategy']} (learning)"}
-                       for f in learned["failed"]]
+            failed += [{**f, "regime": regime, "strategy": f"{f['strategy']} (learning)",
+                        "learning": True} for f in learned["failed"]]
             regimes[regime]["learning"] = {**summarise_learning(learned),
                                            "sets": learned["sets"], "config": learned["config"]}
     return {"config": config.to_dict(), "software_version": __version__,

@@ -8,7 +8,7 @@ from dataclasses import replace
 from evoeye.results.config import ResultsConfig
 from evoeye.results.efficiency import runner
 from evoeye.results.efficiency.part import failed_units, regime_results, run_efficiency
-from evoeye.results.efficiency.report import regime_markdown
+from evoeye.results.efficiency.report import efficiency_markdown, regime_markdown
 from evoeye.results.efficiency.restate import main as restate_main
 from evoeye.results.efficiency.restate import restate
 from evoeye.results.ledger import Ledger
@@ -65,6 +65,7 @@ def test_the_study_runs_in_workers_resumes_and_writes_its_files(tiny_regime, tin
     assert "qbc (pool-mode diagnostic)" in text and "(oracle-seeds) chooses no runs" in text
     assert "### Failures found" in text and "Minimum detectable effect" in text
     assert "oracle-seeds's runs are Uniform's" in text
+    assert "The oracle picks by true benefit" in text
     assert regime["found"]["14"]["boundary"]["runs"] == 2 * (14 - 6)  # two seeds, initial apart
     assert "Does acquisition earn its budget?" in (folder / "findings.md").read_text()
     assert (folder / "results.html").read_text().count("<svg") == 3  # one chart per summary
@@ -98,6 +99,7 @@ def test_a_curve_that_fails_is_named_left_out_and_retried_alone(tiny_regime, tin
     ledger = Ledger(root)
     again = run_efficiency(root, config, workers=1, ledger=ledger)
     assert again["regimes"][config.regimes[0]]["failed"] == [] and not failed_units(again)
+    assert "oracle" not in efficiency_markdown(again).split("\n## ")[0]  # --no-oracle: no word
     assert ledger.computed["efficiency-curve"] == 1 and ledger.found["efficiency-curve"] == 1
 
 
