@@ -78,6 +78,16 @@ MAX_MEMBERS = 8  # evoeye.monitor.ensemble.MAX_MEMBERS (importing it loads torch
 LATER_FIELDS = ("members", "val_collisions", "oracle_step")
 
 
+def dataclass_from(cls, data: Mapping, noun: str):
+    """`cls(**data)` for a frozen config dataclass, with a ValueError naming the config (`noun`)
+    when `data` is not a mapping or holds a key no field has."""
+    if not isinstance(data, Mapping):
+        raise ValueError(f"the {noun} config must be a mapping, got {data!r}")
+    if unknown := sorted(set(data) - {f.name for f in fields(cls)}):
+        raise ValueError(f"unknown {noun} config key(s) {unknown}")
+    return cls(**data)
+
+
 def parse_regime(regime: str) -> tuple[str, str]:
     """"scenario" or "scenario:profile" → (scenario, profile)."""
     scenario, _, profile = regime.partition(":")
@@ -223,8 +233,4 @@ class EfficiencyConfig:
 
     @classmethod
     def from_dict(cls, data: Mapping) -> EfficiencyConfig:
-        if not isinstance(data, Mapping):
-            raise ValueError(f"the efficiency config must be a mapping, got {data!r}")
-        if unknown := sorted(set(data) - {f.name for f in fields(cls)}):
-            raise ValueError(f"unknown efficiency config key(s) {unknown}")
-        return cls(**data)
+        return dataclass_from(cls, data, "efficiency")

@@ -23,7 +23,7 @@ from __future__ import annotations
 from collections.abc import Mapping
 from dataclasses import dataclass, fields
 
-from evoeye.results.efficiency.config import MAX_MEMBERS, RECIPES, parse_regime
+from evoeye.results.efficiency.config import MAX_MEMBERS, RECIPES, dataclass_from, parse_regime
 
 REFERENCE = "uniform"
 STRATEGIES = (REFERENCE, "ce-is")
@@ -78,11 +78,7 @@ class LearnConfig:
 
     @classmethod
     def from_dict(cls, data: Mapping) -> LearnConfig:
-        if not isinstance(data, Mapping):
-            raise ValueError(f"the learning config must be a mapping, got {data!r}")
-        if unknown := sorted(set(data) - {f.name for f in fields(cls)}):
-            raise ValueError(f"unknown learning config key(s) {unknown}")
-        return cls(**data)
+        return dataclass_from(cls, data, "learning")
 
 
 @dataclass(frozen=True)
@@ -171,8 +167,4 @@ class RareConfig:
 
     @classmethod
     def from_dict(cls, data: Mapping) -> RareConfig:
-        if not isinstance(data, Mapping):
-            raise ValueError(f"the rare-failure config must be a mapping, got {data!r}")
-        if unknown := sorted(set(data) - {f.name for f in fields(cls)}):
-            raise ValueError(f"unknown rare-failure config key(s) {unknown}")
-        return cls(**data)
+        return dataclass_from(cls, data, "rare-failure")

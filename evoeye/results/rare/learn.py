@@ -91,7 +91,6 @@ def set_batch(name: str, data_seed: int) -> tuple[str, int]:
 def prepare_sets(root: DataRoot, regime: str, learn: LearnConfig, data_seed: int, *,
                  workers: int = 1, say: Say | None = None) -> DataRoot:
     """Simulate (or resume) and ingest a regime's Test and validation sets; their data root."""
-
     say = say or (lambda msg: None)
     scenario, profile = parse_regime(regime)
     data = learn_root(root, regime)
@@ -112,7 +111,6 @@ def prepare_sets(root: DataRoot, regime: str, learn: LearnConfig, data_seed: int
 def load_sets(data: DataRoot, learn: LearnConfig, data_seed: int) -> dict[str, Windows]:
     """{"test", "val"} windows of a regime's sets (validation with its further collisions'
     unsafe windows)."""
-
     def windows(runs):
         return load_windows(data, runs, context_len=learn.context_len, horizon_s=learn.horizon_s)
 
@@ -159,7 +157,6 @@ def curve_windows(regime: str, curve: dict, seed_of: Callable[[int], int], n: in
                   learn: LearnConfig) -> tuple[list, list[str]]:
     """(windows per run, run ids) of a curve's first n runs, simulated again in memory from
     their recorded θ and run seed; RuntimeError where a run's outcome differs from its record."""
-
     scenario, profile = parse_regime(regime)
     out, ids = [], []
     for k in range(n):
@@ -180,7 +177,6 @@ def curve_windows(regime: str, curve: dict, seed_of: Callable[[int], int], n: in
 def learnable(train: Windows | None, params) -> bool:
     """Whether a monitor can learn from these windows: both classes among those its recipe
     trains on (`training_windows`)."""
-
     if train is None or not len(train):
         return False
     kept = training_windows(train, params.min_lead_s, params.near_misses).label
@@ -189,7 +185,6 @@ def learnable(train: Windows | None, params) -> bool:
 
 def no_skill(learner: Learner) -> dict:
     """The judging figures of a monitor that scores every frame alike (module doc)."""
-
     thresholds = calibrate(np.zeros(len(learner.val)), learner.val.label)
     return {name: metrics_dict(np.zeros(len(w)), w.label, thresholds)
             for name, w in learner.judging.items()}
@@ -198,7 +193,6 @@ def no_skill(learner: Learner) -> dict:
 def learn_curve(ctx: _Context, strategy: str, seed: int, curve: dict) -> dict:
     """One curve's figures: per budget the Test Set metrics of its monitor, the collisions it
     trained on, its runs' effective number under their weights, and whether it is no-skill."""
-
     learn = ctx.learn
     runs, ids = curve_windows(ctx.regime, curve, lambda k: ctx.seed_of(strategy, seed, k),
                               learn.budgets[-1], learn)
@@ -295,7 +289,6 @@ def summarise_learning(learned: dict, reference: str = "uniform") -> dict:
     (mean with its t interval), the mean collisions trained on, the no-skill share; beside
     Uniform, the paired difference of the areas (`compare_paired`) and what the seeds could
     detect (`efficiency.power.detectable`)."""
-
     budgets = [int(b) for b in learned["config"]["budgets"]]
     curves = learned["curves"]
     seeds = sorted({int(s) for c in curves.values() for s in c})

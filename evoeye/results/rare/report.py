@@ -192,10 +192,13 @@ def learning_lines(learning: dict) -> list[str]:
                      " / ".join(num(a["mean"], 1) for a in row["auprc"]),
                      interval(row["area"]["mean"], row["area"]["low"], row["area"]["high"]),
                      paired(vs["area"]) if vs else DASH,
-                     num(vs["detectable"]["mde"]) if vs else DASH])
+                     num(vs["detectable"]["mde"]) if vs else DASH,
+                     paired(vs["final"]) if vs else DASH,
+                     " / ".join(num(e, 0) for e in row["effective_runs"])])
     header = ["strategy", "seeds", "collisions trained on", "no-skill share",
               "Test AUPRC at " + " / ".join(map(str, budgets)), "area [95 % CI]",
-              "area − Uniform's [95 % CI] p", "MDE"]
+              "area − Uniform's [95 % CI] p", "MDE", f"at {budgets[-1]} runs − Uniform's",
+              "effective runs (weights)"]
     return lines + md_table(header, rows, numbers=False) + [""]
 
 
