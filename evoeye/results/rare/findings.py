@@ -189,7 +189,9 @@ def advice(findings: list[dict]) -> dict[str, dict[str, str]]:
     """Per regime, which strategy to use to find failures and which to estimate the failure
     rate with, from the claims' checks alone: the strategy whose ratio to Uniform has a CI above
     1 (the largest, to find; the smallest error with a bias CI holding 0, to estimate), else
-    Uniform — a strategy no check showed better is no reason to leave p."""
+    Uniform — a strategy no check showed better is no reason to leave p. Where the learning side
+    ran, also which strategy's runs to train a monitor on ("learn"): the one whose `rare-learn`
+    check reproduces (the largest gain), else Uniform."""
     by_id = {f["id"]: f["checks"] for f in findings}
 
     def finds(c: dict) -> float | None:
@@ -202,12 +204,19 @@ def advice(findings: list[dict]) -> dict[str, dict[str, str]]:
         return ratio["value"] or math.inf if unbiased and ratio["low"] is not None and \
             ratio["low"] > 1 else None
 
-    regimes = {c["regime"]: {} for checks in by_id.values() for c in checks}
+    def learns(c: dict) -> float | None:
+        return c["cell"]["mean_diff"] if c["verdict"] == REPRODUCES else None
+
+    regimes = {c["regime"]: {} for claim in ("rare-found", "rare-estimate")
+               for c in by_id.get(claim, [])}
     for use, claim, score in (("find", "rare-found", finds),
-                              ("estimate", "rare-estimate", estimates)):
+                              ("estimate", "rare-estimate", estimates),
+                              ("learn", "rare-learn", learns)):
         for regime, row in regimes.items():
-            shown = [(v, c["strategy"]) for c in by_id.get(claim, [])
-                     if c["regime"] == regime and (v := score(c)) is not None]
+            checks = [c for c in by_id.get(claim, []) if c["regime"] == regime]
+            if use == "learn" and not checks:
+                continue  # the learning side did not run on this regime
+            shown = [(v, c["strategy"]) for c in checks if (v := score(c)) is not None]
             row[use] = max(shown)[1] if shown else REFERENCE
     return regimes
 

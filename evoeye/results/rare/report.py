@@ -288,7 +288,10 @@ def advice_lines(findings: list[dict]) -> list[str]:
     return ["Which strategy, when (a strategy is named only where its ratio to "
             "Uniform has a 95 % CI above 1, else Uniform):", "",
             *(f"* `{regime}`: to find failures, **{row['find']}**; to estimate how often "
-              f"they happen, **{row['estimate']}**." for regime, row in rows.items()), ""]
+              f"they happen, **{row['estimate']}**"
+              + (f"; to train a monitor on, the runs of **{row['learn']}**"
+                 + (" weighted by their p/q" if row["learn"] != REFERENCE else "")
+                 if "learn" in row else "") + "." for regime, row in rows.items()), ""]
 
 
 def rare_findings_markdown(findings: list[dict]) -> str:

@@ -13,10 +13,10 @@ import pytest
 from evoeye.paths import DataRoot
 from evoeye.results.findings import AGAINST, NOT_RUN, NOT_SHOWN, PARTLY, REPRODUCES
 from evoeye.results.rare.config import LearnConfig, RareConfig
-from evoeye.results.rare.findings import learn_checks, rare_findings
+from evoeye.results.rare.findings import advice, learn_checks, rare_findings
 from evoeye.results.rare.learn import curve_windows, learn_root, load_sets, no_skill
 from evoeye.results.rare.part import rare_results
-from evoeye.results.rare.report import rare_findings_markdown, rare_markdown
+from evoeye.results.rare.report import advice_lines, rare_findings_markdown, rare_markdown
 from evoeye.results.rare.runner import run_seed
 
 REGIME = "highway-cut-in:default"  # collisions are common: a small run learns something
@@ -79,6 +79,22 @@ def test_the_learning_claim_holds_over_the_regimes_that_learned():
     plain = {"found": {}, "estimates": {}, "distinct": {}}
     claim = {f["id"]: f for f in rare_findings({"regimes": {"a": plain}})}["rare-learn"]
     assert claim["verdict"] == NOT_RUN
+
+
+def test_advice_names_the_runs_to_learn_from_only_where_learning_was_shown():
+    found = {"regime": "r", "strategy": "ce-is", "ratio": 2.0, "ratio_low": 1.5,
+             "ratio_high": 3.0, "verdict": NOT_SHOWN}
+    learned = [{"id": "rare-found", "checks": [found, {**found, "regime": "s"}]},
+               {"id": "rare-learn", "checks": learn_checks({
+                   "r": _summary(_cell(3.0, 1.0, 5.0, 0.001), 1.5, 60),
+                   "s": _summary(_cell(0.2, -0.8, 1.2, 0.6), 1.8, 60)})}]
+    rows = advice(learned)
+    assert rows["r"] == {"find": "ce-is", "estimate": "uniform", "learn": "ce-is"}
+    assert rows["s"]["learn"] == "uniform"  # a null: no reason to leave p
+    assert "learn" not in advice([learned[0]])["r"]  # not run: no advice either way
+    text = "\n".join(advice_lines(learned))
+    assert "to train a monitor on, the runs of **ce-is** weighted by their p/q" in text
+    assert "to train a monitor on, the runs of **uniform**." in text
 
 
 @pytest.fixture(scope="module")
