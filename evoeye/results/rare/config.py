@@ -32,6 +32,9 @@ USABLE = (REFERENCE, "ce-is", "subset", "sobol", "avfuzzer")
 # the strategies that estimate the failure rate under p: from their runs' exact p/q (Uniform:
 # 1; ce-is), or, for subset simulation, from its levels (`evoeye.evolve.search.subset`)
 ESTIMATING = (REFERENCE, "ce-is", "subset")
+# the strategies whose runs carry their exact p/q (Uniform: 1): the ones an importance-weighted
+# monitor can be trained on (the learning side trains the others unweighted)
+WEIGHTED = (REFERENCE, "ce-is")
 REGIMES = ("highway-cut-in:cautious", "highway-cut-in:defensive")
 
 

@@ -23,7 +23,9 @@ paired per-seed cell it rests on (`compare_paired`'s fields: n, mean_diff, ci_lo
   reversed; otherwise it is not shown, with the minimum detectable effect the seeds had (80 %
   power): a null at an MDE ≤ NULL_MDE points is the issue's stated null, a larger one is not.
   A regime whose Test Set holds fewer than its `min_test_failures` collisions is not shown
-  (too few failures to judge a monitor by). Cell: the paired difference of the areas.
+  (too few failures to judge a monitor by). Cell: the paired difference of the areas. Only
+  strategies whose runs carry their exact p/q (`WEIGHTED`) are checked: the others' monitors
+  train unweighted, and their comparison with Uniform is in rare.md, not in this claim.
 
 A claim reproduces when one strategy reproduces in every regime run; does not reproduce when
 every check goes against it; is partly shown when some check reproduces; not shown otherwise,
@@ -50,7 +52,7 @@ from evoeye.results.findings import (
     check_verdict,
 )
 from evoeye.results.merge import merge_runs
-from evoeye.results.rare.config import ESTIMATING, REFERENCE, RareConfig
+from evoeye.results.rare.config import ESTIMATING, REFERENCE, WEIGHTED, RareConfig
 
 RARE_BELOW = 0.003  # a regime whose reference failure rate is below this is the ≈ 0.1 % one
 FOUND_TARGETS = (10.0, 3.0)  # × Uniform's failures per run: below RARE_BELOW, else
@@ -139,7 +141,7 @@ def learn_checks(regimes: dict[str, dict]) -> list[dict]:
         failures = learning["sets"]["test"]["failures"]
         enough = failures >= learning["config"]["min_test_failures"]
         for name, row in learning["strategies"].items():
-            if "vs_reference" not in row:
+            if "vs_reference" not in row or name not in WEIGHTED:
                 continue
             vs = row["vs_reference"]
             verdict = check_verdict(vs["area"], "better") if enough else NOT_SHOWN

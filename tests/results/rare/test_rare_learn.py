@@ -51,7 +51,8 @@ def _summary(cell: dict, mde: float, failures: int) -> dict:
     return {"found": {}, "estimates": {}, "distinct": {},
             "learning": {"config": LearnConfig().to_dict(),
                          "sets": {"test": {"failures": failures}},
-                         "strategies": {"uniform": {}, "ce-is": {"vs_reference": vs}}}}
+                         "strategies": {"uniform": {}, "ce-is": {"vs_reference": vs},
+                                        "subset": {"vs_reference": vs}}}}
 
 
 @pytest.mark.parametrize("cell, mde, failures, verdict, null", [
@@ -63,7 +64,8 @@ def _summary(cell: dict, mde: float, failures: int) -> dict:
 ])
 def test_a_learning_check_needs_a_gain_and_a_test_set_with_enough_failures(
         cell, mde, failures, verdict, null):
-    (check,) = learn_checks({"r": _summary(cell, mde, failures)})
+    (check,) = learn_checks({"r": _summary(cell, mde, failures)})  # subset's: unweighted
+    assert check["strategy"] == "ce-is"
     assert (check["verdict"], check["null_at_mde"]) == (verdict, null)
     assert check["cell"] is cell and check["test_failures"] == failures
 
