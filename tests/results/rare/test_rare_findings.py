@@ -102,6 +102,8 @@ def test_runs_of_one_protocol_are_checked_over_all_their_regimes():
     assert merged["paths"] == ["a.json", "b.json"]
     assert merged["config"]["seeds"] == {RARE: list(range(20)), COMMON: list(range(20))}
     assert [f["verdict"] for f in merged["findings"]] == [REPRODUCES, REPRODUCES, NOT_RUN]
+    learned = _run("e.json", {COMMON: "rare"}, learn={})  # its learning side: still one protocol
+    assert [m["paths"] for m in merge_rare([a, learned])] == [["a.json", "e.json"]]
     other = _run("c.json", {RARE: "rare"}, runs=400)  # another protocol
     assert [m["paths"] for m in merge_rare([a, b, other])] == [["a.json", "b.json"],
                                                                ["c.json"]]
