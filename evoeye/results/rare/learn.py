@@ -48,6 +48,7 @@ from evoeye import __version__
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.evaluation.stats import compare_paired, mean_ci
 from evoeye.evolve.campaign.assess import metrics_dict
+from evoeye.evolve.search.cross_entropy import effective_size
 from evoeye.lifeline import die_with_parent
 from evoeye.monitor.calibration import calibrate
 from evoeye.monitor.lookahead import training_windows
@@ -149,8 +150,7 @@ class _Context:
     learner: Learner
     set_print: str  # the sets' fingerprint: a learned curve is keyed by it
     ledger: Ledger
-    unit: Callable[[str, int], dict]  # (strategy, seed) → the curve's key (RareConfig.unit)
-    seed_of: Callable[[str, int, int], int]  # (strategy, seed, k) → run k's run seed
+    config: RareConfig  # the protocol's: its curves' keys and run seeds
 
 
 def curve_windows(regime: str, curve: dict, seed_of: Callable[[int], int], n: int,
@@ -194,7 +194,8 @@ def learn_curve(ctx: _Context, strategy: str, seed: int, curve: dict) -> dict:
     """One curve's figures: per budget the Test Set metrics of its monitor, the collisions it
     trained on, its runs' effective number under their weights, and whether it is no-skill."""
     learn = ctx.learn
-    runs, ids = curve_windows(ctx.regime, curve, lambda k: ctx.seed_of(strategy, seed, k),
+    runs, ids = curve_windows(ctx.regime, curve,
+                              lambda k: run_seed(ctx.config, ctx.regime, strategy, seed, k),
                               learn.budgets[-1], learn)
     ratio = curve_weights(curve)[: learn.budgets[-1]]
     out = {}
@@ -203,9 +204,8 @@ def learn_curve(ctx: _Context, strategy: str, seed: int, curve: dict) -> dict:
             have = [w for w in runs[:n] if w is not None and len(w)]
             train = concat_windows(have) if have else None
             w = {ids[k]: float(ratio[k]) for k in range(n)}
-            norm = ratio[:n] / ratio[:n].mean()
             row = {"collisions": int(sum(r["collided"] for r in curve["runs"][:n])),
-                   "effective_runs": float(norm.sum() ** 2 / (norm**2).sum()),
+                   "effective_runs": effective_size(ratio[:n]),
                    "max_weight": float(ratio[:n].max())}
             if learnable(train, ctx.learner.params):
                 monitor = ctx.learner.checkpoint(train, training_seed(seed, n), w)
@@ -220,7 +220,7 @@ def _unit(job: tuple[str, int, dict]) -> tuple[str, int, dict, bool]:
     strategy, seed, curve = job
     ctx = _CONTEXT
     assert ctx is not None, "a worker needs the regime's context"
-    key = {"curve": ctx.unit(strategy, seed), "learn": ctx.learn.to_dict(),
+    key = {"curve": ctx.config.unit(ctx.regime, strategy, seed), "learn": ctx.learn.to_dict(),
            "sets": ctx.set_print, "software_version": __version__}
     before = sum(ctx.ledger.computed.values())
     try:
@@ -231,24 +231,20 @@ def _unit(job: tuple[str, int, dict]) -> tuple[str, int, dict, bool]:
 
 
 def learn_regime(root: DataRoot, regime: str, curves: dict[str, dict[str, dict]],
-                 learn: LearnConfig, config: RareConfig, *, workers: int = 1,
-                 say: Say | None = None) -> dict:
+                 config: RareConfig, *, workers: int = 1, say: Say | None = None) -> dict:
     """The learning side of one regime (module doc): {"config", "sets", "curves": {strategy:
     {seed: learned}}, "failed", "computed"}. `curves`: the regime's recorded curves; `config`:
-    the protocol's RareConfig (their keys and run seeds)."""
+    the protocol's RareConfig, with its learning side (`config.learning`)."""
     global _CONTEXT
-
-
+    learn = config.learning
+    if learn is None:
+        raise ValueError("the protocol's config has no learning side (RareConfig.learn)")
     say = say or (lambda msg: None)
-    learn.check_runs(config.runs)
     data = prepare_sets(root, regime, learn, config.data_seed, workers=workers, say=say)
     sets = load_sets(data, learn, config.data_seed)
     params = replace(recipe_params(learn.recipe), importance_weights=True)
     learner = Learner(sets["val"], {"test": sets["test"]}, params, learn.members)
-    _CONTEXT = _Context(
-        regime, learn, learner, fingerprint(sets), Ledger(root),
-        lambda strategy, seed: config.unit(regime, strategy, seed),
-        lambda strategy, seed, k: run_seed(config, regime, strategy, seed, k))
+    _CONTEXT = _Context(regime, learn, learner, fingerprint(sets), Ledger(root), config)
     jobs = [(strategy, int(seed), curve) for seed in sorted({int(s) for c in curves.values()
                                                              for s in c})
             for strategy, by_seed in curves.items() if (curve := by_seed.get(str(seed)))]
@@ -285,10 +281,10 @@ def learn_regime(root: DataRoot, regime: str, curves: dict[str, dict[str, dict]]
 
 
 def summarise_learning(learned: dict, reference: str = "uniform") -> dict:
-    """Per strategy: the mean Test AUPRC (points) at each budget, the area under the curve
-    (mean with its t interval), the mean collisions trained on, the no-skill share; beside
-    Uniform, the paired difference of the areas (`compare_paired`) and what the seeds could
-    detect (`efficiency.power.detectable`)."""
+    """`learn_regime`'s sets and config, and per strategy: the mean Test AUPRC (points) at
+    each budget, the area under the curve (mean with its t interval), the mean collisions
+    trained on, the no-skill share; beside Uniform, the paired difference of the areas
+    (`compare_paired`) and what the seeds could detect (`efficiency.power.detectable`)."""
     budgets = [int(b) for b in learned["config"]["budgets"]]
     curves = learned["curves"]
     seeds = sorted({int(s) for c in curves.values() for s in c})
@@ -302,7 +298,8 @@ def summarise_learning(learned: dict, reference: str = "uniform") -> dict:
         value = row["test"]["auprc"]
         return np.nan if value is None else 100.0 * value
 
-    out = {"budgets": budgets, "seeds": len(seeds), "strategies": {}}
+    out = {"budgets": budgets, "seeds": len(seeds), "strategies": {},
+           "sets": learned["sets"], "config": learned["config"]}
     areas = {name: area(table(name, auprc), budgets) for name in curves}
     for name in curves:
         values = table(name, auprc)

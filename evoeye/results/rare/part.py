@@ -76,16 +76,15 @@ def run_rare(root: DataRoot, config: RareConfig, *, workers: int = 1,
             for done in pool.map(_unit, todo):
                 keep(*done)
     regimes = {r: summarise(curves[r], config) for r in config.regimes}
-    if (learning := config.learning) is not None:
+    if config.learn is not None:
         from evoeye.results.rare.learn import learn_regime, summarise_learning  # loads torch
 
         for regime in config.regimes:
-            learned = learn_regime(root, regime, curves[regime], learning, config,
-                                   workers=workers, say=say)
+            learned = learn_regime(root, regime, curves[regime], config, workers=workers,
+                                   say=say)
             failed += [{**f, "regime": regime, "strategy": f"{f['strategy']} (learning)",
                         "learning": True} for f in learned["failed"]]
-            regimes[regime]["learning"] = {**summarise_learning(learned),
-                                           "sets": learned["sets"], "config": learned["config"]}
+            regimes[regime]["learning"] = summarise_learning(learned)
     return {"config": config.to_dict(), "software_version": __version__,
             "regimes": regimes, "failed": failed, "computed": computed}
 
