@@ -89,7 +89,8 @@ class Walk:
     def reach(self, level: int) -> float:
         """P(F_level) as the estimator takes it: p0 per level (by construction; counting the
         ties a chain that stayed put adds at a threshold overestimated P by a third on the
-        synthetic outcome of the tests)."""
+        synthetic outcome of the tests). A running product, not p0 ** level: the bits every
+        recorded estimate was computed with."""
         out = 1.0
         for _ in range(level):
             out *= self.p0
