@@ -6,6 +6,9 @@ the way in, the others never) are written as MCAP logs, then
   bare    read_run + JSON-decode every message of the topics the warehouse keeps, and nothing else
   ingest  one full `evoeye ingest` pass over the same logs: decode, convert, monitor features,
           three Parquet parts per partition written atomically, commit, catalog refresh.
+Then the same pass with each of `--workers` processes reading the logs (`ingest(workers=N)`):
+wall seconds and CPU seconds of this process and its workers, and the speed-up over one
+process (target on 2 cores: ≥ 1.6×; the warehouse is the same either way).
 
 Windows (target ≤ 2×): the ingested parts are replicated under new scenario ids until the
 warehouse holds ≥ `--window-frames` frames (content does not change the cost; every replica
@@ -22,6 +25,7 @@ Every timing is the best of `--repeat` (the machine may be shared).
 from __future__ import annotations
 
 import argparse
+import resource
 import tempfile
 import time
 from collections.abc import Callable
@@ -37,8 +41,9 @@ from evoeye.log import read_run, write_episode
 from evoeye.log.synthetic import synthetic_episode, with_collision
 from evoeye.paths import DataRoot
 from evoeye.store import Warehouse, ingest, load_windows
-from evoeye.store.ingest import Ingester, discover_logs
+from evoeye.store.ingest import discover_logs
 from evoeye.store.parts import PartStore
+from evoeye.store.reading import ingest_topics
 from evoeye.store.schema import PARTITION_KEYS, TABLES
 
 COLLIDE_EVERY = 10  # one run in ten collides; its frames from the collision on are no windows
@@ -110,6 +115,31 @@ def replicate(root: DataRoot, min_frames: int) -> int:
     return base * (copies + 1)
 
 
+def _cpu_s() -> float:
+    """CPU seconds of this process and of its finished children."""
+    return sum(r.ru_utime + r.ru_stime for r in (resource.getrusage(resource.RUSAGE_SELF),
+                                                 resource.getrusage(resource.RUSAGE_CHILDREN)))
+
+
+def ingest_workers(root: DataRoot, runs: int, repeat: int, workers: list[int]) -> None:
+    """The ingest pass with logs read by 1 and by each of `workers` processes (best wall of
+    `repeat`, and the CPU seconds of that pass)."""
+    print("| ingest, logs read by | runs | wall s | CPU s (all processes) | speed-up (wall) |")
+    print("|---|---|---|---|---|")
+    base = None
+    for n in sorted({1, *workers}):
+        best = (float("inf"), 0.0)
+        for _ in range(repeat):
+            reset_warehouse(root)
+            t0, c0 = time.perf_counter(), _cpu_s()
+            ingest(root, workers=n)
+            best = min(best, (time.perf_counter() - t0, _cpu_s() - c0))
+        base = base or best[0]
+        print(f"| {n} process{'es' if n > 1 else ''} | {runs} | {best[0]:.2f} | {best[1]:.2f} "
+              f"| {base / best[0]:.2f}× |")
+    print()
+
+
 def numpy_windows(frames: dict[str, np.ndarray], run_lengths: np.ndarray, context_len: int
                   ) -> dict[str, np.ndarray]:
     """The same windows from per-frame arrays in (scenario, frame) order, by numpy alone."""
@@ -130,12 +160,14 @@ def main() -> None:
     ap.add_argument("--window-frames", type=int, default=500_000)
     ap.add_argument("--context-len", type=int, default=5)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--workers", type=int, nargs="*", default=[2],
+                    help="processes reading logs in the side-by-side ingest (1 is the reference)")
     args = ap.parse_args()
     print(f"Machine: {describe()}\n")
     with tempfile.TemporaryDirectory(prefix="bench-warehouse-") as tmp:
         root = DataRoot.resolve(tmp)
         logs = write_logs(root, args.runs, args.frames)
-        topics = Ingester(root).topics
+        topics = ingest_topics()
         bare_s, _ = best_of(args.repeat, lambda: bare_decode(logs, topics))
         ingest_s, report = best_of(args.repeat, lambda: ingest(root),
                                    before=lambda: reset_warehouse(root))
@@ -146,6 +178,7 @@ def main() -> None:
         print(f"| {args.runs} × {args.frames} frames | {args.runs} | {n:,} | {bare_s:.2f} "
               f"| {ingest_s:.2f} | {n / bare_s:,.0f} | {n / ingest_s:,.0f} "
               f"| {ingest_s / bare_s:.2f}× |\n")
+        ingest_workers(root, args.runs, args.repeat, args.workers)
 
         total = replicate(root, args.window_frames)
         L = args.context_len

@@ -9,7 +9,6 @@ once, and the runs in progress leave no file behind (`BatchInterrupted`).
 
 from __future__ import annotations
 
-import multiprocessing as mp
 import os
 import time
 from collections.abc import Callable, Iterable, Sequence
@@ -21,7 +20,7 @@ import numpy as np
 
 from evoeye.ads.profiles import DEFAULT_PROFILE
 from evoeye.atomic import remove_stale_temps
-from evoeye.lifeline import stop_workers, stoppable, stoppable_worker
+from evoeye.lifeline import pool_context, stop_workers, stoppable, stoppable_worker
 from evoeye.log import LogError, read_run, write_episode
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import get_scenario
@@ -126,12 +125,6 @@ class BatchSummary:
     @property
     def simulated_s(self) -> float:
         return sum(r.sim_time_s for r in self.results if not r.skipped)
-
-
-def pool_context() -> mp.context.BaseContext:
-    """The multiprocessing context worker pools start in."""
-    # fork starts workers in milliseconds with highway-env already imported; spawn elsewhere.
-    return mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
 
 
 class BatchInterrupted(KeyboardInterrupt):

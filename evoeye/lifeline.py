@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import ctypes
 import ctypes.util
+import multiprocessing as mp
 import os
 import signal
 import sys
@@ -24,6 +25,12 @@ PR_SET_PDEATHSIG = 1  # <linux/prctl.h>
 POLL_S = 0.5
 STOP_TIMEOUT_S = 1.5  # a stopped worker's time to unwind before SIGKILL
 T = TypeVar("T")
+
+
+def pool_context() -> mp.context.BaseContext:
+    """The multiprocessing context worker pools start in."""
+    # fork starts workers in milliseconds with highway-env already imported; spawn elsewhere.
+    return mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
 
 
 def _watch(parent_pid: int) -> None:

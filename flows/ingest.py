@@ -20,19 +20,20 @@ from flows.runners import retry_while_locked
 
 
 class IngestParams(BaseModel):
-    """Where to ingest and how many runs go into one Parquet part."""
+    """Where to ingest, how many runs go into one Parquet part, how many processes read logs."""
 
     root: str | None = None  # default: $EVOEYE_HOME or ./evoeye-data
     runs_per_part: int = Field(DEFAULT_RUNS_PER_PART, ge=1, le=10_000)
+    workers: int = Field(1, ge=1, le=256)  # processes reading logs side by side
 
     def run_name(self) -> str:
         return f"ingest-{DataRoot.resolve(self.root).path.name}"
 
 
 @task(retries=5, retry_delay_seconds=10, retry_condition_fn=retry_while_locked)
-def ingest_logs(root: DataRoot, runs_per_part: int) -> dict[str, Any]:
+def ingest_logs(root: DataRoot, runs_per_part: int, workers: int = 1) -> dict[str, Any]:
     """One ingest pass; the IngestReport as a dict."""
-    return asdict(ingest(root, runs_per_part=runs_per_part))
+    return asdict(ingest(root, runs_per_part=runs_per_part, workers=workers))
 
 
 @flow(name="evoeye-ingest", log_prints=True,
@@ -41,7 +42,7 @@ def ingest_flow(params: IngestParams | None = None) -> dict[str, Any]:
     """Ingest the runs of `params.root`; the report names every quarantined log."""
     params = params or IngestParams()
     root = DataRoot.resolve(params.root)
-    report = ingest_logs(root, params.runs_per_part)
+    report = ingest_logs(root, params.runs_per_part, params.workers)
     logger = get_run_logger()
     logger.info("%d runs (%d frames) ingested, %d already in, into %s",
                 len(report["ingested"]), report["frames"], report["skipped"], root.warehouse)

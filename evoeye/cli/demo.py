@@ -68,7 +68,7 @@ def demo(
     out().print(summary_table("evoeye demo: simulate", rows))
     code = failures_code(rows)
     try:
-        ingest_into(data)
+        ingest_into(data, workers=workers)
     except typer.Exit as partial:
         code = ExitCode(partial.exit_code)
     with StepBar("demo", total=3 * len(names)) as bar:

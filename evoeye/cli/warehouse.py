@@ -58,15 +58,17 @@ def ingest_command(
     runs_per_part: Annotated[
         int, typer.Option(min=1, help="Runs per Parquet part file.")
     ] = RUNS_PER_PART,
+    workers: Annotated[int, typer.Option(
+        min=1, help="Processes reading logs side by side (the warehouse is the same).")] = 1,
 ) -> None:
     """Append every run log under <root>/runs not yet ingested to the warehouse.
 
     Exits 3 if any log was quarantined (listed with its reason).
     """
-    ingest_into(DataRoot.resolve(root), runs_per_part)
+    ingest_into(DataRoot.resolve(root), runs_per_part, workers)
 
 
-def ingest_into(data: DataRoot, runs_per_part: int = RUNS_PER_PART) -> None:
+def ingest_into(data: DataRoot, runs_per_part: int = RUNS_PER_PART, workers: int = 1) -> None:
     """Ingest with a progress bar, print the report; exit 3 if any log was quarantined."""
     from tqdm import tqdm
 
@@ -84,7 +86,7 @@ def ingest_into(data: DataRoot, runs_per_part: int = RUNS_PER_PART) -> None:
         err().print(f"creating a new warehouse at {data.warehouse}{where}")
     bars: list[tqdm] = []  # made once ingest knows how many logs it will read
     try:
-        report = ingest(data, runs_per_part=runs_per_part,
+        report = ingest(data, runs_per_part=runs_per_part, workers=workers,
                         on_start=lambda n: bars.append(tqdm(total=n, desc="ingest", unit="log")),
                         on_log=lambda p: bars[0].update(1))
     finally:

@@ -16,7 +16,7 @@ from typing import Any
 
 from evoeye import __version__
 from evoeye.ads.profiles import DEFAULT_PROFILE
-from evoeye.batch import pool_context
+from evoeye.lifeline import pool_context
 from evoeye.paths import DataRoot
 from evoeye.sim.counterfactual import VARIANTS, Explanation, explain_run
 from evoeye.sim.episode import RunSpec

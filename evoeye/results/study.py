@@ -142,7 +142,7 @@ def prepare_data(root: DataRoot, config: ResultsConfig, progress: Progress | Non
                       workers=config.workers)
             planned.setdefault(scenario, {})[batch] = n
     say("ingesting new logs")
-    ingest(root)
+    ingest(root, workers=config.workers)
     return planned
 
 

@@ -4,6 +4,9 @@
   already there is skipped without being read.
 * One conversion per log: a log the caller has converted already (`LoggedRun`, e.g. the
   campaign's, which scored it) is written from that conversion, not read again.
+* Logs read side by side: with `workers` > 1, that many processes read and convert logs
+  (`reading.py`: most of the cost) while this one writes parts in the logs' order; the
+  warehouse's rows are the same with any number of workers.
 * Crash-safe: a part's frames and frame_features are written before its scenarios rows (see
   `parts.py`); the views hide uncommitted parts, and the next ingest deletes them and ingests
   those runs again.
@@ -24,6 +27,8 @@ from __future__ import annotations
 import os
 import uuid
 from collections.abc import Callable, Iterator, Sequence
+from concurrent.futures import Future
+from contextlib import closing
 from dataclasses import dataclass, field
 from datetime import UTC, datetime
 from pathlib import Path
@@ -31,7 +36,7 @@ from pathlib import Path
 import duckdb
 import pyarrow as pa
 
-from evoeye.log import LogError, read_run
+from evoeye.log import LogError
 from evoeye.paths import LOG_SUFFIX, DataRoot
 from evoeye.sim.worlds import DEFAULT_WORLD
 from evoeye.store.catalog import Warehouse, write_catalog
@@ -41,12 +46,10 @@ from evoeye.store.log_windows import LoggedRun
 from evoeye.store.metadata import check_metadata
 from evoeye.store.migrate import migrate
 from evoeye.store.parts import PartStore
+from evoeye.store.reading import read_logs
 from evoeye.store.records import (
-    FRAME_CLOCK,
     RunRecordError,
-    frame_column_sources,
     frame_features_table,
-    frames_table,
     scenario_row,
     scenarios_table,
     with_ingest_id,
@@ -123,6 +126,7 @@ class Ingester:
         on_log: Callable[[Path], None] | None = None,
         on_start: Callable[[int], None] | None = None,
         batch: Partition | None = None,
+        workers: int = 1,
     ) -> None:
         if runs_per_part < 1:
             raise ValueError(f"runs_per_part must be at least 1, got {runs_per_part}")
@@ -132,8 +136,10 @@ class Ingester:
         self.on_start = on_start  # called once with the number of logs to read
         self.store = PartStore(self.root)
         self.quarantine = Quarantine(self.root)
-        self.topics = sorted({FRAME_CLOCK, *(t for t, _ in frame_column_sources().values())})
         self.batch = batch  # only this batch's folder, as a writer of its keys (module doc)
+        if workers < 1:
+            raise ValueError(f"workers must be at least 1, got {workers}")
+        self.workers = workers  # processes reading logs (`reading.py`); parts are written here
 
     def run(self, converted: Sequence[LoggedRun] = ()) -> IngestReport:
         """One pass; `converted`: runs of the logs to ingest already converted (by path)."""
@@ -177,7 +183,7 @@ class Ingester:
         pending = list(self._pending(logs, report, done_paths, done_ids))
         if self.on_start is not None:
             self.on_start(len(pending))
-        self._ingest(iter(pending), given, done_ids, report)
+        self._ingest(pending, given, done_ids, report)
 
     def _pending(
         self, logs: Sequence[Path], report: IngestReport, done_paths: set[str], done_ids: set[str]
@@ -191,8 +197,15 @@ class Ingester:
             else:
                 yield log
 
-    def _ingest(self, logs: Iterator[Path], given: dict[str, LoggedRun], done_ids: set[str],
+    def _ingest(self, logs: Sequence[Path], given: dict[str, LoggedRun], done_ids: set[str],
                 report: IngestReport) -> None:
+        reads = read_logs([log for log in logs if self.root.relative(log) not in given],
+                          self.workers)
+        with closing(reads):  # its pool stops however this loop ends
+            self._write_runs(logs, reads, given, done_ids, report)
+
+    def _write_runs(self, logs: Sequence[Path], reads: Iterator[tuple[Path, Future]],
+                    given: dict[str, LoggedRun], done_ids: set[str], report: IngestReport) -> None:
         stamp = datetime.now(UTC)
         prefix = f"part-{stamp:%Y%m%dT%H%M%SZ}-{uuid.uuid4().hex[:8]}"
         counter = iter(range(1_000_000))
@@ -201,12 +214,14 @@ class Ingester:
             if self.on_log is not None:
                 self.on_log(log)
             rel = self.root.relative(log)
+            converted = given.get(rel)
             try:
-                converted = given.get(rel)
-                source = None if converted else read_run(log, topics=self.topics)
-                meta = converted.metadata if converted else source.metadata
-                check_metadata(meta)
-                if meta.get("world", DEFAULT_WORLD) != DEFAULT_WORLD:
+                if converted is None:
+                    meta, read = next(reads)[1].result()  # raises what reading it raised
+                else:
+                    meta, read = converted.metadata, converted
+                    check_metadata(meta)
+                if read is None or meta.get("world", DEFAULT_WORLD) != DEFAULT_WORLD:
                     report.left_out.append(rel)
                     continue
                 scenario_id = str(meta["scenario_id"])
@@ -215,10 +230,8 @@ class Ingester:
                     continue
                 key = tuple(str(meta[k]) for k in PARTITION_KEYS)
                 part = pending.get(key) or _PendingPart(f"{prefix}-{next(counter):04d}")
-                frames = (with_ingest_id(converted.frames, part.part) if converted
-                          else frames_table(source, scenario_id, part.part))
-                features = frame_features_table(
-                    frames, features=converted.features if converted else None)
+                frames = with_ingest_id(read.frames, part.part)
+                features = frame_features_table(frames, features=read.features)
                 row = scenario_row(
                     meta, n_frames=frames.num_rows, log_path=rel, ingest_id=part.part,
                     ingested_at=stamp,
@@ -261,10 +274,13 @@ def ingest(
     runs_per_part: int = DEFAULT_RUNS_PER_PART,
     on_log: Callable[[Path], None] | None = None,
     on_start: Callable[[int], None] | None = None,
+    workers: int = 1,
 ) -> IngestReport:
     """Ingest every log under `<root>/runs` not yet in the warehouse (see the module doc);
-    `on_start(n)` learns how many logs will be read, `on_log(path)` is called before each."""
-    return Ingester(root, runs_per_part=runs_per_part, on_log=on_log, on_start=on_start).run()
+    `on_start(n)` learns how many logs will be read, `on_log(path)` is called before each;
+    `workers` processes read the logs (`evoeye.store.reading`), with the same result."""
+    return Ingester(root, runs_per_part=runs_per_part, on_log=on_log, on_start=on_start,
+                    workers=workers).run()
 
 
 def ingest_batch(root: DataRoot, batch: Partition,

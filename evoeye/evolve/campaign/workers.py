@@ -23,12 +23,11 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from importlib import import_module
 
-from evoeye.batch import pool_context
 from evoeye.evolve.campaign.assess import Assessor
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.campaign.state import redrawn_note
-from evoeye.lifeline import stop_workers, stoppable, stoppable_worker
+from evoeye.lifeline import pool_context, stop_workers, stoppable, stoppable_worker
 from evoeye.paths import DataRoot
 from evoeye.store.feedback import RoundMetrics
 

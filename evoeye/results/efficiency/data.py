@@ -82,10 +82,10 @@ def prepare_regime(root: DataRoot, regime: str, config: EfficiencyConfig, *, wor
     if config.val_collisions:
         extend_validation(data, regime, config, workers=workers, say=say)
     say(f"{regime}: ingesting")
-    ingest(data)
+    ingest(data, workers=workers)
     if not (data.path / BOUNDARY_FILE).is_file():
         build_boundary_set(data, regime, config, workers=workers, say=say)
-        ingest(data)
+        ingest(data, workers=workers)
     return data
 
 

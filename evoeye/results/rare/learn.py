@@ -105,7 +105,7 @@ def prepare_sets(root: DataRoot, regime: str, learn: LearnConfig, data_seed: int
         draw_collisions(data, regime, seed, learn.val_runs, learn.val_collisions, batch,
                         workers=workers, say=say)
     say(f"{regime}: ingesting")
-    ingest(data)
+    ingest(data, workers=workers)
     return data
 
 

@@ -19,8 +19,7 @@ from concurrent.futures import ProcessPoolExecutor
 from pathlib import Path
 
 from evoeye import __version__
-from evoeye.batch import pool_context
-from evoeye.lifeline import die_with_parent
+from evoeye.lifeline import die_with_parent, pool_context
 from evoeye.paths import DataRoot
 from evoeye.results.ledger import Ledger
 from evoeye.results.rare.config import RareConfig
