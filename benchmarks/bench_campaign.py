@@ -202,8 +202,8 @@ def main() -> None:
     ap.add_argument("--root", type=Path, help="data root with initial runs and a G_0, split "
                     "as this script splits them (seed 0, train 0.5, val 0.25)")
     ap.add_argument("--update", nargs="+", default=["retrain"],
-                    help="campaign option, MODE or MODE:EPOCHS; several: one campaign each, "
-                    "compared with the first")
+                    help="campaign option, MODE or MODE:EPOCHS, +keep for keep_parent (e.g. "
+                    "warm:1+keep); several: one campaign each, compared with the first")
     ap.add_argument("--seeds", type=int, nargs="+", default=[0], help="campaign seeds")
     ap.add_argument("--scenario", default="highway-cut-in")
     ap.add_argument("--strategy", default="evoeye")
@@ -222,12 +222,14 @@ def main() -> None:
                else seed_root(Path(tmp) / "seed", [args.scenario], args.runs, splits))
         for seed in args.seeds:
             for update in args.update:
-                mode, _, epochs = update.partition(":")
+                spec, keep, _ = update.partition("+keep")
+                mode, _, epochs = spec.partition(":")
                 cfg = CampaignConfig(args.scenario, strategy=args.strategy, budget_s=1e9,
                                      seed=seed, n_round=args.n_round, splits=splits,
                                      epochs=int(epochs) if epochs else args.epochs,
-                                     patience=args.patience, update=mode)
-                work = Path(tmp) / f"{mode}-{epochs}-s{seed}"
+                                     patience=args.patience, update=mode,
+                                     keep_parent=bool(keep))
+                work = Path(tmp) / f"{mode}-{epochs}{'-keep' * bool(keep)}-s{seed}"
                 rows.append({**report(cfg, run_one(src, cfg, args.rounds, work)),
                              "update": update})
                 shutil.rmtree(work)

@@ -63,14 +63,17 @@ class RunResult:
     reason: str = ""
     skipped: bool = False  # already on disk
     sim_time_s: float = 0.0
+    logged: bool = True  # its log is at `path` (False: simulated for its outcome only)
 
 
-def simulate_and_log(spec: RunSpec, root: DataRoot) -> RunResult:
-    """Simulate one run and write its log, unless its log already exists. Picklable."""
-    return simulate_and_keep(spec, root)[0]
+def simulate_and_log(spec: RunSpec, root: DataRoot, collisions_only: bool = False) -> RunResult:
+    """Simulate one run and write its log, unless its log already exists (with
+    `collisions_only`, only a colliding run's log is written). Picklable."""
+    return simulate_and_keep(spec, root, collisions_only)[0]
 
 
-def simulate_and_keep(spec: RunSpec, root: DataRoot) -> tuple[RunResult, Episode | None]:
+def simulate_and_keep(spec: RunSpec, root: DataRoot,
+                      collisions_only: bool = False) -> tuple[RunResult, Episode | None]:
     """`simulate_and_log`, and the Episode it simulated (None when the log was on disk), for a
     caller that converts the run in memory (`evoeye.store.log_windows.episode_run`)."""
     path = root.run_log(spec.scenario, spec.batch, spec.scenario_id)
@@ -84,11 +87,13 @@ def simulate_and_keep(spec: RunSpec, root: DataRoot) -> tuple[RunResult, Episode
         except LogError:
             path.unlink()  # a final-named log that does not read back: simulate it again
     episode = run_episode(spec)
-    path.parent.mkdir(parents=True, exist_ok=True)
-    write_episode(episode, path)
     o = episode.outcome
+    logged = not collisions_only or (o.status == STATUS_OK and o.collided)
+    if logged:
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_episode(episode, path)
     return RunResult(spec.scenario_id, str(path), o.status, o.collided, o.reason,
-                     sim_time_s=o.duration_s), episode
+                     sim_time_s=o.duration_s, logged=logged), episode
 
 
 def remove_stale_logs(specs: Sequence[RunSpec], root: DataRoot) -> list[Path]:
@@ -141,10 +146,12 @@ class BatchInterrupted(KeyboardInterrupt):
 
 def run_batch(
     specs: Sequence[RunSpec], root: DataRoot, *, workers: int = 1,
-    progress: Callable[[Iterable], Iterable] | None = None,
+    progress: Callable[[Iterable], Iterable] | None = None, collisions_only: bool = False,
 ) -> BatchSummary:
     """Run every spec (in `workers` processes); one broken run never stops the others. Ctrl-C
-    stops the workers at once and raises BatchInterrupted with what finished."""
+    stops the workers at once and raises BatchInterrupted with what finished. With
+    `collisions_only`, only the colliding runs' logs are written (the others are simulated for
+    their outcome: a long draw of a rare failure's stream keeps its failures, not terabytes)."""
     if workers < 1:
         raise ValueError(f"--workers must be at least 1, got {workers}")
     t0 = time.perf_counter()
@@ -153,9 +160,9 @@ def run_batch(
     try:
         if workers == 1:
             for spec in wrap(specs):
-                summary.results.append(_guarded(spec, root))
+                summary.results.append(_guarded(spec, root, collisions_only))
         else:
-            _in_pool(specs, root, workers, wrap, summary)
+            _in_pool(specs, root, workers, wrap, summary, collisions_only)
     except KeyboardInterrupt:
         on_disk = sum(root.run_log(s.scenario, s.batch, s.scenario_id).exists() for s in specs)
         raise BatchInterrupted(_finish(summary, t0), on_disk, len(specs)) from None
@@ -163,12 +170,13 @@ def run_batch(
 
 
 def _in_pool(specs: Sequence[RunSpec], root: DataRoot, workers: int,
-             wrap: Callable[[Iterable], Iterable], summary: BatchSummary) -> None:
+             wrap: Callable[[Iterable], Iterable], summary: BatchSummary,
+             collisions_only: bool) -> None:
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=pool_context(),
                                initializer=stoppable_worker, initargs=(os.getpid(),))
     try:
         futures: dict[Future, RunSpec] = {
-            pool.submit(stoppable, simulate_and_log, s, root): s for s in specs
+            pool.submit(stoppable, simulate_and_log, s, root, collisions_only): s for s in specs
         }
         for fut in wrap(as_completed(futures)):
             summary.results.append(_result(fut, futures[fut], root))
@@ -185,9 +193,9 @@ def _finish(summary: BatchSummary, t0: float) -> BatchSummary:
     return summary
 
 
-def _guarded(spec: RunSpec, root: DataRoot) -> RunResult:
+def _guarded(spec: RunSpec, root: DataRoot, collisions_only: bool = False) -> RunResult:
     try:
-        return simulate_and_log(spec, root)
+        return simulate_and_log(spec, root, collisions_only)
     except Exception as exc:  # noqa: BLE001 - reported per run, the batch goes on
         return _error(spec, root, exc)
 

@@ -206,6 +206,11 @@ def results_command(
     rare_test_runs: Annotated[int, typer.Option(
         min=1, help="Rare-failure protocol, learning side: uniform Test Set runs per regime "
                     "(enough to hold ≥ 50 failures).")] = L.test_runs,
+    rare_test_max_runs: Annotated[int, typer.Option(
+        min=0, help="Rare-failure protocol, learning side: where the Test Set's runs hold "
+                    "fewer than 50 failures, draw its stream on to this many runs at most, "
+                    "logging only the collisions, and weight the set back (0: no more runs).")
+    ] = L.test_max_runs,
     rare_members: Annotated[int, typer.Option(
         min=1, max=8, help="Rare-failure protocol, learning side: from-scratch members of "
                            "each monitor.")] = L.members,
@@ -264,7 +269,8 @@ def results_command(
                 seeds=tuple(range(first_rare_seed, first_rare_seed + rare_seeds)),
                 runs=rare_runs, batch=rare_batch, explain=rare_explain,
                 learn={"test_runs": rare_test_runs, "members": rare_members,
-                       "recipe": recipe} if rare_learn else None, **fresh).changed())
+                       "recipe": recipe, "test_max_runs": rare_test_max_runs}
+                if rare_learn else None, **fresh).changed())
         config.check_names()
     except ValueError as exc:
         raise typer.BadParameter(str(exc)) from None

@@ -21,17 +21,18 @@ CURVE_POINTS = 200  # points kept per curve for reports
 
 @dataclass(frozen=True)
 class PRF:
-    """Confusion counts and the rates derived from them (0 where a rate is undefined).
+    """Confusion counts and the rates derived from them (0 where a rate is undefined); sums of
+    the frames' weights where the set is weighted (`prf`'s `weight`).
 
     At a threshold whose target FPR was unreachable on validation (`reachable` False,
     `evoeye.monitor.calibration`) precision, recall and F1 are None: no operating point at that
     FPR exists to measure, and a 0 would read as a monitor that misses everything.
     """
 
-    tp: int
-    fp: int
-    fn: int
-    tn: int
+    tp: float
+    fp: float
+    fn: float
+    tn: float
     reachable: bool = True
 
     @property
@@ -63,23 +64,35 @@ class PRF:
                 "reachable": self.reachable}
 
 
-def prf(predicted: np.ndarray, labels: np.ndarray, reachable: bool = True) -> PRF:
-    """Counts of predicted-positive vs true labels (both (N,), truthy = positive)."""
+def prf(predicted: np.ndarray, labels: np.ndarray, reachable: bool = True,
+        weight: np.ndarray | None = None) -> PRF:
+    """Counts of predicted-positive vs true labels (both (N,), truthy = positive); with
+    `weight` (N,), the sums of the frames' weights instead (a stratified set, each frame
+    standing for `weight` frames of the population)."""
     p, y = np.asarray(predicted, bool), np.asarray(labels, bool)
-    return PRF(int((p & y).sum()), int((p & ~y).sum()), int((~p & y).sum()), int((~p & ~y).sum()),
-               reachable)
+    cells = (p & y, p & ~y, ~p & y, ~p & ~y)
+    if weight is None:
+        return PRF(*(int(c.sum()) for c in cells), reachable)
+    w = np.asarray(weight, float)
+    return PRF(*(float(w[c].sum()) for c in cells), reachable)
 
 
-def auroc(scores: np.ndarray, labels: np.ndarray) -> float | None:
-    """Area under the ROC curve; None when only one class is present."""
+def auroc(scores: np.ndarray, labels: np.ndarray,
+          weight: np.ndarray | None = None) -> float | None:
+    """Area under the ROC curve (each frame weighted by `weight`, if given); None when only
+    one class is present."""
     y = np.asarray(labels, bool)
-    return float(roc_auc_score(y, scores)) if 0 < y.sum() < len(y) else None
+    return (float(roc_auc_score(y, scores, sample_weight=weight)) if 0 < y.sum() < len(y)
+            else None)
 
 
-def auprc(scores: np.ndarray, labels: np.ndarray) -> float | None:
-    """Area under the precision-recall curve (average precision); None without positives."""
+def auprc(scores: np.ndarray, labels: np.ndarray,
+          weight: np.ndarray | None = None) -> float | None:
+    """Area under the precision-recall curve (average precision; each frame weighted by
+    `weight`, if given); None without positives."""
     y = np.asarray(labels, bool)
-    return float(average_precision_score(y, scores)) if 0 < y.sum() < len(y) else None
+    return (float(average_precision_score(y, scores, sample_weight=weight))
+            if 0 < y.sum() < len(y) else None)
 
 
 def _thin(*arrays: np.ndarray, n: int = CURVE_POINTS) -> list[list[float]]:
@@ -127,11 +140,16 @@ class FrameMetrics:
 
 
 def frame_metrics(scores: np.ndarray, labels: np.ndarray, thresholds: Thresholds,
-                  fprs: Iterable[float] | None = None) -> FrameMetrics:
-    """P / R / F1 at each calibrated threshold (alarm: score > threshold), AUROC, AUPRC."""
+                  fprs: Iterable[float] | None = None,
+                  weight: np.ndarray | None = None) -> FrameMetrics:
+    """P / R / F1 at each calibrated threshold (alarm: score > threshold), AUROC, AUPRC; with
+    `weight`, of a weighted (stratified) set: every count and area weighs each frame by it
+    (`frames` and `unsafe` stay the frames' numbers)."""
     scores, labels = np.asarray(scores, float), np.asarray(labels).astype(bool)
     fprs = sorted(thresholds.by_fpr, reverse=True) if fprs is None else list(fprs)
     return FrameMetrics(
-        {f: prf(alarms(scores, thresholds.at(f)), labels, thresholds.reachable(f)) for f in fprs},
-        auroc(scores, labels), auprc(scores, labels), len(labels), int(labels.sum()),
+        {f: prf(alarms(scores, thresholds.at(f)), labels, thresholds.reachable(f), weight)
+         for f in fprs},
+        auroc(scores, labels, weight), auprc(scores, labels, weight), len(labels),
+        int(labels.sum()),
     )

@@ -55,3 +55,18 @@ def test_an_unreachable_operating_point_has_no_rates_but_keeps_its_counts() -> N
     assert (strict.precision, strict.recall, strict.f1) == (None, None, None)
     assert (strict.tp, strict.fp) == (1, 0) and strict.fpr == 0.0
     assert strict.to_dict()["reachable"] is False and strict.to_dict()["f1"] is None
+
+
+def test_a_weighted_set_scores_as_the_set_its_weights_stand_for() -> None:
+    # frame i weighs w[i]: the same as frame i repeated w[i] times
+    weight = np.array([1, 3, 2, 1, 4, 1, 2, 5, 1, 3])
+    weighted = frame_metrics(SCORES, LABELS, THRESHOLDS, weight=weight)
+    repeated = frame_metrics(np.repeat(SCORES, weight), np.repeat(LABELS, weight), THRESHOLDS)
+    assert weighted.auroc == pytest.approx(repeated.auroc)
+    assert weighted.auprc == pytest.approx(repeated.auprc)
+    for fpr in THRESHOLDS.by_fpr:
+        a, b = weighted.at_fpr[fpr], repeated.at_fpr[fpr]
+        assert (a.tp, a.fp, a.fn, a.tn) == (b.tp, b.fp, b.fn, b.tn)
+        assert (a.precision, a.recall) == pytest.approx((b.precision, b.recall))
+    assert weighted.auprc != pytest.approx(frame_metrics(SCORES, LABELS, THRESHOLDS).auprc)
+    assert weighted.frames == 10 and weighted.unsafe_frames == 4  # the frames themselves

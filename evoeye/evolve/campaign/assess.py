@@ -89,10 +89,12 @@ def ensure_scored(root: DataRoot, monitor, scenario: str, windows: Windows) -> N
                                      windows.frame, windows.t_s, monitor.score(windows)))
 
 
-def metrics_dict(scores: np.ndarray, labels: np.ndarray, thresholds) -> dict:
+def metrics_dict(scores: np.ndarray, labels: np.ndarray, thresholds,
+                 weight: np.ndarray | None = None) -> dict:
     """F1 / precision / recall at each target FPR, AUROC and AUPRC, as plain numbers; at a
-    target FPR the thresholds could not reach (`reachable@…` False) the three rates are None."""
-    m = frame_metrics(scores, labels, thresholds, FPRS)
+    target FPR the thresholds could not reach (`reachable@…` False) the three rates are None.
+    `weight`: of each frame of a weighted (stratified) set (`frame_metrics`)."""
+    m = frame_metrics(scores, labels, thresholds, FPRS, weight)
     out = {"auroc": m.auroc, "auprc": m.auprc, "frames": m.frames, "unsafe": m.unsafe_frames}
     for fpr, c in m.at_fpr.items():
         out[f"f1@{fpr}"], out[f"recall@{fpr}"], out[f"precision@{fpr}"] = (

@@ -33,6 +33,9 @@ class Learner:
     judging: dict[str, Windows]  # set name → windows (the Test Set, the boundary set)
     params: TrainParams = field(default_factory=recipe_params)  # the seed is given per call
     members: int = 1  # of every checkpoint's monitor (`checkpoint`)
+    # set name → per-window weights of a judging set that is a stratified sample (none: each
+    # window counts once; `evoeye.evaluation.metrics.frame_metrics`)
+    judging_weights: Mapping[str, np.ndarray] = field(default_factory=dict)
 
     @property
     def recipe(self) -> dict:
@@ -93,7 +96,8 @@ class Learner:
 
     def judge(self, monitor: FusionMonitor | EnsembleMonitor) -> dict[str, dict]:
         """{set: metrics} of the monitor on every judging set, at its calibrated thresholds."""
-        return {name: metrics_dict(monitor.score(w), w.label, monitor.thresholds)
+        return {name: metrics_dict(monitor.score(w), w.label, monitor.thresholds,
+                                   self.judging_weights.get(name))
                 for name, w in self.judging.items()}
 
 

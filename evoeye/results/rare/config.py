@@ -36,6 +36,7 @@ ESTIMATING = (REFERENCE, "ce-is", "subset")
 # monitor can be trained on (the learning side trains the others unweighted)
 WEIGHTED = (REFERENCE, "ce-is")
 REGIMES = ("highway-cut-in:cautious", "highway-cut-in:defensive")
+LEARN_LATER_FIELDS = ("test_max_runs",)  # LearnConfig's, absent from a dict at their default
 
 
 @dataclass(frozen=True)
@@ -51,6 +52,9 @@ class LearnConfig:
     horizon_s: float = 3.0
     context_len: int = 5
     min_test_failures: int = 50  # a Test Set with fewer cannot judge the regime (issue 38)
+    # where test_runs hold fewer, the Test stream drawn on to this many runs at most, outcome
+    # first, and the set weighted back (`testset.py`); 0: the test_runs batch alone
+    test_max_runs: int = 0
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "budgets", tuple(self.budgets))
@@ -60,6 +64,9 @@ class LearnConfig:
         for name in ("test_runs", "val_runs", "context_len", "min_test_failures"):
             if getattr(self, name) < 1:
                 raise ValueError(f"{name} must be >= 1, got {getattr(self, name)}")
+        if self.test_max_runs and self.test_max_runs <= self.test_runs:
+            raise ValueError(f"test_max_runs ({self.test_max_runs}) must exceed test_runs "
+                             f"({self.test_runs}), or be 0 (no further Test runs)")
         if self.val_collisions < 0:
             raise ValueError(f"val_collisions must be >= 0, got {self.val_collisions}")
         if not 1 <= self.members <= MAX_MEMBERS:
@@ -76,8 +83,11 @@ class LearnConfig:
                              f"curve holds ({runs})")
 
     def to_dict(self) -> dict:
+        """Every field, but those added later only where set (LEARN_LATER_FIELDS: the configs
+        recorded before them, and their ledger keys, stay as they were)."""
         return {f.name: list(v) if isinstance(v, tuple) else v
-                for f in fields(self) if (v := getattr(self, f.name)) is not None}
+                for f in fields(self) if (v := getattr(self, f.name)) is not None
+                and not (f.name in LEARN_LATER_FIELDS and v == f.default)}
 
     @classmethod
     def from_dict(cls, data: Mapping) -> LearnConfig:

@@ -17,11 +17,15 @@ log2(budget) (`efficiency.summary.area`), paired with Uniform's at the same seed
 * **No redraw.** A budget whose runs hold no window a monitor can learn a collision from gets
   no network: its monitor scores every frame alike (AUPRC = the Test Set's unsafe share, the
   no-skill figure) and is part of the result, as the issue asks of a curve that starts with no
-  failure.
+  failure. A curve with no collision among its runs is not simulated again (every budget of
+  it is no-skill; at ≈ 0.1 % most curves are): its outcomes are the recorded ones, unchecked.
 * **The sets no strategy shaped.** The Test Set is `test_runs` uniform runs of their own seed
   (data_seed + 1), large enough to hold ≥ `min_test_failures` collisions where failures are
-  ≈ 1 %; a regime whose Test Set holds fewer is reported with its count, and its check is not
-  shown. Validation (early stopping and calibration) is `val_runs` uniform runs (data_seed + 2)
+  ≈ 1 %. Where they are rarer, `test_max_runs` draws that stream on, outcome first, until it
+  holds them, and the Test Set is the stream stratified by outcome and weighted back to it
+  (`testset.py`: every colliding run, the batch's safe runs each standing for several). A
+  regime whose Test Set holds fewer is reported with its count, and its check is not shown.
+  Validation (early stopping and calibration) is `val_runs` uniform runs (data_seed + 2)
   and the unsafe windows of further runs of that stream until it holds `val_collisions`
   colliding runs (`efficiency.data.draw_collisions`): its negatives stay the uniform batch's.
 * **Pairing.** The training seed of seed s at budget n is shared by every strategy
@@ -66,8 +70,9 @@ from evoeye.results.ledger import Ledger
 from evoeye.results.rare.config import LearnConfig, RareConfig
 from evoeye.results.rare.runner import run_seed
 from evoeye.results.rare.summary import weights as curve_weights
+from evoeye.results.rare.testset import TestDraw, draw_test_failures
 from evoeye.sim.runner import run_episode, run_spec
-from evoeye.store import ingest
+from evoeye.store import Warehouse, ingest
 from evoeye.store.log_windows import episode_run
 from evoeye.store.windows import Windows, load_windows
 
@@ -90,8 +95,9 @@ def set_batch(name: str, data_seed: int) -> tuple[str, int]:
 
 
 def prepare_sets(root: DataRoot, regime: str, learn: LearnConfig, data_seed: int, *,
-                 workers: int = 1, say: Say | None = None) -> DataRoot:
-    """Simulate (or resume) and ingest a regime's Test and validation sets; their data root."""
+                 workers: int = 1, say: Say | None = None) -> tuple[DataRoot, TestDraw | None]:
+    """Simulate (or resume) and ingest a regime's Test and validation sets; their data root,
+    and the Test stream's draw past its batch (`testset.py`; None without `test_max_runs`)."""
     say = say or (lambda msg: None)
     scenario, profile = parse_regime(regime)
     data = learn_root(root, regime)
@@ -100,30 +106,45 @@ def prepare_sets(root: DataRoot, regime: str, learn: LearnConfig, data_seed: int
         say(f"{regime}: {name} set, {n} runs (seed {seed})")
         run_batch(plan_uniform(scenario, n, seed, batch=batch, ads=profile), data,
                   workers=workers)
+    draw = None
+    if learn.test_max_runs:
+        batch, seed = set_batch("test", data_seed)
+        draw = draw_test_failures(data, regime, seed, learn.test_runs, batch,
+                                  learn.min_test_failures, learn.test_max_runs,
+                                  workers=workers, say=say)
     if learn.val_collisions:
         batch, seed = set_batch("val", data_seed)
         draw_collisions(data, regime, seed, learn.val_runs, learn.val_collisions, batch,
                         workers=workers, say=say)
     say(f"{regime}: ingesting")
     ingest(data, workers=workers)
-    return data
+    return data, draw
 
 
-def load_sets(data: DataRoot, learn: LearnConfig, data_seed: int) -> dict[str, Windows]:
+def load_sets(data: DataRoot, learn: LearnConfig, data_seed: int,
+              draw: TestDraw | None = None) -> tuple[dict[str, Windows], np.ndarray | None]:
     """{"test", "val"} windows of a regime's sets (validation with its further collisions'
-    unsafe windows)."""
+    unsafe windows; the Test Set with the further colliding runs of its stream, `draw`), and
+    the Test Set's per-window weights (None: unweighted)."""
     def windows(runs):
         return load_windows(data, runs, context_len=learn.context_len, horizon_s=learn.horizon_s)
 
-    def of_batch(name: str):
-        return windows(f"SELECT scenario_id FROM scenarios WHERE batch = "
-                       f"'{set_batch(name, data_seed)[0]}' AND status = 'ok'")
+    def of_batch(name: str, safe: bool = False):
+        return (f"SELECT scenario_id FROM scenarios WHERE batch = "
+                f"'{set_batch(name, data_seed)[0]}' AND status = 'ok'"
+                + (" AND NOT collided" if safe else ""))
 
-    out = {name: of_batch(name) for name in ("test", "val")}
+    out = {name: windows(of_batch(name)) for name in ("test", "val")}
     _, seed = set_batch("val", data_seed)
     if extra := kept_collisions(data, seed, learn.val_runs, learn.val_collisions):
         out["val"] = with_unsafe_windows(out["val"], windows(extra))
-    return out
+    if draw is None:
+        return out, None
+    if draw.further:
+        out["test"] = concat_windows([out["test"], windows(list(draw.further))])
+    safe = Warehouse(data).sql(of_batch("test", safe=True)).column("scenario_id").to_pylist()
+    stands_for = np.isin(np.asarray(out["test"].scenario_id).astype(str), safe)
+    return out, np.where(stands_for, draw.safe_weight, 1.0)
 
 
 def set_figures(windows: Windows) -> dict:
@@ -186,17 +207,21 @@ def learnable(train: Windows | None, params) -> bool:
 def no_skill(learner: Learner) -> dict:
     """The judging figures of a monitor that scores every frame alike (module doc)."""
     thresholds = calibrate(np.zeros(len(learner.val)), learner.val.label)
-    return {name: metrics_dict(np.zeros(len(w)), w.label, thresholds)
+    return {name: metrics_dict(np.zeros(len(w)), w.label, thresholds,
+                               learner.judging_weights.get(name))
             for name, w in learner.judging.items()}
 
 
 def learn_curve(ctx: _Context, strategy: str, seed: int, curve: dict) -> dict:
     """One curve's figures: per budget the Test Set metrics of its monitor, the collisions it
     trained on, its runs' effective number under their weights, and whether it is no-skill."""
-    learn = ctx.learn
-    runs, ids = curve_windows(ctx.regime, curve,
-                              lambda k: run_seed(ctx.config, ctx.regime, strategy, seed, k),
-                              learn.budgets[-1], learn)
+    learn, last = ctx.learn, ctx.learn.budgets[-1]
+    if any(r["collided"] for r in curve["runs"][:last]):
+        runs, ids = curve_windows(ctx.regime, curve,
+                                  lambda k: run_seed(ctx.config, ctx.regime, strategy, seed, k),
+                                  last, learn)
+    else:  # nothing to learn at any budget: every monitor is no-skill, no run is needed again
+        runs, ids = [None] * last, [""] * last
     ratio = curve_weights(curve)[: learn.budgets[-1]]
     out = {}
     with intra_op_threads():
@@ -240,10 +265,11 @@ def learn_regime(root: DataRoot, regime: str, curves: dict[str, dict[str, dict]]
     if learn is None:
         raise ValueError("the protocol's config has no learning side (RareConfig.learn)")
     say = say or (lambda msg: None)
-    data = prepare_sets(root, regime, learn, config.data_seed, workers=workers, say=say)
-    sets = load_sets(data, learn, config.data_seed)
+    data, draw = prepare_sets(root, regime, learn, config.data_seed, workers=workers, say=say)
+    sets, test_weight = load_sets(data, learn, config.data_seed, draw)
     params = replace(recipe_params(learn.recipe), importance_weights=True)
-    learner = Learner(sets["val"], {"test": sets["test"]}, params, learn.members)
+    learner = Learner(sets["val"], {"test": sets["test"]}, params, learn.members,
+                      {} if test_weight is None else {"test": test_weight})
     _CONTEXT = _Context(regime, learn, learner, fingerprint(sets), Ledger(root), config)
     jobs = [(strategy, int(seed), curve) for seed in sorted({int(s) for c in curves.values()
                                                              for s in c})
@@ -275,8 +301,10 @@ def learn_regime(root: DataRoot, regime: str, curves: dict[str, dict[str, dict]]
                     keep(*done)
     finally:
         _CONTEXT = None
-    return {"config": learn.to_dict(),
-            "sets": {name: set_figures(w) for name, w in sets.items()},
+    figures = {name: set_figures(w) for name, w in sets.items()}
+    if draw is not None:
+        figures["test"].update(draw.to_dict())
+    return {"config": learn.to_dict(), "sets": figures,
             "curves": learned, "failed": failed, "computed": computed}
 
 

@@ -165,6 +165,19 @@ def mechanism_lines(distinct: dict[str, dict]) -> list[str]:
     return out
 
 
+def describe_test_set(test: dict) -> str:
+    """The Test Set of the learning side: uniform runs, or its stream drawn on and weighted
+    back (`testset.py`)."""
+    if "stream_runs" not in test:
+        return (f"Test Set: {test['runs']} uniform runs of their own seed, **{test['failures']} "
+                f"collided** ({test['unsafe']} unsafe of {test['windows']} windows)")
+    return (f"Test Set: a uniform stream of {test['stream_runs']} runs of its own seed, "
+            f"stratified by outcome: its {test['stream_collisions']} colliding runs and the "
+            f"safe runs of its first ones, each weighing {test['safe_weight']:.2f} (every count "
+            f"and area is the whole stream's); {test['runs']} runs, **{test['failures']} "
+            f"with unsafe windows** ({test['unsafe']} unsafe of {test['windows']} windows)")
+
+
 def learning_lines(learning: dict) -> list[str]:
     """The learning side of a regime (`learn.summarise_learning`): the sets, then per strategy
     the Test AUPRC at each budget, the area and its paired difference from Uniform's."""
@@ -176,8 +189,7 @@ def learning_lines(learning: dict) -> list[str]:
              "weighted by its p/q: exact for ce-is, 1 for Uniform; subset simulation's runs "
              "carry none and train unweighted); a budget whose runs hold no collision to learn "
              "from scores every frame alike (the no-skill AUPRC, the Test Set's unsafe share). "
-             f"Test Set: {test['runs']} uniform runs of their own seed, **{test['failures']} "
-             f"collided** ({test['unsafe']} unsafe of {test['windows']} windows)"
+             + describe_test_set(test)
              + (f", fewer than the {cfg['min_test_failures']} a check needs: not shown" if few
                 else "")
              + f"; validation: {val['runs']} runs, {val['failures']} of them colliding. Test "

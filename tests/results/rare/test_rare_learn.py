@@ -115,11 +115,13 @@ def test_every_curve_is_learned_from_at_every_budget_and_judged_on_its_test_set(
     test = learning["sets"]["test"]
     assert test["runs"] == 12 and learning["sets"]["val"]["runs"] == 10
     assert learning["budgets"] == [5, 10] and set(learning["strategies"]) == {"uniform", "ce-is"}
-    sets = load_sets(learn_root(root, REGIME), config.learning, config.data_seed)
+    sets, weight = load_sets(learn_root(root, REGIME), config.learning, config.data_seed)
+    assert weight is None  # no further Test runs were drawn: every window counts once
     share = sets["test"].label.mean()
     assert test["unsafe"] == int(sets["test"].label.sum())
     # a no-skill monitor scores every frame alike: its AUPRC is the Test Set's unsafe share
-    flat = no_skill(SimpleNamespace(val=sets["val"], judging={"test": sets["test"]}))
+    flat = no_skill(SimpleNamespace(val=sets["val"], judging={"test": sets["test"]},
+                                    judging_weights={}))
     assert flat["test"]["auprc"] == pytest.approx(share)
     for name, row in learning["strategies"].items():
         assert row["seeds"] == 2 and len(row["auprc"]) == 2
