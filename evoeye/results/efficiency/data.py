@@ -17,8 +17,10 @@ With `val_collisions` the validation set is enriched with collisions (`extend_va
 validation batch's own stream (`plan_uniform` with its seed; a longer plan begins with the
 shorter one) is drawn on past its `val_runs`, in chunks of `val_runs` runs (batch
 `val-more-seed<its seed>`), until the further runs hold enough collisions; the first ones in
-stream order are kept, so the set is the same whatever was simulated before. Only the unsafe
-windows of those runs join the validation set (`sets.RegimeData.load`): its negatives stay the
+stream order are kept, so the set is the same whatever was simulated before (the further runs
+are simulated for their outcome and only the colliding ones logged: where failures are rare the
+others would be gigabytes of logs no set reads). Only the unsafe windows of those runs join the
+validation set (`sets.RegimeData.load`): its negatives stay the
 uniform batch's, so a threshold calibrated for a target false-positive rate is calibrated on the
 same frames, while early stopping gets more positives, drawn from the same distribution (uniform
 runs that collided). Whole colliding runs would not do: their frames before the horizon are
@@ -202,8 +204,8 @@ def draw_collisions(data: DataRoot, regime: str, seed: int, n: int, want: int, b
                              ads=profile)[n + drawn:]
         say(f"{regime}: validation stream, runs {n + drawn}–{n + drawn + n - 1} "
             f"({len(kept)} of {need} further collisions)")
-        outcome = {r.scenario_id: r.status == "ok" and r.collided
-                   for r in run_batch(specs, data, workers=workers).results}
+        outcome = {r.scenario_id: r.status == "ok" and r.collided  # only they are logged
+                   for r in run_batch(specs, data, workers=workers, collisions_only=True).results}
         kept += [s.scenario_id for s in specs if outcome[s.scenario_id]]
         drawn += n
     kept = kept[:max(need, 0)]

@@ -38,10 +38,13 @@ def test_the_validation_set_holds_the_asked_collisions_from_its_own_stream(tmp_p
     kept = extend_validation(data, REGIME, asked)
     assert len(kept) == 2 and base + len(kept) >= asked.val_collisions
     drawn = json.loads((data.path / VAL_FILE).read_text())["drawn"]
+    logged = sorted(p.name.removesuffix(".mcap") for p in
+                    data.batch_dir(REGIME, f"val-more-seed{seed}").glob("*.mcap"))
     stream = plan_uniform(REGIME, 4 + drawn, seed)[4:]  # the batch's stream, past the batch
     collided = {r.scenario_id: r.collided for r in run_batch(
         [replace(s, batch=f"val-more-seed{seed}") for s in stream], data).results}
     assert kept == [s.scenario_id for s in stream if collided[s.scenario_id]][:2]  # the first
+    assert logged == sorted(i for i, hit in collided.items() if hit)  # only they were logged
     assert val_extra_ids(data, asked) == kept
     logs = sorted(data.path.rglob("*.mcap"))
     fewer = extend_validation(data, REGIME, replace(config, val_collisions=base + 1))
