@@ -18,8 +18,8 @@ validation batch's own stream (`plan_uniform` with its seed; a longer plan begin
 shorter one) is drawn on past its `val_runs`, in chunks of `val_runs` runs (batch
 `val-more-seed<its seed>`), until the further runs hold enough collisions; the first ones in
 stream order are kept, so the set is the same whatever was simulated before (the further runs
-are simulated for their outcome and only the colliding ones logged: where failures are rare the
-others would be gigabytes of logs no set reads). Only the unsafe windows of those runs join the
+are simulated for their outcome and only the colliding ones logged, chunk by chunk, resumably:
+`stream.py`). Only the unsafe windows of those runs join the
 validation set (`sets.RegimeData.load`): its negatives stay the
 uniform batch's, so a threshold calibrated for a target false-positive rate is calibrated on the
 same frames, while early stopping gets more positives, drawn from the same distribution (uniform
@@ -40,6 +40,7 @@ from evoeye.atomic import atomic_file
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.paths import DataRoot
 from evoeye.results.efficiency.config import EfficiencyConfig, parse_regime
+from evoeye.results.efficiency.stream import collisions, draw_on
 from evoeye.scenarios import get_scenario
 from evoeye.sim.episode import RunSpec
 from evoeye.sim.runner import run_spec
@@ -49,7 +50,8 @@ SETS = ("pool", "test", "val", "oracle")  # uniform batches, seeds data_seed + t
 BOUNDARY_BATCH = "boundary"
 BOUNDARY_FILE = "boundary.json"
 VAL_FILE = "val-collisions.json"
-VAL_MAX_CHUNKS = 50  # further validation runs drawn at most, in units of val_runs
+VAL_MAX_CHUNKS = 100  # further validation runs drawn at most, in units of val_runs
+VAL_DRAW_FILE = "val-draw.json"  # the further runs drawn (`stream.draw_on`'s record)
 Say = Callable[[str], None]
 
 
@@ -189,25 +191,20 @@ def draw_collisions(data: DataRoot, regime: str, seed: int, n: int, want: int, b
     """Draw the stream of the uniform batch `batch` (`n` runs of `seed`) on until it holds
     `want` colliding runs (module doc); the ids of the further colliding runs kept, in stream
     order (none when the batch holds enough), also written to `val-collisions.json`.
-    ValueError, with nothing written, if VAL_MAX_CHUNKS × n further runs do not hold enough."""
-    say = say or (lambda msg: None)
+    ValueError, with `val-collisions.json` not written, if VAL_MAX_CHUNKS × n further runs do
+    not hold enough (the draw's record keeps what was simulated)."""
     scenario, profile = parse_regime(regime)
     base = run_batch(plan_uniform(scenario, n, seed, batch=batch, ads=profile), data,
                      workers=workers).collisions
-    need, drawn, kept = want - base, 0, []
-    while len(kept) < need:
-        if drawn >= VAL_MAX_CHUNKS * n:
-            raise ValueError(f"{regime}: {drawn} further validation runs held {len(kept)} "
-                             f"collisions, {need} short of val_collisions = "
-                             f"{want} with the batch's {base}: ask fewer")
-        specs = plan_uniform(scenario, n + drawn + n, seed, batch=f"val-more-seed{seed}",
-                             ads=profile)[n + drawn:]
-        say(f"{regime}: validation stream, runs {n + drawn}–{n + drawn + n - 1} "
-            f"({len(kept)} of {need} further collisions)")
-        outcome = {r.scenario_id: r.status == "ok" and r.collided  # only they are logged
-                   for r in run_batch(specs, data, workers=workers, collisions_only=True).results}
-        kept += [s.scenario_id for s in specs if outcome[s.scenario_id]]
-        drawn += n
+    need = want - base
+    chunks = draw_on(data, regime, seed, n, n, f"val-more-seed{seed}", data.path / VAL_DRAW_FILE,
+                     lambda cs: len(collisions(cs)) >= need, VAL_MAX_CHUNKS, workers=workers,
+                     say=say)
+    kept, drawn = collisions(chunks), len(chunks) * n
+    if len(kept) < need:
+        raise ValueError(f"{regime}: {drawn} further validation runs held {len(kept)} "
+                         f"collisions, {need} short of val_collisions = {want} with the batch's "
+                         f"{base}: ask fewer")
     kept = kept[:max(need, 0)]
     with atomic_file(data.path / VAL_FILE) as f:
         f.write(json.dumps({"regime": regime, "val_runs": n, "seed": seed,

@@ -17,20 +17,19 @@ stratified by outcome:
 Every count and area on it (`frame_metrics`' `weight`) is then the one of the whole stream's
 windows in expectation: unbiased for each threshold's counts, and consistent for AUPRC and AUROC
 (ratios of them). Runs that failed to simulate are in neither stratum. The chunks drawn, with
-their colliding runs in stream order, are kept in `test-draw.json`: a re-run draws only what is
-missing, and the set is the same whatever was simulated before.
+their colliding runs in stream order, are kept in `test-draw.json` (`efficiency.stream`): a
+re-run draws only what is missing, and the set is the same whatever was simulated before.
 """
 
 from __future__ import annotations
 
-import json
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from evoeye.atomic import atomic_file
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.paths import DataRoot
 from evoeye.results.efficiency.config import parse_regime
+from evoeye.results.efficiency.stream import collisions, draw_on
 from evoeye.sim.episode import STATUS_OK
 
 TEST_DRAW_FILE = "test-draw.json"
@@ -69,55 +68,16 @@ def more_batch(seed: int) -> str:
     return f"test-more-seed{seed}"
 
 
-def _key(seed: int, n: int) -> dict:
-    return {"seed": seed, "test_runs": n, "chunk": min(CHUNK, n)}
-
-
-def _record(data: DataRoot, seed: int, n: int) -> list[dict]:
-    """The chunks drawn so far past the `n`-run batch of `seed` (none if another was drawn)."""
-    path = data.path / TEST_DRAW_FILE
-    found = json.loads(path.read_bytes()) if path.is_file() else {}
-    return list(found["chunks"]) if {k: found.get(k) for k in _key(seed, n)} == _key(seed, n) \
-        else []
-
-
-def _used(chunks: list[dict], base_collided: int, want: int, n: int,
-          max_runs: int) -> tuple[int, bool]:
-    """(chunks of the record the set uses, whether they are enough: `want` collisions reached,
-    or the stream at `max_runs`)."""
-    hit, size = base_collided, min(CHUNK, n)
-    for k, chunk in enumerate(chunks):
-        if hit >= want or n + k * size >= max_runs:
-            return k, True
-        hit += len(chunk["collided"])
-    return len(chunks), hit >= want or n + len(chunks) * size >= max_runs
-
-
 def draw_test_failures(data: DataRoot, regime: str, seed: int, n: int, batch: str, want: int,
                        max_runs: int, *, workers: int = 1, say: Say | None = None) -> TestDraw:
     """Simulate (or resume) the `n`-run Test batch `batch` of `seed`, then draw its stream on
     until it holds `want` collisions or `max_runs` runs (module doc); the draw."""
-    say = say or (lambda msg: None)
     scenario, profile = parse_regime(regime)
     base = run_batch(plan_uniform(scenario, n, seed, batch=batch, ads=profile), data,
                      workers=workers)
-    base_ok = base.count(lambda r: r.status == STATUS_OK)
-    chunks, size = _record(data, seed, n), min(CHUNK, n)
-    while not (done := _used(chunks, base.collisions, want, n, max_runs))[1]:
-        start = n + len(chunks) * size
-        specs = plan_uniform(scenario, start + size, seed, batch=more_batch(seed),
-                             ads=profile)[start:]
-        found = sum(len(c["collided"]) for c in chunks) + base.collisions
-        say(f"{regime}: Test stream, runs {start}–{start + size - 1} ({found} of {want} "
-            "collisions; outcome only, logs of the collisions)")
-        results = {r.scenario_id: r for r in run_batch(specs, data, workers=workers,
-                                                        collisions_only=True).results}
-        ok = [s.scenario_id for s in specs if results[s.scenario_id].status == STATUS_OK]
-        chunks.append({"ok": len(ok), "collided": [i for i in ok if results[i].collided]})
-        with atomic_file(data.path / TEST_DRAW_FILE) as f:
-            f.write(json.dumps({"regime": regime, **_key(seed, n), "chunks": chunks},
-                               indent=1).encode())
-    used = chunks[:done[0]]
-    return TestDraw(n + len(used) * size, base_ok, base.collisions,
-                    sum(c["ok"] for c in used),
-                    tuple(i for c in used for i in c["collided"]))
+    size = min(CHUNK, n)
+    used = draw_on(data, regime, seed, n, size, more_batch(seed), data.path / TEST_DRAW_FILE,
+                   lambda cs: base.collisions + len(collisions(cs)) >= want,
+                   max(0, -(-(max_runs - n) // size)), workers=workers, say=say)
+    return TestDraw(n + len(used) * size, base.count(lambda r: r.status == STATUS_OK),
+                    base.collisions, sum(c["ok"] for c in used), tuple(collisions(used)))

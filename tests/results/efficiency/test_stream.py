@@ -1,0 +1,37 @@
+"""A batch's stream drawn on for its collisions: outcome first, only collisions logged, and a
+killed draw resumed at its first missing chunk."""
+
+from __future__ import annotations
+
+from evoeye.batch import plan_uniform
+from evoeye.paths import DataRoot
+from evoeye.results.efficiency.stream import collisions, draw_on
+from evoeye.sim.runner import run_episode
+
+REGIME = "highway-cut-in:default"  # collisions are common: a short stream holds some
+SEED, START, CHUNK = 77, 4, 4
+
+
+def test_a_draw_stops_when_told_and_resumes_at_its_first_missing_chunk(tmp_path) -> None:
+    data = DataRoot.resolve(tmp_path / "data")
+    record = data.path / "draw.json"
+    said: list[str] = []
+
+    def draw(max_chunks: int, enough=lambda chunks: False):
+        return draw_on(data, REGIME, SEED, START, CHUNK, "more", record, enough, max_chunks,
+                       say=said.append)
+
+    first = draw(1)  # as if killed after one chunk
+    assert len(first) == 1 and len(said) == 1 and f"runs {START}–{START + CHUNK - 1}" in said[0]
+    said.clear()
+    both = draw(2)
+    assert both[0] == first[0] and len(both) == 2
+    assert len(said) == 1 and f"runs {START + CHUNK}–" in said[0]  # only the missing chunk
+    stream = plan_uniform("highway-cut-in", START + 2 * CHUNK, SEED, batch="more")[START:]
+    hit = [s.scenario_id for s in stream if run_episode(s).outcome.collided]
+    assert collisions(both) == hit and [c["ok"] for c in both] == [CHUNK, CHUNK]
+    logged = sorted(p.name.removesuffix(".mcap") for p in data.path.rglob("*.mcap"))
+    assert logged == sorted(hit)  # the safe runs were simulated for their outcome only
+    said.clear()
+    assert draw(2, enough=lambda chunks: len(chunks) >= 1) == first  # less asked: a prefix
+    assert said == []
