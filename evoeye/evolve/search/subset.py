@@ -33,6 +33,13 @@ Why not openturns' `SubsetSampling`: it owns the sampling loop (it calls the mod
 while a strategy here proposes a batch at a time, resumably; the algorithm is a few dozen
 lines on scipy.stats.norm.
 
+`subset-deep`: the same walk at p0 = 0.5, so every chain takes one step per level and a level
+costs one batch (N = 2c). The cost of a factor e in probability is c (1/p0 − 1) / ln(1/p0)
+runs: 25 at p0 = 0.2 and c = 10, 14 at p0 = 0.5. At P ≈ 10⁻³ with 200 runs, p0 = 0.2 spends its
+budget reaching the fourth level (P(F_4) = 0.0016 at run 170), while p0 = 0.5 reaches 2⁻⁹ by
+run 110 and walks inside F for the rest. Its estimate is the same estimator at p0 = 0.5 (more
+levels, each of more correlated samples: a larger spread, the same asymptotic validity).
+
 Determinism and resume. Every quantity above is a function of the strategy's own records (its
 runs after the n_init there were at its first proposal) and of `default_rng([seed, b])` for
 batch b, so a resumed strategy rebuilds every proposal. Generative mode only: a pool's finite
@@ -54,6 +61,7 @@ from evoeye.evolve.search.strategies import BatchedStrategy
 from evoeye.scenarios import LogicalScenario
 
 P0 = 0.2  # the conditional probability of each level
+P0_DEEP = 0.5  # `subset-deep`'s: a level per batch of chain steps
 SIGMA = 0.6  # the conditional sampling's spread on the first level of chains
 SIGMA_MIN = 0.1
 TARGET_ACCEPT = 0.44
@@ -194,3 +202,17 @@ class SubsetSimulation(BatchedStrategy):
         return [Proposal(x=np.array(xi_, dtype=float), kind=self.name,
                          parent=records.n - b * self.batch + int(s))
                 for xi_, s in zip(x, w.states, strict=True)]
+
+
+class DeepSubsetSimulation(SubsetSimulation):
+    """`subset-deep`: subset simulation at p0 = 0.5, a level per batch (module doc)."""
+
+    name = "subset-deep"
+
+    def __init__(self, space: LogicalScenario, seed: int, batch: int = 20,
+                 p0: float = P0_DEEP) -> None:
+        super().__init__(space, seed, batch, p0)
+
+
+# every subset-simulation strategy by name, with the p0 its estimate is taken at
+LEVEL_P0 = {SubsetSimulation.name: P0, DeepSubsetSimulation.name: P0_DEEP}

@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from evoeye.evolve.search import Records, StrategyError, make_strategy
-from evoeye.evolve.search.subset import Walk, subset_estimate
+from evoeye.evolve.search.subset import LEVEL_P0, Walk, subset_estimate
 from evoeye.scenarios import get_scenario
 
 HIGHWAY = get_scenario("highway-cut-in")
@@ -96,3 +96,49 @@ def test_it_refuses_a_pool_and_a_bad_p0():
         s.propose(Records.empty(HIGHWAY.dim))
     with pytest.raises(StrategyError, match="p0 must be in"):
         make_strategy("subset", HIGHWAY, 0, p0=0.9)
+
+
+def deep_and_default(seed, p, n=200):
+    """The collisions `subset` and `subset-deep` find in n runs at one seed, and their walks."""
+    out = []
+    for name in ("subset", "subset-deep"):
+        _, records, _ = acquire(seed, n, p, strategy=make_strategy(name, HIGHWAY, seed,
+                                                                   batch=CHAINS))
+        p0 = LEVEL_P0[name]
+        out.append((int(records.collided.sum()),
+                    Walk.replay(records.fitness, records.collided, CHAINS, p0),
+                    subset_estimate(records.fitness, records.collided, CHAINS, p0)))
+    return out
+
+
+def test_subset_deep_goes_deeper_and_finds_more_where_subset_runs_out_of_budget():
+    # p = 10⁻⁴: four levels of p0 = 0.2 (all 200 runs allow) stop at P(F_4) = 0.0016
+    p, seeds = 1e-4, range(12)
+    runs = [deep_and_default(seed, p) for seed in seeds]
+    default_found = [r[0][0] for r in runs]
+    deep_found = [r[1][0] for r in runs]
+    assert all(r[0][1].level <= 4 for r in runs)
+    assert all(r[1][1].level >= 9 for r in runs)  # 0.5⁹ ≈ 0.002: past p0 = 0.2's reach
+    assert np.mean(deep_found) >= 5 * max(np.mean(default_found), 200 * p)
+    assert sum(f > 0 for f in deep_found) > sum(f > 0 for f in default_found)
+
+
+def test_subset_deep_estimates_p_from_its_own_levels():
+    p = 0.0016
+    estimates = [deep_and_default(seed, p)[1][2] for seed in range(30)]
+    assert np.mean(estimates) == pytest.approx(p, rel=0.35)
+    # the same runs read at p0 = 0.2 would be off several times over: the p0 matters
+    _, records, _ = acquire(0, 200, p, strategy=make_strategy("subset-deep", HIGHWAY, 0,
+                                                              batch=CHAINS))
+    deep = subset_estimate(records.fitness, records.collided, CHAINS, LEVEL_P0["subset-deep"])
+    assert subset_estimate(records.fitness, records.collided, CHAINS) > 5 * deep
+
+
+def test_subset_deep_is_subset_at_another_p0_and_subset_keeps_its_own():
+    a = make_strategy("subset-deep", HIGHWAY, 5, batch=CHAINS, p0=0.2)
+    _, _, deep = acquire(5, 120, 0.014, strategy=a)
+    _, _, default = acquire(5, 120, 0.014)
+    assert [q.x.tolist() for q in deep] == [q.x.tolist() for q in default]
+    assert make_strategy("subset", HIGHWAY, 0).p0 == 0.2
+    assert make_strategy("subset-deep", HIGHWAY, 0).p0 == 0.5
+    assert Walk(CHAINS, 0.5).steps_per_level == 1 and Walk(CHAINS, 0.5).per_level == 20

@@ -101,3 +101,16 @@ def test_bias_interval_stays_open_where_uniform_saw_no_failure():
     # Wilson's reaches 0.48 %, so the difference's interval holds 0
     assert b["diff"] == pytest.approx(0.00125)
     assert b["low"] < 0 < b["high"]
+
+
+def test_subset_strategies_estimate_at_their_own_p0():
+    # 12 collisions in the first 20 runs, then 40 safe ones: subset-deep's level 0 is 20 runs
+    # (c / p0 = 10 / 0.5) and holds c collisions (estimate 12 / 20); subset's is 50 (12 / 50)
+    c = curve([i < 12 for i in range(60)])
+    for i, run in enumerate(c["runs"]):
+        run["fitness"] = 0.0 if i < 12 else 0.5
+    seeds = {str(s): c for s in range(2)}
+    out = estimates({"uniform": seeds, "subset": seeds, "subset-deep": seeds}, runs=60,
+                    batch=10)
+    assert out["subset-deep"]["per_seed"]["0"] == pytest.approx(12 / 20)
+    assert out["subset"]["per_seed"]["0"] == pytest.approx(12 / 50)
