@@ -40,10 +40,11 @@ from evoeye.evaluation.stats import (
     rate_ci,
 )
 from evoeye.evolve.search.records import Records
-from evoeye.evolve.search.subset import LEVEL_P0, subset_estimate
+from evoeye.evolve.search.subset import subset_estimate
 from evoeye.results.rare.config import ESTIMATING, REFERENCE, RareConfig
 
 PER = 100  # failures per PER simulated runs
+SUBSET = "subset"  # estimates from its levels, not from weights
 N_RESAMPLES = 10_000
 
 
@@ -139,9 +140,8 @@ def bias(values: np.ndarray, hits: int, runs: int) -> dict:
 def estimate(name: str, curve: dict, batch: int) -> float:
     """One curve's estimate of the failure rate under p (module doc); `batch`: the runs
     between two adaptations (subset simulation's chains)."""
-    if name in LEVEL_P0:  # subset simulation estimates from its levels, not from weights
-        return subset_estimate([r["fitness"] for r in curve["runs"]], _hits(curve), batch,
-                               LEVEL_P0[name])
+    if name == SUBSET:
+        return subset_estimate([r["fitness"] for r in curve["runs"]], _hits(curve), batch)
     return failure_rate(_hits(curve), weights(curve)).value or 0.0
 
 
