@@ -8,8 +8,9 @@ SPLIT_SEED, TRAIN_FRAC, VAL_FRAC = 0, 0.5, 0.125  # evoeye.store.SplitSpec()
 # evoeye.monitor.recipes
 RECIPE_NAMES, COMMAND_RECIPE = ("v1", "v2", "v3", "lookahead-v1"), "lookahead-v1"
 STRATEGY_NAMES = ("evoeye", "no-feedback", "no-density", "uniform", "avfuzzer", "sobol",
-                  "boundary", "disagreement", "evoeye-knn",
-                  "evoeye-forest", "ce-is", "subset")  # evoeye.evolve.search.STRATEGIES
+                  "boundary", "disagreement", "evoeye-knn", "evoeye-forest", "ce-is",
+                  "subset", "subset-deep",
+                  "subset-spread")  # evoeye.evolve.search.STRATEGIES
 FAMILY_NAMES = ("fusion", "aem")  # evoeye.monitor.families.evolvable_families()
 METHOD_NAMES = (*STRATEGY_NAMES, "aem-evo")  # evoeye.evolve.campaign.experiment.methods()
 CONTEXT_LEN = 5  # evoeye.store.windows.DEFAULT_CONTEXT_LEN

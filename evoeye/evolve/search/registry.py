@@ -8,7 +8,8 @@
   smoothed feedback potential, `smoothed.py`), and `ce-is` (cross-entropy adaptive importance
   sampling with a defensive mixture: exact weights p/q for rare events, `cross_entropy.py`) and
   `subset` (subset simulation: Markov chains conditioned level by level towards the failures,
-  `subset.py`).
+  `subset.py`), and `subset-deep` (the same at p0 = 0.5: a level per batch, deeper in the
+  same budget), and `subset-spread` (`subset-deep` seeded from distinct runs only).
 
 `make_strategy(…, pool=rows)` restricts any of them to a finite pool of candidates (`pool.py`).
 """
@@ -31,7 +32,11 @@ from evoeye.evolve.search.protocol import Strategy, StrategyError
 from evoeye.evolve.search.smoothed import smoothed
 from evoeye.evolve.search.sobol import SobolStrategy
 from evoeye.evolve.search.strategies import UniformStrategy, density_strategy
-from evoeye.evolve.search.subset import SubsetSimulation
+from evoeye.evolve.search.subset import (
+    DeepSubsetSimulation,
+    SpreadSubsetSimulation,
+    SubsetSimulation,
+)
 from evoeye.scenarios import LogicalScenario
 
 StrategyFactory = Callable[..., Strategy]
@@ -49,14 +54,16 @@ STRATEGIES: dict[str, StrategyFactory] = {
     "evoeye-forest": smoothed("evoeye-forest"),
     "ce-is": CrossEntropyIS,
     "subset": SubsetSimulation,
+    "subset-deep": DeepSubsetSimulation,
+    "subset-spread": SpreadSubsetSimulation,
 }
 # Strategies whose proposals never read the records' feedback: the feedback mode cannot change
 # what they acquire (the monitor updates are the same too), so it is not part of their identity.
 # (`disagreement` reads the committee's scores, which the feedback mode rescales.)
 FEEDBACK_BLIND = frozenset({"uniform", "avfuzzer", "no-feedback", "sobol", "boundary",
-                            "ce-is", "subset"})
+                            "ce-is", "subset", "subset-deep", "subset-spread"})
 # Strategies that propose new points only: a pool's finite rows cannot host them.
-GENERATIVE_ONLY = frozenset({"subset"})
+GENERATIVE_ONLY = frozenset({"subset", "subset-deep", "subset-spread"})
 # Strategies whose records need the committee's disagreement (`Records.disagreement`).
 READS_DISAGREEMENT = frozenset({"disagreement"})
 

@@ -33,6 +33,25 @@ Why not openturns' `SubsetSampling`: it owns the sampling loop (it calls the mod
 while a strategy here proposes a batch at a time, resumably; the algorithm is a few dozen
 lines on scipy.stats.norm.
 
+`subset-deep`: the same walk at p0 = 0.5, so every chain takes one step per level and a level
+costs one batch (N = 2c). The cost of a factor e in probability is c (1/p0 − 1) / ln(1/p0)
+runs: 25 at p0 = 0.2 and c = 10, 14 at p0 = 0.5. At P ≈ 10⁻³ with 200 runs, p0 = 0.2 spends its
+budget reaching the fourth level (P(F_4) = 0.0016 at run 170), while p0 = 0.5 reaches 2⁻⁹ by
+run 110 and walks inside F for the rest. The same estimator at p0 = 0.5 is near P on a clean
+level (the tests' synthetic outcome) but not where the level is noisy (below): one step per
+level leaves the chains no time to mix, a level's threshold falls with its luckiest runs rather
+than with half its mass, and on the highway under the `defensive` stack its estimates were a
+tenth of Uniform's. The rare-failure protocol takes no estimate from it.
+
+`subset-spread`: `subset-deep` whose levels are taken over distinct runs, so a chain that
+stayed put is one sample, not one per step. Where the level is noisy (on the highway under the
+`defensive` stack a colliding θ collides again in about 1 of 8 runs with other run seeds, and a
+safe run's peak risk of 30 falls to a median of 1.3), a lucky run drags the threshold below
+anything its neighbours reach, its copies fill the next level's seeds and every chain parks on
+it. Seeding from distinct runs keeps c chains on c different runs, and the walk enters F only
+once c distinct runs collided. Its levels are no longer conditional probabilities of p0
+either: it does not estimate P(F).
+
 Determinism and resume. Every quantity above is a function of the strategy's own records (its
 runs after the n_init there were at its first proposal) and of `default_rng([seed, b])` for
 batch b, so a resumed strategy rebuilds every proposal. Generative mode only: a pool's finite
@@ -54,6 +73,7 @@ from evoeye.evolve.search.strategies import BatchedStrategy
 from evoeye.scenarios import LogicalScenario
 
 P0 = 0.2  # the conditional probability of each level
+P0_DEEP = 0.5  # `subset-deep`'s: a level per batch of chain steps
 SIGMA = 0.6  # the conditional sampling's spread on the first level of chains
 SIGMA_MIN = 0.1
 TARGET_ACCEPT = 0.44
@@ -66,6 +86,7 @@ class Walk:
 
     chains: int
     p0: float
+    distinct: bool = False  # seeds from distinct runs only (`subset-spread`: no estimate)
     level: int = 0
     final: bool = False  # the chains walk in F itself
     threshold: float = math.inf
@@ -97,10 +118,11 @@ class Walk:
         return out
 
     @classmethod
-    def replay(cls, fitness: np.ndarray, collided: np.ndarray, chains: int, p0: float) -> Walk:
+    def replay(cls, fitness: np.ndarray, collided: np.ndarray, chains: int, p0: float,
+               distinct: bool = False) -> Walk:
         """The walk after the runs (fitness, collided) (n,), in the order they were proposed
         (level 0's N, then whole batches of `chains`)."""
-        w = cls(chains, p0)
+        w = cls(chains, p0, distinct)
         n, pos = len(fitness), w.per_level
         w.samples = list(range(min(n, pos)))
         if n < pos:
@@ -127,6 +149,9 @@ class Walk:
         """The next level from the current one's samples (complete): its seeds and threshold,
         or, once c of them collided, the walk inside F; σ from this level's acceptance."""
         rows = np.array(self.samples, dtype=np.int64)
+        if self.distinct:  # a chain that stayed put counts once: ≥ c rows remain (level 0's
+            # N are distinct, and every later level holds its c distinct seeds)
+            rows = np.array(list(dict.fromkeys(self.samples)), dtype=np.int64)
         if self.steps:
             rate = self.accepted / (self.chains * self.steps)
             self.sigma = float(np.clip(self.sigma * math.exp(rate - TARGET_ACCEPT), SIGMA_MIN,
@@ -169,6 +194,7 @@ class SubsetSimulation(BatchedStrategy):
     """Subset simulation with c = `batch` chains (module doc)."""
 
     name = "subset"
+    distinct = False  # Walk.distinct
 
     def __init__(self, space: LogicalScenario, seed: int, batch: int = 20,
                  p0: float = P0) -> None:
@@ -182,7 +208,7 @@ class SubsetSimulation(BatchedStrategy):
             raise StrategyError(f"{self.name}: generative mode only (a chain's proposals are "
                                 "new points, not rows of a pool)")
         mine = records.tail(records.n - b * self.batch)  # its own runs
-        w = Walk.replay(mine.fitness, mine.collided, self.batch, self.p0)
+        w = Walk.replay(mine.fitness, mine.collided, self.batch, self.p0, self.distinct)
         rng = np.random.default_rng([self.seed, b])
         if b * self.batch < w.per_level:  # level 0: draws from p
             x = self.space.sample(rng, self.batch)
@@ -194,3 +220,21 @@ class SubsetSimulation(BatchedStrategy):
         return [Proposal(x=np.array(xi_, dtype=float), kind=self.name,
                          parent=records.n - b * self.batch + int(s))
                 for xi_, s in zip(x, w.states, strict=True)]
+
+
+class DeepSubsetSimulation(SubsetSimulation):
+    """`subset-deep`: subset simulation at p0 = 0.5, a level per batch (module doc)."""
+
+    name = "subset-deep"
+
+    def __init__(self, space: LogicalScenario, seed: int, batch: int = 20,
+                 p0: float = P0_DEEP) -> None:
+        super().__init__(space, seed, batch, p0)
+
+
+class SpreadSubsetSimulation(DeepSubsetSimulation):
+    """`subset-spread`: `subset-deep` whose seeds are distinct runs (module doc); it does not
+    estimate P(F)."""
+
+    name = "subset-spread"
+    distinct = True

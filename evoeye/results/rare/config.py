@@ -28,9 +28,10 @@ from evoeye.results.efficiency.config import MAX_MEMBERS, RECIPES, dataclass_fro
 REFERENCE = "uniform"
 STRATEGIES = (REFERENCE, "ce-is")
 # the strategies that need no monitor (the protocol trains none): the others read feedback
-USABLE = (REFERENCE, "ce-is", "subset", "sobol", "avfuzzer")
+USABLE = (REFERENCE, "ce-is", "subset", "subset-deep", "subset-spread", "sobol", "avfuzzer")
 # the strategies that estimate the failure rate under p: from their runs' exact p/q (Uniform:
-# 1; ce-is), or, for subset simulation, from its levels (`evoeye.evolve.search.subset`)
+# 1; ce-is), or, for subset simulation, from its levels (`evoeye.evolve.search.subset`; not
+# subset-deep's one-step levels, whose estimate a noisy level biases, nor subset-spread's)
 ESTIMATING = (REFERENCE, "ce-is", "subset")
 # the strategies whose runs carry their exact p/q (Uniform: 1): the ones an importance-weighted
 # monitor can be trained on (the learning side trains the others unweighted)

@@ -48,7 +48,8 @@ def _run(strategy, space, records, n, start=0):
 def test_registry_holds_the_paper_strategies_and_the_new_ones_and_each_is_a_strategy():
     assert set(STRATEGIES) == {"evoeye", "uniform", "avfuzzer", "no-feedback", "no-density",
                                "sobol", "boundary", "disagreement", "evoeye-knn",
-                               "evoeye-forest", "ce-is", "subset"}
+                               "evoeye-forest", "ce-is", "subset", "subset-deep",
+                               "subset-spread"}
     for name in STRATEGIES:
         strategy = make_strategy(name, CROSSING, seed=1)
         assert isinstance(strategy, Strategy)

@@ -96,3 +96,72 @@ def test_it_refuses_a_pool_and_a_bad_p0():
         s.propose(Records.empty(HIGHWAY.dim))
     with pytest.raises(StrategyError, match="p0 must be in"):
         make_strategy("subset", HIGHWAY, 0, p0=0.9)
+
+
+
+def found_and_walk(name, seed, p, n=200):
+    """The collisions strategy `name` finds in n runs at one seed, and its walk after them."""
+    strategy = make_strategy(name, HIGHWAY, seed, batch=CHAINS)
+    _, records, _ = acquire(seed, n, p, strategy=strategy)
+    walk = Walk.replay(records.fitness, records.collided, CHAINS, strategy.p0,
+                       strategy.distinct)
+    return int(records.collided.sum()), walk
+
+
+def test_subset_deep_goes_deeper_and_finds_more_where_subset_runs_out_of_budget():
+    # p = 10⁻⁴: the levels of p0 = 0.2 that 200 runs allow stop at P(F_4) = 0.0016
+    p, seeds = 1e-4, range(12)
+    default = [found_and_walk("subset", seed, p) for seed in seeds]
+    deep = [found_and_walk("subset-deep", seed, p) for seed in seeds]
+    assert all(w.level <= 4 for _, w in default)
+    assert all(w.level >= 9 for _, w in deep)  # 0.5⁹ ≈ 0.002: past p0 = 0.2's reach
+    assert np.mean([f for f, _ in deep]) >= 5 * max(np.mean([f for f, _ in default]), 200 * p)
+    assert sum(f > 0 for f, _ in deep) > sum(f > 0 for f, _ in default)
+
+
+def test_subset_deep_is_subset_at_another_p0_and_subset_keeps_its_own():
+    a = make_strategy("subset-deep", HIGHWAY, 5, batch=CHAINS, p0=0.2)
+    _, _, deep = acquire(5, 120, 0.014, strategy=a)
+    _, _, default = acquire(5, 120, 0.014)
+    assert [q.x.tolist() for q in deep] == [q.x.tolist() for q in default]
+    assert make_strategy("subset", HIGHWAY, 0).p0 == 0.2
+    assert make_strategy("subset-deep", HIGHWAY, 0).p0 == 0.5
+    assert Walk(CHAINS, 0.5).steps_per_level == 1 and Walk(CHAINS, 0.5).per_level == 20
+    # subset-spread is subset-deep until a level's seeds would repeat a run
+    _, _, deep = acquire(5, 200, 0.0016, strategy=make_strategy("subset-deep", HIGHWAY, 5,
+                                                                 batch=CHAINS))
+    _, _, spread = acquire(5, 200, 0.0016, strategy=make_strategy("subset-spread", HIGHWAY, 5,
+                                                                   batch=CHAINS))
+    same = [d.x.tolist() == s.x.tolist() for d, s in zip(deep, spread, strict=True)]
+    assert all(same[:30]) and not all(same)
+
+
+def test_subset_spread_seeds_its_chains_from_distinct_runs():
+    # level 0 (20 runs), then one step in which only chain 0 (seeded at run 19) moved, to the
+    # lowest run yet: in subset-deep's level every chain that stayed put counts twice (its seed
+    # and its state), so five runs fill its ten seeds; subset-spread's are ten distinct runs,
+    # and its threshold falls less
+    fitness = np.r_[np.linspace(0.9, 0.3, 20), [0.1], [0.95] * 9]
+    collided = np.zeros(30, bool)
+    deep = Walk.replay(fitness, collided, CHAINS, 0.5)
+    spread = Walk.replay(fitness, collided, CHAINS, 0.5, distinct=True)
+    assert deep.level == spread.level == 2
+    assert sorted(deep.states) == [15, 15, 16, 16, 17, 17, 18, 18, 19, 20]
+    assert sorted(spread.states) == list(range(11, 21))
+    assert spread.threshold == fitness[11] > deep.threshold == fitness[15]
+
+
+def test_subset_spread_does_not_walk_inside_f_on_copies_of_one_failure():
+    # one collision in level 0, then every candidate rejected: its copies double every level
+    fitness = np.r_[[0.5] * 19, [0.0], [0.9] * 40]
+    collided = fitness == 0.0
+    deep = Walk.replay(fitness, collided, CHAINS, 0.5)
+    spread = Walk.replay(fitness, collided, CHAINS, 0.5, distinct=True)
+    assert deep.final and set(deep.states) == {19}  # every chain parked on the one failure
+    assert not spread.final and len(set(spread.states)) == CHAINS
+
+
+def test_subset_spread_finds_more_failures_than_p_and_reaches_them_on_every_seed():
+    p = 0.0016
+    found = [found_and_walk("subset-spread", seed, p)[0] for seed in range(12)]
+    assert np.mean(found) >= 10 * 200 * p and min(found) > 0

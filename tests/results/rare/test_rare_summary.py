@@ -101,3 +101,15 @@ def test_bias_interval_stays_open_where_uniform_saw_no_failure():
     # Wilson's reaches 0.48 %, so the difference's interval holds 0
     assert b["diff"] == pytest.approx(0.00125)
     assert b["low"] < 0 < b["high"]
+
+
+def test_subset_variants_find_but_do_not_estimate():
+    # their levels are not conditional probabilities of p0 where the level is noisy
+    # (`evoeye.evolve.search.subset`): they get a failures-found row and no estimate
+    hits = {str(s): curve([i < 2 for i in range(50)]) for s in range(3)}
+    for c in hits.values():
+        for r in c["runs"]:
+            r["fitness"] = 0.0 if r["collided"] else 0.5
+    curves = {"uniform": hits, "subset": hits, "subset-deep": hits, "subset-spread": hits}
+    assert set(found(curves)) == set(curves)
+    assert set(estimates(curves, runs=50, batch=10)) == {"reference", "uniform", "subset"}
