@@ -214,6 +214,10 @@ def results_command(
     rare_members: Annotated[int, typer.Option(
         min=1, max=8, help="Rare-failure protocol, learning side: from-scratch members of "
                            "each monitor.")] = L.members,
+    rare_learn_control: Annotated[list[str] | None, typer.Option(
+        "--rare-learn-control", help="Rare-failure protocol, learning side: a weighted "
+        "strategy (ce-is) whose runs also train unweighted, beside, as the control for what "
+        "the weights add (repeatable).")] = None,
     recipe: Annotated[str, typer.Option(
         help=f"Training recipe of every monitor trained from scratch, one of "
              f"{', '.join(RECIPES)} (campaign updates keep theirs).")] = D.recipe,
@@ -269,7 +273,8 @@ def results_command(
                 seeds=tuple(range(first_rare_seed, first_rare_seed + rare_seeds)),
                 runs=rare_runs, batch=rare_batch, explain=rare_explain,
                 learn={"test_runs": rare_test_runs, "members": rare_members,
-                       "recipe": recipe, "test_max_runs": rare_test_max_runs}
+                       "recipe": recipe, "test_max_runs": rare_test_max_runs,
+                       "controls": tuple(rare_learn_control or ())}
                 if rare_learn else None, **fresh).changed())
         config.check_names()
     except ValueError as exc:

@@ -37,7 +37,8 @@ ESTIMATING = (REFERENCE, "ce-is", "subset")
 # monitor can be trained on (the learning side trains the others unweighted)
 WEIGHTED = (REFERENCE, "ce-is")
 REGIMES = ("highway-cut-in:cautious", "highway-cut-in:defensive")
-LEARN_LATER_FIELDS = ("test_max_runs",)  # LearnConfig's, absent from a dict at their default
+LEARN_LATER_FIELDS = ("test_max_runs", "controls")  # LearnConfig's, absent at their default
+UNWEIGHTED = "-unweighted"  # a control's name: a weighted strategy's runs trained unweighted
 
 
 @dataclass(frozen=True)
@@ -56,9 +57,13 @@ class LearnConfig:
     # where test_runs hold fewer, the Test stream drawn on to this many runs at most, outcome
     # first, and the set weighted back (`testset.py`); 0: the test_runs batch alone
     test_max_runs: int = 0
+    # weighted strategies whose runs also train unweighted, beside (`<name>-unweighted`): the
+    # control for what the weights themselves add
+    controls: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "budgets", tuple(self.budgets))
+        object.__setattr__(self, "controls", tuple(self.controls))
         b = self.budgets
         if len(b) < 2 or list(b) != sorted(set(b)) or b[0] < 1:
             raise ValueError(f"budgets must be at least two increasing run counts, got {b}")
@@ -88,7 +93,7 @@ class LearnConfig:
         recorded before them, and their ledger keys, stay as they were)."""
         return {f.name: list(v) if isinstance(v, tuple) else v
                 for f in fields(self) if (v := getattr(self, f.name)) is not None
-                and not (f.name in LEARN_LATER_FIELDS and v == f.default)}
+                and not (f.name in LEARN_LATER_FIELDS and v == getattr(LearnConfig(), f.name))}
 
     @classmethod
     def from_dict(cls, data: Mapping) -> LearnConfig:
@@ -139,6 +144,10 @@ class RareConfig:
         if self.learn is not None:
             learning = LearnConfig.from_dict(self.learn)
             learning.check_runs(self.runs)
+            able = [s for s in self.strategies if s in WEIGHTED and s != REFERENCE]
+            if bad := [c for c in learning.controls if c not in able]:
+                raise ValueError(f"learning controls {bad}: a control trains a weighted "
+                                 f"strategy's runs unweighted; pick from {able}")
             object.__setattr__(self, "learn", learning.to_dict())
 
     @property

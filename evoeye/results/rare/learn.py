@@ -67,7 +67,7 @@ from evoeye.results.efficiency.power import detectable
 from evoeye.results.efficiency.sets import concat_windows, with_unsafe_windows
 from evoeye.results.efficiency.summary import area
 from evoeye.results.ledger import Ledger
-from evoeye.results.rare.config import LearnConfig, RareConfig
+from evoeye.results.rare.config import UNWEIGHTED, LearnConfig, RareConfig
 from evoeye.results.rare.runner import run_seed
 from evoeye.results.rare.summary import weights as curve_weights
 from evoeye.results.rare.testset import TestDraw, draw_test_failures
@@ -212,9 +212,11 @@ def no_skill(learner: Learner) -> dict:
             for name, w in learner.judging.items()}
 
 
-def learn_curve(ctx: _Context, strategy: str, seed: int, curve: dict) -> dict:
+def learn_curve(ctx: _Context, strategy: str, seed: int, curve: dict,
+                weighted: bool = True) -> dict:
     """One curve's figures: per budget the Test Set metrics of its monitor, the collisions it
-    trained on, its runs' effective number under their weights, and whether it is no-skill."""
+    trained on, its runs' effective number under their weights, and whether it is no-skill;
+    with `weighted` False every run weighs 1 (the control for what the weights add)."""
     learn, last = ctx.learn, ctx.learn.budgets[-1]
     if any(r["collided"] for r in curve["runs"][:last]):
         runs, ids = curve_windows(ctx.regime, curve,
@@ -222,7 +224,7 @@ def learn_curve(ctx: _Context, strategy: str, seed: int, curve: dict) -> dict:
                                   last, learn)
     else:  # nothing to learn at any budget: every monitor is no-skill, no run is needed again
         runs, ids = [None] * last, [""] * last
-    ratio = curve_weights(curve)[: learn.budgets[-1]]
+    ratio = curve_weights(curve)[:last] if weighted else np.ones(last)
     out = {}
     with intra_op_threads():
         for n in learn.budgets:
@@ -242,17 +244,21 @@ def learn_curve(ctx: _Context, strategy: str, seed: int, curve: dict) -> dict:
 
 
 def _unit(job: tuple[str, int, dict]) -> tuple[str, int, dict, bool]:
-    strategy, seed, curve = job
+    name, seed, curve = job  # name: a strategy, or its control (`UNWEIGHTED`)
+    strategy = name.removesuffix(UNWEIGHTED)
+    weighted = name == strategy
     ctx = _CONTEXT
     assert ctx is not None, "a worker needs the regime's context"
     key = {"curve": ctx.config.unit(ctx.regime, strategy, seed), "learn": ctx.learn.to_dict(),
-           "sets": ctx.set_print, "software_version": __version__}
+           "sets": ctx.set_print, "software_version": __version__,
+           **({} if weighted else {"weighted": False})}
     before = sum(ctx.ledger.computed.values())
     try:
-        learned = ctx.ledger.remember(KIND, key, lambda: learn_curve(ctx, strategy, seed, curve))
+        learned = ctx.ledger.remember(
+            KIND, key, lambda: learn_curve(ctx, strategy, seed, curve, weighted))
     except Exception as exc:  # noqa: BLE001 — one curve's failure must not stop the others
-        return strategy, seed, {"error": f"{type(exc).__name__}: {exc}"}, False
-    return strategy, seed, learned, sum(ctx.ledger.computed.values()) > before
+        return name, seed, {"error": f"{type(exc).__name__}: {exc}"}, False
+    return name, seed, learned, sum(ctx.ledger.computed.values()) > before
 
 
 def learn_regime(root: DataRoot, regime: str, curves: dict[str, dict[str, dict]],
@@ -271,9 +277,11 @@ def learn_regime(root: DataRoot, regime: str, curves: dict[str, dict[str, dict]]
     learner = Learner(sets["val"], {"test": sets["test"]}, params, learn.members,
                       {} if test_weight is None else {"test": test_weight})
     _CONTEXT = _Context(regime, learn, learner, fingerprint(sets), Ledger(root), config)
-    jobs = [(strategy, int(seed), curve) for seed in sorted({int(s) for c in curves.values()
-                                                             for s in c})
-            for strategy, by_seed in curves.items() if (curve := by_seed.get(str(seed)))]
+    jobs = [(name, int(seed), curve) for seed in sorted({int(s) for c in curves.values()
+                                                         for s in c})
+            for strategy, by_seed in curves.items() if (curve := by_seed.get(str(seed)))
+            for name in (strategy, *([strategy + UNWEIGHTED] if strategy in learn.controls
+                                     else []))]
     learned: dict[str, dict[str, dict]] = {}
     failed, computed = [], 0
 
@@ -343,5 +351,9 @@ def summarise_learning(learned: dict, reference: str = "uniform") -> dict:
                 "area": compare_paired(areas[name], areas[reference]).to_dict(),
                 "final": compare_paired(values[:, -1], table(reference, auprc)[:, -1]).to_dict(),
                 "detectable": detectable(areas[name], areas[reference])}
+        if (base := name.removesuffix(UNWEIGHTED)) != name and base in areas:
+            row["weights_add"] = {  # the weighted curves' area − this control's, per seed
+                "area": compare_paired(areas[base], areas[name]).to_dict(),
+                "detectable": detectable(areas[base], areas[name])}
         out["strategies"][name] = row
     return out

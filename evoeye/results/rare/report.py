@@ -15,7 +15,7 @@ from evoeye.evaluation.report import Table
 from evoeye.results.efficiency.config import parse_regime
 from evoeye.results.findings import ALPHA
 from evoeye.results.markdown import DASH, FLOOR_MARK, FLOOR_NOTE, MINUS, md_table, p_text
-from evoeye.results.rare.config import REFERENCE
+from evoeye.results.rare.config import REFERENCE, UNWEIGHTED
 from evoeye.results.rare.findings import NULL_MDE, advice
 
 HEADING = "### Does testing find and measure rare failures faster than Uniform?"
@@ -211,7 +211,12 @@ def learning_lines(learning: dict) -> list[str]:
               "Test AUPRC at " + " / ".join(map(str, budgets)), "area [95 % CI]",
               "area − Uniform's [95 % CI] p", "MDE", f"at {budgets[-1]} runs − Uniform's",
               "effective runs (weights)"]
-    return lines + md_table(header, rows, numbers=False) + [""]
+    controls = [f"* **What the weights add**, {name.removesuffix(UNWEIGHTED)}'s runs weighted − "
+                f"unweighted (the control, `{name}`): area {paired(row['weights_add']['area'])}, "
+                f"MDE {num(row['weights_add']['detectable']['mde'])}."
+                for name, row in learning["strategies"].items() if "weights_add" in row]
+    return lines + md_table(header, rows, numbers=False) + [""] + (controls + [""] if controls
+                                                                   else [])
 
 
 def regime_markdown(regime: str, summary: dict, runs: int,

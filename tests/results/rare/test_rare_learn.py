@@ -12,7 +12,7 @@ import pytest
 
 from evoeye.paths import DataRoot
 from evoeye.results.findings import AGAINST, NOT_RUN, NOT_SHOWN, PARTLY, REPRODUCES
-from evoeye.results.rare.config import LearnConfig, RareConfig
+from evoeye.results.rare.config import UNWEIGHTED, LearnConfig, RareConfig
 from evoeye.results.rare.findings import advice, learn_checks, rare_findings
 from evoeye.results.rare.learn import curve_windows, learn_root, load_sets, no_skill
 from evoeye.results.rare.part import rare_results
@@ -20,7 +20,8 @@ from evoeye.results.rare.report import advice_lines, rare_findings_markdown, rar
 from evoeye.results.rare.runner import run_seed
 
 REGIME = "highway-cut-in:default"  # collisions are common: a small run learns something
-LEARN = {"budgets": [5, 10], "test_runs": 12, "val_runs": 10, "val_collisions": 0}
+LEARN = {"budgets": [5, 10], "test_runs": 12, "val_runs": 10, "val_collisions": 0,
+         "controls": ["ce-is"]}  # ce-is's runs also unweighted: the control
 
 
 def test_the_learning_config_is_validated_and_stored_whole():
@@ -34,6 +35,11 @@ def test_the_learning_config_is_validated_and_stored_whole():
     with pytest.raises(ValueError, match="exceeds the runs"):
         RareConfig(runs=100, learn={"budgets": [50, 200]})
     assert "learn" not in RareConfig().to_dict()  # every recorded protocol's config as it was
+    assert "controls" not in LearnConfig().to_dict()  # nor the learning side's keys
+    for bad in ("uniform", "subset", "sobol"):  # no weights, or not among the strategies
+        with pytest.raises(ValueError, match="learning controls"):
+            RareConfig(strategies=("uniform", "ce-is", "subset"), learn={"controls": [bad]})
+    assert RareConfig(learn={"controls": ["ce-is"]}).learning.controls == ("ce-is",)
     cfg = RareConfig(learn={"members": 3})
     assert cfg.learn == {**LearnConfig().to_dict(), "members": 3}  # stored whole
     assert cfg.learning == LearnConfig(members=3)
@@ -114,7 +120,8 @@ def test_every_curve_is_learned_from_at_every_budget_and_judged_on_its_test_set(
     learning = out["regimes"][REGIME]["learning"]
     test = learning["sets"]["test"]
     assert test["runs"] == 12 and learning["sets"]["val"]["runs"] == 10
-    assert learning["budgets"] == [5, 10] and set(learning["strategies"]) == {"uniform", "ce-is"}
+    assert learning["budgets"] == [5, 10]
+    assert set(learning["strategies"]) == {"uniform", "ce-is", "ce-is" + UNWEIGHTED}
     sets, weight = load_sets(learn_root(root, REGIME), config.learning, config.data_seed)
     assert weight is None  # no further Test runs were drawn: every window counts once
     share = sets["test"].label.mean()
@@ -125,12 +132,17 @@ def test_every_curve_is_learned_from_at_every_budget_and_judged_on_its_test_set(
     assert flat["test"]["auprc"] == pytest.approx(share)
     for name, row in learning["strategies"].items():
         assert row["seeds"] == 2 and len(row["auprc"]) == 2
-        curves = out["regimes"][REGIME]["found"][name]
+        curves = out["regimes"][REGIME]["found"][name.removesuffix(UNWEIGHTED)]
         assert curves["collisions"] >= row["collisions"][-1]  # trained on the runs it found
     for name in ("uniform", "ce-is"):
         assert ("vs_reference" in learning["strategies"][name]) == (name == "ce-is")
+    control = learning["strategies"]["ce-is" + UNWEIGHTED]
+    assert control["effective_runs"] == [5.0, 10.0]  # every run weighs 1
+    assert control["collisions"] == learning["strategies"]["ce-is"]["collisions"]  # same runs
+    assert "weights_add" in control and "weights_add" not in learning["strategies"]["ce-is"]
     text = rare_markdown(out)
     assert "### What a monitor learns from these runs" in text
+    assert "**What the weights add**, ce-is's runs weighted − unweighted" in text
     assert "fewer than the 50 a check needs" in text  # 12 Test runs cannot hold 50 failures
     claim = {f["id"]: f for f in out["findings"]}["rare-learn"]
     assert [c["verdict"] for c in claim["checks"]] == [NOT_SHOWN]
