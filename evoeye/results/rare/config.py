@@ -95,6 +95,11 @@ class LearnConfig:
                 for f in fields(self) if (v := getattr(self, f.name)) is not None
                 and not (f.name in LEARN_LATER_FIELDS and v == getattr(LearnConfig(), f.name))}
 
+    def curve_key(self) -> dict:
+        """What fixes how one curve is learned (a learned curve's ledger key): every field but
+        `controls`, which adds curves and changes none."""
+        return {k: v for k, v in self.to_dict().items() if k != "controls"}
+
     @classmethod
     def from_dict(cls, data: Mapping) -> LearnConfig:
         return dataclass_from(cls, data, "learning")

@@ -249,7 +249,7 @@ def _unit(job: tuple[str, int, dict]) -> tuple[str, int, dict, bool]:
     weighted = name == strategy
     ctx = _CONTEXT
     assert ctx is not None, "a worker needs the regime's context"
-    key = {"curve": ctx.config.unit(ctx.regime, strategy, seed), "learn": ctx.learn.to_dict(),
+    key = {"curve": ctx.config.unit(ctx.regime, strategy, seed), "learn": ctx.learn.curve_key(),
            "sets": ctx.set_print, "software_version": __version__,
            **({} if weighted else {"weighted": False})}
     before = sum(ctx.ledger.computed.values())

@@ -39,7 +39,9 @@ def test_the_learning_config_is_validated_and_stored_whole():
     for bad in ("uniform", "subset", "sobol"):  # no weights, or not among the strategies
         with pytest.raises(ValueError, match="learning controls"):
             RareConfig(strategies=("uniform", "ce-is", "subset"), learn={"controls": [bad]})
-    assert RareConfig(learn={"controls": ["ce-is"]}).learning.controls == ("ce-is",)
+    with_control = RareConfig(learn={"controls": ["ce-is"]}).learning
+    assert with_control.controls == ("ce-is",)
+    assert with_control.curve_key() == LearnConfig().curve_key()  # learned curves resume
     cfg = RareConfig(learn={"members": 3})
     assert cfg.learn == {**LearnConfig().to_dict(), "members": 3}  # stored whole
     assert cfg.learning == LearnConfig(members=3)
