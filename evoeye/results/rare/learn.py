@@ -104,8 +104,9 @@ def prepare_sets(root: DataRoot, regime: str, learn: LearnConfig, data_seed: int
     for name, n in (("test", learn.test_runs), ("val", learn.val_runs)):
         batch, seed = set_batch(name, data_seed)
         say(f"{regime}: {name} set, {n} runs (seed {seed})")
-        run_batch(plan_uniform(scenario, n, seed, batch=batch, ads=profile), data,
-                  workers=workers)
+        if name == "val" or not learn.test_max_runs:  # else the Test draw simulates its batch
+            run_batch(plan_uniform(scenario, n, seed, batch=batch, ads=profile), data,
+                      workers=workers)
     draw = None
     if learn.test_max_runs:
         batch, seed = set_batch("test", data_seed)
