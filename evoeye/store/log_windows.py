@@ -65,12 +65,19 @@ def episode_run(episode: Episode, path: str | Path, context_len: int,
     return convert_run(EpisodeLog(episode, path), Path(path), context_len, horizon_s)
 
 
+def frames_of(run: RunSource, path: Path) -> LoggedRun:
+    """A run's frames and their features as ingest stores them (in no part yet), without
+    windows: what ingest needs of a log (`evoeye.store.reading`)."""
+    meta = dict(run.metadata)
+    frames = frames_table(run, str(meta["scenario_id"]), UNCOMMITTED)
+    return LoggedRun(path, meta, frames, frame_features(frames, FEATURES), None)
+
+
 def convert_run(run: RunSource, path: Path, context_len: int, horizon_s: float) -> LoggedRun:
     """A run's conversion from its log's contents (`read_logged_run`)."""
-    meta = dict(run.metadata)
+    base = frames_of(run, path)
+    meta, frames, features = base.metadata, base.frames, base.features
     sid = str(meta["scenario_id"])
-    frames = frames_table(run, sid, UNCOMMITTED)
-    features = frame_features(frames, FEATURES)  # one row per frame, as ingest stores them
     t_s = frames.column("t_s").to_numpy()
     collided = frames.column("gt_ego_collision").to_numpy(zero_copy_only=False)
     keep = eligible_frames(t_s, collided)
@@ -78,7 +85,7 @@ def convert_run(run: RunSource, path: Path, context_len: int, horizon_s: float) 
     rows = np.flatnonzero(keep)
     n = len(rows)
     if n == 0:
-        return LoggedRun(path, meta, frames, features, None)
+        return base
     ctx, mask = context_rows(np.zeros(n, np.int64), context_len)  # one run, from row 0
     xy = np.stack([frames.column(c).to_numpy(zero_copy_only=False)[rows].astype(np.float64)
                    for c in ("loc_x_m", "loc_y_m")], axis=1)  # (N, 2)

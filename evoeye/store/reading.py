@@ -22,10 +22,9 @@ from pathlib import Path
 from evoeye.lifeline import die_with_parent, pool_context
 from evoeye.log import read_run
 from evoeye.sim.worlds import DEFAULT_WORLD
-from evoeye.store.features import FEATURES, frame_features
-from evoeye.store.log_windows import UNCOMMITTED, LoggedRun
+from evoeye.store.log_windows import LoggedRun, frames_of
 from evoeye.store.metadata import check_metadata
-from evoeye.store.records import FRAME_CLOCK, frame_column_sources, frames_table
+from evoeye.store.records import FRAME_CLOCK, frame_column_sources
 
 AHEAD_PER_WORKER = 4  # logs read ahead of the writer per worker: bounds the memory held
 MIN_LOGS_PER_WORKER = 8  # below this a pool's start-up is not worth it: read in this process
@@ -44,8 +43,7 @@ def read_for_ingest(log: Path) -> tuple[dict, LoggedRun | None]:
     check_metadata(meta)
     if meta.get("world", DEFAULT_WORLD) != DEFAULT_WORLD:
         return meta, None
-    frames = frames_table(source, str(meta["scenario_id"]), UNCOMMITTED)
-    return meta, LoggedRun(log, meta, frames, frame_features(frames, FEATURES), None)
+    return meta, frames_of(source, log)
 
 
 def read_logs(logs: Sequence[Path], workers: int = 1) -> Iterator[tuple[Path, Future]]:
