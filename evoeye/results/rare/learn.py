@@ -101,18 +101,17 @@ def prepare_sets(root: DataRoot, regime: str, learn: LearnConfig, data_seed: int
     say = say or (lambda msg: None)
     scenario, profile = parse_regime(regime)
     data = learn_root(root, regime)
+    simulated = {}
     for name, n in (("test", learn.test_runs), ("val", learn.val_runs)):
         batch, seed = set_batch(name, data_seed)
         say(f"{regime}: {name} set, {n} runs (seed {seed})")
-        if name == "val" or not learn.test_max_runs:  # else the Test draw simulates its batch
-            run_batch(plan_uniform(scenario, n, seed, batch=batch, ads=profile), data,
-                      workers=workers)
+        simulated[name] = run_batch(plan_uniform(scenario, n, seed, batch=batch, ads=profile),
+                                    data, workers=workers)
     draw = None
     if learn.test_max_runs:
-        batch, seed = set_batch("test", data_seed)
-        draw = draw_test_failures(data, regime, seed, learn.test_runs, batch,
-                                  learn.min_test_failures, learn.test_max_runs,
-                                  workers=workers, say=say)
+        draw = draw_test_failures(data, regime, set_batch("test", data_seed)[1],
+                                  simulated["test"], learn.min_test_failures,
+                                  learn.test_max_runs, workers=workers, say=say)
     if learn.val_collisions:
         batch, seed = set_batch("val", data_seed)
         draw_collisions(data, regime, seed, learn.val_runs, learn.val_collisions, batch,

@@ -26,9 +26,8 @@ from __future__ import annotations
 from collections.abc import Callable
 from dataclasses import dataclass
 
-from evoeye.batch import plan_uniform, run_batch
+from evoeye.batch import BatchSummary
 from evoeye.paths import DataRoot
-from evoeye.results.efficiency.config import parse_regime
 from evoeye.results.efficiency.stream import collisions, draw_on
 from evoeye.sim.episode import STATUS_OK
 
@@ -68,13 +67,11 @@ def more_batch(seed: int) -> str:
     return f"test-more-seed{seed}"
 
 
-def draw_test_failures(data: DataRoot, regime: str, seed: int, n: int, batch: str, want: int,
+def draw_test_failures(data: DataRoot, regime: str, seed: int, base: BatchSummary, want: int,
                        max_runs: int, *, workers: int = 1, say: Say | None = None) -> TestDraw:
-    """Simulate (or resume) the `n`-run Test batch `batch` of `seed`, then draw its stream on
-    until it holds `want` collisions or `max_runs` runs (module doc); the draw."""
-    scenario, profile = parse_regime(regime)
-    base = run_batch(plan_uniform(scenario, n, seed, batch=batch, ads=profile), data,
-                     workers=workers)
+    """Draw the stream of the Test batch of `seed` (`base`: its runs, simulated) on until it
+    holds `want` collisions or `max_runs` runs (module doc); the draw."""
+    n = base.runs
     size = min(CHUNK, n)
     used = draw_on(data, regime, seed, n, size, more_batch(seed), data.path / TEST_DRAW_FILE,
                    lambda cs: base.collisions + len(collisions(cs)) >= want,

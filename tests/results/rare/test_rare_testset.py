@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from sklearn.metrics import average_precision_score
 
-from evoeye.batch import plan_uniform
+from evoeye.batch import plan_uniform, run_batch
 from evoeye.monitor.calibration import calibrate
 from evoeye.paths import DataRoot
 from evoeye.results.efficiency.learner import Learner
@@ -55,11 +55,12 @@ def test_a_re_run_simulates_nothing_more_and_a_cap_cuts_the_stream(drawn):
     data, draw = drawn
     batch, seed = set_batch("test", DATA_SEED)
     record = (data.path / TEST_DRAW_FILE).read_bytes()
-    again = draw_test_failures(data, REGIME, seed, LEARN.test_runs, batch,
-                               LEARN.min_test_failures, LEARN.test_max_runs)
+    base = run_batch(plan_uniform(SCENARIO, LEARN.test_runs, seed, batch=batch), data)
+    assert base.skipped == LEARN.test_runs  # simulated by prepare_sets
+    again = draw_test_failures(data, REGIME, seed, base, LEARN.min_test_failures,
+                               LEARN.test_max_runs)
     assert again == draw and (data.path / TEST_DRAW_FILE).read_bytes() == record
-    capped = draw_test_failures(data, REGIME, seed, LEARN.test_runs, batch, 10_000,
-                                2 * LEARN.test_runs)
+    capped = draw_test_failures(data, REGIME, seed, base, 10_000, 2 * LEARN.test_runs)
     assert capped.runs == 2 * LEARN.test_runs  # one further chunk, whatever it held
     assert set(capped.further) <= set(draw.further)
     assert (data.path / TEST_DRAW_FILE).read_bytes() == record  # it was drawn already
