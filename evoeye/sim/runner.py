@@ -4,11 +4,17 @@ The loop at 20 Hz: read the ground truth, let the ADS compute its messages from 
 frame, apply the control command and advance the world by one step. A run lasts `duration_s`
 of simulated time and ends `post_collision_s` after the ego's first collision. A run that
 raises or produces a non-finite value is returned as a failed Episode with the reason.
+
+A *branch* (frame k, key) reseeds both random streams at the top of frame k, after the world's
+state at k is read and before the ADS senses it: a run with branches is the run without them up
+to frame k, and from there on an independent continuation of the same state: how much of a
+collision its own randomness decided, and from when (`experiments.decided_by`). The reseeded
+streams derive from (seed, k, key), so a run with the same branches is the same run.
 """
 
 from __future__ import annotations
 
-from collections.abc import Callable
+from collections.abc import Callable, Sequence
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -69,6 +75,14 @@ def _seeds(seed: int) -> tuple[np.random.Generator, np.random.Generator]:
     return np.random.default_rng(world_ss), np.random.default_rng(ads_ss)
 
 
+def _reseed(streams: Sequence[np.random.Generator], seed: int, frame: int, key: int) -> None:
+    """Give every stream a fresh state from (seed, frame, key), in place: whoever holds one (the
+    road, the sensors, the localiser) draws from the new state."""
+    for stream, fresh in zip(streams, np.random.SeedSequence([seed, frame, key]).spawn(
+            len(streams)), strict=True):
+        stream.bit_generator.state = np.random.default_rng(fresh).bit_generator.state
+
+
 def build_world(spec: RunSpec, world_rng: np.random.Generator | None = None) -> tuple[World, float]:
     """The world of a run and the ego's cruise speed, exactly as `run_episode` sets it up."""
     params = SCENARIO_SPECS[spec.scenario].space.as_dict(spec.params)
@@ -99,12 +113,13 @@ def default_driver(road_map: RoadMap, rng: np.random.Generator, config: ADSConfi
 
 def run_episode(
     spec: RunSpec, config: SimConfig | None = None, ads_config: ADSConfig | None = None,
-    *, driver: DriverFactory = default_driver,
+    *, driver: DriverFactory = default_driver, branches: Sequence[tuple[int, int]] = (),
 ) -> Episode:
     """Simulate one run. Never raises for a problem inside the run: it returns a failed Episode.
 
     `driver` builds what drives the ego (default: the ADS); counterfactual re-simulations pass
     another factory and get the same world, the same random streams and the same frame loop.
+    `branches`: (frame, key) pairs at which both streams are reseeded (module doc).
     """
     config = config or SimConfig()
     # a bad vector is the caller's error: raise
@@ -112,6 +127,9 @@ def run_episode(
     check_profile(spec.ads)
     check_world(spec.world, spec.scenario)
     world_rng, ads_rng = _seeds(spec.seed)
+    reseed = dict(branches)
+    if len(reseed) != len(branches) or any(k < 0 for k in reseed):
+        raise ValueError(f"branches need distinct frames >= 0, got {list(branches)}")
     dt = 1.0 / config.rate_hz
     n_frames = int(round(config.duration_s * config.rate_hz))
     frames: list[Frame] = []
@@ -128,6 +146,8 @@ def run_episode(
         for k in range(n_frames):
             scene = world.scene()
             scene.t_s = k * dt  # exact frame time, free of float accumulation
+            if k in reseed:
+                _reseed((world_rng, ads_rng), spec.seed, k, reseed[k])
             msgs = ads.step(scene)
             if not (scene_finite(scene) and msgs.all_finite()):
                 raise SimulationError(f"non-finite value at t={scene.t_s:.2f} s")
