@@ -98,7 +98,8 @@ def _label(name: str) -> str:
 
 
 def found_table(found: dict[str, dict]) -> list[str]:
-    """Per strategy: runs, collisions, per 100 runs [CI], × Uniform [CI], paired Δ, MDE."""
+    """Per strategy: runs, collisions (of distinct θ), per 100 runs [CI], × Uniform [CI],
+    paired Δ, MDE."""
     rows = []
     for name, f in found.items():
         p = f["per_100"]
@@ -106,9 +107,11 @@ def found_table(found: dict[str, dict]) -> list[str]:
         ratio = (interval(vs["ratio"], vs["ratio_low"], vs["ratio_high"], open_ends=True,
                           prefix="×") if vs else "")
         rows.append([_label(name), str(f["seeds"]), str(f["runs"]), str(f["collisions"]),
+                     str(f.get("distinct_x", DASH)),
                      interval(p["value"], p["low"], p["high"]), ratio,
                      paired(vs["paired"]) if vs else "", num(vs["mde_per_100"]) if vs else ""])
-    return md_table(["strategy", "seeds", "runs", "collisions", "per 100 runs [95 % CI]",
+    return md_table(["strategy", "seeds", "runs", "collisions", "of distinct θ",
+                     "per 100 runs [95 % CI]",
                      "× Uniform [95 % CI]", f"Δ per 100 runs, strategy {MINUS} Uniform",
                      "detectable Δ"], rows)
 

@@ -1,9 +1,9 @@
 """A regime's testing-efficiency figures, from its curves: found, estimated, told apart.
 
-* **Failures found** per 100 simulated runs: Σ collisions / Σ runs over the seeds with a
-  bootstrap interval resampling whole seeds (`rate_ci`); beside Uniform, the ratio of the two
-  with a paired bootstrap interval over seeds (seeds resampled jointly), and the paired
-  difference of per-seed rates (`compare_paired`) with its minimum detectable effect.
+* **Failures found** per 100 simulated runs (and of how many distinct θ): Σ collisions / Σ runs
+  over the seeds with a bootstrap interval resampling whole seeds (`rate_ci`); beside Uniform,
+  the ratio of the two with a paired bootstrap interval over seeds (seeds resampled jointly),
+  and the paired difference of per-seed rates (`compare_paired`) with its minimum detectable effect.
 * **The failure rate under p.** Each seed's estimate from its own runs: Uniform's share that
   collided (plain Monte Carlo), an importance-sampling strategy's mean of w·y with its runs'
   exact w = p/q (`evoeye.evaluation.failure_rate`), subset simulation's product of its levels'
@@ -95,6 +95,7 @@ def found(curves: dict[str, dict[str, dict]]) -> dict[str, dict]:
         events, runs = zip(*rows.values(), strict=True)
         ci = rate_ci(list(events), list(runs)).to_dict()
         out[name] = {"seeds": len(rows), "runs": int(sum(runs)), "collisions": int(sum(events)),
+                     "distinct_x": sum(_distinct_x(c) for c in curves[name].values()),
                      "per_100": {k: (v * PER if isinstance(v, float) and k in
                                      ("value", "low", "high") else v) for k, v in ci.items()}}
     ref = counts.get(REFERENCE)
@@ -118,6 +119,11 @@ def found(curves: dict[str, dict[str, dict]]) -> dict[str, dict]:
             "mde_per_100": minimum_detectable_effect(len(common), paired["sd_diff"])
             if paired["sd_diff"] else None}
     return out
+
+
+def _distinct_x(curve: dict) -> int:
+    """The distinct θ among a curve's collisions (a walk that parks on a failure repeats it)."""
+    return len({tuple(x) for x, hit in zip(curve["x"], _hits(curve), strict=True) if hit})
 
 
 def bias(values: np.ndarray, hits: int, runs: int) -> dict:

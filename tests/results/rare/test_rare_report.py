@@ -50,12 +50,15 @@ def test_rare_md_has_every_table_per_regime(two_regimes):
     assert "## occluded-crossing, cautious ADS" in text
     rare = text.split("## occluded-crossing")[0]
     found = _row(rare, "ce-is")  # the first ce-is row: failures found
-    assert "| 20 | 4000 | 200 | 5.00 [" in found and "| ×25.00 [" in found
+    assert "| 20 | 4000 | 200 | 20 | 5.00 [" in found and "| ×25.00 [" in found
     assert "+4.80 [" in found  # 5 per 100 against 0.2, paired per seed
     assert "Reference P = Uniform's pooled share, 8 of 4000 runs collided: 0.200 % [" in rare
     estimate = [line for line in rare.splitlines() if line.startswith("| ce-is |")][1]
     assert "0.200 % [" in estimate and "| ×8.66 [" in estimate
-    assert "| uniform (reference) | 20 | 4000 | 8 | 0.20 [" in rare
+    uniform = _row(rare, "uniform (reference)")
+    cells = [c.strip() for c in uniform.split("|")[2:7]]
+    assert cells[:3] == ["20", "4000", "8"] and cells[4].startswith("0.20 [")
+    assert 1 <= int(cells[3]) <= 8  # of distinct θ: one θ per synthetic curve
     assert "* ce-is: cut-in / perception (200)" in rare
     common = text.split("## occluded-crossing")[1]
     assert "No estimate" not in common and "| sobol |" in common
