@@ -24,7 +24,7 @@ from evoeye.paths import DataRoot
 from evoeye.results.ledger import Ledger
 from evoeye.results.rare.config import RareConfig
 from evoeye.results.rare.runner import run_curve
-from evoeye.results.rare.summary import summarise
+from evoeye.results.rare.summary import found_pooled, summarise
 
 KIND = "rare-curve"
 Say = Callable[[str], None]
@@ -84,6 +84,9 @@ def run_rare(root: DataRoot, config: RareConfig, *, workers: int = 1,
             failed += [{**f, "regime": regime, "strategy": f"{f['strategy']} (learning)",
                         "learning": True} for f in learned["failed"]]
             regimes[regime]["learning"] = summarise_learning(learned)
+            if "stream_runs" in (test := learned["sets"]["test"]):
+                regimes[regime]["found_pooled"] = found_pooled(
+                    curves[regime], test["stream_runs"], test["stream_collisions"])
     return {"config": config.to_dict(), "software_version": __version__,
             "regimes": regimes, "failed": failed, "computed": computed}
 

@@ -116,6 +116,19 @@ def found_table(found: dict[str, dict]) -> list[str]:
                      "detectable Δ"], rows)
 
 
+def pooled_line(pooled: dict) -> str:
+    """The failures found against Uniform's rate pooled with the Test stream (`found_pooled`)."""
+    ref = pooled["reference"]
+    ratios = [f"{name} {interval(r['ratio'], r['low'], r['high'], open_ends=True, prefix='×')}"
+              for name, r in pooled.items() if name != "reference"]
+    return (f"Against a tighter Uniform rate, its curves' runs pooled with the learning side's "
+            f"Test stream ({ref['further_runs']} uniform runs of another seed, "
+            f"{ref['further_collisions']} collisions): {ref['collisions']} collisions in "
+            f"{ref['runs']} runs, {rate(ref['value'])} [{rate(ref['low'])}, {rate(ref['high'])}]"
+            f" (Wilson 95 %); × that rate [95 % CI]: {'; '.join(ratios)}. A supplement: the "
+            "claims pair each strategy with Uniform's curves by seed.")
+
+
 def reference_line(ref: dict, runs: int) -> str:
     return (f"Reference P = Uniform's pooled share, {ref['uniform_collisions']} of "
             f"{ref['uniform_runs']} runs collided: {rate(ref['value'])} [{rate(ref['low'])}, "
@@ -231,6 +244,8 @@ def regime_markdown(regime: str, summary: dict, runs: int,
         lines += ["No curve of this regime finished.", ""]
     else:
         lines += ["### Failures found", "", *found_table(summary["found"]), ""]
+        if summary.get("found_pooled"):
+            lines += [pooled_line(summary["found_pooled"]), ""]
         est = summary["estimates"]
         lines += ["### The failure rate under p", ""]
         if est.get("reference"):

@@ -4,6 +4,9 @@
   over the seeds with a bootstrap interval resampling whole seeds (`rate_ci`); beside Uniform,
   the ratio of the two with a paired bootstrap interval over seeds (seeds resampled jointly),
   and the paired difference of per-seed rates (`compare_paired`) with its minimum detectable effect.
+* **Against a tighter Uniform rate** (`found_pooled`, where the learning side drew a Test
+  stream): the same ratio with Uniform's rate pooled over its curves and that stream's uniform
+  runs of another seed. A supplement: the claims pair each strategy with Uniform's curves.
 * **The failure rate under p.** Each seed's estimate from its own runs: Uniform's share that
   collided (plain Monte Carlo), an importance-sampling strategy's mean of w·y with its runs'
   exact w = p/q (`evoeye.evaluation.failure_rate`), subset simulation's product of its levels'
@@ -124,6 +127,44 @@ def found(curves: dict[str, dict[str, dict]]) -> dict[str, dict]:
 def _distinct_x(curve: dict) -> int:
     """The distinct θ among a curve's collisions (a walk that parks on a failure repeats it)."""
     return len({tuple(x) for x, hit in zip(curve["x"], _hits(curve), strict=True) if hit})
+
+
+def found_pooled(curves: dict[str, dict[str, dict]], runs: int, collisions: int) -> dict:
+    """Failures found against a tighter Uniform rate: Uniform's curves pooled with `runs`
+    further uniform runs of another seed holding `collisions` (the learning side's Test stream).
+    Per strategy the ratio of its rate to the pooled one, with a percentile interval: the seeds
+    its curves share with Uniform's resampled jointly, the further runs' collisions redrawn
+    binomially. A supplement to `found`: no claim is checked on it."""
+    ref = curves.get(REFERENCE)
+    if not ref or runs <= 0:
+        return {}
+    hits, total = sum(int(_hits(c).sum()) for c in ref.values()) + collisions, \
+        sum(len(c["runs"]) for c in ref.values()) + runs
+    wilson = proportion_ci(hits, total)
+    out: dict = {"reference": {"runs": total, "collisions": hits, "further_runs": runs,
+                               "further_collisions": collisions, "value": wilson.value,
+                               "low": wilson.low, "high": wilson.high}}
+    rng = np.random.default_rng(0)
+    further = rng.binomial(runs, collisions / runs, N_RESAMPLES)
+    for name, seeds in curves.items():
+        common = [s for s in _seeds(seeds) if s in ref]
+        if name == REFERENCE or len(common) < 2:
+            continue
+        a = np.array([(_hits(seeds[s]).sum(), len(seeds[s]["runs"])) for s in common], float)
+        u = np.array([(_hits(ref[s]).sum(), len(ref[s]["runs"])) for s in common], float)
+        idx = rng.integers(0, len(common), (N_RESAMPLES, len(common)))
+        mine = a[idx, 0].sum(axis=1) / a[idx, 1].sum(axis=1)
+        pooled = (u[idx, 0].sum(axis=1) + further) / (u[idx, 1].sum(axis=1) + runs)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ratios = np.sort(np.where(pooled > 0, mine / pooled, np.inf))
+        tail = (1.0 - CONFIDENCE) / 2
+        low, high = (ratios[int(math.floor(tail * N_RESAMPLES))],
+                     ratios[int(math.ceil((1.0 - tail) * N_RESAMPLES)) - 1])
+        point = (a[:, 0].sum() / a[:, 1].sum()) / (hits / total) if hits else math.inf
+        out[name] = {"ratio": point if math.isfinite(point) else None,
+                     "low": float(low) if math.isfinite(low) else None,
+                     "high": float(high) if math.isfinite(high) else None}
+    return out
 
 
 def bias(values: np.ndarray, hits: int, runs: int) -> dict:

@@ -2,7 +2,7 @@
 
 from __future__ import annotations
 
-from rare_curves import COMMON, RARE, rare_part
+from rare_curves import COMMON, RARE, rare_curves, rare_part
 
 from evoeye.results.rare.report import (
     HEADING,
@@ -15,6 +15,7 @@ from evoeye.results.rare.report import (
     rare_words,
     regime_markdown,
 )
+from evoeye.results.rare.summary import found_pooled
 
 
 def assert_tables_aligned(text: str) -> None:
@@ -100,3 +101,15 @@ def test_the_html_part_shows_the_claims_and_a_chart_per_regime(two_regimes):
     html = "".join(rare_html(two_regimes))
     assert html.count("<svg") == 2 and "<h2>Rare failures</h2>" in html
     assert "highway-cut-in, cautious ADS: failures found" in html and "partly" in html
+
+
+def test_the_pooled_uniform_rate_is_a_line_under_the_failures_found(two_regimes):
+    summary = dict(two_regimes["regimes"][RARE])
+    summary["found_pooled"] = found_pooled(rare_curves(), 40_000, 40)
+    text = regime_markdown(RARE, summary, 200)
+    line = next(x for x in text.splitlines() if x.startswith("Against a tighter Uniform rate"))
+    assert ("(40000 uniform runs of another seed, 40 collisions): 48 collisions in 44000 runs"
+            in line)
+    assert "0.109 % [" in line and "ce-is ×45.83 [" in line
+    assert text.index("### Failures found") < text.index(line) < text.index(
+        "### The failure rate under p")

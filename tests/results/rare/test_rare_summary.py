@@ -6,9 +6,17 @@ import math
 
 import numpy as np
 import pytest
+from rare_curves import rare_curves
 
 from evoeye.results.rare.config import RareConfig
-from evoeye.results.rare.summary import distinct, estimates, found, summarise, weights
+from evoeye.results.rare.summary import (
+    distinct,
+    estimates,
+    found,
+    found_pooled,
+    summarise,
+    weights,
+)
 
 
 def curve(hits: list[bool], log_q: list[float | None] | None = None,
@@ -113,3 +121,19 @@ def test_subset_variants_find_but_do_not_estimate():
     curves = {"uniform": hits, "subset": hits, "subset-deep": hits, "subset-spread": hits}
     assert set(found(curves)) == set(curves)
     assert set(estimates(curves, runs=50, batch=10)) == {"reference", "uniform", "subset"}
+
+
+def test_a_tighter_uniform_rate_narrows_the_ratio_and_moves_it_with_the_pooled_rate():
+    curves = rare_curves()  # Uniform: 8 in 4 000 (0.2 %); ce-is: 200 in 4 000 (5 %)
+    alone = found(curves)["ce-is"]["vs_reference"]
+    pooled = found_pooled(curves, 40_000, 40)  # 48 in 44 000: ≈ 0.109 %
+    ref = pooled["reference"]
+    assert (ref["runs"], ref["collisions"]) == (44_000, 48)
+    assert ref["value"] == pytest.approx(48 / 44_000) and ref["low"] < ref["value"] < ref["high"]
+    r = pooled["ce-is"]
+    assert r["ratio"] == pytest.approx(0.05 / (48 / 44_000))
+    assert r["low"] < r["ratio"] < r["high"]
+    # a denominator of 48 collisions, not 8: the interval is far narrower
+    assert r["high"] / r["low"] < 0.6 * alone["ratio_high"] / alone["ratio_low"]  # 1.8 vs 3.4
+    assert found_pooled(curves, 0, 0) == {}
+    assert found_pooled({"ce-is": curves["ce-is"]}, 10, 1) == {}
