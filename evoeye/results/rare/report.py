@@ -122,8 +122,8 @@ def pooled_line(pooled: dict) -> str:
     ratios = [f"{name} {interval(r['ratio'], r['low'], r['high'], open_ends=True, prefix='×')}"
               for name, r in pooled.items() if name != "reference"]
     return (f"Against a tighter Uniform rate, its curves' runs pooled with the learning side's "
-            f"Test stream ({ref['further_runs']} uniform runs of another seed, "
-            f"{ref['further_collisions']} collisions): {ref['collisions']} collisions in "
+            f"Test stream ({ref['stream_runs']} uniform runs of another seed, "
+            f"{ref['stream_collisions']} collisions): {ref['collisions']} collisions in "
             f"{ref['runs']} runs, {rate(ref['value'])} [{rate(ref['low'])}, {rate(ref['high'])}]"
             f" (Wilson 95 %); × that rate [95 % CI]: {'; '.join(ratios)}. A supplement: the "
             "claims pair each strategy with Uniform's curves by seed.")

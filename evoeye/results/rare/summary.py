@@ -131,21 +131,22 @@ def _distinct_x(curve: dict) -> int:
 
 def found_pooled(curves: dict[str, dict[str, dict]], runs: int, collisions: int) -> dict:
     """Failures found against a tighter Uniform rate: Uniform's curves pooled with `runs`
-    further uniform runs of another seed holding `collisions` (the learning side's Test stream).
-    Per strategy the ratio of its rate to the pooled one, with a percentile interval: the seeds
-    its curves share with Uniform's resampled jointly, the further runs' collisions redrawn
-    binomially. A supplement to `found`: no claim is checked on it."""
+    more uniform runs of another seed holding `collisions` (the learning side's Test stream: its
+    batch and the runs drawn past it). Per strategy the ratio of its rate to the pooled one,
+    with a percentile interval: the seeds its curves share with Uniform's resampled jointly,
+    the stream's collisions redrawn binomially. A supplement to `found`: no claim is checked on
+    it."""
     ref = curves.get(REFERENCE)
     if not ref or runs <= 0:
         return {}
     hits, total = sum(int(_hits(c).sum()) for c in ref.values()) + collisions, \
         sum(len(c["runs"]) for c in ref.values()) + runs
     wilson = proportion_ci(hits, total)
-    out: dict = {"reference": {"runs": total, "collisions": hits, "further_runs": runs,
-                               "further_collisions": collisions, "value": wilson.value,
+    out: dict = {"reference": {"runs": total, "collisions": hits, "stream_runs": runs,
+                               "stream_collisions": collisions, "value": wilson.value,
                                "low": wilson.low, "high": wilson.high}}
     rng = np.random.default_rng(0)
-    further = rng.binomial(runs, collisions / runs, N_RESAMPLES)
+    stream = rng.binomial(runs, collisions / runs, N_RESAMPLES)
     for name, seeds in curves.items():
         common = [s for s in _seeds(seeds) if s in ref]
         if name == REFERENCE or len(common) < 2:
@@ -154,7 +155,7 @@ def found_pooled(curves: dict[str, dict[str, dict]], runs: int, collisions: int)
         u = np.array([(_hits(ref[s]).sum(), len(ref[s]["runs"])) for s in common], float)
         idx = rng.integers(0, len(common), (N_RESAMPLES, len(common)))
         mine = a[idx, 0].sum(axis=1) / a[idx, 1].sum(axis=1)
-        pooled = (u[idx, 0].sum(axis=1) + further) / (u[idx, 1].sum(axis=1) + runs)
+        pooled = (u[idx, 0].sum(axis=1) + stream) / (u[idx, 1].sum(axis=1) + runs)
         with np.errstate(divide="ignore", invalid="ignore"):
             ratios = np.sort(np.where(pooled > 0, mine / pooled, np.inf))
         tail = (1.0 - CONFIDENCE) / 2
