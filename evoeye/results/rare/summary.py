@@ -80,7 +80,13 @@ def _boot(seeds: int, statistic, seed: int = 0) -> tuple[float | None, float | N
     where it is undefined (a zero denominator: non-finite) counts as +inf, so the upper end is
     None when more than the tail share of resamples leave it undefined."""
     rng = np.random.default_rng(seed)
-    values = np.array([statistic(rng.integers(0, seeds, seeds)) for _ in range(N_RESAMPLES)])
+    return _percentiles(np.array([statistic(rng.integers(0, seeds, seeds))
+                                  for _ in range(N_RESAMPLES)]))
+
+
+def _percentiles(values: np.ndarray) -> tuple[float | None, float | None]:
+    """The CONFIDENCE percentile interval of N_RESAMPLES resampled values, an undefined value
+    (non-finite) counting as +inf: an end past the defined ones is None."""
     values = np.sort(np.where(np.isfinite(values), values, np.inf))
     tail = (1.0 - CONFIDENCE) / 2
     low = values[int(math.floor(tail * N_RESAMPLES))]
@@ -157,14 +163,9 @@ def found_pooled(curves: dict[str, dict[str, dict]], runs: int, collisions: int)
         mine = a[idx, 0].sum(axis=1) / a[idx, 1].sum(axis=1)
         pooled = (u[idx, 0].sum(axis=1) + stream) / (u[idx, 1].sum(axis=1) + runs)
         with np.errstate(divide="ignore", invalid="ignore"):
-            ratios = np.sort(np.where(pooled > 0, mine / pooled, np.inf))
-        tail = (1.0 - CONFIDENCE) / 2
-        low, high = (ratios[int(math.floor(tail * N_RESAMPLES))],
-                     ratios[int(math.ceil((1.0 - tail) * N_RESAMPLES)) - 1])
+            low, high = _percentiles(np.where(pooled > 0, mine / pooled, np.inf))
         point = (a[:, 0].sum() / a[:, 1].sum()) / (hits / total) if hits else math.inf
-        out[name] = {"ratio": point if math.isfinite(point) else None,
-                     "low": float(low) if math.isfinite(low) else None,
-                     "high": float(high) if math.isfinite(high) else None}
+        out[name] = {"ratio": point if math.isfinite(point) else None, "low": low, "high": high}
     return out
 
 
