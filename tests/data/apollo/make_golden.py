@@ -1,4 +1,4 @@
-"""Write the golden Apollo record (tests/data/apollo/golden.record.xz): the run of
+"""Write the golden Apollo record (tests/data/apollo/golden.record.xz): the stored run log of
 tests/data/autoware/make_golden.py (the first second of a simulated highway-cut-in run), every
 channel on the 20 Hz clock, with its ground truth, xz-compressed (the record itself is mostly
 the descriptors each channel carries).
