@@ -24,7 +24,9 @@ from evoeye.results.markdown import README_BEGIN, README_END
 from evoeye.store import SplitSpec
 from evoeye.store.feedback import read_rounds
 
-pytestmark = pytest.mark.slow
+# its module fixtures are built once only if its tests share a worker (pytest-xdist
+# --dist loadgroup); spread over two, each worker builds them again
+pytestmark = [pytest.mark.slow, pytest.mark.xdist_group("results-end-to-end")]
 RUNNER = CliRunner()
 SCENARIO = "highway-cut-in"
 METHODS = ("uniform", "evoeye", "no-feedback", "aem-evo")  # a row in every RQ2 table

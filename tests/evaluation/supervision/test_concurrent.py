@@ -16,6 +16,10 @@ from evoeye.evaluation.supervision.settings import Settings
 from evoeye.evaluation.supervision.sweep import RunJob, supervise_run
 from evoeye.evaluation.supervision.triggers import calibrate_triggers, oracle_trigger
 
+# its module fixtures are built once only if its tests share a worker (pytest-xdist
+# --dist loadgroup); spread over two, each worker builds them again
+pytestmark = pytest.mark.xdist_group("supervision-concurrent")
+
 TRIGGERS = [("baseline", "ttc"), ("baseline", "rss")]
 
 

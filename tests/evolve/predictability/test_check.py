@@ -15,6 +15,10 @@ from evoeye.monitor import read_card
 from evoeye.paths import DataRoot
 from evoeye.store import RunFilter, Warehouse, ingest
 
+# its module fixtures are built once only if its tests share a worker (pytest-xdist
+# --dist loadgroup); spread over two, each worker builds them again
+pytestmark = pytest.mark.xdist_group("predictability-check")
+
 SCENARIO = "unprotected-intersection"
 
 

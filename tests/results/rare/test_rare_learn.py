@@ -19,6 +19,10 @@ from evoeye.results.rare.part import rare_results
 from evoeye.results.rare.report import advice_lines, rare_findings_markdown, rare_markdown
 from evoeye.results.rare.runner import run_seed
 
+# its module fixtures are built once only if its tests share a worker (pytest-xdist
+# --dist loadgroup); spread over two, each worker builds them again
+pytestmark = pytest.mark.xdist_group("rare-learn")
+
 REGIME = "highway-cut-in:default"  # collisions are common: a small run learns something
 LEARN = {"budgets": [5, 10], "test_runs": 12, "val_runs": 10, "val_collisions": 0,
          "controls": ["ce-is"]}  # ce-is's runs also unweighted: the control

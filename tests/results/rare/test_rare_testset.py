@@ -20,6 +20,10 @@ from evoeye.results.rare.testset import TEST_DRAW_FILE, draw_test_failures, more
 from evoeye.sim.episode import STATUS_OK
 from evoeye.sim.runner import run_episode
 
+# its module fixtures are built once only if its tests share a worker (pytest-xdist
+# --dist loadgroup); spread over two, each worker builds them again
+pytestmark = pytest.mark.xdist_group("rare-testset")
+
 REGIME, SCENARIO = "highway-cut-in:default", "highway-cut-in"  # collisions are common here
 DATA_SEED = 500
 LEARN = LearnConfig(budgets=(5, 10), test_runs=8, val_runs=4, val_collisions=0,
