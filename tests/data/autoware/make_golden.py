@@ -10,8 +10,8 @@ bytes, so a change of the exporter's conventions shows as a changed golden bag i
 The run log both golden files are exported from is stored beside (golden-run.mcap.xz), not
 simulated by the tests: the simulation's last bits depend on the CPU (on an AVX2 machine one
 prediction point of this second came out one ulp from the AVX-512 machine's that wrote the
-first goldens; numpy's float64 sin, cos and exp take SIMD paths on AVX-512 that round unlike
-libm's), and the goldens test the exporters, not the simulator. Re-simulate it
+first goldens, most likely where numpy's float64 functions take SIMD paths on one CPU and not
+the other; not traced further), and the goldens test the exporters, not the simulator. Re-simulate it
 (`--log`) when the log's format changes.
 """
 
