@@ -44,7 +44,12 @@ class TrackingPerception:
         self._pending: deque[Detections] = deque(maxlen=self.latency_frames + 1)
 
     def perceive(self, scene: SceneState, ego: Localization) -> Obstacles:
-        self._pending.append(self.sensor.detect(scene, ego))
+        return self.track(scene, self.sensor.detect(scene, ego))
+
+    def track(self, scene: SceneState, detections: Detections) -> Obstacles:
+        """The tracks published at scene.t_s, given this frame's `detections` (the lockstep
+        engine detects for a whole batch of runs at once and hands each run its own)."""
+        self._pending.append(detections)
         if len(self._pending) == self._pending.maxlen:
             self.tracker.step(self._pending[0].z)
         trk = self.tracker

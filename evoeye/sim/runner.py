@@ -111,6 +111,94 @@ def default_driver(road_map: RoadMap, rng: np.random.Generator, config: ADSConfi
     return ADS(road_map, rng, config)
 
 
+class RunLoop:
+    """One run's frame loop, shared by `run_episode` and the lockstep engine
+    (`evoeye.sim.lockstep`): what to read at frame k, what to record of it, when the run ends,
+    and the Episode it leaves. Whatever raises inside the run goes to `fail` and the run ends as
+    a failed Episode; the engines differ only in how they call `driver.step` and `world.step`."""
+
+    def __init__(self, spec: RunSpec, config: SimConfig | None = None,
+                 ads_config: ADSConfig | None = None, *, driver: DriverFactory = default_driver,
+                 branches: Sequence[tuple[int, int]] = ()) -> None:
+        self.spec = spec
+        self.config = c = config or SimConfig()
+        # a bad vector is the caller's error: raise
+        simulable(spec.scenario).space.validate(spec.params)
+        check_profile(spec.ads)
+        check_world(spec.world, spec.scenario)
+        self._reseed = dict(branches)
+        if len(self._reseed) != len(branches) or any(k < 0 for k in self._reseed):
+            raise ValueError(f"branches need distinct frames >= 0, got {list(branches)}")
+        self._streams = _seeds(spec.seed)
+        self._ads_config = ads_config
+        self._driver_factory = driver
+        self.dt = 1.0 / c.rate_hz
+        self.n_frames = int(round(c.duration_s * c.rate_hz))
+        self._post_frames = int(round(c.post_collision_s * c.rate_hz))
+        self.frames: list[Frame] = []
+        self.done = False
+        self._collision: tuple[float, int, int | None] | None = None  # (t, frame, other actor)
+        self._failure = ""
+        self.road_map: RoadMap | None = None
+        self.world: World | None = None
+        self.driver: Driver | None = None
+
+    def start(self) -> None:
+        """Build the world and what drives the ego (may raise: `fail`)."""
+        world_rng, ads_rng = self._streams
+        world, cruise_mps = build_world(self.spec, world_rng)
+        self.world, self.road_map = world, world.road_map
+        self.driver = self._driver_factory(
+            world.road_map, ads_rng,
+            (self._ads_config or ads_profile(self.spec.ads)).with_cruise_speed(cruise_mps))
+
+    def observe(self, k: int, scene: SceneState | None = None) -> SceneState:
+        """The ground truth of frame k (`scene`: the world's, read for a batch of runs at once),
+        at its exact frame time; reseeds the streams at a branch, after the world is read and
+        before the ego senses it."""
+        scene = scene or self.world.scene()
+        scene.t_s = k * self.dt  # exact frame time, free of float accumulation
+        if k in self._reseed:
+            _reseed(self._streams, self.spec.seed, k, self._reseed[k])
+        return scene
+
+    def record(self, k: int, scene: SceneState, msgs: FrameMessages) -> bool:
+        """Keep frame k; True if the world is to be stepped on (False: the run has ended; after
+        its last frame, a run ends once its world has stepped, as it always has)."""
+        if not (scene_finite(scene) and msgs.all_finite()):
+            raise SimulationError(f"non-finite value at t={scene.t_s:.2f} s")
+        self.frames.append(Frame(scene, msgs))
+        if scene.ego_collision and self._collision is None:
+            self._collision = (scene.t_s, k, scene.collision_actor)
+        if self._collision is not None and k >= self._collision[1] + self._post_frames:
+            self.done = True
+        return not self.done
+
+    def fail(self, exc: BaseException) -> None:
+        """End the run as failed: a broken run is data, not a crash of the batch."""
+        self._failure = f"{type(exc).__name__}: {exc}"
+        self.done = True
+
+    def episode(self) -> Episode:
+        """The Episode of the ended run."""
+        duration_s = len(self.frames) * self.dt
+        if self._failure:
+            outcome = Outcome(status=STATUS_FAILED, reason=self._failure, duration_s=duration_s)
+        else:
+            min_gap = min_ego_gap([f.scene for f in self.frames])  # footprint distance; 0: touch
+            t, _, other = self._collision or (None, -1, None)
+            outcome = Outcome(
+                status=STATUS_OK, collided=t is not None, collision_time_s=t,
+                other_actor=other, duration_s=duration_s,
+                min_distance_m=min_gap if np.isfinite(min_gap) else None,
+            )
+        return Episode(
+            spec=self.spec, road_map=self.road_map or RoadMap.empty(self.spec.scenario),
+            outcome=outcome, software_version=__version__, rate_hz=self.config.rate_hz,
+            frames=self.frames,
+        )
+
+
 def run_episode(
     spec: RunSpec, config: SimConfig | None = None, ads_config: ADSConfig | None = None,
     *, driver: DriverFactory = default_driver, branches: Sequence[tuple[int, int]] = (),
@@ -121,56 +209,16 @@ def run_episode(
     another factory and get the same world, the same random streams and the same frame loop.
     `branches`: (frame, key) pairs at which both streams are reseeded (module doc).
     """
-    config = config or SimConfig()
-    # a bad vector is the caller's error: raise
-    simulable(spec.scenario).space.validate(spec.params)
-    check_profile(spec.ads)
-    check_world(spec.world, spec.scenario)
-    world_rng, ads_rng = _seeds(spec.seed)
-    reseed = dict(branches)
-    if len(reseed) != len(branches) or any(k < 0 for k in reseed):
-        raise ValueError(f"branches need distinct frames >= 0, got {list(branches)}")
-    dt = 1.0 / config.rate_hz
-    n_frames = int(round(config.duration_s * config.rate_hz))
-    frames: list[Frame] = []
-    collision_t: float | None = None
-    collision_k = -1
-    post_frames = int(round(config.post_collision_s * config.rate_hz))
-    other: int | None = None
-    road_map = None
+    run = RunLoop(spec, config, ads_config, driver=driver, branches=branches)
     try:
-        world, cruise_mps = build_world(spec, world_rng)
-        road_map = world.road_map
-        ads = driver(road_map, ads_rng,
-                     (ads_config or ads_profile(spec.ads)).with_cruise_speed(cruise_mps))
-        for k in range(n_frames):
-            scene = world.scene()
-            scene.t_s = k * dt  # exact frame time, free of float accumulation
-            if k in reseed:
-                _reseed((world_rng, ads_rng), spec.seed, k, reseed[k])
-            msgs = ads.step(scene)
-            if not (scene_finite(scene) and msgs.all_finite()):
-                raise SimulationError(f"non-finite value at t={scene.t_s:.2f} s")
-            frames.append(Frame(scene, msgs))
-            if scene.ego_collision and collision_t is None:
-                collision_t, collision_k, other = scene.t_s, k, scene.collision_actor
-            if collision_t is not None and k >= collision_k + post_frames:
+        run.start()
+        for k in range(run.n_frames):
+            scene = run.observe(k)
+            msgs = run.driver.step(scene)
+            if not run.record(k, scene, msgs):
                 break
-            world.step(msgs.control.accel_cmd_mps2, msgs.control.steering_rad, dt)
+            run.world.step(msgs.control.accel_cmd_mps2, msgs.control.steering_rad, run.dt)
+        run.done = True
     except Exception as exc:  # noqa: BLE001 - a broken run is data, not a crash of the batch
-        outcome = Outcome(
-            status=STATUS_FAILED, reason=f"{type(exc).__name__}: {exc}",
-            duration_s=len(frames) * dt,
-        )
-    else:
-        min_gap = min_ego_gap([f.scene for f in frames])  # footprint distance; 0: touching
-        outcome = Outcome(
-            status=STATUS_OK, collided=collision_t is not None, collision_time_s=collision_t,
-            other_actor=other, duration_s=len(frames) * dt,
-            min_distance_m=min_gap if np.isfinite(min_gap) else None,
-        )
-    return Episode(
-        spec=spec, road_map=road_map or RoadMap.empty(spec.scenario), outcome=outcome,
-        software_version=__version__,
-        rate_hz=config.rate_hz, frames=frames,
-    )
+        run.fail(exc)
+    return run.episode()

@@ -11,8 +11,8 @@ The run log both golden files are exported from is stored beside (golden-run.mca
 simulated by the tests: the simulation's last bits depend on the CPU (on an AVX2 machine one
 prediction point of this second came out one ulp from the AVX-512 machine's that wrote the
 first goldens, most likely where numpy's float64 functions take SIMD paths on one CPU and not
-the other; not traced further), and the goldens test the exporters, not the simulator. Re-simulate it
-(`--log`) when the log's format changes.
+the other; not traced further), and the goldens test the exporters, not the simulator.
+Re-simulate it (`--log`) when the log's format changes.
 """
 
 from __future__ import annotations
