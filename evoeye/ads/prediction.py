@@ -81,7 +81,6 @@ class IntentPredictor:
             self.gives_way = np.array([ln.yields_to_route for ln in road_map.lanes])  # (L,)
 
     def predict(self, obstacles: Obstacles, ego: Localization) -> Predictions:
-        c = self.c
         t = self.t_s
         n = len(obstacles.x_m)
         ox, oy = obstacles.x_m, obstacles.y_m  # (n,)
@@ -90,8 +89,22 @@ class IntentPredictor:
             x = ox[:, None] + vx[:, None] * t  # (n, K) constant velocity
             y = oy[:, None] + vy[:, None] * t
             return self._message(obstacles, np.arange(n), np.zeros(n, np.int64), np.ones(n), x, y)
+        obs, mode, prob, x, y = self.modes(ox, oy, obstacles.heading_rad, vx, vy)
+        return self._message(obstacles, obs, mode, prob, x, y)
+
+    def modes(
+        self, ox: np.ndarray, oy: np.ndarray, heading: np.ndarray, vx: np.ndarray,
+        vy: np.ndarray, first: np.ndarray | None = None,
+    ) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """The rows (obstacle, mode, probability, x (r, K), y (r, K)) of n ≥ 1 obstacles on a
+        map with lanes. Every step is elementwise per obstacle or per row of the obstacle's own
+        (M + 4) columns, except the ordering: so `first` ((n,), the index of the first obstacle
+        of each obstacle's run) lets the obstacles of several runs be predicted at once
+        (`evoeye.ads.lockstep.prediction`), each run ordered by its own sort key."""
+        c = self.c
+        t = self.t_s
         lanes, graph = self.lanes, self.graph
-        v = lanes.candidates(ox, oy, obstacles.heading_rad)  # (n,) nearest lane heading our way
+        v = lanes.candidates(ox, oy, heading)  # (n,) nearest lane heading our way
         g, lat, tx, ty = lanes.project(ox, oy, v)
         lane = lanes.line.take(v)  # −1: no lane
         on = (lane >= 0) & (np.abs(lat) <= c.lane_match_radius_m)
@@ -116,7 +129,7 @@ class IntentPredictor:
         else:
             ahead = s + np.maximum(v_along * c.turn_lookahead_s, c.turn_lookahead_min_m)
             path_off = graph.paths.offset.take(np.maximum(paths, 0))  # (n, M)
-            dh = graph.paths.heading_at(path_off + ahead[:, None]) - obstacles.heading_rad[:, None]
+            dh = graph.paths.heading_at(path_off + ahead[:, None]) - heading[:, None]
             dh = (dh + np.pi) % (2.0 * np.pi) - np.pi
             w = np.exp(dh * dh * (-0.5 / c.turn_heading_sigma_rad**2)) * (paths >= 0)
             p_path = w * (p_keep / np.maximum(w.sum(axis=1), 1e-12))[:, None]  # (n, M)
@@ -137,7 +150,10 @@ class IntentPredictor:
         best = p_all.max(axis=1, keepdims=True)
         obs, col = ((p_all >= np.minimum(best, c.min_mode_prob)) & (p_all > 0.0)).nonzero()
         prob = p_all[obs, col]
-        order = (obs - 0.5 * prob).argsort(kind="stable")  # per obstacle, most probable first
+        if first is None:
+            order = (obs - 0.5 * prob).argsort(kind="stable")  # per obstacle, most probable first
+        else:  # by obstacle, then the key each run computes (on its own obstacle index)
+            order = np.lexsort(((obs - first.take(obs)) - 0.5 * prob, obs))
         obs, col, prob = obs.take(order), col.take(order), prob.take(order)
         mode = MODE_AFTER_PATHS.take(np.maximum(col - (m - 1), 0))  # col m → LEFT, m+1 …
         x = np.empty((len(obs), self.k))  # (r, K)
@@ -174,7 +190,7 @@ class IntentPredictor:
             dur = c.lane_change_duration_s * np.abs(target - d0) / width[:, None]
             d = d0 + (target - d0) * _smoothstep(t / np.maximum(dur, c.dt_s))
             x[change], y[change] = cx - d * np.sin(hd), cy + d * np.cos(hd)
-        return self._message(obstacles, obs, mode, prob, x, y)
+        return obs, mode, prob, x, y
 
     def _message(
         self, obstacles: Obstacles, rows: np.ndarray, mode: np.ndarray, prob: np.ndarray,

@@ -94,29 +94,45 @@ class World:
 
     # -- advancing -----------------------------------------------------------------------------
     def step(self, accel_mps2: float, steering_rad: float, dt: float) -> None:
-        """Apply the ego command, let the NPCs decide and move, integrate dt, check contacts."""
+        """Apply the ego command, let the NPCs decide and move, integrate dt, check contacts.
+        In phases that `lockstep_world.step_worlds` also calls, doing the array ones for many
+        worlds at once."""
         x, y, heading, speed = self._state()
         rel = Relations.of(x, y, heading, speed, *self._half_sums)
-        shift = np.array([0.0] + [n.lateral_target_m() for n in self.npcs])
-        gap, v_lead, block = leaders(rel, shift)
+        gap, v_lead, block = leaders(rel, np.array(self._lateral_targets()))
         self._block_along_paths(block, x, y, heading)
-        self._blocked_s = np.where(np.isfinite(block), self._blocked_s + dt, 0.0)
-        seen = self._blocked_s > NPC_REACTION_S  # a crossing car, answered after a reaction time
-        gap, v_lead = np.where(seen & (block < gap), block, gap), np.where(
-            seen & (block < gap), 0.0, v_lead)
+        gap, v_lead, self._blocked_s = answer_blocks(gap, v_lead, block, self._blocked_s, dt)
         self._wait_at_crossings(gap, v_lead)
-        if self._scripted:  # lane-change triggers to update, on floats
-            v, cos_dh = speed.tolist(), rel.cos_dh[0].tolist()
-            for i, npc in self._scripted:
-                closing = v[0] - v[i] * cos_dh[i]
-                if npc.wants_lane_change(rel.gap_ahead_of(i, 0), closing) and clear_to_change(
-                    rel, i, npc.lane_change.offset_m
-                ):
-                    npc.start_lane_change()
-        gaps, v_leads = gap.tolist(), v_lead.tolist()  # floats for the scalar driver models
-        accels = [npc.longitudinal(gaps[i], v_leads[i], dt)
-                  for i, npc in enumerate(self.npcs, start=1)]
+        self._lane_changes(rel, speed)
+        accels = self._decide(gap.tolist(), v_lead.tolist(), dt)
+        self._accel = np.array(self._advance(accel_mps2, steering_rad, accels, dt))
+        self._contacts()
 
+    def _lateral_targets(self) -> list[float]:
+        """Each row's lateral target (0 for the ego), the shift `leaders` looks for leaders at."""
+        return [0.0] + [n.lateral_target_m() for n in self.npcs]
+
+    def _lane_changes(self, rel: Relations, speed: np.ndarray) -> None:
+        """Update the scripted lane changes' triggers (on floats) and start those that fire."""
+        if not self._scripted:
+            return
+        v, cos_dh = speed.tolist(), rel.cos_dh[0].tolist()
+        for i, npc in self._scripted:
+            closing = v[0] - v[i] * cos_dh[i]
+            if npc.wants_lane_change(rel.gap_ahead_of(i, 0), closing) and clear_to_change(
+                rel, i, npc.lane_change.offset_m
+            ):
+                npc.start_lane_change()
+
+    def _decide(self, gaps: list[float], v_leads: list[float], dt: float) -> list[float]:
+        """Every NPC's acceleration from its gap and leader speed (floats for the scalar driver
+        models; row 0, the ego's, is not read)."""
+        return [npc.longitudinal(gaps[i], v_leads[i], dt)
+                for i, npc in enumerate(self.npcs, start=1)]
+
+    def _advance(self, accel_mps2: float, steering_rad: float, accels: list[float],
+                 dt: float) -> list[float]:
+        """Move the ego (highway-env's bicycle) and the NPCs by dt; the accelerations applied."""
         ego = self.ego
         v_before = ego.speed
         ego.action = {"acceleration": float(accel_mps2), "steering": float(steering_rad)}
@@ -125,8 +141,7 @@ class World:
         for npc, a in zip(self.npcs, accels, strict=True):
             npc.advance(a, dt)
         self.t_s += dt
-        self._accel = np.array([(ego.speed - v_before) / dt] + [n.accel_mps2 for n in self.npcs])
-        self._contacts()
+        return [(ego.speed - v_before) / dt] + [n.accel_mps2 for n in self.npcs]
 
     def _block_along_paths(self, block: np.ndarray, x: np.ndarray, y: np.ndarray,
                            heading: np.ndarray) -> None:
@@ -175,9 +190,12 @@ class World:
         i, j = i[near], j[near]
         corners = box_corners(x, y, heading, length, width)
         touching = box_gaps(corners[i], corners[j]) <= 0.0
-        if not np.count_nonzero(touching):
-            return
-        i, j = i[touching], j[touching]
+        if np.count_nonzero(touching):
+            self._crash(i[touching], j[touching], x, y)
+
+    def _crash(self, i: np.ndarray, j: np.ndarray, x: np.ndarray, y: np.ndarray) -> None:
+        """Pairs (i, j) (i < j) touch, at positions x, y: both crashed, the ego's partner (the
+        nearest, if several) remembered at its first contact."""
         if not self.crashed[0] and np.count_nonzero(i == 0):
             partners = j[i == 0]
             d = np.hypot(x[partners] - x[0], y[partners] - y[0])
@@ -186,3 +204,12 @@ class World:
         self.crashed[j] = True
         for k in np.concatenate((i, j)).tolist():
             self.vehicles[k].crashed = True
+
+
+def answer_blocks(gap: np.ndarray, v_lead: np.ndarray, block: np.ndarray,
+                  blocked_s: np.ndarray, dt: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(gap, leader speed, blocked time) once each driver answers a crossing car that has blocked
+    its way for longer than `NPC_REACTION_S` as a standing leader. Elementwise: any shape."""
+    blocked_s = np.where(np.isfinite(block), blocked_s + dt, 0.0)
+    answered = (blocked_s > NPC_REACTION_S) & (block < gap)  # seen after a reaction time
+    return np.where(answered, block, gap), np.where(answered, 0.0, v_lead), blocked_s
