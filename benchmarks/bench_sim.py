@@ -7,6 +7,8 @@ vehicles at the same poses, speeds and desired speeds, a fixed ego command) for 
 of frames, and nothing else: no ground-truth read, no ADS, no log. Our world steps its NPCs
 itself (bounded path dynamics, vectorised relations and contacts), more cheaply than
 highway-env does, so the table also gives the cost relative to our own bare world.
+`--engines`: the per-run engine against the lockstep one (`evoeye.sim.lockstep`), simulate +
+log, on the same runs, CPU s per run (issue 41: ≥ 3×, logs included).
 Targets (issues 2 and 10): full stack with logging ≥ 50× real time per core, ≤ 2× the cost of
 bare highway-env stepping of the same vehicles.
 """
@@ -14,6 +16,8 @@ bare highway-env stepping of the same vehicles.
 from __future__ import annotations
 
 import argparse
+import io
+import math
 import os
 import tempfile
 import time
@@ -27,8 +31,10 @@ from highway_env.vehicle.kinematics import Vehicle
 from benchmarks.machine import describe
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.log import write_episode
+from evoeye.log.writer import write_stream
 from evoeye.paths import DataRoot
 from evoeye.scenarios import SCENARIOS
+from evoeye.sim.lockstep import run_lockstep
 from evoeye.sim.runner import build_world, run_episode
 
 DT_S = 0.05
@@ -94,11 +100,55 @@ def bench_workers(scenario: str, n: int, workers: int) -> float:
         return run_batch(specs, DataRoot.resolve(root), workers=workers).wall_s
 
 
+def bench_engines(specs, sizes: list[int], repeat: int) -> tuple[float, dict[int, float], bool]:
+    """CPU s per run of simulate + log on the same specs: the per-run engine, and the lockstep
+    engine at each batch size; interleaved `repeat` times, best of each. Also whether every
+    lockstep log has the per-run log's bytes."""
+    per_run, lockstep, same = math.inf, dict.fromkeys(sizes, math.inf), True
+    for _ in range(repeat):
+        t0 = time.process_time()
+        ref = {s.scenario_id: _log_bytes(run_episode(s)) for s in specs}
+        per_run = min(per_run, (time.process_time() - t0) / len(specs))
+        for size in sizes:
+            t0 = time.process_time()
+            got = {e.spec.scenario_id: _log_bytes(e) for e in run_lockstep(specs, size=size)}
+            lockstep[size] = min(lockstep[size], (time.process_time() - t0) / len(specs))
+            same = same and got == ref
+    return per_run, lockstep, same
+
+
+def _log_bytes(episode) -> bytes:
+    out = io.BytesIO()
+    write_stream(episode, out)
+    return out.getvalue()
+
+
+def engines_table(runs: int, sizes: list[int], repeat: int) -> None:
+    print("| logical scenario | runs | per-run engine, CPU ms per run | "
+          + " | ".join(f"lockstep B={b}, CPU ms per run (×)" for b in sizes)
+          + " | same log bytes |")
+    print("|---|---|---|" + "---|" * len(sizes) + "---|")
+    for name in SCENARIOS:
+        specs = plan_uniform(name, runs, seed=7)
+        run_episode(specs[0])  # warm the per-process caches (road networks, imports)
+        per_run, lockstep, same = bench_engines(specs, sizes, repeat)
+        cells = " | ".join(f"{1e3 * lockstep[b]:.0f} ({per_run / lockstep[b]:.2f}×)" for b in sizes)
+        print(f"| {name} | {runs} | {1e3 * per_run:.0f} | {cells} | {'yes' if same else 'NO'} |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--runs", type=int, default=20, help="runs per logical scenario")
+    ap.add_argument("--engines", action="store_true",
+                    help="only the per-run against the lockstep engine, side by side")
+    ap.add_argument("--sizes", type=int, nargs="+", default=[8, 64],
+                    help="lockstep batch sizes for --engines")
+    ap.add_argument("--repeat", type=int, default=2, help="interleaved repeats for --engines")
     args = ap.parse_args()
     print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}\n")
+    if args.engines:
+        engines_table(args.runs, args.sizes, args.repeat)
+        return
     print("| logical scenario | runs | sim s | full RTF (sim+ADS+log) "
           "| bare RTF (highway-env) | full / bare cost | bare RTF (our world) "
           "| full / world cost | full ms/frame | of which log | 1 worker s | 2 workers s "

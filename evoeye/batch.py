@@ -11,7 +11,7 @@ from __future__ import annotations
 
 import os
 import time
-from collections.abc import Callable, Iterable, Sequence
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from concurrent.futures import Future, ProcessPoolExecutor, as_completed
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -25,6 +25,7 @@ from evoeye.log import LogError, read_run, write_episode
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import get_scenario
 from evoeye.sim.episode import STATUS_OK, Episode, RunSpec
+from evoeye.sim.lockstep import chunks, run_lockstep
 from evoeye.sim.runner import run_episode, run_spec
 from evoeye.sim.worlds import DEFAULT_WORLD
 
@@ -76,24 +77,60 @@ def simulate_and_keep(spec: RunSpec, root: DataRoot,
                       collisions_only: bool = False) -> tuple[RunResult, Episode | None]:
     """`simulate_and_log`, and the Episode it simulated (None when the log was on disk), for a
     caller that converts the run in memory (`evoeye.store.log_windows.episode_run`)."""
-    path = root.run_log(spec.scenario, spec.batch, spec.scenario_id)
-    if path.exists():
-        try:
-            meta = read_run(path, topics=()).metadata
-            return RunResult(
-                spec.scenario_id, str(path), meta["status"], bool(meta["collided"]),
-                meta.get("reason") or "", skipped=True, sim_time_s=float(meta["duration_s"]),
-            ), None
-        except LogError:
-            path.unlink()  # a final-named log that does not read back: simulate it again
+    on_disk = logged_result(spec, root)
+    if on_disk is not None:
+        return on_disk, None
     episode = run_episode(spec)
-    o = episode.outcome
+    return keep(episode, root, collisions_only), episode
+
+
+def simulate_chunk(specs: Sequence[RunSpec], root: DataRoot,
+                   collisions_only: bool = False) -> list[RunResult]:
+    """`simulate_and_log` for runs of one logical scenario, ADS profile and world stepped
+    together by the lockstep engine (`evoeye.sim.lockstep`): the same logs, bit for bit.
+    Picklable. A log that cannot be written is that run's error; the others are kept."""
+    results, todo = [], []
+    for spec in specs:
+        on_disk = logged_result(spec, root)
+        if on_disk is None:
+            todo.append(spec)
+        else:
+            results.append(on_disk)
+    for episode in run_lockstep(todo, size=max(len(todo), 1)):
+        try:
+            results.append(keep(episode, root, collisions_only))
+        except Exception as exc:  # noqa: BLE001 - reported per run, the chunk goes on
+            results.append(_error(episode.spec, root, exc))
+    return results
+
+
+def logged_result(spec: RunSpec, root: DataRoot) -> RunResult | None:
+    """The result of a run whose log is on disk (None: to be simulated; a final-named log
+    that does not read back is removed, to be simulated again)."""
+    path = root.run_log(spec.scenario, spec.batch, spec.scenario_id)
+    if not path.exists():
+        return None
+    try:
+        meta = read_run(path, topics=()).metadata
+    except LogError:
+        path.unlink()
+        return None
+    return RunResult(
+        spec.scenario_id, str(path), meta["status"], bool(meta["collided"]),
+        meta.get("reason") or "", skipped=True, sim_time_s=float(meta["duration_s"]),
+    )
+
+
+def keep(episode: Episode, root: DataRoot, collisions_only: bool = False) -> RunResult:
+    """Write a simulated run's log (with `collisions_only`, only if it collided); its result."""
+    spec, o = episode.spec, episode.outcome
+    path = root.run_log(spec.scenario, spec.batch, spec.scenario_id)
     logged = not collisions_only or (o.status == STATUS_OK and o.collided)
     if logged:
         path.parent.mkdir(parents=True, exist_ok=True)
         write_episode(episode, path)
     return RunResult(spec.scenario_id, str(path), o.status, o.collided, o.reason,
-                     sim_time_s=o.duration_s, logged=logged), episode
+                     sim_time_s=o.duration_s, logged=logged)
 
 
 def remove_stale_logs(specs: Sequence[RunSpec], root: DataRoot) -> list[Path]:
@@ -147,39 +184,62 @@ class BatchInterrupted(KeyboardInterrupt):
 def run_batch(
     specs: Sequence[RunSpec], root: DataRoot, *, workers: int = 1,
     progress: Callable[[Iterable], Iterable] | None = None, collisions_only: bool = False,
+    lockstep: int = 1,
 ) -> BatchSummary:
     """Run every spec (in `workers` processes); one broken run never stops the others. Ctrl-C
     stops the workers at once and raises BatchInterrupted with what finished. With
     `collisions_only`, only the colliding runs' logs are written (the others are simulated for
-    their outcome: a long draw of a rare failure's stream keeps its failures, not terabytes)."""
+    their outcome: a long draw of a rare failure's stream keeps its failures, not terabytes).
+    `lockstep` > 1: up to that many runs are stepped together (`evoeye.sim.lockstep`; the same
+    logs), in chunks spread over the workers."""
     if workers < 1:
         raise ValueError(f"--workers must be at least 1, got {workers}")
+    if lockstep < 1:
+        raise ValueError(f"--lockstep must be at least 1, got {lockstep}")
     t0 = time.perf_counter()
     summary = BatchSummary(stale_removed=remove_stale_logs(specs, root))
     wrap = progress or (lambda it: it)
+    size = min(lockstep, -(-len(specs) // workers)) if len(specs) else 1
+    simulate = simulate_each if lockstep == 1 else simulate_chunk
+    groups = [[s] for s in specs] if lockstep == 1 else list(chunks(specs, size))
     try:
-        if workers == 1:
-            for spec in wrap(specs):
-                summary.results.append(_guarded(spec, root, collisions_only))
-        else:
-            _in_pool(specs, root, workers, wrap, summary, collisions_only)
+        results = (_local(simulate, groups, root, collisions_only) if workers == 1
+                   else _in_pool(simulate, groups, root, workers, collisions_only))
+        for result in wrap(results):
+            summary.results.append(result)
     except KeyboardInterrupt:
         on_disk = sum(root.run_log(s.scenario, s.batch, s.scenario_id).exists() for s in specs)
         raise BatchInterrupted(_finish(summary, t0), on_disk, len(specs)) from None
     return _finish(summary, t0)
 
 
-def _in_pool(specs: Sequence[RunSpec], root: DataRoot, workers: int,
-             wrap: Callable[[Iterable], Iterable], summary: BatchSummary,
-             collisions_only: bool) -> None:
+def simulate_each(specs: Sequence[RunSpec], root: DataRoot,
+                  collisions_only: bool = False) -> list[RunResult]:
+    """`simulate_and_log` for every spec, one run at a time. Picklable."""
+    return [_guarded(spec, root, collisions_only) for spec in specs]
+
+
+Simulate = Callable[[Sequence[RunSpec], DataRoot, bool], list[RunResult]]
+
+
+def _local(simulate: Simulate, groups: list[list[RunSpec]], root: DataRoot,
+           collisions_only: bool) -> Iterator[RunResult]:
+    for specs in groups:
+        try:
+            yield from simulate(specs, root, collisions_only)
+        except Exception as exc:  # noqa: BLE001 - reported per run, the batch goes on
+            yield from (_error(spec, root, exc) for spec in specs)
+
+
+def _in_pool(simulate: Simulate, groups: list[list[RunSpec]], root: DataRoot, workers: int,
+             collisions_only: bool) -> Iterator[RunResult]:
     pool = ProcessPoolExecutor(max_workers=workers, mp_context=pool_context(),
                                initializer=stoppable_worker, initargs=(os.getpid(),))
     try:
-        futures: dict[Future, RunSpec] = {
-            pool.submit(stoppable, simulate_and_log, s, root, collisions_only): s for s in specs
-        }
-        for fut in wrap(as_completed(futures)):
-            summary.results.append(_result(fut, futures[fut], root))
+        futures = {pool.submit(stoppable, simulate, specs, root, collisions_only): specs
+                   for specs in groups}
+        for fut in as_completed(futures):
+            yield from _results(fut, futures[fut], root)
     except KeyboardInterrupt:
         stop_workers(pool)
         raise
@@ -200,11 +260,12 @@ def _guarded(spec: RunSpec, root: DataRoot, collisions_only: bool = False) -> Ru
         return _error(spec, root, exc)
 
 
-def _result(fut: Future, spec: RunSpec, root: DataRoot) -> RunResult:
+def _results(fut: Future, specs: Sequence[RunSpec], root: DataRoot) -> list[RunResult]:
     try:
-        return fut.result()
+        result: list[RunResult] = fut.result()
     except Exception as exc:  # noqa: BLE001 - includes a worker that died
-        return _error(spec, root, exc)
+        return [_error(spec, root, exc) for spec in specs]
+    return result
 
 
 def _error(spec: RunSpec, root: DataRoot, exc: BaseException) -> RunResult:
