@@ -70,6 +70,15 @@ class FalsePositives:
     def ghosts(self, radar: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """(actor ids, (DET_FIELDS, k) detections) of the multipath ghosts of these radar
         detections (DET_FIELDS, m): the ones the sensor model drew to have one."""
+        visible, z = self.mirror(radar)
+        if np.count_nonzero(visible) < len(visible):
+            z = z[:, visible]
+        return np.full(z.shape[1], GHOST_ID, dtype=np.int64), z
+
+    def mirror(self, radar: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(visible mask, mirrored detections (DET_FIELDS, m)): each radar detection mirrored in
+        the guard rail on its side, and whether the radar would see the mirror image.
+        Elementwise per column, so the detections of many runs can share one call."""
         c = self.c
         z = radar.copy()
         rail = np.where(z[DET_Y] >= 0.0, c.ghost_rail_offset_m, -c.ghost_rail_offset_m)
@@ -79,6 +88,4 @@ class FalsePositives:
         z[DET_RANGE] = np.hypot(z[DET_X], z[DET_Y])
         visible = (np.abs(np.arctan2(z[DET_Y], z[DET_X])) <= c.radar_half_fov_rad) & (
             z[DET_RANGE] <= c.radar_range_m)
-        if np.count_nonzero(visible) < len(visible):
-            z = z[:, visible]
-        return np.full(z.shape[1], GHOST_ID, dtype=np.int64), z
+        return visible, z

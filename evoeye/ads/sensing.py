@@ -143,6 +143,61 @@ class SensorModel:
         d = np.abs(np.subtract.outer(pos, pos))  # (m, m)
         return np.count_nonzero(d < reach) > len(pos)  # the diagonal is 0
 
+    # The elementwise steps of `detect`, on arrays of n actors (n,) or of B runs' actors (B, n)
+    # (`evoeye.ads.lockstep.sensing`): u, g are the frame's draws, (…, 3n + clutter) and
+    # (…, N_NORMALS·n), sliced on their last axis.
+    def seen_by(self, u: np.ndarray, n: int, r: np.ndarray, occ: np.ndarray,
+                bearing: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """(lidar, radar): which actors each sensor detects, from range, occlusion, bearing."""
+        c = self.c
+        r2 = r * r
+        p_lidar = (c.lidar_detect_prob_near - self._lidar_drop * r2) * (
+            1.0 - occ * self._inv_occ_lidar)
+        p_radar = (c.radar_detect_prob_near - self._radar_drop * r2) * (
+            1.0 - occ * self._inv_occ_radar)
+        lidar = (u[..., :n] < p_lidar) & (r <= c.lidar_range_m)
+        radar = (u[..., n:2 * n] < p_radar) & (r <= c.radar_range_m) & (
+            np.abs(bearing) <= c.radar_half_fov_rad)
+        return lidar, radar
+
+    def lidar_boxes(self, g: np.ndarray, n: int, rel: np.ndarray, los: np.ndarray,
+                    vrel: np.ndarray, h_rel: np.ndarray, r: np.ndarray, length: np.ndarray,
+                    width: np.ndarray, cos_phi: np.ndarray, sin_phi: np.ndarray) -> tuple:
+        """(pos, vel, heading, length, width, var_pos, var_vel) of the lidar boxes: made from
+        the visible points (shorter end-on, centred on the visible part), with noise."""
+        c = self.c
+        gc = g[..., :4 * n].view(np.complex128)  # (…, 2n) position noise, velocity noise
+        f = c.lidar_depth_seen_frac
+        len_l = length * (f + (1.0 - f) * sin_phi)
+        wid_l = width * (f + (1.0 - f) * cos_phi)
+        shift = 0.5 * ((length - len_l) * cos_phi + (width - wid_l) * sin_phi)
+        sig_p = c.pos_sigma_m + c.pos_sigma_per_m * r
+        sig_v = c.vel_sigma_mps + c.vel_sigma_per_m * r
+        pos_l = rel - shift * los + sig_p * gc[..., :n]
+        vel_l = vrel + sig_v * gc[..., n:]
+        head_l = h_rel + (c.heading_sigma_rad + c.heading_sigma_per_m * r) * g[..., 4 * n:5 * n]
+        return (pos_l, vel_l, head_l, len_l, wid_l, sig_p * sig_p + VAR_FLOOR,
+                sig_v * sig_v + VAR_FLOOR)
+
+    def radar_fusion(self, g: np.ndarray, n: int, r: np.ndarray, bearing: np.ndarray,
+                     vrel: np.ndarray, los: np.ndarray, both: np.ndarray, pos_l: np.ndarray,
+                     vel_l: np.ndarray, var_pl: np.ndarray, var_vl: np.ndarray) -> tuple:
+        """(range, line of sight, range rate) of the radar, and the lidar's position and
+        velocity fused with it where `both` see the actor. The radar measures range and range
+        rate only, so it corrects the lidar along its line of sight (a Kalman update with a
+        radial measurement)."""
+        c = self.c
+        rm = r + c.radar_range_sigma_m * g[..., 5 * n:6 * n]
+        los_r = np.exp(1j * (bearing + c.radar_azimuth_sigma_rad * g[..., 6 * n:7 * n]))
+        rr = (vrel * los.conj()).real + c.radar_range_rate_sigma_mps * g[..., 7 * n:]
+        if np.count_nonzero(both):
+            back = los_r.conj()
+            d_pos = (var_pl / (var_pl + self._var_range)) * (rm - (pos_l * back).real)
+            d_vel = (var_vl / (var_vl + self._var_range_rate)) * (rr - (vel_l * back).real)
+            pos_l = np.where(both, pos_l + d_pos * los_r, pos_l)
+            vel_l = np.where(both, vel_l + d_vel * los_r, vel_l)
+        return rm, los_r, rr, pos_l, vel_l
+
     def detect(self, scene: SceneState, ego: Localization | None = None) -> Detections:
         """Detections of every actor but the ego (row 0) at scene.t_s, in the world frame placed
         with `ego` (the localisation estimate at capture; None: the true pose)."""
@@ -152,7 +207,6 @@ class SensorModel:
         # a fixed number of draws per frame, whatever is detected: the stream stays aligned
         u = self.rng.random(3 * n + fp.n_uniforms)
         g = self.rng.standard_normal(N_NORMALS * n)
-        gc = g[: 4 * n].view(np.complex128)  # (2n,) lidar position noise, velocity noise
         x, y, h, v = scene.x_m, scene.y_m, scene.heading_rad, scene.speed_mps
         x0, y0, h0, v0 = float(x[0]), float(y[0]), float(h[0]), float(v[0])
         pose = (x0, y0, h0, v0) if ego is None else (
@@ -174,46 +228,17 @@ class SensorModel:
         occ = occluded_fraction(r, bearing, np.arctan2(length * sin_phi + width * cos_phi, r + r))
         if scene.occluders is not None:  # a building between: nothing to see
             occ = np.where(line_of_sight_blocked(x0, y0, x[1:], y[1:], scene.occluders), 1.0, occ)
-        r2 = r * r
-        p_lidar = (c.lidar_detect_prob_near - self._lidar_drop * r2) * (
-            1.0 - occ * self._inv_occ_lidar)
-        p_radar = (c.radar_detect_prob_near - self._radar_drop * r2) * (
-            1.0 - occ * self._inv_occ_radar)
-        lidar = (u[:n] < p_lidar) & (r <= c.lidar_range_m)
-        radar = (u[n:2 * n] < p_radar) & (r <= c.radar_range_m) & (
-            np.abs(bearing) <= c.radar_half_fov_rad)
-
-        # lidar boxes from the visible points: shorter end-on, centred on the visible part
-        f = c.lidar_depth_seen_frac
-        len_l = length * (f + (1.0 - f) * sin_phi)
-        wid_l = width * (f + (1.0 - f) * cos_phi)
-        shift = 0.5 * ((length - len_l) * cos_phi + (width - wid_l) * sin_phi)
-        sig_p = c.pos_sigma_m + c.pos_sigma_per_m * r
-        sig_v = c.vel_sigma_mps + c.vel_sigma_per_m * r
-        pos_l = rel - shift * los + sig_p * gc[:n]
-        vel_l = vrel + sig_v * gc[n:]
-        head_l = h_rel + (c.heading_sigma_rad + c.heading_sigma_per_m * r) * g[4 * n:5 * n]
-        var_pl, var_vl = sig_p * sig_p + VAR_FLOOR, sig_v * sig_v + VAR_FLOOR
+        lidar, radar = self.seen_by(u, n, r, occ, bearing)
+        pos_l, vel_l, head_l, len_l, wid_l, var_pl, var_vl = self.lidar_boxes(
+            g, n, rel, los, vrel, h_rel, r, length, width, cos_phi, sin_phi)
         if np.count_nonzero(lidar) > 1 and self._may_merge(pos_l[lidar], length, width):
             i = lidar.nonzero()[0]
             keep, pos_l[i], vel_l[i], len_l[i], wid_l[i] = merge_segments(
                 pos_l[i], vel_l[i], h_rel[i], length[i], width[i], r[i], c.lidar_merge_gap_m)
             lidar[i[~keep]] = False
 
-        # radar: range and azimuth → position; range rate → the radial velocity only
-        rm = r + c.radar_range_sigma_m * g[5 * n:6 * n]
-        los_r = np.exp(1j * (bearing + c.radar_azimuth_sigma_rad * g[6 * n:7 * n]))
-        rr = (vrel * los.conj()).real + c.radar_range_rate_sigma_mps * g[7 * n:]
-
-        # fusion where both see the actor: the radar measures range and range rate only, so it
-        # corrects the lidar along its line of sight (a Kalman update with a radial measurement)
-        both = lidar & radar
-        if np.count_nonzero(both):
-            back = los_r.conj()
-            d_pos = (var_pl / (var_pl + self._var_range)) * (rm - (pos_l * back).real)
-            d_vel = (var_vl / (var_vl + self._var_range_rate)) * (rr - (vel_l * back).real)
-            pos_l = np.where(both, pos_l + d_pos * los_r, pos_l)
-            vel_l = np.where(both, vel_l + d_vel * los_r, vel_l)
+        rm, los_r, rr, pos_l, vel_l = self.radar_fusion(
+            g, n, r, bearing, vrel, los, lidar & radar, pos_l, vel_l, var_pl, var_vl)
         z = pack(pos_l, vel_l, head_l, len_l, wid_l, r, var_pl, var_vl)  # (DET_FIELDS, n)
         radar_only = radar & ~lidar
         if np.count_nonzero(radar_only):

@@ -205,20 +205,6 @@ def _clutter(fp, u: np.ndarray, v0: list[float]) -> tuple[np.ndarray, np.ndarray
     return runs, np.full(len(runs), CLUTTER_ID, dtype=np.int64), z
 
 
-def _ghosts(c, radar: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """`FalsePositives.ghosts` of radar columns (DET_FIELDS, k) of any runs: (visible mask,
-    ghosts (DET_FIELDS, k)) — every step is elementwise, so the runs can share one pass."""
-    z = radar.copy()
-    rail = np.where(z[DET_Y] >= 0.0, c.ghost_rail_offset_m, -c.ghost_rail_offset_m)
-    z[DET_Y] = 2.0 * rail - z[DET_Y]
-    z[DET_VY] = -z[DET_VY]
-    z[DET_HEADING] = -z[DET_HEADING]
-    z[DET_RANGE] = np.hypot(z[DET_X], z[DET_Y])
-    visible = (np.abs(np.arctan2(z[DET_Y], z[DET_X])) <= c.radar_half_fov_rad) & (
-        z[DET_RANGE] <= c.radar_range_m)
-    return visible, z
-
-
 def _actors(models: Sequence[SensorModel], scenes: Sequence[SceneState], u: np.ndarray,
             g: np.ndarray, x: np.ndarray, y: np.ndarray, h: np.ndarray, v: np.ndarray,
             ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -228,7 +214,6 @@ def _actors(models: Sequence[SensorModel], scenes: Sequence[SceneState], u: np.n
     m0 = models[0]
     c = m0.c
     n = x.shape[1] - 1
-    gc = g[:, :4 * n].view(np.complex128)  # (B, 2n)
     x0, y0, h0, v0 = x[:, :1], y[:, :1], h[:, :1], v[:, :1]
     rot = np.array([cmath.exp(-1j * a) for a in h[:, 0].tolist()])[:, None]
     rel = ((x[:, 1:] - x0) + 1j * (y[:, 1:] - y0)) * rot  # (B, n)
@@ -246,39 +231,14 @@ def _actors(models: Sequence[SensorModel], scenes: Sequence[SceneState], u: np.n
     blocked = _line_of_sight_blocked(x0, y0, x[:, 1:], y[:, 1:], scenes)
     if blocked is not None:
         occ = np.where(blocked, 1.0, occ)
-    r2 = r * r
-    p_lidar = (c.lidar_detect_prob_near - m0._lidar_drop * r2) * (
-        1.0 - occ * m0._inv_occ_lidar)
-    p_radar = (c.radar_detect_prob_near - m0._radar_drop * r2) * (
-        1.0 - occ * m0._inv_occ_radar)
-    lidar = (u[:, :n] < p_lidar) & (r <= c.lidar_range_m)
-    radar = (u[:, n:2 * n] < p_radar) & (r <= c.radar_range_m) & (
-        np.abs(bearing) <= c.radar_half_fov_rad)
-
-    f = c.lidar_depth_seen_frac
-    len_l = length * (f + (1.0 - f) * sin_phi)
-    wid_l = width * (f + (1.0 - f) * cos_phi)
-    shift = 0.5 * ((length - len_l) * cos_phi + (width - wid_l) * sin_phi)
-    sig_p = c.pos_sigma_m + c.pos_sigma_per_m * r
-    sig_v = c.vel_sigma_mps + c.vel_sigma_per_m * r
-    pos_l = rel - shift * los + sig_p * gc[:, :n]
-    vel_l = vrel + sig_v * gc[:, n:]
-    head_l = h_rel + (c.heading_sigma_rad + c.heading_sigma_per_m * r) * g[:, 4 * n:5 * n]
-    var_pl, var_vl = sig_p * sig_p + VAR_FLOOR, sig_v * sig_v + VAR_FLOOR
+    lidar, radar = m0.seen_by(u, n, r, occ, bearing)
+    pos_l, vel_l, head_l, len_l, wid_l, var_pl, var_vl = m0.lidar_boxes(
+        g, n, rel, los, vrel, h_rel, r, length, width, cos_phi, sin_phi)
     if n > 1:
         _merge(c, lidar, pos_l, vel_l, len_l, wid_l, h_rel, length, width, r)
 
-    rm = r + c.radar_range_sigma_m * g[:, 5 * n:6 * n]
-    los_r = np.exp(1j * (bearing + c.radar_azimuth_sigma_rad * g[:, 6 * n:7 * n]))
-    rr = (vrel * los.conj()).real + c.radar_range_rate_sigma_mps * g[:, 7 * n:]
-
-    both = lidar & radar
-    if np.count_nonzero(both):
-        back = los_r.conj()
-        d_pos = (var_pl / (var_pl + m0._var_range)) * (rm - (pos_l * back).real)
-        d_vel = (var_vl / (var_vl + m0._var_range_rate)) * (rr - (vel_l * back).real)
-        pos_l = np.where(both, pos_l + d_pos * los_r, pos_l)
-        vel_l = np.where(both, vel_l + d_vel * los_r, vel_l)
+    rm, los_r, rr, pos_l, vel_l = m0.radar_fusion(
+        g, n, r, bearing, vrel, los, lidar & radar, pos_l, vel_l, var_pl, var_vl)
     z = np.empty((DET_FIELDS,) + r.shape)
     z[DET_X], z[DET_Y] = pos_l.real, pos_l.imag
     z[DET_VX], z[DET_VY] = vel_l.real, vel_l.imag
@@ -335,7 +295,7 @@ def _detect_group(models: Sequence[SensorModel], scenes: Sequence[SceneState],
         parts_runs, parts_ids = [rows], [_rows([s.actor_id for s in scenes])[:, 1:][seen]]
         parts_z = [z[:, seen]]
         if np.count_nonzero(multipath):
-            visible, ghosts = _ghosts(models[0].c, z[:, multipath])
+            visible, ghosts = models[0].false_positives.mirror(z[:, multipath])
             parts_runs.append(multipath.nonzero()[0][visible])
             parts_ids.append(np.full(np.count_nonzero(visible), GHOST_ID, dtype=np.int64))
             parts_z.append(ghosts[:, visible])
