@@ -72,43 +72,16 @@ class CVTracker:
         self._prune()
 
     def _update(self, rows: np.ndarray | None, z: np.ndarray) -> None:
-        """Closed-form Kalman update of the tracks `rows` (None: all) with detections z (10, r).
-
-        Per axis, with P = [[pp, pv], [pv, vv]], S = P + R, R = diag(rp, rv): K = P S⁻¹, and since
-        the whole state is measured, the posterior covariance P − K P equals K R.
-        """
+        """Update the tracks `rows` (None: all) with detections z (10, r) (`update_tracks`)."""
         s = self.state if rows is None else self.state[:, rows]  # (13, r)
-        pp, pv, vv = s[P_PP], s[P_PV], s[P_VV]
-        rp, rv = z[DET_VAR_POS], z[DET_VAR_VEL]
-        s00 = pp + rp
-        s11 = vv + rv
-        pv2 = pv * pv
-        inv_det = 1.0 / (s00 * s11 - pv2)
-        k00 = (pp * s11 - pv2) * inv_det
-        k11 = (vv * s00 - pv2) * inv_det
-        q = pv * inv_det  # K[0, 1] = q·rp, K[1, 0] = q·rv
-        e = z[DET_X:DET_HEADING] - s[X:P_PP]  # (4, r) innovations x, y, vx, vy
-        k01 = q * rp
-        s[X:P_PP] += np.concatenate((k00 * e[:2] + k01 * e[2:], (q * rv) * e[:2] + k11 * e[2:]))
-        s[P_PV] = k01 * rv
-        s[P_PP] = k00 * rp
-        s[P_VV] = k11 * rv
-        s[HEADING:HITS] = z[DET_HEADING:DET_RANGE + 1]  # box orientation and size as detected
-        s[HITS] += 1.0
-        s[MISSES] = 0.0
+        update_tracks(s, z)
         if rows is not None:
             self.state[:, rows] = s
 
     def _spawn(self, z: np.ndarray) -> None:
         """A tentative track per unassociated detection."""
         n = z.shape[1]
-        s = np.zeros((TRACK_FIELDS, n))
-        s[X:P_PP] = z[DET_X:DET_HEADING]
-        s[P_PP] = z[DET_VAR_POS]
-        s[P_VV] = z[DET_VAR_VEL]
-        s[HEADING:HITS] = z[DET_HEADING:DET_RANGE + 1]
-        s[HITS] = 1.0
-        self.state = np.concatenate((self.state, s), axis=1)
+        self.state = np.concatenate((self.state, new_tracks(z)), axis=1)
         self.track_id = np.concatenate((self.track_id, np.arange(self._next_id, self._next_id + n)))
         self._next_id += n
 
@@ -132,3 +105,41 @@ class CVTracker:
             (1.0 - (c.confidence_range_drop / range_m) * s[RANGE])  # detection range ≤ range_m
             * c.confidence_coast_decay ** s[MISSES]
         )
+
+
+def update_tracks(s: np.ndarray, z: np.ndarray) -> None:
+    """Closed-form Kalman update, in place, of the tracks with states s (13, r) with their
+    detections z (10, r) (the lockstep engine updates the tracks of many runs in one call).
+
+    Per axis, with P = [[pp, pv], [pv, vv]], S = P + R, R = diag(rp, rv): K = P S⁻¹, and since
+    the whole state is measured, the posterior covariance P − K P equals K R.
+    """
+    pp, pv, vv = s[P_PP], s[P_PV], s[P_VV]
+    rp, rv = z[DET_VAR_POS], z[DET_VAR_VEL]
+    s00 = pp + rp
+    s11 = vv + rv
+    pv2 = pv * pv
+    inv_det = 1.0 / (s00 * s11 - pv2)
+    k00 = (pp * s11 - pv2) * inv_det
+    k11 = (vv * s00 - pv2) * inv_det
+    q = pv * inv_det  # K[0, 1] = q·rp, K[1, 0] = q·rv
+    e = z[DET_X:DET_HEADING] - s[X:P_PP]  # (4, r) innovations x, y, vx, vy
+    k01 = q * rp
+    s[X:P_PP] += np.concatenate((k00 * e[:2] + k01 * e[2:], (q * rv) * e[:2] + k11 * e[2:]))
+    s[P_PV] = k01 * rv
+    s[P_PP] = k00 * rp
+    s[P_VV] = k11 * rv
+    s[HEADING:HITS] = z[DET_HEADING:DET_RANGE + 1]  # box orientation and size as detected
+    s[HITS] += 1.0
+    s[MISSES] = 0.0
+
+
+def new_tracks(z: np.ndarray) -> np.ndarray:
+    """The states (13, n) of new tentative tracks, one per detection of z (10, n)."""
+    s = np.zeros((TRACK_FIELDS, z.shape[1]))
+    s[X:P_PP] = z[DET_X:DET_HEADING]
+    s[P_PP] = z[DET_VAR_POS]
+    s[P_VV] = z[DET_VAR_VEL]
+    s[HEADING:HITS] = z[DET_HEADING:DET_RANGE + 1]
+    s[HITS] = 1.0
+    return s

@@ -123,10 +123,12 @@ def test_a_world_that_raises_ends_its_run_alone(monkeypatch):
 
 
 @pytest.mark.parametrize(("stage", "work_first"), [
-    ("detect_batch", True), ("predict_batch", True), ("plan_batch", False)])
+    ("detect_batch", True), ("track_batch", False), ("predict_batch", True),
+    ("plan_batch", False)])
 def test_a_batched_stage_that_raises_is_redone_run_by_run(monkeypatch, stage, work_first):
     """On the fifth frame the batched stage raises (sensing and prediction after doing their
-    work, sensing's draws included; planning, which keeps state, before changing any): the
+    work, sensing's draws included; tracking and planning, which keep state, before changing
+    any): the
     stage is redone per run from where it started, and every log is unchanged."""
     real = getattr(stack, stage)
     calls = []

@@ -25,21 +25,18 @@ convert them). Any other run and a group of one run are planned by their own pla
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Sequence
 
 import numpy as np
 
+from evoeye.ads.lockstep.keys import GroupKeys, bits
 from evoeye.ads.messages import Localization, PlannedTrajectory, Predictions
 from evoeye.ads.planning import Crossings, InPath, Planner, RoutePlanner, speed_profile
 
 # below this many runs, the scalar projection of the ego is the cheaper one
 _VECTOR_EGO_MIN = 4
 
-# what each planner plans by: the objects it was built with (checked by identity on every call)
-# and the key they give, computed once per planner
-_KEYS: weakref.WeakKeyDictionary[RoutePlanner, tuple[tuple, tuple]] = (
-    weakref.WeakKeyDictionary())
+_KEYS = GroupKeys()  # what each planner plans by
 
 
 def plan_batch(
@@ -106,17 +103,10 @@ def _key(p: RoutePlanner) -> tuple:
     """Equal for planners whose array work is the same: the same route index object, configs of
     equal repr (its fields are scalars, whose reprs are exact and tell 0.0 from −0.0), the same
     derived thresholds and plan times (bit for bit)."""
-    hit = _KEYS.get(p)
-    if hit is not None:
-        c, route, t_rel, corridor, aligned, half_len = hit[0]
-        if (c is p.c and route is p.route and t_rel is p.t_rel and corridor is p._corridor_half
-                and aligned is p._cos_aligned and half_len is p._half_len):
-            return hit[1]
     made = (p.c, p.route, p.t_rel, p._corridor_half, p._cos_aligned, p._half_len)
-    key = (type(p.c), repr(p.c), id(p.route), p.t_rel.dtype.str, p.t_rel.tobytes(),
-           repr(p._corridor_half), repr(p._cos_aligned), repr(p._half_len))
-    _KEYS[p] = (made, key)  # made keeps the route alive with p, so its id stays its own
-    return key
+    return _KEYS.get(p, made, lambda: (
+        type(p.c), repr(p.c), id(p.route), bits(p.t_rel), repr(p._corridor_half),
+        repr(p._cos_aligned), repr(p._half_len)))
 
 
 def _prepare(

@@ -21,18 +21,15 @@ without obstacles, the first (the others get empty arrays of the same dtypes and
 
 from __future__ import annotations
 
-import weakref
 from collections.abc import Sequence
 
 import numpy as np
 
+from evoeye.ads.lockstep.keys import GroupKeys, bits
 from evoeye.ads.messages import PREDICTION_MODES, Localization, Obstacles, Predictions
 from evoeye.ads.prediction import IntentPredictor, Predictor
 
-# what each predictor predicts by: the objects it was built with (checked by identity on every
-# call) and the key they give, computed once per predictor
-_KEYS: weakref.WeakKeyDictionary[IntentPredictor, tuple[tuple, tuple]] = (
-    weakref.WeakKeyDictionary())
+_KEYS = GroupKeys()  # what each predictor predicts by
 
 
 def predict_batch(
@@ -92,17 +89,9 @@ def _key(p: IntentPredictor) -> tuple:
     tell 0.0 from −0.0 and 1 from 1.0)."""
     graph, lane_len, gives_way = (getattr(p, a, None) for a in ("graph", "lane_len", "gives_way"))
     made = (p.c, p.k, p.t_s, p.lanes, graph, lane_len, gives_way)
-    hit = _KEYS.get(p)
-    if hit is not None and all(a is b for a, b in zip(hit[0], made, strict=True)):
-        return hit[1]
-    key = (type(p.c), repr(p.c), p.k, _bits(p.t_s), id(p.lanes), id(graph), _bits(lane_len),
-           _bits(gives_way))  # the ids are of objects `made` keeps alive with p
-    _KEYS[p] = (made, key)
-    return key
-
-
-def _bits(a: np.ndarray | None) -> tuple | None:
-    return None if a is None else (a.dtype.str, a.shape, a.tobytes())
+    return _KEYS.get(p, made, lambda: (
+        type(p.c), repr(p.c), p.k, bits(p.t_s), id(p.lanes), id(graph), bits(lane_len),
+        bits(gives_way)))
 
 
 def _empty_like(pred: Predictions, t_s: float) -> Predictions:

@@ -1,15 +1,15 @@
 """One frame of the ADS for every run of a lockstep batch: `step_batch`.
 
 The stages run in the stack's order (`evoeye.ads.stack.ADS.step`), each once for the whole
-batch: localization and tracking per run (a few scalar draws; ragged per-run association),
-sensing, prediction and planning as array programs over every run (`sensing`, `prediction`,
-`planning` in this package), control per run (scalar). Every run gets the messages its own
-`ADS.step` would give it, bit for bit.
+batch: localization per run (a few scalar draws), sensing, tracking, prediction and planning as
+array programs over every run (`sensing`, `tracking`, `prediction`, `planning` in this
+package; what is ragged or scalar in them stays per run), control per run (scalar). Every run
+gets the messages its own `ADS.step` would give it, bit for bit.
 
 A run whose stage raises ends there (its entry in the result is the exception) and the other
 runs go on: a batched stage that raises is redone run by run from the state it started from
-(the batched stages change no run's state before their array work has succeeded, and the
-random streams sensing drew from are rewound), so only the run that raises is affected.
+(the batched stages change no run's state unless they succeed, and the random streams sensing
+drew from are rewound), so only the run that raises is affected.
 """
 
 from __future__ import annotations
@@ -20,6 +20,7 @@ from typing import Any, TypeVar
 from evoeye.ads.lockstep.planning import plan_batch
 from evoeye.ads.lockstep.prediction import predict_batch
 from evoeye.ads.lockstep.sensing import detect_batch
+from evoeye.ads.lockstep.tracking import track_batch
 from evoeye.ads.messages import FrameMessages
 from evoeye.ads.stack import ADS
 from evoeye.scene import SceneState
@@ -77,8 +78,8 @@ def step_batch(stacks: Sequence[ADS],
 
     det = done(_stage(detect_batch, lambda m, s, e: m.detect(s, e),
                       [(stacks[i].perception.sensor, scenes[i], ego[i]) for i in rows], rewind))
-    obs = done(_per_run(lambda a, s, d: a.perception.track(s, d),
-                        [(stacks[i], scenes[i], det[i]) for i in rows]))
+    obs = done(_stage(track_batch, lambda p, s, d: p.track(s, d),
+                      [(stacks[i].perception, scenes[i], det[i]) for i in rows]))
     pred = done(_stage(predict_batch, lambda p, o, e: p.predict(o, e),
                        [(stacks[i].predictor, obs[i], ego[i]) for i in rows]))
     plan = done(_stage(plan_batch, lambda p, pr, e: p.plan(pr, e),
