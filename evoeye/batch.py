@@ -25,9 +25,11 @@ from evoeye.log import LogError, read_run, write_episode
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import get_scenario
 from evoeye.sim.episode import STATUS_OK, Episode, RunSpec
-from evoeye.sim.lockstep import chunks, run_lockstep
+from evoeye.sim.lockstep import DEFAULT_BATCH, chunks, run_lockstep
 from evoeye.sim.runner import run_episode, run_spec
 from evoeye.sim.worlds import DEFAULT_WORLD
+
+DEFAULT_LOCKSTEP = DEFAULT_BATCH  # what a large draw passes as `run_batch(lockstep=…)`
 
 
 def plan_uniform(

@@ -35,6 +35,7 @@ class SimulateParams(BaseModel):
     seed: int = Field(0, ge=0)
     root: str | None = None
     workers: int = Field(2, ge=1, le=64)
+    lockstep: int = Field(64, ge=1, le=4096)  # runs stepped together (evoeye.sim.lockstep)
     dask_address: str | None = None
     batch: str | None = None  # default uniform-seed<seed>
     ingest: bool = False  # then ingest the new logs, as the ingest flow does (a subflow run)
@@ -56,7 +57,7 @@ class SimulateParams(BaseModel):
 
 @task(retries=1, retry_delay_seconds=1, cache_policy=NONE, task_run_name="batch-{name}")
 def simulate_locally(specs: list[RunSpec], root: DataRoot, workers: int,
-                     name: str) -> BatchSummary:
+                     name: str, lockstep: int = 1) -> BatchSummary:
     """The whole batch on `workers` local processes, its progress in the task run's log."""
     logger = get_run_logger()
     done = 0
@@ -69,7 +70,7 @@ def simulate_locally(specs: list[RunSpec], root: DataRoot, workers: int,
                 logger.info("%d / %d runs", done, len(specs))
             yield r
 
-    return run_batch(specs, root, workers=workers, progress=progress)
+    return run_batch(specs, root, workers=workers, progress=progress, lockstep=lockstep)
 
 
 @task(retries=1, retry_delay_seconds=1, cache_policy=NONE,
@@ -97,7 +98,8 @@ def simulate_batch_flow(params: SimulateParams) -> list[RunResult]:
         with shared_with_workers():
             summary = BatchSummary(fan_out_flow.with_options(task_runner=runner)(specs, root))
     else:
-        summary = simulate_locally(specs, root, params.workers, params.batch_name)
+        summary = simulate_locally(specs, root, params.workers, params.batch_name,
+                                   params.lockstep)
     logger = get_run_logger()
     logger.info("%d runs, %d collisions, %d failed; logs under %s", summary.runs,
                 summary.collisions, summary.failures, root.batch_dir(params.scenario,

@@ -4,6 +4,7 @@ from; tests/cli/test_defaults.py checks each against its source."""
 # evoeye.ads.profiles.ADS_PROFILES
 ADS_PROFILE_NAMES = ("default", "cautious", "firm-yield", "defensive")
 WORLD_NAMES = ("default", "follower")  # evoeye.sim.worlds.WORLD_NAMES
+DEFAULT_LOCKSTEP = 64  # evoeye.sim.lockstep.DEFAULT_BATCH
 SPLIT_SEED, TRAIN_FRAC, VAL_FRAC = 0, 0.5, 0.125  # evoeye.store.SplitSpec()
 # evoeye.monitor.recipes
 RECIPE_NAMES, COMMAND_RECIPE = ("v1", "v2", "v3", "lookahead-v1"), "lookahead-v1"

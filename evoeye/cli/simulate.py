@@ -9,7 +9,7 @@ import typer
 
 from evoeye.cli.app import app, exit_with
 from evoeye.cli.choices import scenario_check, scenario_help
-from evoeye.cli.defaults import ADS_PROFILE_NAMES, WORLD_NAMES
+from evoeye.cli.defaults import ADS_PROFILE_NAMES, DEFAULT_LOCKSTEP, WORLD_NAMES
 from evoeye.cli.errors import ExitCode, UserError
 from evoeye.cli.output import err, out, table
 from evoeye.paths import BadNameError, DataRoot, check_batch_name
@@ -78,13 +78,18 @@ WorldOpt = Annotated[str, typer.Option(
     "runs get ids, and a default batch name, of their own; `evoeye ingest` leaves them out.")]
 
 
+LockstepOpt = Annotated[int, typer.Option(
+    "--lockstep", min=1, help="Runs stepped together by the lockstep engine (the same logs, "
+    "byte for byte, at about half the CPU time per run; docs/world.md). 1: one run at a time.")]
+
+
 SimulatedOpt = Annotated[str, typer.Option(
     "--scenario", callback=scenario_check(), help=scenario_help("Logical scenario."))]
 
 
 def simulate_batch(scenario: str, n: int, seed: int, data: DataRoot, workers: int,
                    batch: str | None = None, ads: str = "default",
-                   world: str = "default") -> BatchSummary:
+                   world: str = "default", lockstep: int = DEFAULT_LOCKSTEP) -> BatchSummary:
     """Plan, check the root can be written (PermissionError & co. if not), run with a progress
     bar, and report failures by scenario id."""
     from tqdm import tqdm
@@ -97,7 +102,7 @@ def simulate_batch(scenario: str, n: int, seed: int, data: DataRoot, workers: in
         raise UserError(str(exc), "see `evoeye simulate --help`") from exc
     data.runs.mkdir(parents=True, exist_ok=True)
     bar = lambda it: tqdm(it, total=len(specs), desc=scenario, unit="run")  # noqa: E731
-    summary = run_batch(specs, data, workers=workers, progress=bar)
+    summary = run_batch(specs, data, workers=workers, progress=bar, lockstep=lockstep)
     for path in summary.stale_removed:
         out().print(f"[dim]removed the unfinished log of a killed run: {path}[/]")
     for r in summary.results:
@@ -127,13 +132,14 @@ def simulate(
     batch: BatchOpt = None,
     ads: AdsOpt = "default",
     world: WorldOpt = "default",
+    lockstep: LockstepOpt = DEFAULT_LOCKSTEP,
 ) -> None:
     """Simulate N uniformly sampled concrete scenarios and write one MCAP log per run.
 
     Exits 3 if any run failed (the table and the lines above say which and why).
     """
     data = DataRoot.resolve(root)
-    summary = simulate_batch(scenario, n, seed, data, workers, batch, ads, world)
+    summary = simulate_batch(scenario, n, seed, data, workers, batch, ads, world, lockstep)
     out().print(summary_table("simulate", [(scenario, summary)]))
     out().print(f"logs: {data.runs / scenario}")
     exit_with(failures_code([(scenario, summary)]))

@@ -14,6 +14,7 @@ def test_help_defaults_equal_their_sources() -> None:
     from evoeye.monitor.inputs import ABLATIONS, MODULES
     from evoeye.monitor.protocol import TARGET_FPRS, WARNING_K
     from evoeye.monitor.recipes import COMMAND_RECIPE, RECIPES
+    from evoeye.sim.lockstep import DEFAULT_BATCH
     from evoeye.sim.worlds import WORLD_NAMES
     from evoeye.store import SplitSpec
     from evoeye.store.ingest import DEFAULT_RUNS_PER_PART
@@ -22,7 +23,7 @@ def test_help_defaults_equal_their_sources() -> None:
     split = SplitSpec()
     pairs = {
         "ADS_PROFILE_NAMES": tuple(ADS_PROFILES),
-        "WORLD_NAMES": WORLD_NAMES,
+        "WORLD_NAMES": WORLD_NAMES, "DEFAULT_LOCKSTEP": DEFAULT_BATCH,
         "SPLIT_SEED": split.seed, "TRAIN_FRAC": split.train_frac, "VAL_FRAC": split.val_frac,
         "CONTEXT_LEN": DEFAULT_CONTEXT_LEN, "HORIZON_S": DEFAULT_HORIZON_S,
         "TARGET_FPRS": TARGET_FPRS, "WARNING_K": WARNING_K,

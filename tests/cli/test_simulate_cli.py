@@ -18,12 +18,14 @@ runner = CliRunner()
 SIM = ["simulate", "--scenario", "highway-cut-in", "--n", "2"]
 
 
-def test_failed_runs_give_exit_code_3_and_say_how_many(tmp_path, monkeypatch) -> None:
-    def broken(spec):
+@pytest.mark.parametrize("lockstep", ["1", "64"])
+def test_failed_runs_give_exit_code_3_and_say_how_many(tmp_path, monkeypatch, lockstep) -> None:
+    def broken(*args, **kwargs):
         raise OSError("disk on fire")
 
-    monkeypatch.setattr(evoeye.batch, "run_episode", broken)
-    result = runner.invoke(app, [*SIM, "--root", str(tmp_path)])
+    monkeypatch.setattr(evoeye.batch, "run_episode", broken)  # one run at a time
+    monkeypatch.setattr(evoeye.batch, "run_lockstep", broken)  # runs stepped together
+    result = runner.invoke(app, [*SIM, "--root", str(tmp_path), "--lockstep", lockstep])
     assert result.exit_code == ExitCode.PARTIAL, result.output
     assert "2 of 2 runs failed" in result.output and "disk on fire" in result.output
 

@@ -18,7 +18,7 @@ from collections.abc import Callable
 from pathlib import Path
 
 from evoeye.atomic import atomic_file
-from evoeye.batch import plan_uniform, run_batch
+from evoeye.batch import DEFAULT_LOCKSTEP, plan_uniform, run_batch
 from evoeye.paths import DataRoot
 from evoeye.results.efficiency.config import parse_regime
 from evoeye.sim.episode import STATUS_OK
@@ -55,8 +55,9 @@ def draw_on(data: DataRoot, regime: str, seed: int, start: int, chunk: int, batc
             say(f"{regime}: stream of seed {seed}, runs {first}–{first + chunk - 1} "
                 f"({len(collisions(chunks))} collisions so far; outcome only, collisions "
                 "logged)")
-            results = {r.scenario_id: r for r in run_batch(specs, data, workers=workers,
-                                                            collisions_only=True).results}
+            results = {r.scenario_id: r for r in run_batch(
+                specs, data, workers=workers, collisions_only=True, lockstep=DEFAULT_LOCKSTEP,
+            ).results}
             ok = [s.scenario_id for s in specs if results[s.scenario_id].status == STATUS_OK]
             chunks.append({"ok": len(ok), "collided": [i for i in ok if results[i].collided]})
             with atomic_file(record) as f:

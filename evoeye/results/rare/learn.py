@@ -49,7 +49,7 @@ from pathlib import Path
 import numpy as np
 
 from evoeye import __version__
-from evoeye.batch import plan_uniform, run_batch
+from evoeye.batch import DEFAULT_LOCKSTEP, plan_uniform, run_batch
 from evoeye.evaluation.stats import compare_paired, mean_ci
 from evoeye.evolve.campaign.assess import metrics_dict
 from evoeye.evolve.search.cross_entropy import effective_size
@@ -106,7 +106,7 @@ def prepare_sets(root: DataRoot, regime: str, learn: LearnConfig, data_seed: int
         batch, seed = set_batch(name, data_seed)
         say(f"{regime}: {name} set, {n} runs (seed {seed})")
         simulated[name] = run_batch(plan_uniform(scenario, n, seed, batch=batch, ads=profile),
-                                    data, workers=workers)
+                                    data, workers=workers, lockstep=DEFAULT_LOCKSTEP)
     draw = None
     if learn.test_max_runs:
         draw = draw_test_failures(data, regime, set_batch("test", data_seed)[1],
