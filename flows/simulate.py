@@ -3,8 +3,9 @@
 On this machine the batch runs in one task on the command line's own process pool
 (`evoeye.batch.run_batch`: forked workers with highway-env already imported, finished logs
 skipped, a broken run reported and the others kept), so the flow costs what the command costs
-plus one Prefect API. With `dask_address` every run is its own task on the Dask cluster
-(prefect-dask), for batches one machine cannot carry. Either way the batch is idempotent: a
+plus one Prefect API. With `dask_address` every chunk of up to `lockstep` runs (runs stepped
+together, `evoeye.sim.lockstep`) is its own task on the Dask cluster (prefect-dask), for
+batches one machine cannot carry. Either way the batch is idempotent: a
 crashed flow run is simply run again, and skips the logs it finished. With `ingest` the new
 logs then go into the warehouse, as the ingest flow puts them (a subflow run).
 """
@@ -15,10 +16,11 @@ from prefect import flow, get_run_logger, task
 from prefect.cache_policies import NONE
 from pydantic import BaseModel, Field
 
-from evoeye.batch import BatchSummary, RunResult, plan_uniform, run_batch, simulate_and_log
+from evoeye.batch import BatchSummary, RunResult, plan_uniform, run_batch, simulate_chunk
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import SCENARIOS
 from evoeye.sim.episode import RunSpec
+from evoeye.sim.lockstep import chunks
 from flows.api import shared_with_workers
 from flows.ingest import IngestParams, ingest_flow
 from flows.published import batch_markdown, named, publish
@@ -73,18 +75,20 @@ def simulate_locally(specs: list[RunSpec], root: DataRoot, workers: int,
     return run_batch(specs, root, workers=workers, progress=progress, lockstep=lockstep)
 
 
-@task(retries=1, retry_delay_seconds=1, cache_policy=NONE,
-      task_run_name="run-{spec.scenario_id}")
-def simulate_run(spec: RunSpec, root: DataRoot) -> RunResult:
-    """Simulate and log one run (skipped if its log exists): the result names the log file."""
-    return simulate_and_log(spec, root)
+@task(retries=1, retry_delay_seconds=1, cache_policy=NONE, task_run_name="runs-{name}")
+def simulate_runs(specs: list[RunSpec], root: DataRoot, name: str) -> list[RunResult]:
+    """Simulate and log runs of one scenario stepped together (skipped where their logs exist):
+    the results name the log files."""
+    return simulate_chunk(specs, root)
 
 
 @flow(name="evoeye-simulate-dask", log_prints=True)
-def fan_out_flow(specs: list[RunSpec], root: DataRoot) -> list[RunResult]:
-    """Every spec a task on the flow's task runner (the Dask cluster simulate_flow picks)."""
-    futures = [simulate_run.submit(s, root) for s in specs]
-    return sorted((f.result() for f in futures), key=lambda r: r.scenario_id)
+def fan_out_flow(specs: list[RunSpec], root: DataRoot, lockstep: int = 1) -> list[RunResult]:
+    """Every chunk of up to `lockstep` runs a task on the flow's task runner (the Dask cluster
+    simulate_flow picks)."""
+    futures = [simulate_runs.submit(c, root, f"{c[0].scenario_id}+{len(c) - 1}")
+               for c in chunks(specs, lockstep)]
+    return sorted((r for f in futures for r in f.result()), key=lambda r: r.scenario_id)
 
 
 @flow(name="evoeye-simulate", log_prints=True, flow_run_name=named(SimulateParams.run_name))
@@ -96,7 +100,9 @@ def simulate_batch_flow(params: SimulateParams) -> list[RunResult]:
     if params.dask_address:
         runner = task_runner(params.workers, params.dask_address)
         with shared_with_workers():
-            summary = BatchSummary(fan_out_flow.with_options(task_runner=runner)(specs, root))
+            size = min(params.lockstep, -(-len(specs) // params.workers))  # every worker busy
+            summary = BatchSummary(fan_out_flow.with_options(task_runner=runner)(specs, root,
+                                                                                 size))
     else:
         summary = simulate_locally(specs, root, params.workers, params.batch_name,
                                    params.lockstep)

@@ -6,7 +6,9 @@ import pytest
 from distributed import LocalCluster
 from pydantic import ValidationError
 
+from evoeye.batch import plan_uniform, run_batch
 from evoeye.log import read_run
+from evoeye.paths import DataRoot
 from flows.simulate import SimulateParams, simulate_batch_flow
 
 
@@ -31,11 +33,16 @@ def test_simulate_flow_writes_one_log_per_run_and_reruns_skip(tmp_path, latest_a
 def test_simulate_flow_on_a_two_worker_dask_cluster(prefect_server, tmp_path):
     with LocalCluster(n_workers=2, threads_per_worker=1, processes=True,
                                   dashboard_address=None) as cluster:
-        params = SimulateParams(scenario="highway-cut-in", n=2, seed=9, root=str(tmp_path),
-                                dask_address=cluster.scheduler_address)
-        results = simulate_batch_flow(params)
-    assert len(results) == 2 and all(r.status == "ok" for r in results)
-    assert len(list(tmp_path.rglob("*.mcap"))) == 2
+        params = SimulateParams(scenario="highway-cut-in", n=3, seed=9,
+                                root=str(tmp_path / "dask"), dask_address=cluster.scheduler_address)
+        results = simulate_batch_flow(params)  # two tasks: runs stepped together, 2 and 1
+    assert len(results) == 3 and all(r.status == "ok" for r in results)
+    one = DataRoot.resolve(tmp_path / "one")  # the same runs, one at a time, in this process
+    run_batch(plan_uniform("highway-cut-in", 3, 9), one)
+    dask_logs = sorted((tmp_path / "dask").rglob("*.mcap"))
+    assert [p.name for p in dask_logs] == [p.name for p in sorted(one.path.rglob("*.mcap"))]
+    assert [p.read_bytes() for p in dask_logs] == [
+        p.read_bytes() for p in sorted(one.path.rglob("*.mcap"))]
 
 
 def test_bad_parameters_are_refused_before_anything_runs():
