@@ -100,40 +100,66 @@ def bench_workers(scenario: str, n: int, workers: int) -> float:
         return run_batch(specs, DataRoot.resolve(root), workers=workers).wall_s
 
 
-def bench_engines(specs, sizes: list[int], repeat: int) -> tuple[float, dict[int, float], bool]:
-    """CPU s per run of simulate + log on the same specs: the per-run engine, and the lockstep
-    engine at each batch size; interleaved `repeat` times, best of each. Also whether every
-    lockstep log has the per-run log's bytes."""
-    per_run, lockstep, same = math.inf, dict.fromkeys(sizes, math.inf), True
+def bench_engines(specs, sizes: list[int], repeat: int) -> dict:
+    """CPU s per run on the same specs, simulation and log apart: the per-run engine and the
+    lockstep engine at each batch size, interleaved `repeat` times, best of each; and how many
+    lockstep runs have the per-run run's log bytes and outcome (equivalence)."""
+    best = {"per-run": (math.inf, math.inf), **dict.fromkeys(sizes, (math.inf, math.inf))}
+    same_bytes, same_outcome = dict.fromkeys(sizes, 0), dict.fromkeys(sizes, 0)
     for _ in range(repeat):
         t0 = time.process_time()
-        ref = {s.scenario_id: _log_bytes(run_episode(s)) for s in specs}
-        per_run = min(per_run, (time.process_time() - t0) / len(specs))
+        ref = {s.scenario_id: run_episode(s) for s in specs}
+        sim = time.process_time() - t0
+        ref_bytes, log = _logs(ref.values())
+        best["per-run"] = min(best["per-run"], (sim / len(specs), log / len(specs)))
+        ref = {k: e.outcome for k, e in ref.items()}  # the episodes go: both engines write with
+        # only their own episodes alive (more live objects make Python's collector slower)
         for size in sizes:
             t0 = time.process_time()
-            got = {e.spec.scenario_id: _log_bytes(e) for e in run_lockstep(specs, size=size)}
-            lockstep[size] = min(lockstep[size], (time.process_time() - t0) / len(specs))
-            same = same and got == ref
-    return per_run, lockstep, same
+            got = {e.spec.scenario_id: e for e in run_lockstep(specs, size=size)}
+            sim = time.process_time() - t0
+            got_bytes, log = _logs(got.values())
+            best[size] = min(best[size], (sim / len(specs), log / len(specs)))
+            same_bytes[size] = sum(got_bytes[k] == ref_bytes[k] for k in ref)
+            same_outcome[size] = sum(got[k].outcome == ref[k] for k in ref)
+            del got
+    return {"best": best, "same_bytes": same_bytes, "same_outcome": same_outcome,
+            "collided": sum(o.collided for o in ref.values())}
 
 
-def _log_bytes(episode) -> bytes:
-    out = io.BytesIO()
-    write_stream(episode, out)
-    return out.getvalue()
+def _logs(episodes) -> tuple[dict[str, bytes], float]:
+    """Each episode's log bytes, and the CPU s it took to write them."""
+    t0 = time.process_time()
+    out = {}
+    for episode in episodes:
+        f = io.BytesIO()
+        write_stream(episode, f)
+        out[episode.spec.scenario_id] = f.getvalue()
+    return out, time.process_time() - t0
 
 
-def engines_table(runs: int, sizes: list[int], repeat: int) -> None:
-    print("| logical scenario | runs | per-run engine, CPU ms per run | "
-          + " | ".join(f"lockstep B={b}, CPU ms per run (×)" for b in sizes)
-          + " | same log bytes |")
-    print("|---|---|---|" + "---|" * len(sizes) + "---|")
+def engines_table(runs: int, sizes: list[int], repeat: int, seed: int, profiles: list[str]) -> None:
+    print("CPU ms per run: simulation + log (× the per-run engine, with the log; simulation "
+          "alone)")
+    print("| logical scenario | ADS | runs (collided) | per-run engine | "
+          + " | ".join(f"lockstep B={b}" for b in sizes)
+          + " | same log bytes, same outcome |")
+    print("|---|---|---|---|" + "---|" * len(sizes) + "---|")
     for name in SCENARIOS:
-        specs = plan_uniform(name, runs, seed=7)
-        run_episode(specs[0])  # warm the per-process caches (road networks, imports)
-        per_run, lockstep, same = bench_engines(specs, sizes, repeat)
-        cells = " | ".join(f"{1e3 * lockstep[b]:.0f} ({per_run / lockstep[b]:.2f}×)" for b in sizes)
-        print(f"| {name} | {runs} | {1e3 * per_run:.0f} | {cells} | {'yes' if same else 'NO'} |")
+        for ads in profiles:
+            specs = plan_uniform(name, runs, seed=seed, ads=ads)
+            run_episode(specs[0])  # warm the per-process caches (road networks, imports)
+            r = bench_engines(specs, sizes, repeat)
+            ref_sim, ref_log = r["best"]["per-run"]
+            cells = []
+            for b in sizes:
+                sim, log = r["best"][b]
+                cells.append(f"{1e3 * sim:.0f} + {1e3 * log:.0f} "
+                             f"(×{(ref_sim + ref_log) / (sim + log):.2f}; ×{ref_sim / sim:.2f})")
+            same = ", ".join(f"{r['same_bytes'][b]}/{runs}, {r['same_outcome'][b]}/{runs}"
+                             for b in sizes)
+            print(f"| {name} | {ads} | {runs} ({r['collided']}) | {1e3 * ref_sim:.0f} + "
+                  f"{1e3 * ref_log:.0f} | {' | '.join(cells)} | {same} |")
 
 
 def main() -> None:
@@ -144,10 +170,12 @@ def main() -> None:
     ap.add_argument("--sizes", type=int, nargs="+", default=[8, 64],
                     help="lockstep batch sizes for --engines")
     ap.add_argument("--repeat", type=int, default=2, help="interleaved repeats for --engines")
+    ap.add_argument("--seed", type=int, default=7, help="batch seed of the runs (--engines)")
+    ap.add_argument("--ads", nargs="+", default=["default"], help="ADS profiles (--engines)")
     args = ap.parse_args()
     print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}\n")
     if args.engines:
-        engines_table(args.runs, args.sizes, args.repeat)
+        engines_table(args.runs, args.sizes, args.repeat, args.seed, args.ads)
         return
     print("| logical scenario | runs | sim s | full RTF (sim+ADS+log) "
           "| bare RTF (highway-env) | full / bare cost | bare RTF (our world) "

@@ -53,7 +53,6 @@ def test_bad_parameters_are_refused_before_anything_runs():
 
 
 def test_simulate_flow_can_ingest_its_batch(prefect_server, tmp_path):
-    from evoeye.paths import DataRoot
     from evoeye.store import Warehouse
 
     params = SimulateParams(scenario="highway-cut-in", n=2, seed=5, root=str(tmp_path),

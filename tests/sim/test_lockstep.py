@@ -56,29 +56,47 @@ def test_runs_that_collide_end_early_and_still_match():
         assert log_bytes(episode) == log_bytes(run_episode(episode.spec))
 
 
-def test_a_run_that_raises_ends_alone(monkeypatch):
+def controllers(run):
+    return [run.driver.controller]
+
+
+def npcs(run):
+    return run.world.npcs
+
+
+FAULTS = {  # where one run breaks: in its ADS (control) or in its world (an NPC driver model)
+    "ads": (controllers, PurePursuitController, "control",
+            lambda self, plan, ego: plan.t_s >= 1.0, RuntimeError("actuator fault")),
+    "world": (npcs, Npc, "decide", lambda self, gap, v: self.clock_s >= 2.0,
+              ZeroDivisionError("float division by zero")),
+}
+
+
+@pytest.mark.parametrize("where", sorted(FAULTS))
+def test_a_run_that_raises_ends_alone(monkeypatch, where):
+    parts, cls, method, when, error = FAULTS[where]
     specs = plan_uniform("highway-cut-in", 4, seed=8)
     bad = specs[1].seed
-    start = runner.RunLoop.start
+    start, real = runner.RunLoop.start, getattr(cls, method)
 
     def marked_start(self):
         start(self)
-        self.driver.controller.broken = self.spec.seed == bad
+        for part in parts(self):
+            part.broken = self.spec.seed == bad
 
-    control = PurePursuitController.control
-
-    def flaky(self, plan, ego):
-        if getattr(self, "broken", False) and plan.t_s >= 1.0:
-            raise RuntimeError("actuator fault")
-        return control(self, plan, ego)
+    def flaky(self, *args):
+        if getattr(self, "broken", False) and when(self, *args):
+            raise error
+        return real(self, *args)
 
     monkeypatch.setattr(runner.RunLoop, "start", marked_start)
-    monkeypatch.setattr(PurePursuitController, "control", flaky)
+    monkeypatch.setattr(cls, method, flaky)
     got = by_id(list(run_lockstep(specs, SHORT)))
     broken = got[specs[1].scenario_id]
     assert broken.outcome.status == STATUS_FAILED
-    assert broken.outcome.reason == "RuntimeError: actuator fault"
-    assert len(broken.frames) == 20  # frames 0 … 19 recorded; it raised at t = 1.0 s
+    assert broken.outcome.reason == f"{type(error).__name__}: {error}"
+    if where == "ads":
+        assert len(broken.frames) == 20  # frames 0 … 19 recorded; it raised at t = 1.0 s
     for spec in (specs[0], *specs[2:]):
         assert got[spec.scenario_id].outcome.status == STATUS_OK
         assert log_bytes(got[spec.scenario_id]) == log_bytes(run_episode(spec, SHORT))
@@ -93,33 +111,6 @@ def test_chunks_keep_one_scenario_profile_and_world_per_batch():
     assert all(len(set(c)) == 1 for c in sizes)
     with pytest.raises(ValueError, match="at least 1 run"):
         list(chunks(specs, 0))
-
-
-def test_a_world_that_raises_ends_its_run_alone(monkeypatch):
-    specs = plan_uniform("highway-cut-in", 4, seed=9)
-    bad = specs[2].seed
-    start = runner.RunLoop.start
-
-    def marked_start(self):
-        start(self)
-        for npc in self.world.npcs:
-            npc.broken = self.spec.seed == bad
-
-    decide = Npc.decide
-
-    def flaky(self, gap_m, leader_speed_mps):
-        if getattr(self, "broken", False) and self.clock_s >= 2.0:
-            raise ZeroDivisionError("float division by zero")
-        return decide(self, gap_m, leader_speed_mps)
-
-    monkeypatch.setattr(runner.RunLoop, "start", marked_start)
-    monkeypatch.setattr(Npc, "decide", flaky)
-    got = by_id(list(run_lockstep(specs, SHORT)))
-    broken = got[specs[2].scenario_id]
-    assert broken.outcome.status == STATUS_FAILED
-    assert broken.outcome.reason == "ZeroDivisionError: float division by zero"
-    for spec in (*specs[:2], specs[3]):
-        assert log_bytes(got[spec.scenario_id]) == log_bytes(run_episode(spec, SHORT))
 
 
 @pytest.mark.parametrize(("stage", "work_first"), [
