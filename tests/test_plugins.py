@@ -6,6 +6,7 @@ list of scenarios and baselines."""
 from __future__ import annotations
 
 import os
+import re
 import subprocess
 import sys
 from pathlib import Path
@@ -85,11 +86,16 @@ def _evoeye(site: Path, *args: str) -> subprocess.CompletedProcess:
                           text=True, env={**os.environ, "PYTHONPATH": path}, timeout=600)
 
 
+def _unwrapped(help_text: str) -> str:
+    """Help text as one line: a name the terminal width broke at a hyphen is whole again."""
+    return re.sub(r"\s+", " ", re.sub(r"-\n\s+", "-", help_text))
+
+
 def test_the_whole_pipeline_runs_a_plugin_scenario_and_lists_the_plugin_baseline(
         tmp_path: Path) -> None:
     site, root = install(tmp_path / "site"), str(tmp_path / "data")
-    assert SCENARIO in _evoeye(site, "simulate", "--help").stdout
-    assert BASELINE in _evoeye(site, "evaluate", "--help").stdout
+    assert SCENARIO in _unwrapped(_evoeye(site, "simulate", "--help").stdout)
+    assert BASELINE in _unwrapped(_evoeye(site, "evaluate", "--help").stdout)
     done = _evoeye(site, "simulate", "--scenario", SCENARIO, "--n", "3", "--root", root)
     assert done.returncode == 0, done.stderr
     assert len(list((tmp_path / "data" / "runs" / SCENARIO).rglob("*.mcap"))) == 3

@@ -28,7 +28,7 @@ from evoeye.ads.detections import (
 # rows of the (TRACK_FIELDS, m) track state: kinematics, per-axis covariance, the rest
 X, Y, VX, VY, P_PP, P_PV, P_VV, HEADING, LENGTH, WIDTH, RANGE, HITS, MISSES = range(13)
 TRACK_FIELDS = 13
-_UNASSIGNABLE = 1.0e6
+UNASSIGNABLE = 1.0e6
 
 
 class CVTracker:
@@ -57,7 +57,7 @@ class CVTracker:
         if m and k:
             gate = self.c.gate_m
             cost = np.hypot(st[X][:, None] - z[DET_X], st[Y][:, None] - z[DET_Y])  # (m, k)
-            rows, cols = linear_sum_assignment(np.where(cost <= gate, cost, _UNASSIGNABLE))
+            rows, cols = linear_sum_assignment(np.where(cost <= gate, cost, UNASSIGNABLE))
             ok = cost[rows, cols] <= gate
             if np.count_nonzero(ok) < len(ok):
                 rows, cols = rows[ok], cols[ok]

@@ -29,7 +29,7 @@ from evoeye.sim.traffic import (
     CORRIDOR_MARGIN_M,
     LOOKAHEAD_M,
     Relations,
-    _not_self,
+    not_self,
 )
 from evoeye.sim.world import CONTACT_SLACK_M, World, answer_blocks
 
@@ -130,7 +130,7 @@ def _leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarra
     in_lane = np.abs(rel.eta) < reach
     if np.count_nonzero(shift_m):
         in_lane |= (shift_m != 0.0)[:, :, None] & (np.abs(rel.eta - shift_m[:, :, None]) < reach)
-    ahead = (rel.xi > 0.0) & _not_self(n) & in_lane
+    ahead = (rel.xi > 0.0) & not_self(n) & in_lane
     aligned = rel.cos_dh > ALIGNED_COS
     gap = np.where(ahead & aligned & (rel.xi < LOOKAHEAD_M), rel.bumper, np.inf)
     block = np.where(ahead & ~aligned & (rel.xi < BLOCKING_M), rel.bumper, np.inf).min(axis=2)

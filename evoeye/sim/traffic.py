@@ -60,7 +60,7 @@ def half_sums(length: np.ndarray, width: np.ndarray) -> tuple[np.ndarray, np.nda
 
 
 @functools.cache
-def _not_self(n: int) -> np.ndarray:
+def not_self(n: int) -> np.ndarray:
     """(n, n) True off the diagonal (read-only: shared by every call)."""
     mask = ~np.eye(n, dtype=bool)
     mask.flags.writeable = False
@@ -78,7 +78,7 @@ def leaders(rel: Relations, shift_m: np.ndarray) -> tuple[np.ndarray, np.ndarray
     in_lane = np.abs(rel.eta) < reach
     if np.count_nonzero(shift_m):  # someone changes lanes: its target lane counts too
         in_lane |= (shift_m != 0.0)[:, None] & (np.abs(rel.eta - shift_m[:, None]) < reach)
-    ahead = (rel.xi > 0.0) & _not_self(n) & in_lane
+    ahead = (rel.xi > 0.0) & not_self(n) & in_lane
     aligned = rel.cos_dh > ALIGNED_COS
     gap = np.where(ahead & aligned & (rel.xi < LOOKAHEAD_M), rel.bumper, np.inf)
     block = np.where(ahead & ~aligned & (rel.xi < BLOCKING_M), rel.bumper, np.inf).min(axis=1)

@@ -36,7 +36,7 @@ from evoeye.ads.planning import Crossings, InPath, Planner, RoutePlanner, speed_
 # below this many runs, the scalar projection of the ego is the cheaper one
 _VECTOR_EGO_MIN = 4
 
-_KEYS = GroupKeys()  # what each planner plans by
+_KEYS = GroupKeys("planning")  # what each planner plans by
 
 
 def plan_batch(

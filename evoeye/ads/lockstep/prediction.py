@@ -29,7 +29,7 @@ from evoeye.ads.lockstep.keys import GroupKeys, bits
 from evoeye.ads.messages import PREDICTION_MODES, Localization, Obstacles, Predictions
 from evoeye.ads.prediction import IntentPredictor, Predictor
 
-_KEYS = GroupKeys()  # what each predictor predicts by
+_KEYS = GroupKeys("prediction")  # what each predictor predicts by
 
 
 def predict_batch(

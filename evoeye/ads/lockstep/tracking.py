@@ -44,13 +44,13 @@ from evoeye.ads.lockstep.keys import GroupKeys, bits
 from evoeye.ads.messages import Obstacles
 from evoeye.ads.perception import TrackingPerception
 from evoeye.ads.tracking import (
-    _UNASSIGNABLE,
     HEADING,
     HITS,
     LENGTH,
     MISSES,
     P_PP,
     TRACK_FIELDS,
+    UNASSIGNABLE,
     VX,
     VY,
     WIDTH,
@@ -65,7 +65,7 @@ from evoeye.scene import SceneState
 # groups of at most this many runs are tracked by each run's own `track`
 ALONE_MAX = 4
 
-_KEYS = GroupKeys()  # how each perception tracks
+_KEYS = GroupKeys("tracking")  # how each perception tracks
 
 
 def track_batch(
@@ -217,7 +217,7 @@ def _step(trackers: list[CVTracker], olds: list[np.ndarray], zs: list[np.ndarray
         gd = np.arange(gt.size) - np.repeat(first_pair - doff.take(track_run), kt)  # … in z
         cost = np.hypot(s[X].take(gt) - z[DET_X].take(gd), s[Y].take(gt) - z[DET_Y].take(gd))
         gate = c.gate_m
-        gated = np.where(cost <= gate, cost, _UNASSIGNABLE)
+        gated = np.where(cost <= gate, cost, UNASSIGNABLE)
         fp = first_pair.tolist()
         rows, cols = zip(*[linear_sum_assignment(
             gated[fp[a]:fp[a] + m_l[j] * k_l[j]].reshape(m_l[j], k_l[j]))
