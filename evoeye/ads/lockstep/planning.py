@@ -31,7 +31,8 @@ import numpy as np
 
 from evoeye.ads.lockstep.keys import GroupKeys, bits
 from evoeye.ads.messages import Localization, PlannedTrajectory, Predictions
-from evoeye.ads.planning import Crossings, InPath, Planner, RoutePlanner, speed_profile
+from evoeye.ads.plan_arrays import Crossings, InPath, speed_profile
+from evoeye.ads.planning import Planner, RoutePlanner
 
 # below this many runs, the scalar projection of the ego is the cheaper one
 _VECTOR_EGO_MIN = 4
