@@ -25,7 +25,7 @@ from evoeye.log import LogError, read_run, write_episode
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import get_scenario
 from evoeye.sim.episode import STATUS_OK, Episode, RunSpec
-from evoeye.sim.lockstep import DEFAULT_BATCH, chunks, run_lockstep
+from evoeye.sim.lockstep import DEFAULT_BATCH, batch_size, chunks, run_lockstep
 from evoeye.sim.runner import run_episode, run_spec
 from evoeye.sim.worlds import DEFAULT_WORLD
 
@@ -201,7 +201,7 @@ def run_batch(
     t0 = time.perf_counter()
     summary = BatchSummary(stale_removed=remove_stale_logs(specs, root))
     wrap = progress or (lambda it: it)
-    size = min(lockstep, -(-len(specs) // workers)) if len(specs) else 1
+    size = batch_size(len(specs), workers, lockstep)
     simulate = simulate_each if lockstep == 1 else simulate_chunk
     groups = [[s] for s in specs] if lockstep == 1 else list(chunks(specs, size))
     try:

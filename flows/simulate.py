@@ -20,7 +20,7 @@ from evoeye.batch import BatchSummary, RunResult, plan_uniform, run_batch, simul
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import SCENARIOS
 from evoeye.sim.episode import RunSpec
-from evoeye.sim.lockstep import chunks
+from evoeye.sim.lockstep import batch_size, chunks
 from flows.api import shared_with_workers
 from flows.ingest import IngestParams, ingest_flow
 from flows.published import batch_markdown, named, publish
@@ -100,7 +100,7 @@ def simulate_batch_flow(params: SimulateParams) -> list[RunResult]:
     if params.dask_address:
         runner = task_runner(params.workers, params.dask_address)
         with shared_with_workers():
-            size = min(params.lockstep, -(-len(specs) // params.workers))  # every worker busy
+            size = batch_size(len(specs), params.workers, params.lockstep)
             summary = BatchSummary(fan_out_flow.with_options(task_runner=runner)(specs, root,
                                                                                  size))
     else:

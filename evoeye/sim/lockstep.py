@@ -37,6 +37,12 @@ def chunks(specs: Iterable[RunSpec], size: int = DEFAULT_BATCH) -> Iterator[list
             yield chunk
 
 
+def batch_size(n_runs: int, workers: int, size: int = DEFAULT_BATCH) -> int:
+    """Runs per lockstep batch when n_runs are spread over `workers`: at most `size`, and small
+    enough that every worker gets a batch."""
+    return max(1, min(size, -(-n_runs // workers)))
+
+
 def run_lockstep(specs: Iterable[RunSpec], config: SimConfig | None = None, *,
                  size: int = DEFAULT_BATCH) -> Iterator[Episode]:
     """Simulate every spec, `size` runs at a time; each Episode is yielded as its run ends

@@ -15,7 +15,7 @@ from evoeye.log.writer import write_stream
 from evoeye.scenarios import SCENARIOS
 from evoeye.sim import runner
 from evoeye.sim.episode import STATUS_FAILED, STATUS_OK
-from evoeye.sim.lockstep import chunks, run_lockstep
+from evoeye.sim.lockstep import batch_size, chunks, run_lockstep
 from evoeye.sim.npc import Npc
 from evoeye.sim.runner import SimConfig, run_episode
 
@@ -111,6 +111,8 @@ def test_chunks_keep_one_scenario_profile_and_world_per_batch():
     assert all(len(set(c)) == 1 for c in sizes)
     with pytest.raises(ValueError, match="at least 1 run"):
         list(chunks(specs, 0))
+    # spread over workers: at most the size asked, every worker a batch
+    assert [batch_size(n, 2) for n in (200, 100, 3, 1, 0)] == [64, 50, 2, 1, 1]
 
 
 @pytest.mark.parametrize(("stage", "work_first"), [

@@ -41,6 +41,8 @@ def _per_run(fn: Callable[..., T], args: Sequence[tuple]) -> list[T | Exception]
 def _stage(batched: Callable[..., list[T]], per_run: Callable[..., T], args: Sequence[tuple],
            rewind: Callable[[], None] | None = None) -> list[T | Exception]:
     """The stage for every run at once; if that raises, once per run (after `rewind`)."""
+    if not args:
+        return []
     try:
         return batched(*zip(*args, strict=True))
     except Exception:  # noqa: BLE001 - find the run that raises, keep the others
