@@ -25,7 +25,7 @@ from evoeye.log import LogError, read_run, write_episode
 from evoeye.paths import DataRoot, check_batch_name
 from evoeye.scenarios import get_scenario
 from evoeye.sim.episode import STATUS_OK, Episode, RunSpec
-from evoeye.sim.lockstep import DEFAULT_BATCH, batch_size, chunks, run_lockstep
+from evoeye.sim.lockstep import DEFAULT_BATCH, batch_size, chunks, run_indexed
 from evoeye.sim.runner import run_episode, run_spec
 from evoeye.sim.worlds import DEFAULT_WORLD
 
@@ -86,24 +86,33 @@ def simulate_and_keep(spec: RunSpec, root: DataRoot,
     return keep(episode, root, collisions_only), episode
 
 
-def simulate_chunk(specs: Sequence[RunSpec], root: DataRoot,
-                   collisions_only: bool = False) -> list[RunResult]:
-    """`simulate_and_log` for runs of one logical scenario, ADS profile and world stepped
-    together by the lockstep engine (`evoeye.sim.lockstep`): the same logs, bit for bit.
-    Picklable. A log that cannot be written is that run's error; the others are kept."""
-    results, todo = [], []
+def simulate_and_keep_all(specs: Sequence[RunSpec], root: DataRoot,
+                          collisions_only: bool = False,
+                          ) -> list[tuple[RunResult, Episode | None]]:
+    """`simulate_and_keep` for runs of one logical scenario, ADS profile and world, stepped
+    together by the lockstep engine (`evoeye.sim.lockstep`): the same logs, bit for bit. In the
+    order given. A log that cannot be written is that run's error; the others are kept."""
+    out: list[tuple[RunResult, Episode | None] | None] = []
+    todo = []
     for spec in specs:
         on_disk = logged_result(spec, root)
+        out.append(None if on_disk is None else (on_disk, None))
         if on_disk is None:
             todo.append(spec)
-        else:
-            results.append(on_disk)
-    for episode in run_lockstep(todo, size=max(len(todo), 1)):
+    at = [i for i, o in enumerate(out) if o is None]
+    for i, episode in run_indexed(todo, size=max(len(todo), 1)):
         try:
-            results.append(keep(episode, root, collisions_only))
+            kept = (keep(episode, root, collisions_only), episode)
         except Exception as exc:  # noqa: BLE001 - reported per run, the chunk goes on
-            results.append(_error(episode.spec, root, exc))
-    return results
+            kept = (_error(episode.spec, root, exc), None)
+        out[at[i]] = kept
+    return out  # type: ignore[return-value]
+
+
+def simulate_chunk(specs: Sequence[RunSpec], root: DataRoot,
+                   collisions_only: bool = False) -> list[RunResult]:
+    """`simulate_and_log` for runs stepped together (`simulate_and_keep_all`). Picklable."""
+    return [result for result, _ in simulate_and_keep_all(specs, root, collisions_only)]
 
 
 def logged_result(spec: RunSpec, root: DataRoot) -> RunResult | None:

@@ -17,9 +17,9 @@ SHORT = SimConfig(duration_s=2.0)
 @pytest.fixture(autouse=True)
 def short_runs(monkeypatch):
     """2 s runs for both engines (each engine is tested at full length in tests/sim)."""
-    real_run, real_lockstep = batch.run_episode, lockstep.run_lockstep
+    real_run, real_lockstep = batch.run_episode, lockstep.run_indexed
     monkeypatch.setattr(batch, "run_episode", lambda spec: real_run(spec, SHORT))
-    monkeypatch.setattr(batch, "run_lockstep",
+    monkeypatch.setattr(batch, "run_indexed",
                         lambda specs, size: real_lockstep(specs, SHORT, size=size))
 
 

@@ -51,6 +51,14 @@ def run_lockstep(specs: Iterable[RunSpec], config: SimConfig | None = None, *,
         yield from _lockstep(chunk, config)
 
 
+def run_indexed(specs: Sequence[RunSpec], config: SimConfig | None = None, *,
+                size: int = DEFAULT_BATCH) -> Iterator[tuple[int, Episode]]:
+    """`run_lockstep`, each Episode with the index of its spec in `specs` (their ids unique)."""
+    index = {spec.scenario_id: i for i, spec in enumerate(specs)}
+    for episode in run_lockstep(specs, config, size=size):
+        yield index[episode.spec.scenario_id], episode
+
+
 def _lockstep(specs: Sequence[RunSpec], config: SimConfig | None) -> Iterator[Episode]:
     runs = [RunLoop(spec, config) for spec in specs]  # a bad vector raises, as in run_episode
     for run in runs:

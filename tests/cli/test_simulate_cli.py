@@ -24,7 +24,7 @@ def test_failed_runs_give_exit_code_3_and_say_how_many(tmp_path, monkeypatch, lo
         raise OSError("disk on fire")
 
     monkeypatch.setattr(evoeye.batch, "run_episode", broken)  # one run at a time
-    monkeypatch.setattr(evoeye.batch, "run_lockstep", broken)  # runs stepped together
+    monkeypatch.setattr(evoeye.batch, "run_indexed", broken)  # runs stepped together
     result = runner.invoke(app, [*SIM, "--root", str(tmp_path), "--lockstep", lockstep])
     assert result.exit_code == ExitCode.PARTIAL, result.output
     assert "2 of 2 runs failed" in result.output and "disk on fire" in result.output

@@ -3,10 +3,12 @@
 Round r+1 starts from the monitor G_r and the records D_r (D_init, then every run acquired so
 far, each with its feedback under G_r). It proposes one scenario at a time, simulates it, scores
 the new run with G_r (converted from the Episode just logged, not read back) and adds it to D_r,
-until N_round runs or the budget is spent; then it ingests the round's runs (as converted for
-scoring: one conversion per log), updates the monitor on D_r, refreshes the feedback of every
-record with G_{r+1} and stores the round. The campaign stops when no run fits in the budget
-left.
+until N_round runs or the budget is spent (proposals that wait on no outcome — `propose_ahead`:
+Uniform's, Sobol's, the rest of a batched strategy's batch — are simulated together by the
+lockstep engine, then scored and added in order: the same runs, records and logs); then it
+ingests the round's runs (as converted for scoring: one conversion per log), updates the
+monitor on D_r, refreshes the feedback of every record with G_{r+1} and stores the round. The
+campaign stops when no run fits in the budget left.
 
 Monitor update (Algorithm 1, line 12: Train(G_r, D_r)) as `CampaignConfig.update` says: from
 scratch on D_r by default, or G_r fine-tuned (the option's help and docs/evolution.md say how
@@ -43,7 +45,7 @@ from pathlib import Path
 import numpy as np
 
 from evoeye.atomic import remove_stale_temps
-from evoeye.batch import simulate_and_keep
+from evoeye.batch import simulate_and_keep_all
 from evoeye.evolve.campaign.committee import Committee
 from evoeye.evolve.campaign.config import CampaignConfig, campaign_id
 from evoeye.evolve.campaign.guard import CampaignCancelled, campaign_lease
@@ -60,6 +62,7 @@ from evoeye.evolve.campaign.state import (
     run_outcome,
 )
 from evoeye.evolve.campaign.stored import StoredFeedback
+from evoeye.evolve.search.protocol import propose_ahead
 from evoeye.evolve.search.registry import (
     FEEDBACK_BLIND,
     READS_DISAGREEMENT,
@@ -216,6 +219,11 @@ class Campaign(StoredFeedback):
         """No run fits in the budget left."""
         return self.remaining_s(state) < self.config.max_run_s
 
+    def fits(self, state: CampaignState) -> int:
+        """How many runs surely fit in the budget left, however long each one runs (up to
+        `max_run_s`): each of them would also start if they ran one after another."""
+        return int(self.remaining_s(state) // self.config.max_run_s)
+
     def finished(self) -> bool:
         """`done` from the stored rounds alone: a campaign whose last stored round spent its
         budget has nothing to resume, and a worker need not build its state (a state starts
@@ -241,26 +249,30 @@ class Campaign(StoredFeedback):
         while len(new) < cfg.n_round and not self.done(state):
             self.check_stop()
             with self.clock("simulate"):
-                prop = state.strategy.propose(state.records)
-                spec = fresh_spec(cfg, self.campaign_id, prop.x, state, held,
-                                  ads=initial_profile(self.initial))
-                held[spec.scenario_id] = self.campaign_id
-                result, episode = simulate_and_keep(spec, self.root)
-            if result.status == "error":
-                raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
-                                   f"{result.reason}")
-            with self.clock("score"):
-                run, fb, d = fresh_run_feedback(monitor, result.path, episode, cfg.horizon_s,
-                                                cfg.feedback, spread)
-            outcome = run_outcome(run.metadata)
-            state.strategy.tell(prop.x, outcome["fitness"])
-            state.records = state.records.append(np.asarray(run.metadata["params"], float),
-                                                 feedback=float(fb), disagreement=float(d),
-                                                 log_q=prop.log_q, log_p=prop.log_p,
-                                                 **outcome)
-            state.ok = np.append(state.ok, run.ok)
-            new.append(spec.scenario_id)
-            runs.append(run)
+                props = propose_ahead(state.strategy, state.records,
+                                      min(cfg.n_round - len(new), self.fits(state)))
+                specs = []
+                for i, prop in enumerate(props):
+                    spec = fresh_spec(cfg, self.campaign_id, prop.x, state, held,
+                                      ads=initial_profile(self.initial), number=state.acquired + i)
+                    held[spec.scenario_id] = self.campaign_id
+                    specs.append(spec)
+                simulated = simulate_and_keep_all(specs, self.root)
+            for prop, spec, (result, episode) in zip(props, specs, simulated, strict=True):
+                if result.status == "error":
+                    raise RuntimeError(f"run {spec.scenario_id} could not be simulated: "
+                                       f"{result.reason}")
+                with self.clock("score"):
+                    run, fb, d = fresh_run_feedback(monitor, result.path, episode, cfg.horizon_s,
+                                                    cfg.feedback, spread)
+                outcome = run_outcome(run.metadata)
+                state.strategy.tell(prop.x, outcome["fitness"])
+                state.records = state.records.append(
+                    np.asarray(run.metadata["params"], float), feedback=float(fb),
+                    disagreement=float(d), log_q=prop.log_q, log_p=prop.log_p, **outcome)
+                state.ok = np.append(state.ok, run.ok)
+                new.append(spec.scenario_id)
+                runs.append(run)
         if new:  # in the warehouse, with f_r stored, so that a later step can read them by id
             self._ingest(runs)
             added = state.records.tail(state.records.n - len(new))

@@ -126,18 +126,19 @@ def held_runs(root: DataRoot, scenario: str, campaign_id: str,
 
 
 def fresh_spec(cfg: CampaignConfig, campaign_id: str, x: np.ndarray, state: CampaignState,
-               held: dict[str, str], *, ads: str) -> RunSpec:
-    """The run of proposal `x` (number `state.acquired` of the campaign), its run seed redrawn
-    while `held` has the run it gives; each such run is added to `state.redrawn`. Deterministic
-    for the same root, so a resumed round redraws alike."""
+               held: dict[str, str], *, ads: str, number: int | None = None) -> RunSpec:
+    """The run of proposal `x` (number `number` of the campaign, by default `state.acquired`:
+    the next), its run seed redrawn while `held` has the run it gives; each such run is added
+    to `state.redrawn`. Deterministic for the same root, so a resumed round redraws alike."""
+    number = state.acquired if number is None else number
     for attempt in range(MAX_REDRAWS + 1):
-        seed = campaign_run_seed(cfg.seed, campaign_id, state.acquired, attempt)
+        seed = campaign_run_seed(cfg.seed, campaign_id, number, attempt)
         spec = run_spec(cfg.scenario, x, seed, batch=campaign_id, source=cfg.strategy,
                         round=state.round + 1, ads=ads)
         if spec.scenario_id not in held:
             return spec
         state.redrawn.append((spec.scenario_id, held[spec.scenario_id]))
-    raise RuntimeError(f"campaign {campaign_id}: proposal {state.acquired} gave "
+    raise RuntimeError(f"campaign {campaign_id}: proposal {number} gave "
                        f"{MAX_REDRAWS + 1} runs the data root already holds, the last "
                        f"{spec.scenario_id} of batch {held[spec.scenario_id]}")
 

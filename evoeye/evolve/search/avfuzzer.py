@@ -156,6 +156,11 @@ class AVFuzzer:
             f"avfuzzer: tell the results of the {len(self._slots)} scenarios in flight first"
         )
 
+    def propose_ahead(self, records: Records | None, n: int) -> list[Proposal]:
+        """Up to n of the generation's individuals not yet proposed: a generation's results
+        are all told before the next is bred, and in any order."""
+        return [self.propose() for _ in range(max(min(n, self.available()), 1))]
+
     def tell(self, x: np.ndarray, fitness: float) -> None:
         fitness = float(fitness)
         if not np.isfinite(fitness):

@@ -112,6 +112,10 @@ class PooledStrategy:
     def available(self) -> int:
         return self.inner.available()
 
+    def propose_ahead(self, records: Records, n: int) -> list[Proposal]:
+        """One: pool mode simulates nothing, and a pick must see the rows the last one took."""
+        return [self.propose(records)]
+
     def replay(self, params: np.ndarray, fitness: np.ndarray) -> None:
         """Rebuild from the pool rows this strategy acquired (k, dim) and their fitness (k,)."""
         self._in_flight.clear()

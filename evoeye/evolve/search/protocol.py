@@ -19,6 +19,14 @@ Pool mode (`evoeye.evolve.search.pool`): asked with `make_strategy(…, pool=row
 picks rows of a finite (m, dim) array of already-simulated candidates instead of free θ; each
 proposal's `pool_index` is its row, and no row is proposed twice or while it is in the records.
 
+Proposals ahead (optional). A strategy's `propose_ahead(records, n)` gives the next 1 to n
+proposals that do not depend on each other's outcome, all at once: every one for Uniform and
+Sobol', the rest of the current batch for the batched strategies, the individuals in flight for
+AV-Fuzzer, one for the density-aware strategies (each reads the records of the one before). A
+loop that simulates them together and then tells and records them in order acquires exactly
+what the outline below does. A strategy without the method (a plug-in's) is asked one proposal
+at a time (`propose_ahead`).
+
 The loop, in outline (every proposal must be told and recorded, failed runs included):
 
     strategy = make_strategy(name, space, seed)
@@ -80,3 +88,11 @@ class Strategy(Protocol):
     def replay(self, params: np.ndarray, fitness: np.ndarray) -> None:
         """Rebuild the state of a fresh strategy from the runs it acquired before (k, dim), (k,)."""
         ...
+
+
+def propose_ahead(strategy: Strategy, records: Records, n: int) -> list[Proposal]:
+    """The next 1 to n proposals of `strategy` that neither the records nor the results of the
+    ones before them can change (module doc, "Proposals ahead"): a loop may simulate them
+    together, then tell and record them in order. One for a strategy that cannot say."""
+    ahead = getattr(strategy, "propose_ahead", None)
+    return ahead(records, n) if ahead is not None else [strategy.propose(records)]

@@ -59,6 +59,10 @@ class CountedStrategy:
     def available(self) -> int:
         return sys.maxsize
 
+    def propose_ahead(self, records: Records, n: int) -> list[Proposal]:
+        """Proposal k draws from rng([seed, k]) alone: all n (protocol.py, "Proposals ahead")."""
+        return [self.propose(records) for _ in range(max(n, 1))]
+
     def replay(self, params: np.ndarray, fitness: np.ndarray) -> None:
         self.proposals = len(np.asarray(params).reshape(-1, self.space.dim))
 
@@ -101,6 +105,10 @@ class DensityStrategy(CountedStrategy):
         u = self.space.normalise(records.params)
         q = self.potential(u, normalise_feedback(records.feedback))
         return exploit_probability(q, self.epsilon)
+
+    def propose_ahead(self, records: Records, n: int) -> list[Proposal]:
+        """One: a proposal mutates a record, and the records grow with every run."""
+        return [self.propose(records)]
 
     def propose(self, records: Records) -> Proposal:
         if records.n == 0:
@@ -153,6 +161,17 @@ class BatchedStrategy(CountedStrategy):
     def propose_in(self, records: Records, pool: CandidatePool, unused: np.ndarray) -> Proposal:
         """Pool mode: the batch is chosen among the rows unused when it started."""
         return self._serve(records, pool)
+
+    def propose_ahead(self, records: Records, n: int) -> list[Proposal]:
+        """The next proposal and up to n − 1 more of its batch: the batch was chosen from the
+        records at its start, so none of them reads the runs of the others."""
+        out = [self._serve(records, None)]
+        j = self.proposals % self.batch
+        if j and self._served is not None:  # the batch goes on: serve its next ones as chosen
+            more = self._served[1][j:j + max(n, 1) - 1]
+            self.proposals += len(more)
+            out += more
+        return out
 
     def replay(self, params: np.ndarray, fitness: np.ndarray) -> None:
         super().replay(params, fitness)

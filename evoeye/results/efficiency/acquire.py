@@ -16,12 +16,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from evoeye.batch import simulate_and_keep
+from evoeye.batch import RunResult, simulate_and_keep_all
 from evoeye.evolve.campaign.state import run_seed
 from evoeye.evolve.search.fitness import criticality
 from evoeye.evolve.search.protocol import Proposal
 from evoeye.results.efficiency.config import parse_regime
 from evoeye.results.efficiency.sets import RegimeData, RunTable, concat_windows
+from evoeye.sim.episode import Episode, RunSpec
 from evoeye.sim.runner import run_spec
 from evoeye.store.log_windows import episode_run, read_logged_run
 from evoeye.store.windows import Windows
@@ -68,6 +69,10 @@ class Acquirer:
     def acquire(self, prop: Proposal, seed: int, k: int) -> AcquiredRun:
         raise NotImplementedError
 
+    def acquire_all(self, props: Sequence[Proposal], seed: int, k: int) -> list[AcquiredRun]:
+        """`acquire` for proposals k, k + 1, … that wait on no outcome (`propose_ahead`)."""
+        return [self.acquire(prop, seed, k + i) for i, prop in enumerate(props)]
+
 
 class PoolAcquirer(Acquirer):
     """The proposal names a pool row: the run is the pool's."""
@@ -98,11 +103,22 @@ class SimAcquirer(Acquirer):
         self.scenario, self.profile = parse_regime(regime)
         self.context_len, self.horizon_s = context_len, horizon_s
 
-    def acquire(self, prop: Proposal, seed: int, k: int) -> AcquiredRun:
-        spec = run_spec(self.scenario, prop.x, run_seed(seed, k),
+    def _spec(self, prop: Proposal, seed: int, k: int) -> RunSpec:
+        return run_spec(self.scenario, prop.x, run_seed(seed, k),
                         batch=f"gen-{self.strategy}-seed{seed}", source=self.strategy,
                         round=1 + k, ads=self.profile)
-        result, episode = simulate_and_keep(spec, self.bank.data.data)
+
+    def acquire(self, prop: Proposal, seed: int, k: int) -> AcquiredRun:
+        return self.acquire_all([prop], seed, k)[0]
+
+    def acquire_all(self, props: Sequence[Proposal], seed: int, k: int) -> list[AcquiredRun]:
+        """The proposals' runs stepped together by the lockstep engine (the same runs)."""
+        specs = [self._spec(prop, seed, k + i) for i, prop in enumerate(props)]
+        return [self._acquired(spec, result, episode) for spec, (result, episode)
+                in zip(specs, simulate_and_keep_all(specs, self.bank.data.data), strict=True)]
+
+    def _acquired(self, spec: RunSpec, result: RunResult,
+                  episode: Episode | None) -> AcquiredRun:
         if result.status == "error":
             raise RuntimeError(f"run {spec.scenario_id} could not be simulated: {result.reason}")
         run = (read_logged_run(result.path, self.context_len, self.horizon_s) if episode is None

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from evoeye.evaluation.failure_rate import failure_rate
+from evoeye.evolve.search.protocol import propose_ahead
 from evoeye.evolve.search.records import Records
 from evoeye.evolve.search.registry import (
     FEEDBACK_BLIND,
@@ -199,16 +200,20 @@ def _start(ctx: Context, seed: int, reads_disagreement: bool) -> Trajectory:
 
 def _acquire_round(ctx: Context, strategy, acquirer: Acquirer, t: Trajectory,
                    seed: int) -> None:
-    """One round: n_round proposals, each acquired, appended to the records and told."""
-    for _ in range(ctx.config.n_round):
-        prop = strategy.propose(t.records)
-        run = acquirer.acquire(prop, seed, t.records.n - ctx.config.initial_runs)
-        t.records = t.records.append(run.x, feedback=np.nan, fitness=run.fitness,
-                                     collided=run.collided, duration_s=run.duration_s,
-                                     scenario_id=run.scenario_id, log_q=prop.log_q,
-                                     log_p=prop.log_p)
-        t.kinds.append(prop.kind)
-        strategy.tell(run.x, run.fitness)
+    """One round: n_round proposals, each acquired, appended to the records and told (those
+    that wait on no outcome, `propose_ahead`, acquired together)."""
+    done = 0
+    while done < ctx.config.n_round:
+        props = propose_ahead(strategy, t.records, ctx.config.n_round - done)
+        runs = acquirer.acquire_all(props, seed, t.records.n - ctx.config.initial_runs)
+        for prop, run in zip(props, runs, strict=True):
+            t.records = t.records.append(run.x, feedback=np.nan, fitness=run.fitness,
+                                         collided=run.collided, duration_s=run.duration_s,
+                                         scenario_id=run.scenario_id, log_q=prop.log_q,
+                                         log_p=prop.log_p)
+            t.kinds.append(prop.kind)
+            strategy.tell(run.x, run.fitness)
+        done += len(props)
 
 
 def _make(ctx: Context, name: str, seed: int, acquirer: Acquirer):

@@ -71,7 +71,8 @@ from evoeye.results.rare.config import UNWEIGHTED, LearnConfig, RareConfig
 from evoeye.results.rare.runner import run_seed
 from evoeye.results.rare.summary import weights as curve_weights
 from evoeye.results.rare.testset import TestDraw, draw_test_failures
-from evoeye.sim.runner import run_episode, run_spec
+from evoeye.sim.lockstep import DEFAULT_BATCH, run_indexed
+from evoeye.sim.runner import run_spec
 from evoeye.store import Warehouse, ingest
 from evoeye.store.log_windows import episode_run
 from evoeye.store.windows import Windows, load_windows
@@ -177,22 +178,22 @@ class _Context:
 def curve_windows(regime: str, curve: dict, seed_of: Callable[[int], int], n: int,
                   learn: LearnConfig) -> tuple[list, list[str]]:
     """(windows per run, run ids) of a curve's first n runs, simulated again in memory from
-    their recorded θ and run seed; RuntimeError where a run's outcome differs from its record."""
+    their recorded θ and run seed (stepped together by the lockstep engine: `run_episode`'s
+    runs, bit for bit); RuntimeError where a run's outcome differs from its record."""
     scenario, profile = parse_regime(regime)
-    out, ids = [], []
-    for k in range(n):
-        spec = run_spec(scenario, np.asarray(curve["x"][k], float), seed_of(k), ads=profile)
-        ep = run_episode(spec)
+    specs = [run_spec(scenario, np.asarray(curve["x"][k], float), seed_of(k), ads=profile)
+             for k in range(n)]
+    out: list = [None] * n
+    for k, ep in run_indexed(specs, size=DEFAULT_BATCH):
         collided = bool(ep.outcome.collided) and ep.outcome.status == "ok"
         if collided != bool(curve["runs"][k]["collided"]):
-            raise RuntimeError(f"run {k} ({spec.scenario_id}) did not reproduce its recorded "
-                               f"outcome (collided {curve['runs'][k]['collided']}, now "
-                               f"{collided}): the simulator changed since the curve was run")
-        run = episode_run(ep, Path("memory") / spec.scenario_id, learn.context_len,
+            raise RuntimeError(f"run {k} ({ep.spec.scenario_id}) did not reproduce its "
+                               f"recorded outcome (collided {curve['runs'][k]['collided']}, "
+                               f"now {collided}): the simulator changed since the curve was run")
+        run = episode_run(ep, Path("memory") / ep.spec.scenario_id, learn.context_len,
                           learn.horizon_s)
-        out.append(run.windows if run.ok else None)
-        ids.append(spec.scenario_id)
-    return out, ids
+        out[k] = run.windows if run.ok else None
+    return out, [spec.scenario_id for spec in specs]
 
 
 def learnable(train: Windows | None, params) -> bool:

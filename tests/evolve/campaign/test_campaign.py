@@ -159,20 +159,22 @@ def test_killed_mid_round_resumes_to_the_same_records(root_copy, seeded, clean_r
     assert len(expected["logs"]) == 4 and len(expected["rounds"]) == 3
 
     root = root_copy("killed")
-    real = campaign_mod.simulate_and_keep
+    real = campaign_mod.simulate_and_keep_all
     calls = {"n": 0}
 
-    def dies_on_the_fourth_run(spec, where):
-        calls["n"] += 1
-        if calls["n"] == 4:
+    def dies_on_the_fourth_run(specs, where):  # the runs before it are on disk
+        before = calls["n"]
+        calls["n"] += len(specs)
+        if before < 4 <= calls["n"]:
+            real(specs[:3 - before], where)
             raise KeyboardInterrupt("killed mid-round")
-        return real(spec, where)
+        return real(specs, where)
 
-    monkeypatch.setattr(campaign_mod, "simulate_and_keep", dies_on_the_fourth_run)
+    monkeypatch.setattr(campaign_mod, "simulate_and_keep_all", dies_on_the_fourth_run)
     with pytest.raises(KeyboardInterrupt):
         Campaign(root, cfg).run(max_rounds=2)
     assert len(read_rounds(root, Campaign(root, cfg).campaign_id)) == 2  # round 2 cut mid-way
-    monkeypatch.setattr(campaign_mod, "simulate_and_keep", real)
+    monkeypatch.setattr(campaign_mod, "simulate_and_keep_all", real)
     resumed = Campaign(root, cfg)  # round 2's first run is read from its log
     resumed.run(max_rounds=1)
     assert snapshot(root, resumed) == expected

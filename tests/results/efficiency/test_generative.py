@@ -26,10 +26,12 @@ def test_a_generative_curve_simulates_its_proposals_once(context, monkeypatch) -
     for entry in ctx.ledger.folder.glob("efficiency-curve-*.json"):
         entry.unlink()  # the curve is computed again, from the logs on disk
 
-    def no_simulation(spec):
-        raise AssertionError(f"{spec.scenario_id} simulated again")
+    def no_simulation(specs, *args, **kwargs):
+        for spec in specs:
+            raise AssertionError(f"{spec.scenario_id} simulated again")
+        return iter(())
 
-    monkeypatch.setattr(batch, "run_episode", no_simulation)
+    monkeypatch.setattr(batch, "run_indexed", no_simulation)
     ctx.bank.extra.clear()
     again = run_curve(ctx, "sobol", 0, SimAcquirer(ctx.bank, ctx.regime, "sobol", 5, 3.0))
     assert again == curve

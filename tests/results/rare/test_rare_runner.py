@@ -48,6 +48,14 @@ def test_a_curve_is_the_same_twice_and_differs_by_seed():
         {run_seed(config, REGIME, "ce-is", 0, k) for k in range(4)})
 
 
+def test_a_curve_stepped_in_lockstep_has_the_rows_of_its_runs_simulated_one_by_one():
+    config = RareConfig(seeds=(0, 1), runs=6, batch=2, explain=True)
+    curve = run_curve(config, REGIME, "uniform", 0)
+    alone = [simulate(REGIME, np.array(x), run_seed(config, REGIME, "uniform", 0, k), True)
+             for k, x in enumerate(curve["x"])]
+    assert curve["runs"] == alone
+
+
 def test_a_collision_gets_its_mechanism_and_the_explain_root_cause():
     row = simulate(REGIME, np.array(COLLISION_X), COLLISION_SEED, explain=True)
     assert row["collided"] and row["fitness"] == 0.0 and row["mechanism"]
