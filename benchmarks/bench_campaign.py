@@ -25,12 +25,13 @@ import shutil
 import tempfile
 import time
 from collections.abc import Mapping
+from dataclasses import replace
 from pathlib import Path
 
 import numpy as np
 
 from benchmarks.machine import describe
-from evoeye.batch import plan_uniform, run_batch, simulate_and_log
+from evoeye.batch import plan_uniform, run_batch, simulate_and_keep_all, simulate_and_log
 from evoeye.evolve.campaign.assess import Assessor
 from evoeye.evolve.campaign.config import CampaignConfig
 from evoeye.evolve.campaign.loop import Campaign
@@ -67,19 +68,27 @@ def copy_root(src: DataRoot, dst: Path) -> DataRoot:
 
 
 def simulate_alone(root: DataRoot, campaign_id: str, scenario: str,
-                   out: DataRoot) -> tuple[float, float, int]:
+                   out: DataRoot) -> tuple[float, float, int, float]:
     """(wall s, CPU s, runs) to simulate and log the campaign's acquired runs again, one by
-    one."""
-    ids = [s for r in read_rounds(root, campaign_id) for s in r.scenario_ids]
+    one, and the CPU s to do it with the lockstep engine (`simulate_and_keep_all`, one group
+    per round, as the campaign groups them at most)."""
+    rounds = [r.scenario_ids for r in read_rounds(root, campaign_id) if r.scenario_ids]
     specs = []
-    for sid in ids:
-        meta = read_run(root.run_log(scenario, campaign_id, sid), topics=()).metadata
-        specs.append(run_spec(scenario, meta["params"], int(meta["seed"]), batch="alone",
-                              source=str(meta["source"]), round=int(meta["round"])))
+    for ids in rounds:
+        specs.append([])
+        for sid in ids:
+            meta = read_run(root.run_log(scenario, campaign_id, sid), topics=()).metadata
+            specs[-1].append(run_spec(scenario, meta["params"], int(meta["seed"]),
+                                      batch="alone", source=str(meta["source"]),
+                                      round=int(meta["round"])))
     t0, c0 = time.perf_counter(), time.process_time()
-    for spec in specs:
+    for spec in (s for group in specs for s in group):
         simulate_and_log(spec, out)
-    return time.perf_counter() - t0, time.process_time() - c0, len(specs)
+    wall, cpu = time.perf_counter() - t0, time.process_time() - c0
+    c0 = time.process_time()
+    for group in specs:
+        simulate_and_keep_all([replace(s, batch="together") for s in group], out)
+    return wall, cpu, sum(map(len, specs)), time.process_time() - c0
 
 
 def profile(root: DataRoot, cfg: CampaignConfig, rounds: int
@@ -134,10 +143,11 @@ def run_one(src: DataRoot, cfg: CampaignConfig, rounds: int, tmp: Path) -> dict:
     campaign_id = Campaign(root, cfg).campaign_id
     quality = [(r.round, r.metrics.test, r.metrics.hard.get("auprc"))
                for r in read_rounds(root, campaign_id) if r.metrics]
-    alone_s, alone_cpu_s, n_runs = simulate_alone(root, campaign_id, cfg.scenario,
-                                                  DataRoot.resolve(tmp / "alone"))
+    alone_s, alone_cpu_s, n_runs, lockstep_cpu_s = simulate_alone(
+        root, campaign_id, cfg.scenario, DataRoot.resolve(tmp / "alone"))
     return {"campaign_id": campaign_id, "rounds": per_round, "first": first,
-            "quality": quality, "alone": (alone_s, alone_cpu_s), "runs": n_runs}
+            "quality": quality, "alone": (alone_s, alone_cpu_s), "runs": n_runs,
+            "lockstep": lockstep_cpu_s}
 
 
 def report(cfg: CampaignConfig, result: dict) -> dict:
@@ -152,7 +162,9 @@ def report(cfg: CampaignConfig, result: dict) -> dict:
     cpu = table("CPU", [c for _, c in rounds], first[1])
     alone_s, alone_cpu_s = result["alone"]
     print(f"\nsimulate + log the same {result['runs']} runs alone: {alone_s:.2f} s wall, "
-          f"{alone_cpu_s:.2f} s CPU")
+          f"{alone_cpu_s:.2f} s CPU one by one; {result['lockstep']:.2f} s CPU with the "
+          f"lockstep engine, a round's runs together (campaign cost over it, rounds 1+: "
+          f"{cpu['total'] / result['lockstep']:.2f}× CPU)")
     print(f"campaign cost, rounds 1+: {wall['total'] / alone_s:.2f}× wall, "
           f"{cpu['total'] / alone_cpu_s:.2f}× CPU (target ≤ {TARGET}×); with round 0: "
           f"{(wall['total'] + first[0]['total']) / alone_s:.2f}× wall, "
