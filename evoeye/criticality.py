@@ -105,9 +105,52 @@ def scene_risk(scene: SceneState) -> tuple[float, float]:
 
 
 def frame_risk(scenes: list[SceneState]) -> FrameRisk:
-    """`scene_risk` of every frame of a run."""
-    pairs = np.array([scene_risk(s) for s in scenes], dtype=np.float64).reshape(-1, 2)
-    return FrameRisk(pairs[:, 0], pairs[:, 1])
+    """`scene_risk` of every frame of a run, the same numbers: for frames with one actor count
+    as one array program over (frames, actors), else frame by frame."""
+    n = scenes[0].n if scenes else 0
+    if n < 2 or len(scenes) < 2 or any(s.n != n for s in scenes):
+        pairs = np.array([scene_risk(s) for s in scenes], dtype=np.float64).reshape(-1, 2)
+        return FrameRisk(pairs[:, 0], pairs[:, 1])
+    return FrameRisk(*_stacked_risk(scenes))
+
+
+def _stacked_risk(scenes: list[SceneState]) -> tuple[np.ndarray, np.ndarray]:
+    """`scene_risk` over F scenes of n ≥ 2 actors each: elementwise what it does per scene, on
+    (F, n − 1) arrays, its scalar steps (the ego's heading and speed) still scalar per frame."""
+    def col(name: str) -> np.ndarray:
+        return np.array([getattr(s, name) for s in scenes], dtype=np.float64)  # (F, n)
+
+    x, y, h = col("x_m"), col("y_m"), col("heading_rad")
+    speed, accel, length, width = col("speed_mps"), col("accel_mps2"), col("length_m"), \
+        col("width_m")
+    vx = np.array([s.vx_mps for s in scenes])
+    vy = np.array([s.vy_mps for s in scenes])
+    h0 = [float(v) for v in h[:, 0]]  # scalar, as `relative_to_ego` takes it
+    c = np.array([np.cos(v) for v in h0])[:, None]
+    sn = np.array([np.sin(v) for v in h0])[:, None]
+    ddx, ddy = x[:, 1:] - x[:, :1], y[:, 1:] - y[:, :1]
+    rvx, rvy = vx[:, 1:] - vx[:, :1], vy[:, 1:] - vy[:, :1]
+    dx, dy = c * ddx + sn * ddy, -sn * ddx + c * ddy
+    dvx, dvy = c * rvx + sn * rvy, -sn * rvx + c * rvy
+    dh = (h[:, 1:] - np.array(h0)[:, None] + np.pi) % (2 * np.pi) - np.pi
+    f, m = dx.shape
+    other = box_corners(dx.ravel(), dy.ravel(), dh.ravel(), length[:, 1:].ravel(),
+                        width[:, 1:].ravel()).reshape(f, m, 4, 2)
+    zero = np.zeros(f)
+    ego = box_corners(zero, zero, zero, length[:, 0], width[:, 0])[:, None]  # (F, 1, 4, 2)
+    ttc = first_contact_s(np.broadcast_to(ego, other.shape), other, np.stack([dvx, dvy], -1))
+    ahead = (dx > 0) & (np.abs(dy) < (width[:, :1] + width[:, 1:]) / 2 + CORRIDOR_MARGIN_M)
+    gap = np.maximum(dx - (length[:, :1] + length[:, 1:]) / 2, 0.05)
+    closing = np.maximum(-dvx, 0.0)
+    drac = closing**2 / (2 * gap)
+    lead_speed = np.maximum(speed[:, 1:] * np.cos(dh), 0.0)
+    lead_decel = np.maximum(-accel[:, 1:] * np.cos(dh), 0.0)
+    ego_sq = np.array([max(float(v), 0.0) ** 2 for v in speed[:, 0]])[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        stop_gap = gap + np.where(lead_decel > 0, lead_speed**2 / (2 * lead_decel), np.inf)
+        stop = np.where(lead_decel > 0, ego_sq / (2 * stop_gap), 0.0)
+    need = np.where(ahead, np.maximum(drac, stop), 0.0)
+    return ttc.min(axis=1, initial=np.inf), need.max(axis=1, initial=0.0)
 
 
 def peak_risk(scenes: list[SceneState], c: Criticality | None = None) -> float:
