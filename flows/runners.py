@@ -19,6 +19,15 @@ def task_runner(workers: int = 2, dask_address: str | None = None) -> TaskRunner
     return ProcessPoolTaskRunner(max_workers=workers)
 
 
+def cluster_threads(dask_address: str) -> int:
+    """How many tasks the Dask cluster at `dask_address` runs at once now: its workers' threads
+    (what a fan-out should have work for, whatever `workers` says of local processes)."""
+    from distributed import Client
+
+    with Client(dask_address, timeout=30) as client:
+        return max(1, sum(client.nthreads().values()))
+
+
 def retry_while_locked(task: Task, task_run: TaskRun, state: State) -> bool:
     """Retry condition: only while another process holds the warehouse's writer lock."""
     try:

@@ -5,7 +5,8 @@ On this machine the batch runs in one task on the command line's own process poo
 skipped, a broken run reported and the others kept), so the flow costs what the command costs
 plus one Prefect API. With `dask_address` every chunk of up to `lockstep` runs (runs stepped
 together, `evoeye.sim.lockstep`) is its own task on the Dask cluster (prefect-dask), for
-batches one machine cannot carry. Either way the batch is idempotent: a
+batches one machine cannot carry; the chunks are small enough that every thread of the cluster
+(its size when the flow starts, not `workers`) gets one. Either way the batch is idempotent: a
 crashed flow run is simply run again, and skips the logs it finished. With `ingest` the new
 logs then go into the warehouse, as the ingest flow puts them (a subflow run).
 """
@@ -24,7 +25,7 @@ from evoeye.sim.lockstep import batch_size, chunks
 from flows.api import shared_with_workers
 from flows.ingest import IngestParams, ingest_flow
 from flows.published import batch_markdown, named, publish
-from flows.runners import task_runner
+from flows.runners import cluster_threads, task_runner
 
 PROGRESS_EVERY = 10  # runs between two progress lines in the flow run's log
 
@@ -100,7 +101,9 @@ def simulate_batch_flow(params: SimulateParams) -> list[RunResult]:
     if params.dask_address:
         runner = task_runner(params.workers, params.dask_address)
         with shared_with_workers():
-            size = batch_size(len(specs), params.workers, params.lockstep)
+            # a chunk for every thread of the cluster, not for `workers` local processes
+            size = batch_size(len(specs), cluster_threads(params.dask_address),
+                              params.lockstep)
             summary = BatchSummary(fan_out_flow.with_options(task_runner=runner)(specs, root,
                                                                                  size))
     else:

@@ -9,6 +9,8 @@ from pydantic import ValidationError
 from evoeye.batch import plan_uniform, run_batch
 from evoeye.log import read_run
 from evoeye.paths import DataRoot
+from flows import simulate as simulate_mod
+from flows.runners import cluster_threads
 from flows.simulate import SimulateParams, simulate_batch_flow
 
 
@@ -43,6 +45,25 @@ def test_simulate_flow_on_a_two_worker_dask_cluster(prefect_server, tmp_path):
     assert [p.name for p in dask_logs] == [p.name for p in sorted(one.path.rglob("*.mcap"))]
     assert [p.read_bytes() for p in dask_logs] == [
         p.read_bytes() for p in sorted(one.path.rglob("*.mcap"))]
+
+
+def test_a_dask_fan_out_has_a_chunk_for_every_thread_of_the_cluster(prefect_server, tmp_path,
+                                                                     monkeypatch):
+    sizes = []
+    real = simulate_mod.chunks
+
+    def chunked(specs, size):  # the fan-out's chunks, as the flow cuts them
+        sizes.extend(len(c) for c in real(specs, size))
+        return real(specs, size)
+
+    monkeypatch.setattr(simulate_mod, "chunks", chunked)
+    with LocalCluster(n_workers=3, threads_per_worker=1, processes=False,
+                      dashboard_address=None) as cluster:
+        assert cluster_threads(cluster.scheduler_address) == 3
+        params = SimulateParams(scenario="highway-cut-in", n=6, seed=2, workers=1,
+                                root=str(tmp_path), dask_address=cluster.scheduler_address)
+        results = simulate_batch_flow(params)
+    assert len(results) == 6 and sorted(sizes) == [2, 2, 2]  # not one chunk for `workers` 1
 
 
 def test_bad_parameters_are_refused_before_anything_runs():
