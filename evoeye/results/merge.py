@@ -5,9 +5,7 @@ Runs whose configs agree but for regimes, seeds and strategies are one protocol 
 since a run was recorded reads as its default: the behaviour that run had), and their claims
 are checked over all their regimes. Each regime's checks stay paired over its own seeds, so a
 regime may have more seeds than another; a regime in two runs of one protocol is refused by
-name (which of the two counts would be a choice), unless the protocol says how two runs of one
-regime agree (the rare-failure protocol: the same seeds and the same figures for every
-strategy both ran, so neither is chosen over the other).
+name (which of the two counts would be a choice).
 """
 
 from __future__ import annotations
@@ -20,15 +18,12 @@ FREE = ("regimes", "seeds", "strategies")  # what the runs of one protocol may d
 
 def merge_runs(runs: list[dict], default: dict, check: Callable[[dict], list[dict]],
                error: type[ValueError], *, noun: str, label: str = "",
-               free: tuple[str, ...] = (),
-               combine: Callable[[dict, dict], dict | None] | None = None) -> list[dict]:
+               free: tuple[str, ...] = ()) -> list[dict]:
     """Runs ({"path", "config", "findings", "regimes"}) as protocols ({"paths", "config",
     "findings"}): a protocol of one run keeps its own findings; a merged one's are
     `check({"regimes": ...})` over every regime, and its config lists each regime's seeds
     (`{regime: seeds}`). `error` names a regime in two runs (`label` + "regime", `noun`: what
-    a protocol is called in the message; `free`: further fields its runs may differ in) unless
-    both ran it on the same seeds and `combine` makes one regime of their two (None: they
-    disagree)."""
+    a protocol is called in the message; `free`: further fields its runs may differ in)."""
     groups: dict[str, list[dict]] = {}
     free = (*FREE, *free)
     for run in runs:
@@ -47,14 +42,9 @@ def merge_runs(runs: list[dict], default: dict, check: Callable[[dict], list[dic
                             f"checked with the {noun}'s other runs)")
             for regime, result in run["regimes"].items():
                 if regime in owner:
-                    both = (combine(regimes[regime], result) if combine is not None
-                            and seeds[regime] == run["config"]["seeds"] else None)
-                    if both is None:
-                        raise error(f"{run['path']}: {label}regime {regime} is also in "
-                                    f"{owner[regime]}; give each regime of a {noun} from one "
-                                    "run only")
-                    regimes[regime] = both
-                    continue
+                    raise error(f"{run['path']}: {label}regime {regime} is also in "
+                                f"{owner[regime]}; give each regime of a {noun} from one run "
+                                "only")
                 owner[regime], regimes[regime] = run["path"], result
                 seeds[regime] = run["config"]["seeds"]
             strategies += [s for s in run["config"].get("strategies", []) if s not in strategies]

@@ -35,9 +35,7 @@ estimate); not run yet when none ran.
 A protocol too big for one session runs regime by regime: runs whose config agrees but for
 regimes, seeds, strategies and the learning side's settings are one protocol (each regime's
 learning figures carry their own config), and `merge_rare` checks its claims over all their
-regimes. A regime in two runs of one protocol is merged when both ran it on the same seeds and
-agree on every strategy both ran (`combine_regime`: e.g. a run that adds the learning side, or
-more strategies); otherwise it is refused by name.
+regimes; a regime in two runs of one protocol is refused by name.
 """
 
 from __future__ import annotations
@@ -230,26 +228,4 @@ def merge_rare(runs: list[dict]) -> list[dict]:
     file) as protocols ({"paths", "config", "findings"}): runs of one protocol merged, their
     claims checked over every regime (module doc, `evoeye.results.merge`)."""
     return merge_runs(runs, RareConfig().to_dict(), rare_findings, RareMergeError,
-                      noun="protocol", label="rare-failure ", free=("learn",),
-                      combine=combine_regime)
-
-
-def combine_regime(a: dict, b: dict) -> dict | None:
-    """One regime's figures from two runs of it on the same seeds (say, one with more
-    strategies, one with the learning side), or None where they disagree: every strategy
-    that both ran must have the same figures (its curves are the same runs), and only one may
-    have learned, or both alike."""
-    out: dict = {}
-    for part in a.keys() | b.keys():
-        pa, pb = a.get(part), b.get(part)
-        if pa is None or pb is None:
-            out[part] = pa if pb is None else pb
-        elif isinstance(pa, dict) and isinstance(pb, dict) and part != "learning":
-            if any(pa[k] != pb[k] for k in pa.keys() & pb.keys()):
-                return None
-            out[part] = {**pa, **{k: v for k, v in pb.items() if k not in pa}}
-        elif pa != pb:
-            return None
-        else:
-            out[part] = pa
-    return {part: out[part] for part in (*a, *(k for k in b if k not in a))}
+                      noun="protocol", label="rare-failure ", free=("learn",))

@@ -3,15 +3,12 @@ and runs of one protocol merged regime by regime."""
 
 from __future__ import annotations
 
-import copy
-
 import pytest
 from rare_curves import COMMON, RARE, rare_part
 
 from evoeye.results.findings import AGAINST, NOT_RUN, NOT_SHOWN, PARTLY, REPRODUCES
 from evoeye.results.rare.findings import (
     RareMergeError,
-    combine_regime,
     estimate_verdict,
     found_target,
     found_verdict,
@@ -112,41 +109,7 @@ def test_runs_of_one_protocol_are_checked_over_all_their_regimes():
                                                                ["c.json"]]
     with pytest.raises(RareMergeError, match=f"d.json: rare-failure regime {RARE} is also in "
                                              "a.json"):
-        merge_rare([a, b, _run("d.json", {RARE: "blind"})])  # other figures for the regime
-
-
-def test_two_runs_of_a_regime_merge_when_they_agree_on_every_strategy_both_ran():
-    a = _run("a.json", {RARE: "rare"})
-    more = copy.deepcopy(a)  # the same runs, and one strategy more (its curves: ce-is's)
-    more["path"] = "f.json"
-    regime = more["regimes"][RARE]
-    for part in ("found", "distinct"):
-        regime[part]["subset"] = regime[part]["ce-is"]
-    (merged,) = merge_rare([a, more])
-    assert merged["paths"] == ["a.json", "f.json"]
-    assert merged["config"]["seeds"] == {RARE: list(range(20))}
-    assert {c["strategy"] for f in merged["findings"] for c in f["checks"]} >= {"ce-is",
-                                                                               "subset"}
-    moved = copy.deepcopy(more)  # Uniform's figures differ: not the same runs
-    moved["regimes"][RARE]["found"]["uniform"]["collisions"] += 1
-    with pytest.raises(RareMergeError, match=f"f.json: rare-failure regime {RARE} is also in"):
-        merge_rare([a, moved])
-    other_seeds = copy.deepcopy(more)
-    other_seeds["config"]["seeds"] = list(range(1, 21))
-    with pytest.raises(RareMergeError, match="is also in a.json"):
-        merge_rare([a, other_seeds])
-
-
-def test_a_regime_takes_its_learning_side_from_the_one_run_that_learned():
-    tested = {"found": {"uniform": 1, "subset": 3}, "distinct": {"uniform": 1}}
-    learned = {"found": {"uniform": 1, "ce-is": 2}, "distinct": {"uniform": 1},
-               "learning": {"strategies": {"ce-is": 4}}}
-    both = combine_regime(tested, learned)
-    assert both == {"found": {"uniform": 1, "subset": 3, "ce-is": 2},
-                    "distinct": {"uniform": 1}, "learning": {"strategies": {"ce-is": 4}}}
-    assert combine_regime(learned, {**learned, "learning": {"strategies": {"ce-is": 5}}}) \
-        is None
-    assert combine_regime(tested, {**tested, "found": {"uniform": 2}}) is None
+        merge_rare([a, b, _run("d.json", {RARE: "rare"})])
 
 
 def test_advice_names_a_strategy_only_where_it_was_shown_better(two_regimes):
