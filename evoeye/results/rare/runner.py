@@ -94,8 +94,6 @@ def simulate_many(regime: str, xs: list[np.ndarray], seeds: list[int],
                   explain: bool) -> list[dict]:
     """`simulate` for each (x, seed), stepped together by the lockstep engine (the same runs,
     bit for bit); the rows in the order given."""
-    if len(xs) == 1:  # alone, the per-run engine: a batch of one costs ≈ 10 % more
-        return [simulate(regime, xs[0], seeds[0], explain)]
     scenario, profile = parse_regime(regime)
     specs = [run_spec(scenario, x, s, ads=profile) for x, s in zip(xs, seeds, strict=True)]
     rows: list[dict] = [{}] * len(specs)
