@@ -218,6 +218,10 @@ def results_command(
         "--rare-learn-control", help="Rare-failure protocol, learning side: a weighted "
         "strategy (ce-is) whose runs also train unweighted, beside, as the control for what "
         "the weights add (repeatable).")] = None,
+    rare_learn_strategy: Annotated[list[str] | None, typer.Option(
+        "--rare-learn-strategy", help="Rare-failure protocol, learning side: learn only from "
+        "these strategies' curves, beside Uniform's (repeatable; default every strategy's).")
+    ] = None,
     recipe: Annotated[str, typer.Option(
         help=f"Training recipe of every monitor trained from scratch, one of "
              f"{', '.join(RECIPES)} (campaign updates keep theirs).")] = D.recipe,
@@ -274,7 +278,8 @@ def results_command(
                 runs=rare_runs, batch=rare_batch, explain=rare_explain,
                 learn={"test_runs": rare_test_runs, "members": rare_members,
                        "recipe": recipe, "test_max_runs": rare_test_max_runs,
-                       "controls": tuple(rare_learn_control or ())}
+                       "controls": tuple(rare_learn_control or ()),
+                       "strategies": tuple(rare_learn_strategy or ())}
                 if rare_learn else None, **fresh).changed())
         config.check_names()
     except ValueError as exc:

@@ -37,7 +37,8 @@ ESTIMATING = (REFERENCE, "ce-is", "subset")
 # monitor can be trained on (the learning side trains the others unweighted)
 WEIGHTED = (REFERENCE, "ce-is")
 REGIMES = ("highway-cut-in:cautious", "highway-cut-in:defensive")
-LEARN_LATER_FIELDS = ("test_max_runs", "controls")  # LearnConfig's, absent at their default
+# LearnConfig's, absent at their default
+LEARN_LATER_FIELDS = ("test_max_runs", "controls", "strategies")
 UNWEIGHTED = "-unweighted"  # a control's name: a weighted strategy's runs trained unweighted
 
 
@@ -60,10 +61,13 @@ class LearnConfig:
     # weighted strategies whose runs also train unweighted, beside (`<name>-unweighted`): the
     # control for what the weights themselves add
     controls: tuple[str, ...] = ()
+    # the strategies whose curves are learned from, Uniform's always (empty: every one). The
+    # other curves are still simulated and reported on the testing side
+    strategies: tuple[str, ...] = ()
 
     def __post_init__(self) -> None:
-        object.__setattr__(self, "budgets", tuple(self.budgets))
-        object.__setattr__(self, "controls", tuple(self.controls))
+        for name in ("budgets", "controls", "strategies"):
+            object.__setattr__(self, name, tuple(getattr(self, name)))
         b = self.budgets
         if len(b) < 2 or list(b) != sorted(set(b)) or b[0] < 1:
             raise ValueError(f"budgets must be at least two increasing run counts, got {b}")
@@ -97,8 +101,12 @@ class LearnConfig:
 
     def curve_key(self) -> dict:
         """What fixes how one curve is learned (a learned curve's ledger key): every field but
-        `controls`, which adds curves and changes none."""
-        return {k: v for k, v in self.to_dict().items() if k != "controls"}
+        `controls` and `strategies`, which choose the curves and change none."""
+        return {k: v for k, v in self.to_dict().items() if k not in ("controls", "strategies")}
+
+    def learns(self, strategy: str) -> bool:
+        """Whether `strategy`'s curves are learned from (`strategies`; Uniform's always)."""
+        return not self.strategies or strategy in (REFERENCE, *self.strategies)
 
     @classmethod
     def from_dict(cls, data: Mapping) -> LearnConfig:
@@ -149,7 +157,11 @@ class RareConfig:
         if self.learn is not None:
             learning = LearnConfig.from_dict(self.learn)
             learning.check_runs(self.runs)
-            able = [s for s in self.strategies if s in WEIGHTED and s != REFERENCE]
+            if bad := [s for s in learning.strategies if s not in self.strategies]:
+                raise ValueError(f"learning strategies {bad} are not among the protocol's "
+                                 f"strategies {list(self.strategies)}")
+            able = [s for s in self.strategies if s in WEIGHTED and s != REFERENCE
+                    and learning.learns(s)]
             if bad := [c for c in learning.controls if c not in able]:
                 raise ValueError(f"learning controls {bad}: a control trains a weighted "
                                  f"strategy's runs unweighted; pick from {able}")

@@ -32,8 +32,10 @@ log2(budget) (`efficiency.summary.area`), paired with Uniform's at the same seed
   (`efficiency.curves.training_seed`), so strategies differ only in their runs. With `members`
   > 1 a checkpoint's monitor is an ensemble of that many from-scratch members.
 
-Each learned curve is a ledger unit keyed by its curve, this config, the sets and the software
-version: a killed run resumes with the curves it had not learned.
+`strategies` limits the side to some strategies' curves (Uniform's always): learning costs a
+simulation and three trainings per curve with a collision, and the other curves stay on the
+testing side. Each learned curve is a ledger unit keyed by its curve, this config, the sets
+and the software version: a killed run resumes with the curves it had not learned.
 """
 
 from __future__ import annotations
@@ -280,7 +282,8 @@ def learn_regime(root: DataRoot, regime: str, curves: dict[str, dict[str, dict]]
     _CONTEXT = _Context(regime, learn, learner, fingerprint(sets), Ledger(root), config)
     jobs = [(name, int(seed), curve) for seed in sorted({int(s) for c in curves.values()
                                                          for s in c})
-            for strategy, by_seed in curves.items() if (curve := by_seed.get(str(seed)))
+            for strategy, by_seed in curves.items()
+            if learn.learns(strategy) and (curve := by_seed.get(str(seed)))
             for name in (strategy, *([strategy + UNWEIGHTED] if strategy in learn.controls
                                      else []))]
     learned: dict[str, dict[str, dict]] = {}

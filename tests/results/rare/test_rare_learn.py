@@ -5,6 +5,7 @@ run no longer reproduces)."""
 from __future__ import annotations
 
 import copy
+from dataclasses import replace
 from types import SimpleNamespace
 
 import numpy as np
@@ -46,6 +47,16 @@ def test_the_learning_config_is_validated_and_stored_whole():
     with_control = RareConfig(learn={"controls": ["ce-is"]}).learning
     assert with_control.controls == ("ce-is",)
     assert with_control.curve_key() == LearnConfig().curve_key()  # learned curves resume
+    with pytest.raises(ValueError, match="learning strategies"):
+        RareConfig(learn={"strategies": ["subset"]})  # not among the protocol's strategies
+    with pytest.raises(ValueError, match="learning controls"):  # its curves are not learned
+        RareConfig(strategies=("uniform", "ce-is", "subset"),
+                   learn={"strategies": ["subset"], "controls": ["ce-is"]})
+    some = RareConfig(strategies=("uniform", "ce-is", "subset"),
+                      learn={"strategies": ["ce-is"]}).learning
+    assert [s for s in ("uniform", "ce-is", "subset") if some.learns(s)] == ["uniform", "ce-is"]
+    assert LearnConfig().learns("subset")  # by default every strategy's curves
+    assert some.curve_key() == LearnConfig().curve_key()
     cfg = RareConfig(learn={"members": 3})
     assert cfg.learn == {**LearnConfig().to_dict(), "members": 3}  # stored whole
     assert cfg.learning == LearnConfig(members=3)
@@ -160,6 +171,18 @@ def test_a_rerun_learns_nothing_again_and_gives_the_same_figures(learned):
     again, computed = rare_results(root, config, workers=1)
     assert computed == 0
     assert again["regimes"] == out["regimes"]
+
+
+def test_learning_limited_to_some_strategies_reuses_their_learned_curves(learned):
+    root, config, out = learned
+    only = replace(config, learn={**LEARN, "controls": [], "strategies": ["uniform"]})
+    again, computed = rare_results(root, only, workers=1)
+    assert computed == 0  # every curve and every learned curve was found in the ledger
+    regime = again["regimes"][REGIME]
+    assert set(regime["found"]) == {"uniform", "ce-is"}  # the testing side keeps every one
+    assert set(regime["learning"]["strategies"]) == {"uniform"}
+    assert regime["learning"]["strategies"]["uniform"] == (
+        out["regimes"][REGIME]["learning"]["strategies"]["uniform"])
 
 
 def test_a_run_that_no_longer_reproduces_its_record_is_an_error(learned):
