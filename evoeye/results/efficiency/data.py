@@ -198,8 +198,7 @@ def draw_collisions(data: DataRoot, regime: str, seed: int, n: int, want: int, b
                      workers=workers).collisions
     need = want - base
     chunks = draw_on(data, regime, seed, n, n, f"val-more-seed{seed}", data.path / VAL_DRAW_FILE,
-                     lambda cs: len(collisions(cs)) >= need, VAL_MAX_CHUNKS, workers=workers,
-                     say=say)
+                     want, VAL_MAX_CHUNKS, held=base, workers=workers, say=say)
     kept, drawn = collisions(chunks), len(chunks) * n
     if len(kept) < need:
         raise ValueError(f"{regime}: {drawn} further validation runs held {len(kept)} "

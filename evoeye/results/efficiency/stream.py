@@ -38,23 +38,24 @@ def _recorded(record: Path, key: dict) -> list[Chunk]:
 
 
 def draw_on(data: DataRoot, regime: str, seed: int, start: int, chunk: int, batch: str,
-            record: Path, enough: Callable[[list[Chunk]], bool], max_chunks: int, *,
-            workers: int = 1, say: Say | None = None) -> list[Chunk]:
+            record: Path, want: int, max_chunks: int, *, held: int = 0, workers: int = 1,
+            say: Say | None = None) -> list[Chunk]:
     """The shortest run of chunks of the stream of `seed` past its first `start` runs (in batch
-    `batch`) after which `enough(chunks)` holds, or `max_chunks` chunks if none does (module
-    doc); drawn where `record` does not hold them yet."""
+    `batch`) after which the set holds `want` collisions, `held` of them (the batch's) before
+    the stream, or `max_chunks` chunks if none does (module doc); drawn where `record` does not
+    hold them yet."""
     say = say or (lambda msg: None)
     scenario, profile = parse_regime(regime)
     key = {"regime": regime, "seed": seed, "start": start, "chunk": chunk}
     chunks, k = _recorded(record, key), 0
-    while not (enough(chunks[:k]) or k == max_chunks):
+    while not (held + len(collisions(chunks[:k])) >= want or k == max_chunks):
         if k == len(chunks):
             first = start + k * chunk
             specs = plan_uniform(scenario, first + chunk, seed, batch=batch,
                                  ads=profile)[first:]
-            say(f"{regime}: stream of seed {seed}, runs {first}–{first + chunk - 1} "
-                f"({len(collisions(chunks))} collisions so far; outcome only, collisions "
-                "logged)")
+            say(f"{regime}: stream of seed {seed}, runs {first}–{first + chunk - 1}: "
+                f"{held + len(collisions(chunks))} of {want} collisions so far, the batch's "
+                f"{held} included (outcome only, collisions logged)")
             results = {r.scenario_id: r for r in run_batch(
                 specs, data, workers=workers, collisions_only=True, lockstep=DEFAULT_LOCKSTEP,
             ).results}

@@ -74,7 +74,7 @@ def draw_test_failures(data: DataRoot, regime: str, seed: int, base: BatchSummar
     n = base.runs
     size = min(CHUNK, n)
     used = draw_on(data, regime, seed, n, size, more_batch(seed), data.path / TEST_DRAW_FILE,
-                   lambda cs: base.collisions + len(collisions(cs)) >= want,
-                   max(0, -(-(max_runs - n) // size)), workers=workers, say=say)
+                   want, max(0, -(-(max_runs - n) // size)), held=base.collisions,
+                   workers=workers, say=say)
     return TestDraw(n + len(used) * size, base.count(lambda r: r.status == STATUS_OK),
                     base.collisions, sum(c["ok"] for c in used), tuple(collisions(used)))

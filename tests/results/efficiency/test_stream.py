@@ -17,9 +17,9 @@ def test_a_draw_stops_when_told_and_resumes_at_its_first_missing_chunk(tmp_path)
     record = data.path / "draw.json"
     said: list[str] = []
 
-    def draw(max_chunks: int, enough=lambda chunks: False):
-        return draw_on(data, REGIME, SEED, START, CHUNK, "more", record, enough, max_chunks,
-                       say=said.append)
+    def draw(max_chunks: int, want: int = 10**9, held: int = 0):
+        return draw_on(data, REGIME, SEED, START, CHUNK, "more", record, want, max_chunks,
+                       held=held, say=said.append)
 
     first = draw(1)  # as if killed after one chunk
     assert len(first) == 1 and len(said) == 1 and f"runs {START}–{START + CHUNK - 1}" in said[0]
@@ -33,5 +33,18 @@ def test_a_draw_stops_when_told_and_resumes_at_its_first_missing_chunk(tmp_path)
     logged = sorted(p.name.removesuffix(".mcap") for p in data.path.rglob("*.mcap"))
     assert logged == sorted(hit)  # the safe runs were simulated for their outcome only
     said.clear()
-    assert draw(2, enough=lambda chunks: len(chunks) >= 1) == first  # less asked: a prefix
-    assert said == []
+    assert draw(1) == first and said == []  # less asked: a prefix of the record
+    assert draw(2, want=3, held=3) == [] and said == []  # the batch held enough: no run
+    again = len(collisions(both))  # wanted with 2 held: the shortest prefix holding them all
+    shortest = next(k for k in range(3) if len(collisions(both[:k])) >= again)
+    assert draw(2, want=again + 2, held=2) == both[:shortest]
+
+
+def test_a_draw_says_how_many_collisions_it_holds_with_the_batchs(tmp_path) -> None:
+    data = DataRoot.resolve(tmp_path / "data")
+    said: list[str] = []
+    draw_on(data, REGIME, SEED, START, CHUNK, "more", data.path / "draw.json", 50, 1, held=6,
+            say=said.append)
+    assert said == [f"{REGIME}: stream of seed {SEED}, runs {START}–{START + CHUNK - 1}: 6 of 50 "
+                    "collisions so far, the batch's 6 included (outcome only, collisions "
+                    "logged)"]
