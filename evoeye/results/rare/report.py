@@ -17,6 +17,7 @@ from evoeye.results.findings import ALPHA
 from evoeye.results.markdown import DASH, FLOOR_MARK, FLOOR_NOTE, MINUS, md_table, p_text
 from evoeye.results.rare.config import REFERENCE, UNWEIGHTED
 from evoeye.results.rare.findings import NULL_MDE, advice
+from evoeye.results.rare.summary import STRETCH
 
 HEADING = "### Does testing find and measure rare failures faster than Uniform?"
 OPEN = "∞"  # an interval end no resample bounds (module doc of summary.py: `_boot`)
@@ -114,6 +115,18 @@ def found_table(found: dict[str, dict]) -> list[str]:
                      "per 100 runs [95 % CI]",
                      "× Uniform [95 % CI]", f"Δ per 100 runs, strategy {MINUS} Uniform",
                      "detectable Δ"], rows)
+
+
+def stretch_line(found: dict[str, dict]) -> str | None:
+    """Collisions per 100 runs over each stretch of the curves (`summary.by_stretch`)."""
+    rows = {name: f["by_stretch"] for name, f in found.items() if f.get("by_stretch")}
+    if not rows or max(len(r) for r in rows.values()) < 2:
+        return None
+    n = max(len(r) for r in rows.values())
+    spans = ", ".join(f"{k * STRETCH + 1}–{(k + 1) * STRETCH}" for k in range(min(n, 2)))
+    return (f"Where in the curve, collisions per 100 runs over runs {spans}, … (seeds pooled): "
+            + "; ".join(f"{name} {', '.join(num(v) for v in r)}" for name, r in rows.items())
+            + ".")
 
 
 def pooled_line(pooled: dict) -> str:
@@ -244,6 +257,8 @@ def regime_markdown(regime: str, summary: dict, runs: int,
         lines += ["No curve of this regime finished.", ""]
     else:
         lines += ["### Failures found", "", *found_table(summary["found"]), ""]
+        if stretches := stretch_line(summary["found"]):
+            lines += [stretches, ""]
         if summary.get("found_pooled"):
             lines += [pooled_line(summary["found_pooled"]), ""]
         est = summary["estimates"]

@@ -4,6 +4,9 @@
   over the seeds with a bootstrap interval resampling whole seeds (`rate_ci`); beside Uniform,
   the ratio of the two with a paired bootstrap interval over seeds (seeds resampled jointly),
   and the paired difference of per-seed rates (`compare_paired`) with its minimum detectable effect.
+* **Where in the curve** (`by_stretch`): the same rate over each stretch of STRETCH runs (runs
+  1–100, 101–200, …) pooled over seeds: a walk that must first climb its levels finds its
+  failures late, so its rate over a curve depends on the curve's length.
 * **Against a tighter Uniform rate** (`found_pooled`, where the learning side drew a Test
   stream): the same ratio with Uniform's rate pooled over its curves and that stream's uniform
   runs of another seed. A supplement: the claims pair each strategy with Uniform's curves.
@@ -47,6 +50,7 @@ from evoeye.evolve.search.subset import subset_estimate
 from evoeye.results.rare.config import ESTIMATING, REFERENCE, RareConfig
 
 PER = 100  # failures per PER simulated runs
+STRETCH = 100  # runs per stretch of a curve (`by_stretch`)
 SUBSET = "subset"  # estimates from its levels, not from weights
 N_RESAMPLES = 10_000
 
@@ -105,6 +109,7 @@ def found(curves: dict[str, dict[str, dict]]) -> dict[str, dict]:
         ci = rate_ci(list(events), list(runs)).to_dict()
         out[name] = {"seeds": len(rows), "runs": int(sum(runs)), "collisions": int(sum(events)),
                      "distinct_x": sum(_distinct_x(c) for c in curves[name].values()),
+                     "by_stretch": by_stretch(curves[name].values()),
                      "per_100": {k: (v * PER if isinstance(v, float) and k in
                                      ("value", "low", "high") else v) for k, v in ci.items()}}
     ref = counts.get(REFERENCE)
@@ -127,6 +132,18 @@ def found(curves: dict[str, dict[str, dict]]) -> dict[str, dict]:
             "ratio_high": high, "paired": paired,
             "mde_per_100": minimum_detectable_effect(len(common), paired["sd_diff"])
             if paired["sd_diff"] else None}
+    return out
+
+
+def by_stretch(curves, stretch: int = STRETCH) -> list[float]:
+    """Collisions per PER runs over each stretch of `stretch` runs of the curves, pooled over
+    them (the last stretch as long as the longest curve reaches)."""
+    hits = [_hits(c) for c in curves]
+    out = []
+    for start in range(0, max((len(h) for h in hits), default=0), stretch):
+        parts = [h[start:start + stretch] for h in hits]
+        runs = sum(len(p) for p in parts)
+        out.append(PER * sum(int(p.sum()) for p in parts) / runs)
     return out
 
 

@@ -113,3 +113,16 @@ def test_the_pooled_uniform_rate_is_a_line_under_the_failures_found(two_regimes)
     assert "0.109 % [" in line and "ce-is ×45.83 [" in line
     assert text.index("### Failures found") < text.index(line) < text.index(
         "### The failure rate under p")
+
+
+def test_the_stretches_of_the_curves_are_a_line_under_the_failures_found(two_regimes):
+    summary = dict(two_regimes["regimes"][RARE])
+    summary["found"] = {name: {**f, "by_stretch": [0.5, 2.25]}
+                        for name, f in summary["found"].items()}
+    text = regime_markdown(RARE, summary, 200)
+    line = next(x for x in text.splitlines() if x.startswith("Where in the curve"))
+    assert "runs 1–100, 101–200, …" in line and "uniform 0.50, 2.25" in line
+    assert text.index("### Failures found") < text.index(line) < text.index(
+        "### The failure rate under p")
+    one = {name: {**f, "by_stretch": [0.5]} for name, f in summary["found"].items()}
+    assert "Where in the curve" not in regime_markdown(RARE, {**summary, "found": one}, 100)

@@ -137,3 +137,9 @@ def test_a_tighter_uniform_rate_narrows_the_ratio_and_moves_it_with_the_pooled_r
     assert r["high"] / r["low"] < 0.6 * alone["ratio_high"] / alone["ratio_low"]  # 1.8 vs 3.4
     assert found_pooled(curves, 0, 0) == {}
     assert found_pooled({"ce-is": curves["ce-is"]}, 10, 1) == {}
+
+
+def test_by_stretch_gives_the_rate_over_each_hundred_runs_of_the_curves():
+    late = {str(s): curve([i >= 150 and i % 5 == 0 for i in range(250)]) for s in range(3)}
+    out = found({"uniform": late})["uniform"]["by_stretch"]
+    assert out == pytest.approx([0.0, 10.0, 20.0])  # 10 of 100, then 10 of the last 50
