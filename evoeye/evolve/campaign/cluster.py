@@ -5,7 +5,9 @@
   version, sees the data root at the client's path (its `warehouse/` and every G_0 the plan
   needs under `monitors/`) and may write there. The first that does not is named in one line.
 * **Live lines**: a worker publishes each round's line on a Dask event topic of the experiment
-  as the round ends, so no line is lost when a campaign moves to another worker.
+  as the round ends. A campaign that moves to another worker says its stored rounds' lines
+  again as it resumes (`workers.run_campaign`): a line still in flight when its worker was
+  killed is otherwise lost.
 * **Loss**: a worker that leaves while running campaigns is reported with the campaigns that
   move; a campaign resumes from its last stored round, so its records are those of a run never
   interrupted. With no worker left for `NO_WORKERS_TIMEOUT_S`, the experiment fails.

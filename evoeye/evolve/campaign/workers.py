@@ -29,7 +29,7 @@ from evoeye.evolve.campaign.loop import Campaign
 from evoeye.evolve.campaign.state import redrawn_note
 from evoeye.lifeline import pool_context, stop_workers, stoppable, stoppable_worker
 from evoeye.paths import DataRoot
-from evoeye.store.feedback import RoundMetrics
+from evoeye.store.feedback import RoundMetrics, read_rounds
 
 # a fixed glibc malloc trim threshold (Dask's nannies set one) without an mmap threshold
 MALLOC_TRIM, MALLOC_MMAP = "MALLOC_TRIM_THRESHOLD_", "MALLOC_MMAP_THRESHOLD_"
@@ -100,6 +100,11 @@ def run_campaign(job: CampaignJob, brief: Brief = no_metrics,
         return CampaignDone(job.label, campaign.campaign_id, 0, ())
     say = say or (_LINES.put if _LINES is not None else None)
     lines: list[str] = []
+    if say is not None:  # a resumed campaign's stored rounds, said again: a worker killed
+        # between storing a round and sending its line (SIGKILL) would otherwise lose the line
+        for row in read_rounds(campaign.root, campaign.campaign_id)[1:]:  # round 0 is G_0's
+            say(f"{job.label} round {row.round}: {brief(row.metrics)} | stored before this "
+                "worker resumed it")
 
     def on_round(row, state) -> None:
         note = redrawn_note(state)

@@ -77,3 +77,18 @@ def test_the_campaigns_of_a_plan_read_d_init_once(root_copy, seeded, monkeypatch
     mixed = campaigns_of(root, [plan[0], other])  # another split: read again
     assert reads.count("initial_records") == 3
     assert mixed[1].campaign_id != mixed[0].campaign_id == expected[0][0]
+
+
+def test_a_resumed_campaign_says_its_stored_rounds_again(root_copy, seeded) -> None:
+    root = root_copy("resumed-lines")
+    cfg = CampaignConfig(scenario=SCENARIO, strategy="uniform", budget_s=100.0, seed=0,
+                         monitor=seeded[1], n_round=2, epochs=1, splits=SPLITS)
+    job = CampaignJob(str(root.path), cfg, "uniform seed 0")
+    prepare_campaigns([job])
+    Campaign(root, cfg).run(max_rounds=1)  # a worker that stored round 1, then died
+    assert not Campaign(root, cfg).finished()
+    said: list[str] = []
+    done = run_campaign(job, brief=lambda m: "M", say=said.append)
+    assert said[0] == "uniform seed 0 round 1: M | stored before this worker resumed it"
+    assert said[1:] == list(done.lines) and done.lines[0].startswith("uniform seed 0 round 2: ")
+    assert done.rounds == len(read_rounds(root, Campaign(root, cfg).campaign_id)) - 2
