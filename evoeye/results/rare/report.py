@@ -121,9 +121,8 @@ def stretch_line(found: dict[str, dict]) -> str | None:
     """Collisions per 100 runs over each stretch of the curves (`summary.by_stretch`)."""
     rows = {name: f["by_stretch"] for name, f in found.items() if f.get("by_stretch")}
     if not rows or max(len(r) for r in rows.values()) < 2:
-        return None
-    n = max(len(r) for r in rows.values())
-    spans = ", ".join(f"{k * STRETCH + 1}–{(k + 1) * STRETCH}" for k in range(min(n, 2)))
+        return None  # a curve of one stretch says nothing its row does not
+    spans = ", ".join(f"{k * STRETCH + 1}–{(k + 1) * STRETCH}" for k in range(2))
     return (f"Where in the curve, collisions per 100 runs over runs {spans}, … (seeds pooled): "
             + "; ".join(f"{name} {', '.join(num(v) for v in r)}" for name, r in rows.items())
             + ".")
