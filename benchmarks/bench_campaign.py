@@ -172,6 +172,7 @@ def report(cfg: CampaignConfig, result: dict) -> dict:
     last = result["quality"][-1][1]
     return {"update": cfg.update, "seed": cfg.seed, "total": cpu["total"], "alone": alone_cpu_s,
             "train": cpu["train"], "wall": wall["total"], "alone_wall": alone_s,
+            "lockstep": result["lockstep"],
             "auprc": last.get("auprc"), "auroc": last.get("auroc")}
 
 
@@ -187,16 +188,18 @@ def paired(diffs: list[float]) -> str:
 
 
 def summary(rows: list[dict], updates: list[str]) -> None:
-    """Per mode: mean cost and ratios; each mode's last Test AUPRC / AUROC against the first's."""
+    """Per mode: mean cost and ratios (over the runs simulated alone one by one, and over them
+    stepped together as the campaign steps them); each mode's last Test AUPRC / AUROC against
+    the first's."""
     print("\n| update | seeds | total CPU s | simulate alone CPU s | train CPU s | × alone (CPU) "
-          "| × alone (wall) | Test AUPRC | paired Δ AUPRC vs "
+          "| × alone (wall) | × alone, lockstep (CPU) | Test AUPRC | paired Δ AUPRC vs "
           f"{updates[0]} [95 % CI] | paired Δ AUROC [95 % CI] |")
-    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|")
+    print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     base = {r["seed"]: r for r in rows if r["update"] == updates[0]}
     for update in updates:
         mine = [r for r in rows if r["update"] == update]
         mean = {k: float(np.mean([r[k] for r in mine])) for k in
-                ("total", "alone", "train", "wall", "alone_wall")}
+                ("total", "alone", "train", "wall", "alone_wall", "lockstep")}
         auprc = [r["auprc"] for r in mine if r["auprc"] is not None]
         both = [(r, base[r["seed"]]) for r in mine if r["seed"] in base]
         delta = "—" if update == updates[0] else paired(
@@ -206,6 +209,7 @@ def summary(rows: list[dict], updates: list[str]) -> None:
         print(f"| {update} | {','.join(str(r['seed']) for r in mine)} | {mean['total']:.2f} "
               f"| {mean['alone']:.2f} | {mean['train']:.2f} "
               f"| {mean['total'] / mean['alone']:.2f}× | {mean['wall'] / mean['alone_wall']:.2f}× "
+              f"| {mean['total'] / mean['lockstep']:.2f}× "
               f"| {_pct(float(np.mean(auprc)) if auprc else None)} | {delta} | {delta_roc} |")
 
 

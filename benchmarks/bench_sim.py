@@ -8,7 +8,8 @@ of frames, and nothing else: no ground-truth read, no ADS, no log. Our world ste
 itself (bounded path dynamics, vectorised relations and contacts), more cheaply than
 highway-env does, so the table also gives the cost relative to our own bare world.
 `--engines`: the per-run engine against the lockstep one (`evoeye.sim.lockstep`), simulate +
-log, on the same runs, CPU s per run (issue 41: ≥ 3×, logs included).
+log, on the same runs, CPU s per run (issue 41: ≥ 3×, logs included). `--stages`: where a
+lockstep run's CPU goes, stage by stage, and what the ratio would be if a stage cost nothing.
 Targets (issues 2 and 10): full stack with logging ≥ 50× real time per core, ≤ 2× the cost of
 bare highway-env stepping of the same vehicles.
 """
@@ -21,6 +22,8 @@ import math
 import os
 import tempfile
 import time
+from collections.abc import Iterator
+from contextlib import contextmanager
 from pathlib import Path
 
 import numpy as np
@@ -33,9 +36,11 @@ from evoeye.batch import plan_uniform, run_batch
 from evoeye.log import write_episode
 from evoeye.log.writer import write_stream
 from evoeye.paths import DataRoot
+from evoeye.phases import PhaseClock
 from evoeye.scenarios import SCENARIOS
+from evoeye.sim import lockstep
 from evoeye.sim.lockstep import run_lockstep
-from evoeye.sim.runner import build_world, run_episode
+from evoeye.sim.runner import RunLoop, build_world, run_episode
 
 DT_S = 0.05
 
@@ -162,6 +167,68 @@ def engines_table(runs: int, sizes: list[int], repeat: int, seed: int, profiles:
                   f"{1e3 * ref_log:.0f} | {' | '.join(cells)} | {same} |")
 
 
+# a lockstep frame's stages: the names `_lockstep` calls them by (owner, attribute)
+STAGES = {"world read": (lockstep, "scenes"), "ADS": (lockstep, "step_batch"),
+          "record and finiteness checks": (RunLoop, "record"),
+          "world step": (lockstep, "step_worlds")}
+
+
+@contextmanager
+def timed_stages(clock: PhaseClock) -> Iterator[None]:
+    """Each of STAGES counted on `clock` while the block runs (the functions themselves are
+    called unchanged); restored after."""
+    saved = {name: getattr(owner, attr) for name, (owner, attr) in STAGES.items()}
+
+    def timed(name, fn):
+        def call(*args, **kwargs):
+            with clock(name):
+                return fn(*args, **kwargs)
+        return call
+
+    try:
+        for name, (owner, attr) in STAGES.items():
+            setattr(owner, attr, timed(name, saved[name]))
+        yield
+    finally:
+        for name, (owner, attr) in STAGES.items():
+            setattr(owner, attr, saved[name])
+
+
+def stages_table(runs: int, size: int, seed: int, profiles: list[str], repeat: int) -> None:
+    """CPU ms per run of each stage of the lockstep engine (the rest of its loop: "other"), the
+    log, and × the per-run engine with the log if that stage alone cost nothing; the engines
+    interleaved `repeat` times, the best per-run pass against the best lockstep pass."""
+    phases = [*STAGES, "other", "log"]
+    print(f"CPU ms per run of a lockstep run (B = {size}) by stage; in brackets × the per-run "
+          "engine, with the log, if that stage cost nothing")
+    print("| logical scenario | ADS | per-run engine, with the log | lockstep, with the log | "
+          + " | ".join(phases) + " |")
+    print("|---|---|---:|---:|" + "---:|" * len(phases))
+    for name in SCENARIOS:
+        for ads in profiles:
+            specs = plan_uniform(name, runs, seed=seed, ads=ads)
+            run_episode(specs[0])  # warm the per-process caches
+            per_run, ms = math.inf, {}
+            for _ in range(repeat):
+                t0 = time.process_time()
+                ref = [run_episode(s) for s in specs]
+                per_run = min(per_run, 1e3 * (time.process_time() - t0 + _logs(ref)[1]) / runs)
+                del ref  # each engine runs with only its own episodes alive
+                clock = PhaseClock(phases)
+                with clock("other"), timed_stages(clock):
+                    got = list(run_lockstep(specs, size=size))
+                with clock("log"):
+                    _logs(got)
+                del got
+                this = {p: 1e3 * clock.cpu_seconds[p] / runs for p in phases}
+                if not ms or sum(this.values()) < sum(ms.values()):
+                    ms = this
+            total = sum(ms.values())
+            cells = [f"{ms[p]:.0f} (×{per_run / (total - ms[p]):.2f})" for p in phases]
+            print(f"| {name} | {ads} | {per_run:.0f} | {total:.0f} (×{per_run / total:.2f}) | "
+                  + " | ".join(cells) + " |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__)
     ap.add_argument("--runs", type=int, default=20, help="runs per logical scenario")
@@ -169,11 +236,17 @@ def main() -> None:
                     help="only the per-run against the lockstep engine, side by side")
     ap.add_argument("--sizes", type=int, nargs="+", default=[8, 64],
                     help="lockstep batch sizes for --engines")
-    ap.add_argument("--repeat", type=int, default=2, help="interleaved repeats for --engines")
+    ap.add_argument("--repeat", type=int, default=2,
+                    help="interleaved repeats for --engines and --stages")
     ap.add_argument("--seed", type=int, default=7, help="batch seed of the runs (--engines)")
     ap.add_argument("--ads", nargs="+", default=["default"], help="ADS profiles (--engines)")
+    ap.add_argument("--stages", action="store_true",
+                    help="only the lockstep engine's CPU by stage (at the first of --sizes)")
     args = ap.parse_args()
     print(f"Machine: {describe()}; load average before: {os.getloadavg()[0]:.2f}\n")
+    if args.stages:
+        stages_table(args.runs, args.sizes[0], args.seed, args.ads, args.repeat)
+        return
     if args.engines:
         engines_table(args.runs, args.sizes, args.repeat, args.seed, args.ads)
         return
