@@ -177,14 +177,21 @@ def report(cfg: CampaignConfig, result: dict) -> dict:
 
 
 def paired(diffs: list[float]) -> str:
-    """Mean of paired differences (in points) with its 95 % t interval."""
+    """Mean of paired differences (in points) with its 95 % t interval, the paired t-test's p and
+    the minimum detectable effect at 80 % power over these pairs (what a null does not exclude)."""
     from scipy import stats
+
+    from evoeye.evaluation.stats import minimum_detectable_effect
 
     d = 100 * np.asarray(diffs, float)
     if len(d) < 2:
         return f"{d.mean():+.2f}"
-    half = stats.t.ppf(0.975, len(d) - 1) * d.std(ddof=1) / np.sqrt(len(d))
-    return f"{d.mean():+.2f} [{d.mean() - half:+.2f}, {d.mean() + half:+.2f}]"
+    sd = d.std(ddof=1)
+    half = stats.t.ppf(0.975, len(d) - 1) * sd / np.sqrt(len(d))
+    p = stats.ttest_1samp(d, 0.0).pvalue
+    mde = minimum_detectable_effect(len(d), sd, test="t")
+    return (f"{d.mean():+.2f} [{d.mean() - half:+.2f}, {d.mean() + half:+.2f}], p {p:.2f}, "
+            f"MDE {mde:.2f}")
 
 
 def summary(rows: list[dict], updates: list[str]) -> None:
@@ -193,7 +200,7 @@ def summary(rows: list[dict], updates: list[str]) -> None:
     the first's."""
     print("\n| update | seeds | total CPU s | simulate alone CPU s | train CPU s | × alone (CPU) "
           "| × alone (wall) | × alone, lockstep (CPU) | Test AUPRC | paired Δ AUPRC vs "
-          f"{updates[0]} [95 % CI] | paired Δ AUROC [95 % CI] |")
+          f"{updates[0]} [95 % CI], p, MDE | paired Δ AUROC [95 % CI], p, MDE |")
     print("|---|---|---:|---:|---:|---:|---:|---:|---:|---:|---:|")
     base = {r["seed"]: r for r in rows if r["update"] == updates[0]}
     for update in updates:

@@ -238,8 +238,10 @@ def main() -> None:
                     help="lockstep batch sizes for --engines")
     ap.add_argument("--repeat", type=int, default=2,
                     help="interleaved repeats for --engines and --stages")
-    ap.add_argument("--seed", type=int, default=7, help="batch seed of the runs (--engines)")
-    ap.add_argument("--ads", nargs="+", default=["default"], help="ADS profiles (--engines)")
+    ap.add_argument("--seed", type=int, default=7,
+                    help="batch seed of the runs (--engines, --stages)")
+    ap.add_argument("--ads", nargs="+", default=["default"],
+                    help="ADS profiles (--engines, --stages)")
     ap.add_argument("--stages", action="store_true",
                     help="only the lockstep engine's CPU by stage (at the first of --sizes)")
     args = ap.parse_args()
